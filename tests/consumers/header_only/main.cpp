@@ -1,0 +1,2 @@
+#define STRATMESH_IMPLEMENTATION
+#include "../consumer.cpp"

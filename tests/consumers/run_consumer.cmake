@@ -1,0 +1,31 @@
+# Builds one consumer project from scratch and runs it: cmake -DROUTE=... -P this file.
+set(consumer_source ${CMAKE_CURRENT_LIST_DIR}/${ROUTE})
+file(REMOVE_RECURSE ${WORK_DIR})
+file(MAKE_DIRECTORY ${WORK_DIR})
+set(extra_args)
+if(ROUTE STREQUAL "find_package")
+  # Install the already-built library into a private prefix, then find it there.
+  set(prefix ${WORK_DIR}/prefix)
+  execute_process(COMMAND ${CMAKE_COMMAND} --install ${STRATMESH_BINARY_DIR} --prefix ${prefix}
+                  RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "installing stratmesh failed")
+  endif()
+  list(APPEND extra_args -DCMAKE_PREFIX_PATH=${prefix})
+else()
+  list(APPEND extra_args -DSTRATMESH_SOURCE_DIR=${STRATMESH_SOURCE_DIR})
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} -S ${consumer_source} -B ${WORK_DIR}/build
+                        -DCMAKE_CXX_COMPILER=${CXX_COMPILER} ${extra_args}
+                RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "configuring the ${ROUTE} consumer failed")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK_DIR}/build RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "building the ${ROUTE} consumer failed")
+endif()
+execute_process(COMMAND ${WORK_DIR}/build/consumer RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "the ${ROUTE} consumer ran but failed (exit ${rc})")
+endif()

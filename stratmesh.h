@@ -107,6 +107,10 @@ namespace stratmesh {
     X(invalid_point, "a coordinate is NaN or infinite")                                   \
     X(too_few_points, "fewer than 3 distinct points")                                     \
     X(collinear, "all points lie on one line")                                            \
+    X(invalid_axis, "the axis direction is zero, NaN or infinite")                        \
+    X(invalid_layers, "a cut, the layer count or the layer height is NaN, infinite or negative") \
+    X(flat_cloud, "the cloud has no extent along the axis")                               \
+    X(not_columnar, "the points do not surround the axis in any layer")                   \
     /* memory */                                                                          \
     X(out_of_memory, "the workspace is smaller than its *_workspace_size() bound")         \
     X(triangle_capacity, "the triangle array is too small for the result")               \
@@ -178,6 +182,103 @@ Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
                    uint32_t* triangles, size_t triangle_capacity,
                    Delaunay2dInfo* info, uint32_t* duplicate_of);
 
+// ==== Surface reconstruction ===============================================================
+
+enum class Scalar : uint32_t { float64 = 0, float32 = 1 };
+
+// A point cloud in the caller's memory: x, y, z of the first point at `xyz`, each next
+// point `stride_bytes` further (0 means packed: 3 scalars). No alignment needed, so
+// interleaved scanner records (normals, colours, intensity) are read in place.
+struct Cloud {
+    const void* xyz;
+    size_t count;
+    size_t stride_bytes;
+    Scalar scalar;
+};
+
+// The direction the layers are stacked along.
+enum class Axis : uint32_t {
+    automatic = 0,  // the principal direction of the cloud (largest-variance eigenvector)
+    x,
+    y,
+    z,
+    direction       // Options::direction
+};
+
+enum Flags : uint32_t {
+    // NaN/Inf points are skipped and counted (Report::rejected) instead of refused with
+    // Status::invalid_point.
+    skip_invalid_points = 1u << 0,
+};
+
+// Phases reported to Options::progress, in the order they run.
+enum class Phase : uint32_t { validate = 0, layers, triangulate, stitch, manifold, done };
+
+// All zero means defaults: `Options options = {};` is always valid.
+struct Options {
+    Axis axis;
+    double direction[3];     // for Axis::direction; any non-zero length
+    // Layers, first match wins: explicit cut positions along the axis (any order,
+    // repeats and cuts outside the cloud are ignored); else layer_count equal-height
+    // layers; else layers of about layer_height; else automatic.
+    const double* cuts;
+    size_t cut_count;
+    uint32_t layer_count;
+    double layer_height;
+    uint32_t flags;          // Flags bits
+    // Optional progress callback: called with each phase as it starts, and with the
+    // fraction of that phase done from time to time. Must not call back into stratmesh.
+    void (*progress)(void* user, Phase phase, double fraction);
+    void* progress_user;
+};
+
+struct LayerInfo {
+    double bottom, top;      // extent along the axis
+    double centre[3];        // the axis of the unrolling cylinder passes through this
+    double radius;           // the unrolling radius (see "Layers" in the docs)
+    uint32_t point_count;    // distinct valid points in the layer
+    uint32_t triangle_count; // triangles whose lowest vertex is in the layer
+    uint32_t fold_count;     // of those, triangles facing the axis
+};
+
+struct Report {
+    // points_in = points_used + duplicates + rejected + unused, always.
+    size_t points_in;
+    size_t points_used;      // vertices of the output
+    size_t duplicates;       // same coordinates as a lower-indexed point: merged into it
+    size_t rejected;         // NaN/Inf (with skip_invalid_points)
+    size_t unused;           // valid and distinct, but not a vertex (see `detail`)
+    size_t first_invalid_point;  // on Status::invalid_point
+    size_t triangle_count;
+    size_t illegal_removed;  // triangles removed by the manifold safety net
+    size_t folds;            // output triangles whose normal faces the axis
+    double axis[3];          // unit axis used
+    double axis_origin[3];   // a point on it
+    size_t layer_count;
+    // Optional per-layer details: the caller points `layers` at an array of
+    // `layer_capacity` entries; the first min(layer_count, layer_capacity) are filled.
+    LayerInfo* layers;
+    size_t layer_capacity;
+    const char* detail;      // a static sentence on why, when something failed or was dropped
+};
+
+// A size in bytes that is always enough workspace for reconstruct() of point_count
+// points with these options.
+size_t reconstruct_workspace_size(size_t point_count, const Options& options);
+
+// The most triangles reconstruct() can produce for point_count points.
+size_t reconstruct_max_triangles(size_t point_count, const Options& options);
+
+// Reconstructs a triangle mesh through the points of a columnar cloud.
+//
+// triangles       receives 3 * (*triangle_count) indices into the cloud, each triangle
+//                 counter-clockwise seen from outside (normals point away from the axis).
+// report          optional; see Report. Filled on every status.
+Status reconstruct(const Cloud& cloud, const Options& options,
+                   void* workspace, size_t workspace_bytes,
+                   uint32_t* triangles, size_t triangle_capacity, size_t* triangle_count,
+                   Report* report);
+
 } // namespace stratmesh
 
 #endif // STRATMESH_H
@@ -191,6 +292,7 @@ Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
 
 #include <cfloat>
 #include <climits>
+#include <cmath>
 #include <cstring>
 
 // >>config ==================================================================================
@@ -1195,6 +1297,1163 @@ Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
         if (m.tr.is_ghost(t)) continue;
         for (uint32_t k = 0; k < 3; ++k) *dst++ = m.order[m.tr.vertex[3 * t + k]];
     }
+    return Status::ok;
+}
+
+namespace detail {
+
+// >>layers ==================================================================================
+//
+// The cloud is read in place (float or double, any stride) and expressed in a frame whose
+// third axis is the stacking axis and whose origin is the centroid, so that clouds far
+// from the origin (georeferenced scans) keep their millimetres. Layers are height ranges
+// along the axis; the points are grouped by layer, in input order within a layer.
+
+struct Vec3 {
+    double x, y, z;
+};
+
+inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3 cross(Vec3 a, Vec3 b) {
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline Vec3 scaled(Vec3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+
+struct CloudReader {
+    const unsigned char* base;
+    size_t stride;
+    bool is_float;
+
+    Vec3 point(size_t i) const {
+        const unsigned char* p = base + i * stride;
+        if (is_float) {
+            float v[3];
+            std::memcpy(v, p, sizeof v);
+            return {static_cast<double>(v[0]), static_cast<double>(v[1]),
+                    static_cast<double>(v[2])};
+        }
+        double v[3];
+        std::memcpy(v, p, sizeof v);
+        return {v[0], v[1], v[2]};
+    }
+    bool valid(size_t i) const {
+        Vec3 p = point(i);
+        return is_finite(p.x) && is_finite(p.y) && is_finite(p.z);
+    }
+};
+
+// Coordinates in the reconstruction frame: (x, y) across the axis, h along it.
+struct Local {
+    double x, y, h;
+};
+
+struct Frame {
+    Vec3 origin, e1, e2, axis;  // (e1, e2, axis) is right-handed and orthonormal
+    Local local(Vec3 p) const {
+        Vec3 d = p - origin;
+        return {dot(d, e1), dot(d, e2), dot(d, axis)};
+    }
+};
+
+inline bool normalize(Vec3& v) {
+    double len = std::sqrt(dot(v, v));
+    if (!(len > 0) || !is_finite(len)) return false;
+    v = scaled(v, 1.0 / len);
+    return true;
+}
+
+// The principal direction of a symmetric 3x3 matrix by power iteration from its largest
+// column; a fixed number of steps keeps the cost bounded and the result deterministic.
+inline Vec3 principal_direction(const double m[3][3]) {
+    Vec3 cols[3] = {{m[0][0], m[1][0], m[2][0]}, {m[0][1], m[1][1], m[2][1]},
+                    {m[0][2], m[1][2], m[2][2]}};
+    Vec3 v = cols[0];
+    for (const Vec3& c : cols)
+        if (dot(c, c) > dot(v, v)) v = c;
+    if (!normalize(v)) return {0, 0, 1};
+    for (int step = 0; step < 100; ++step) {
+        Vec3 w = {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z,
+                  m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
+                  m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
+        if (!normalize(w)) break;
+        v = w;
+    }
+    // The sign of an eigenvector is arbitrary: point it along its largest component.
+    double big = v.x;
+    if (abs_value(v.y) > abs_value(big)) big = v.y;
+    if (abs_value(v.z) > abs_value(big)) big = v.z;
+    return big < 0 ? scaled(v, -1.0) : v;
+}
+
+// The frame: centroid origin, axis from the options (or PCA), e1/e2 completing it.
+inline Status choose_frame(const CloudReader& cloud, size_t count, const Options& options,
+                           Frame& frame) {
+    Vec3 sum = {0, 0, 0};
+    size_t valid = 0;
+    for (size_t i = 0; i < count; ++i) {
+        if (!cloud.valid(i)) continue;
+        Vec3 p = cloud.point(i);
+        sum = {sum.x + p.x, sum.y + p.y, sum.z + p.z};
+        ++valid;
+    }
+    frame.origin = valid ? scaled(sum, 1.0 / static_cast<double>(valid)) : Vec3{0, 0, 0};
+    Vec3 axis = {0, 0, 1};
+    switch (options.axis) {
+    case Axis::x: axis = {1, 0, 0}; break;
+    case Axis::y: axis = {0, 1, 0}; break;
+    case Axis::z: axis = {0, 0, 1}; break;
+    case Axis::direction:
+        axis = {options.direction[0], options.direction[1], options.direction[2]};
+        if (!is_finite(axis.x) || !is_finite(axis.y) || !is_finite(axis.z) || !normalize(axis))
+            return Status::invalid_axis;
+        break;
+    case Axis::automatic: {
+        double m[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+        for (size_t i = 0; i < count; ++i) {
+            if (!cloud.valid(i)) continue;
+            Vec3 d = cloud.point(i) - frame.origin;
+            double c[3] = {d.x, d.y, d.z};
+            for (int r = 0; r < 3; ++r)
+                for (int s = 0; s < 3; ++s) m[r][s] += c[r] * c[s];
+        }
+        axis = principal_direction(m);
+        break;
+    }
+    default: return Status::invalid_axis;
+    }
+    // e1: the coordinate axis least aligned with the stacking axis, made orthogonal.
+    Vec3 helper = {1, 0, 0};
+    if (abs_value(axis.x) > abs_value(axis.y) || abs_value(axis.x) > abs_value(axis.z))
+        helper = abs_value(axis.y) < abs_value(axis.z) ? Vec3{0, 1, 0} : Vec3{0, 0, 1};
+    Vec3 e1 = cross(helper, axis);
+    if (!normalize(e1)) return Status::invalid_axis;
+    frame.axis = axis;
+    frame.e1 = e1;
+    frame.e2 = cross(axis, e1);
+    return Status::ok;
+}
+
+// Layer boundaries: bounds[0] = lowest height, bounds[count] = highest, layer i holds the
+// heights in [bounds[i], bounds[i+1]) (the last layer includes its top).
+struct LayerPlan {
+    double* bounds;
+    uint32_t count;
+};
+
+// The number of layers the options can ask for, before empty layers are dropped.
+inline size_t planned_layer_limit(size_t point_count, const Options& options) {
+    if (options.cuts && options.cut_count > 0) return options.cut_count + 1;
+    if (options.layer_count > 0) return options.layer_count;
+    // A target height or the automatic rule: never more layers than points.
+    return point_count > 0 ? point_count : 1;
+}
+
+inline Status validate_layer_options(const Options& options) {
+    if (options.cuts && options.cut_count > 0) {
+        for (size_t i = 0; i < options.cut_count; ++i)
+            if (!is_finite(options.cuts[i])) return Status::invalid_layers;
+    } else if (options.cut_count > 0) {
+        return Status::invalid_argument;
+    }
+    if (!is_finite(options.layer_height) || options.layer_height < 0)
+        return Status::invalid_layers;
+    return Status::ok;
+}
+
+// Fills plan.bounds (room for planned_layer_limit + 1 entries) for heights [lo, hi];
+// `typical_radius` sets the automatic layer height.
+inline void plan_layers(const Options& options, double lo, double hi, double typical_radius,
+                        size_t point_count, LayerPlan& plan) {
+    double* b = plan.bounds;
+    uint32_t n = 0;
+    b[n++] = lo;
+    if (options.cuts && options.cut_count > 0) {
+        // Insertion sort of the cuts inside (lo, hi]; repeats and outsiders dropped.
+        for (size_t i = 0; i < options.cut_count; ++i) {
+            double c = options.cuts[i];
+            if (!(c > lo) || !(c <= hi)) continue;
+            uint32_t k = n;
+            while (k > 1 && b[k - 1] > c) --k;
+            if (b[k - 1] == c) continue;
+            for (uint32_t m = n; m > k; --m) b[m] = b[m - 1];
+            b[k] = c;
+            ++n;
+        }
+    } else {
+        double height = hi - lo;
+        double layers = 1;
+        if (options.layer_count > 0) {
+            layers = options.layer_count;
+        } else if (options.layer_height > 0) {
+            layers = std::ceil(height / options.layer_height);
+        } else if (typical_radius > 0) {
+            // Automatic, for now: layers about four radii tall.
+            layers = std::floor(height / (4 * typical_radius));
+        }
+        double limit = static_cast<double>(point_count);
+        if (!(layers >= 1)) layers = 1;
+        if (layers > limit) layers = limit;
+        uint32_t count = static_cast<uint32_t>(layers);
+        for (uint32_t i = 1; i < count; ++i) {
+            double c = lo + height * (static_cast<double>(i) / static_cast<double>(count));
+            if (c > b[n - 1] && c < hi) b[n++] = c;
+        }
+    }
+    b[n] = hi;
+    plan.count = n;
+}
+
+inline uint32_t layer_of(const LayerPlan& plan, double h) {
+    uint32_t lo = 0, hi = plan.count;  // answer in [lo, hi)
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (h >= plan.bounds[mid])
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+// >>unroll ==================================================================================
+//
+// Each layer is projected on a cylinder around its own centre, unrolled to (u, v) =
+// (r theta, h) and rolled up again by the conformal map exp((v - v0)/r + i theta) onto a
+// planar annulus: the bottom of the layer on the inner side, the top on the outer side.
+// The map is conformal, so small triangles keep their shape and the 2D Delaunay criterion
+// there is the unrolled one; and the seam along the cut generatrix is closed by
+// construction: there is no cut. With a virtual vertex at the annulus centre, the Delaunay
+// triangles not touching it are the layer's surface; its link is the layer's bottom loop,
+// the convex hull its top loop. No trigonometry is needed: the direction of a point from
+// the centre gives e^{i theta} directly.
+//
+// Centre: the mean of per-sector mean positions (kSectors sectors around the centroid), so
+// a side scanned more densely does not pull the centre towards it. Radius: the mean
+// distance of the points from that centre: it sets the unrolled aspect (arc length r theta
+// against height), so triangles are well shaped on the surface, not only in the plane.
+
+const uint32_t kSectors = 32;
+// Heights are divided by at least layer height / kMaxTurns so exp() stays far from
+// overflow and the annulus from extreme ratios in very tall, thin layers.
+const double kMaxTurns = 24.0;
+
+// e^x for |x| <= kMaxTurns + 1, with + - * only, so every platform computes the same bits.
+inline double exp_portable(double x) {
+    const double ln2_hi = 6.93147180369123816490e-01;
+    const double ln2_lo = 1.90821492927058770002e-10;
+    double k = std::floor(x * 1.44269504088896338700 + 0.5);
+    double r = (x - k * ln2_hi) - k * ln2_lo;  // |r| <= 0.35
+    double p = 1.0 / 6227020800.0;             // 1/13!
+    const double inverse_factorials[13] = {1.0 / 479001600.0, 1.0 / 39916800.0,
+                                           1.0 / 3628800.0,   1.0 / 362880.0,
+                                           1.0 / 40320.0,     1.0 / 5040.0,
+                                           1.0 / 720.0,       1.0 / 120.0,
+                                           1.0 / 24.0,        1.0 / 6.0,
+                                           0.5,               1.0,
+                                           1.0};
+    for (double c : inverse_factorials) p = p * r + c;
+    uint64_t bits = static_cast<uint64_t>(static_cast<int64_t>(k) + 1023) << 52;
+    double two_k;
+    std::memcpy(&two_k, &bits, sizeof two_k);
+    return p * two_k;
+}
+
+struct Cylinder {
+    double cx, cy;   // centre across the axis
+    double radius;   // unrolling radius
+    double h0;       // height mapped to the unit circle
+    double scale;    // 1 / max(radius, height / kMaxTurns)
+};
+
+// The point's place on the annulus: e^{(h - h0) * scale} times its direction from the
+// centre (points on the centre line take direction e1).
+inline void roll(const Cylinder& c, const Local& p, double* out) {
+    double dx = p.x - c.cx, dy = p.y - c.cy;
+    double r = std::sqrt(dx * dx + dy * dy);
+    double rho = exp_portable((p.h - c.h0) * c.scale);
+    if (r > 0 && is_finite(r)) {
+        out[0] = rho * (dx / r);
+        out[1] = rho * (dy / r);
+    } else {
+        out[0] = rho;
+        out[1] = 0;
+    }
+}
+
+// Centre and radius of the points ids[0..count) (all valid), for heights [h0, h1].
+inline Cylinder fit_cylinder(const CloudReader& cloud, const Frame& frame,
+                             const uint32_t* ids, size_t count, double h0, double h1) {
+    double mx = 0, my = 0;
+    for (size_t i = 0; i < count; ++i) {
+        Local p = frame.local(cloud.point(ids[i]));
+        mx += p.x;
+        my += p.y;
+    }
+    double inv = count ? 1.0 / static_cast<double>(count) : 0.0;
+    mx *= inv;
+    my *= inv;
+    // Sector means around the centroid: sector from the signs and ratio of (dx, dy).
+    double sx[kSectors] = {}, sy[kSectors] = {};
+    uint32_t sn[kSectors] = {};
+    for (size_t i = 0; i < count; ++i) {
+        Local p = frame.local(cloud.point(ids[i]));
+        double dx = p.x - mx, dy = p.y - my;
+        double ax = abs_value(dx), ay = abs_value(dy);
+        // A monotone stand-in for the angle, in [0, 4): no trigonometry needed.
+        double t = (ax + ay) > 0 ? dy / (ax + ay) : 0;  // in [-1, 1]
+        double angle = dx >= 0 ? (t < 0 ? 4 + t : t) : 2 - t;
+        uint32_t s = static_cast<uint32_t>(angle * (kSectors / 4.0));
+        if (s >= kSectors) s = kSectors - 1;
+        sx[s] += p.x;
+        sy[s] += p.y;
+        ++sn[s];
+    }
+    double cx = 0, cy = 0;
+    uint32_t used = 0;
+    for (uint32_t s = 0; s < kSectors; ++s) {
+        if (!sn[s]) continue;
+        cx += sx[s] / sn[s];
+        cy += sy[s] / sn[s];
+        ++used;
+    }
+    Cylinder c;
+    c.cx = used ? cx / used : mx;
+    c.cy = used ? cy / used : my;
+    double rsum = 0;
+    for (size_t i = 0; i < count; ++i) {
+        Local p = frame.local(cloud.point(ids[i]));
+        double dx = p.x - c.cx, dy = p.y - c.cy;
+        rsum += std::sqrt(dx * dx + dy * dy);
+    }
+    c.radius = rsum * inv;
+    c.h0 = h0;
+    double floor_radius = (h1 - h0) / kMaxTurns;
+    double r = c.radius > floor_radius ? c.radius : floor_radius;
+    c.scale = r > 0 && is_finite(r) ? 1.0 / r : 1.0;
+    return c;
+}
+
+}  // namespace detail
+
+namespace detail {
+
+// Where reconstructed triangles go: the caller's array, filled in order. Triangles are
+// built counter-clockwise on the annulus, where the outside of the surface faces down,
+// so they are written reversed. Counting continues past the capacity so the caller can
+// be told what is needed; nothing is written past it.
+struct TriangleSink {
+    uint32_t* triangles;
+    size_t capacity;
+    size_t count;
+    size_t folds;
+    const CloudReader* cloud;
+    const Frame* frame;
+
+    void emit(uint32_t a, uint32_t b, uint32_t c, const Cylinder& cyl) {
+        if (count < capacity) {
+            triangles[3 * count] = a;
+            triangles[3 * count + 1] = c;
+            triangles[3 * count + 2] = b;
+        }
+        ++count;
+        if (faces_axis(a, c, b, cyl)) ++folds;
+    }
+
+    // Whether the triangle's normal points towards the cylinder's axis: a fold.
+    bool faces_axis(uint32_t a, uint32_t b, uint32_t c, const Cylinder& cyl) const {
+        Local pa = frame->local(cloud->point(a));
+        Local pb = frame->local(cloud->point(b));
+        Local pc = frame->local(cloud->point(c));
+        Vec3 u = {pb.x - pa.x, pb.y - pa.y, pb.h - pa.h};
+        Vec3 v = {pc.x - pa.x, pc.y - pa.y, pc.h - pa.h};
+        Vec3 n = cross(u, v);
+        double rx = (pa.x + pb.x + pc.x) / 3 - cyl.cx;
+        double ry = (pa.y + pb.y + pc.y) / 3 - cyl.cy;
+        return n.x * rx + n.y * ry < 0;
+    }
+};
+
+// >>stitch ==================================================================================
+//
+// Two neighbouring layers meet at a cut: the top loop A of the lower layer and the bottom
+// loop B of the upper one are closed loops around the axis. Both are rolled onto one
+// annulus around the average of the two cylinders, with the cut on the unit circle, A
+// inside it and B outside. A zipper merges the loops by angle: each step adds a triangle
+// on the next edge of A or of B, so the band is a manifold annulus by construction. Then
+// the paper's diagonal swap: a rung shared by an A-triangle and a B-triangle is swapped
+// when the opposite vertex lies in the circumcircle (Lawson flips, which terminate in one
+// fixed plane). A swap only ever exchanges adjacent A and B steps, so the band stays a
+// band. The rung closing the loop (first A vertex to first B vertex) is kept.
+
+// 0 for angles in [0, pi), 1 for [pi, 2 pi).
+inline int half_turn(const double* v) { return (v[1] < 0 || (v[1] == 0 && v[0] < 0)) ? 1 : 0; }
+
+// Whether u's polar angle is strictly smaller than v's, in [0, 2 pi), exactly.
+inline bool angle_before(const double* u, const double* v) {
+    int hu = half_turn(u), hv = half_turn(v);
+    if (hu != hv) return hu < hv;
+    const double o[2] = {0, 0};
+    return orient2d_robust(o, u, v) > 0;
+}
+
+// Rotates loop[0..n) and its coordinates so the vertex of smallest angle comes first.
+inline void rotate_to_first_angle(uint32_t* loop, double* xy, uint32_t n) {
+    uint32_t first = 0;
+    for (uint32_t i = 1; i < n; ++i)
+        if (angle_before(xy + 2 * i, xy + 2 * first)) first = i;
+    // Three reversals rotate in place.
+    auto reverse = [&](uint32_t lo, uint32_t hi) {  // the range [lo, hi)
+        for (; hi > lo + 1; ++lo) {
+            --hi;
+            uint32_t t = loop[lo];
+            loop[lo] = loop[hi];
+            loop[hi] = t;
+            for (uint32_t k = 0; k < 2; ++k) {
+                double c = xy[2 * lo + k];
+                xy[2 * lo + k] = xy[2 * hi + k];
+                xy[2 * hi + k] = c;
+            }
+        }
+    };
+    reverse(0, first);
+    reverse(first, n);
+    reverse(0, n);
+}
+
+struct Band {
+    const uint32_t* a;  // loop A, original indices
+    const double* xa;   // its annulus coordinates
+    uint32_t p;
+    const uint32_t* b;
+    const double* xb;
+    uint32_t q;
+    unsigned char* steps;  // p + q: 0 = advance A, 1 = advance B
+    double* scratch;       // incircle scratch
+
+    const double* pa(uint32_t i) const { return xa + 2 * (i % p); }
+    const double* pb(uint32_t j) const { return xb + 2 * (j % q); }
+
+    // Whether the steps at t, t+1 (state i, j before t) should be swapped. Counter-clockwise
+    // on the annulus, an A step makes (a1, a0, b0) and a B step (b0, b1, a0).
+    bool should_swap(uint32_t t, uint32_t i, uint32_t j) const {
+        const double *a0 = pa(i), *a1 = pa(i + 1), *b0 = pb(j), *b1 = pb(j + 1);
+        bool a_then_b = steps[t] == 0;
+        // Both current triangles and both swapped ones must be proper, then the test.
+        if (!(orient2d_robust(a1, a0, b0) > 0 && orient2d_robust(b0, b1, a0) > 0 &&
+              orient2d_robust(b0, b1, a1) > 0 && orient2d_robust(a1, a0, b1) > 0))
+            return false;
+        if (a_then_b)  // (a1 a0 b0), (b0 b1 a1): swap for the rung a0-b1?
+            return incircle_perturbed(a1, a0, b0, b1, scratch) > 0;
+        // (b0 b1 a0), (a1 a0 b1): swap for the rung a1-b0?
+        return incircle_perturbed(b0, b1, a0, a1, scratch) > 0;
+    }
+};
+
+inline void zip_by_angle(Band& band) {
+    uint32_t i = 0, j = 0, t = 0;
+    while (i < band.p || j < band.q) {
+        bool take_a;
+        if (i == band.p) take_a = false;
+        else if (j == band.q) take_a = true;
+        else if (i + 1 == band.p) take_a = false;  // A's closing edge comes after B's last
+        else if (j + 1 == band.q) take_a = true;
+        else take_a = !angle_before(band.pb(j + 1), band.pa(i + 1));
+        band.steps[t++] = take_a ? 0 : 1;
+        if (take_a) ++i; else ++j;
+    }
+}
+
+// Lawson flips over the step sequence; returns the number of swaps.
+inline size_t swap_diagonals(Band& band) {
+    const uint32_t length = band.p + band.q;
+    const size_t limit = 16 * static_cast<size_t>(length) + 64;
+    size_t swaps = 0;
+    uint32_t t = 0, i = 0, j = 0;
+    while (t + 1 < length) {
+        if (band.steps[t] != band.steps[t + 1] && swaps < limit && band.should_swap(t, i, j)) {
+            unsigned char s = band.steps[t];
+            band.steps[t] = band.steps[t + 1];
+            band.steps[t + 1] = s;
+            ++swaps;
+            if (t > 0) {
+                --t;
+                if (band.steps[t] == 0) --i; else --j;
+            }
+            continue;
+        }
+        if (band.steps[t] == 0) ++i; else ++j;
+        ++t;
+    }
+    return swaps;
+}
+
+// Stitches loop a (top of the lower layer, cylinder ca) to loop b (bottom of the upper
+// layer, cylinder cb, whose h0 is the cut).
+inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cylinder& ca,
+                          uint32_t* a, uint32_t p, const Cylinder& cb, uint32_t* b, uint32_t q,
+                          Arena& arena, TriangleSink& sink, size_t* swaps) {
+    size_t mark = arena.mark();
+    double* xa = arena.alloc<double>(2 * static_cast<size_t>(p));
+    double* xb = arena.alloc<double>(2 * static_cast<size_t>(q));
+    unsigned char* steps = arena.alloc<unsigned char>(static_cast<size_t>(p) + q);
+    double* scratch = arena.alloc<double>(kIncircleScratch);
+    if (arena.failed) return false;
+    Cylinder shared;
+    shared.cx = (ca.cx + cb.cx) / 2;
+    shared.cy = (ca.cy + cb.cy) / 2;
+    shared.radius = (ca.radius + cb.radius) / 2;
+    shared.h0 = cb.h0;
+    shared.scale = (ca.scale + cb.scale) / 2;
+    for (uint32_t i = 0; i < p; ++i) roll(shared, frame.local(cloud.point(a[i])), xa + 2 * i);
+    for (uint32_t j = 0; j < q; ++j) roll(shared, frame.local(cloud.point(b[j])), xb + 2 * j);
+    rotate_to_first_angle(a, xa, p);
+    rotate_to_first_angle(b, xb, q);
+    Band band = {a, xa, p, b, xb, q, steps, scratch};
+    zip_by_angle(band);
+    *swaps += swap_diagonals(band);
+    uint32_t i = 0, j = 0;
+    for (uint32_t t = 0; t < p + q; ++t) {
+        if (steps[t] == 0) {
+            sink.emit(a[(i + 1) % p], a[i % p], b[j % q], shared);
+            ++i;
+        } else {
+            sink.emit(b[j % q], b[(j + 1) % q], a[i % p], shared);
+            ++j;
+        }
+    }
+    arena.rewind(mark);
+    return true;
+}
+
+}  // namespace detail
+
+namespace detail {
+
+// >>layer triangulation ====================================================================
+
+struct LayerLoops {
+    uint32_t* bottom;  // original indices, counter-clockwise on the annulus
+    uint32_t bottom_count;
+    uint32_t* top;
+    uint32_t top_count;
+};
+
+struct LayerCounts {
+    size_t duplicates;   // same 3D coordinates as an earlier point
+    size_t collisions;   // distinct in 3D, same place on the annulus
+};
+
+// Classifies the points the layer's triangulation found on an existing vertex.
+struct LayerDuplicates {
+    const CloudReader* cloud;
+    const uint32_t* ids;    // layer-local id (1-based; 0 is the centre) -> original index
+    const uint32_t* order;  // insertion position -> layer-local id
+    LayerCounts* counts;
+
+    static void report(void* context, uint32_t point, uint32_t vertex) {
+        LayerDuplicates* d = static_cast<LayerDuplicates*>(context);
+        Vec3 p = d->cloud->point(d->ids[d->order[point] - 1]);
+        Vec3 v = d->cloud->point(d->ids[d->order[vertex] - 1]);
+        if (p.x == v.x && p.y == v.y && p.z == v.z)
+            ++d->counts->duplicates;
+        else
+            ++d->counts->collisions;
+    }
+};
+
+inline uint32_t original_id(const uint32_t* ids, const uint32_t* order, uint32_t v) {
+    return ids[order[v] - 1];
+}
+
+// Collects the link of vertex `centre` counter-clockwise into loop (original indices).
+// False if the centre touches the hull: the layer does not surround its axis.
+inline bool centre_link(const Triangulation& tr, uint32_t centre, const uint32_t* ids,
+                        const uint32_t* order, uint32_t* loop, uint32_t* count) {
+    uint32_t start = kNoIndex;
+    for (uint32_t e = 0; e < 3 * tr.triangle_count; ++e)
+        if (tr.vertex[e] == centre) {
+            start = e;
+            break;
+        }
+    if (start == kNoIndex) return false;
+    uint32_t n = 0, e = start;
+    do {
+        uint32_t u = tr.vertex[next_edge(e)];
+        if (u == kGhost || tr.vertex[prev_edge(e)] == kGhost || n > tr.triangle_count)
+            return false;
+        loop[n++] = original_id(ids, order, u);
+        e = tr.twin[prev_edge(e)];  // the next triangle counter-clockwise around the centre
+    } while (e != start);
+    *count = n;
+    return true;
+}
+
+// Collects the convex hull counter-clockwise into loop (original indices). A ghost
+// (a, b, G) holds G -> a; the twin of G -> a is a -> G in the ghost (z, a, G), whose next
+// half-edge is G -> z: the hull vertex after a.
+inline void hull_loop(const Triangulation& tr, const uint32_t* ids, const uint32_t* order,
+                      uint32_t* loop, uint32_t* count) {
+    uint32_t start = 0;
+    while (tr.vertex[start] != kGhost) ++start;
+    uint32_t n = 0, e = start;
+    do {
+        loop[n++] = original_id(ids, order, tr.vertex[next_edge(e)]);
+        e = next_edge(tr.twin[e]);
+    } while (e != start && n <= tr.triangle_count);
+    *count = n;
+}
+
+}  // namespace detail
+
+namespace detail {
+
+// Triangulates one layer: its points ids[0..count) rolled onto the annulus of `cyl` plus
+// the centre. Emits the surface triangles, fills the loops. Returns ok, not_columnar (the
+// layer does not surround its axis, or is degenerate: the caller merges it with the next
+// one), out_of_memory or internal_error.
+inline Status triangulate_layer(const CloudReader& cloud, const Frame& frame,
+                                const Cylinder& cyl, const uint32_t* ids, size_t count,
+                                Arena& arena, TriangleSink& sink, LayerLoops& loops,
+                                LayerCounts& counts) {
+    const size_t total = count + 1;  // local id 0 is the centre
+    size_t mark = arena.mark();
+    uint32_t* order = arena.alloc<uint32_t>(total);
+    double* xy = arena.alloc<double>(2 * total);
+    if (arena.failed) return Status::out_of_memory;
+    xy[0] = xy[1] = 0;
+    BoundingBox2d box = {{0, 0}, {0, 0}};
+    for (size_t i = 1; i < total; ++i) {
+        double* p = xy + 2 * i;
+        roll(cyl, frame.local(cloud.point(ids[i - 1])), p);
+        for (int k = 0; k < 2; ++k) {
+            if (p[k] < box.min[k]) box.min[k] = p[k];
+            if (p[k] > box.max[k]) box.max[k] = p[k];
+        }
+    }
+    if (!spatial_order(reinterpret_cast<const unsigned char*>(xy), 2 * sizeof(double), total,
+                       box, order, arena))
+        return Status::out_of_memory;
+    // Lay the points out in insertion order, recomputed (the same bits) rather than copied.
+    uint32_t centre = 0;
+    for (size_t k = 0; k < total; ++k) {
+        if (order[k] == 0) {
+            centre = static_cast<uint32_t>(k);
+            xy[2 * k] = xy[2 * k + 1] = 0;
+        } else {
+            roll(cyl, frame.local(cloud.point(ids[order[k] - 1])), xy + 2 * k);
+        }
+    }
+    Triangulation tr;
+    tr.xy = xy;
+    if (!allocate_triangulation(tr, total, arena)) return Status::out_of_memory;
+    counts = LayerCounts{0, 0};
+    LayerDuplicates classify = {&cloud, ids, order, &counts};
+    DuplicateSink duplicates = {LayerDuplicates::report, &classify};
+    uint32_t inserted = 0;
+    Status status = triangulate_points(tr, static_cast<uint32_t>(total), duplicates, &inserted);
+    if (status == Status::internal_error) return status;
+    if (status != Status::ok ||
+        !centre_link(tr, centre, ids, order, loops.bottom, &loops.bottom_count)) {
+        arena.rewind(mark);
+        return Status::not_columnar;
+    }
+    hull_loop(tr, ids, order, loops.top, &loops.top_count);
+    for (uint32_t t = 0; t < tr.triangle_count; ++t) {
+        const uint32_t* v = tr.vertex + 3 * t;
+        if (tr.is_ghost(t) || v[0] == centre || v[1] == centre || v[2] == centre) continue;
+        sink.emit(original_id(ids, order, v[0]), original_id(ids, order, v[1]),
+                  original_id(ids, order, v[2]), cyl);
+    }
+    arena.rewind(mark);
+    return Status::ok;
+}
+
+}  // namespace detail
+
+namespace detail {
+
+// >>manifold ================================================================================
+//
+// The paper's step 5, as a safety net: by construction the layers and bands already form a
+// manifold, so on sound input this removes nothing. Around every vertex v, each triangle
+// (v, b, c) leaves along v->b and arrives along c->v. The surface is an oriented manifold
+// at v when no directed edge repeats (at most two triangles per edge, consistently
+// oriented) and the triangles form one fan: one chain or one cycle of triangles, each
+// arriving where the next leaves. Triangles on a repeated directed edge go (the later
+// one), then every fan but the largest; repeated until nothing changes, since a removal
+// can split a neighbour's fan.
+
+// In-place heap sort of (key, value) pairs by key: O(n log n), no recursion, no memory.
+inline void sort_pairs(uint64_t* items, size_t count) {
+    auto sift = [items](size_t root, size_t end) {
+        for (;;) {
+            size_t child = 2 * root + 1;
+            if (child >= end) return;
+            if (child + 1 < end && items[child + 1] > items[child]) ++child;
+            if (items[root] >= items[child]) return;
+            uint64_t t = items[root];
+            items[root] = items[child];
+            items[child] = t;
+            root = child;
+        }
+    };
+    for (size_t i = count / 2; i-- > 0;) sift(i, count);
+    for (size_t end = count; end > 1; --end) {
+        uint64_t t = items[0];
+        items[0] = items[end - 1];
+        items[end - 1] = t;
+        sift(0, end - 1);
+    }
+}
+
+struct Fan {
+    uint64_t* leave;   // (leaving neighbour << 32 | triangle), sorted
+    uint32_t* arrive;  // arriving neighbour of each entry
+    uint32_t* label;   // fan component of each entry
+    uint32_t* sizes;   // entries per component
+    size_t size;
+};
+
+// The vertices that follow and precede v in triangle t.
+inline void around(const uint32_t* tri, uint32_t t, uint32_t v, uint32_t* leave,
+                   uint32_t* arrive) {
+    const uint32_t* c = tri + 3 * static_cast<size_t>(t);
+    uint32_t k = c[0] == v ? 0u : c[1] == v ? 1u : 2u;
+    *leave = c[(k + 1) % 3];
+    *arrive = c[(k + 2) % 3];
+}
+
+// The fan entry leaving towards `neighbour` (the triangle after one arriving from it).
+inline size_t entry_leaving_to(const Fan& fan, uint32_t neighbour) {
+    size_t lo = 0, hi = fan.size;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if ((fan.leave[mid] >> 32) < neighbour) lo = mid + 1; else hi = mid;
+    }
+    return lo < fan.size && (fan.leave[lo] >> 32) == neighbour ? lo : SIZE_MAX;
+}
+
+// Collects v's live triangles; drops (marks dead) those repeating a leaving edge.
+inline size_t collect_fan(const uint32_t* tri, const uint32_t* incident, size_t begin,
+                          size_t end, uint32_t v, unsigned char* dead, Fan& fan) {
+    fan.size = 0;
+    for (size_t k = begin; k < end; ++k) {
+        uint32_t t = incident[k];
+        if (dead[t]) continue;
+        uint32_t leave, arrive;
+        around(tri, t, v, &leave, &arrive);
+        fan.leave[fan.size++] = (static_cast<uint64_t>(leave) << 32) | t;
+    }
+    sort_pairs(fan.leave, fan.size);
+    size_t kept = 0, removed = 0;
+    for (size_t k = 0; k < fan.size; ++k) {
+        if (kept > 0 && (fan.leave[kept - 1] >> 32) == (fan.leave[k] >> 32)) {
+            dead[static_cast<uint32_t>(fan.leave[k])] = 1;
+            ++removed;
+            continue;
+        }
+        fan.leave[kept++] = fan.leave[k];
+    }
+    fan.size = kept;
+    for (size_t k = 0; k < fan.size; ++k) {
+        uint32_t leave;
+        around(tri, static_cast<uint32_t>(fan.leave[k]), v, &leave, &fan.arrive[k]);
+    }
+    return removed;
+}
+
+// Labels the connected pieces of the fan (each entry linked to the entry after it) and
+// returns how many there are.
+inline uint32_t label_fan(Fan& fan) {
+    const uint32_t unlabeled = kNoIndex;
+    for (size_t k = 0; k < fan.size; ++k) fan.label[k] = unlabeled;
+    uint32_t pieces = 0;
+    for (size_t k = 0; k < fan.size; ++k) {
+        if (fan.label[k] != unlabeled) continue;
+        size_t at = k, walked = 0;
+        while (at != SIZE_MAX && fan.label[at] == unlabeled) {
+            fan.label[at] = pieces;
+            ++walked;
+            at = entry_leaving_to(fan, fan.arrive[at]);
+        }
+        uint32_t joined = (at != SIZE_MAX) ? fan.label[at] : pieces;
+        if (joined != pieces) {
+            // This walk ran into an earlier piece: it belongs to it.
+            for (size_t w = k; w != at; w = entry_leaving_to(fan, fan.arrive[w]))
+                fan.label[w] = joined;
+            fan.sizes[joined] += static_cast<uint32_t>(walked);
+        } else {
+            fan.sizes[pieces++] = static_cast<uint32_t>(walked);
+        }
+    }
+    return pieces;
+}
+
+// Makes v's fan a single oriented piece; returns the number of triangles marked dead.
+inline size_t repair_fan(const uint32_t* tri, const uint32_t* incident, size_t begin,
+                         size_t end, uint32_t v, unsigned char* dead, Fan& fan) {
+    size_t removed = collect_fan(tri, incident, begin, end, v, dead, fan);
+    uint32_t pieces = label_fan(fan);
+    if (pieces <= 1) return removed;
+    uint32_t best = 0;
+    for (uint32_t c = 1; c < pieces; ++c)
+        if (fan.sizes[c] > fan.sizes[best]) best = c;
+    for (size_t k = 0; k < fan.size; ++k) {
+        if (fan.label[k] == best) continue;
+        dead[static_cast<uint32_t>(fan.leave[k])] = 1;
+        ++removed;
+    }
+    return removed;
+}
+
+// Removes triangles until the mesh is edge- and vertex-manifold and consistently oriented.
+// Compacts the survivors in place (keeping their order); returns the number removed, or
+// SIZE_MAX if the arena is too small. *used receives the number of vertices left.
+inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count, Arena& arena,
+                               size_t* used) {
+    size_t mark = arena.mark();
+    uint32_t* offsets = arena.alloc<uint32_t>(point_count + 1);
+    uint32_t* incident = arena.alloc<uint32_t>(3 * count);
+    unsigned char* dead = arena.alloc<unsigned char>(count);
+    if (arena.failed) return SIZE_MAX;
+    std::memset(offsets, 0, sizeof(uint32_t) * (point_count + 1));
+    std::memset(dead, 0, count);
+    for (size_t k = 0; k < 3 * count; ++k) ++offsets[tri[k] + 1];
+    size_t max_degree = 0;
+    for (size_t v = 0; v < point_count; ++v) {
+        if (offsets[v + 1] > max_degree) max_degree = offsets[v + 1];
+        offsets[v + 1] += offsets[v];
+    }
+    {
+        size_t inner = arena.mark();
+        uint32_t* fill = arena.alloc<uint32_t>(point_count);
+        if (arena.failed) return SIZE_MAX;
+        std::memcpy(fill, offsets, sizeof(uint32_t) * point_count);
+        for (size_t k = 0; k < 3 * count; ++k)
+            incident[fill[tri[k]]++] = static_cast<uint32_t>(k / 3);
+        arena.rewind(inner);
+    }
+    Fan fan;
+    fan.leave = arena.alloc<uint64_t>(max_degree);
+    fan.arrive = arena.alloc<uint32_t>(max_degree);
+    fan.label = arena.alloc<uint32_t>(max_degree);
+    fan.sizes = arena.alloc<uint32_t>(max_degree);
+    if (arena.failed) return SIZE_MAX;
+    size_t removed = 0;
+    for (size_t pass = 0; pass <= count; ++pass) {
+        size_t before = removed;
+        for (size_t v = 0; v < point_count; ++v)
+            if (offsets[v + 1] > offsets[v])
+                removed += repair_fan(tri, incident, offsets[v], offsets[v + 1],
+                                      static_cast<uint32_t>(v), dead, fan);
+        if (removed == before) break;
+    }
+    size_t alive = 0, vertices = 0;
+    for (size_t v = 0; v < point_count; ++v) {
+        bool touched = false;
+        for (size_t k = offsets[v]; k < offsets[v + 1] && !touched; ++k)
+            touched = !dead[incident[k]];
+        vertices += touched;
+    }
+    for (size_t t = 0; t < count; ++t) {
+        if (dead[t]) continue;
+        for (size_t k = 0; k < 3; ++k) tri[3 * alive + k] = tri[3 * t + k];
+        ++alive;
+    }
+    count = alive;
+    *used = vertices;
+    arena.rewind(mark);
+    return removed;
+}
+
+}  // namespace detail
+
+namespace detail {
+
+// >>reconstruct =============================================================================
+//
+// Validate, choose the frame and the layers, group the points by layer, then for each
+// layer: fit its cylinder, triangulate it on its annulus, stitch it to the layer below.
+// A layer that cannot be triangulated around its axis (too few points, or a gap in its
+// angular coverage) is merged with the next one; trailing points that never form such a
+// layer stay unused and are reported. Last, the manifold safety net.
+
+// Workspace that lives through the whole call, then the largest scratch of any phase.
+struct ReconstructMemory {
+    double* bounds;        // layer bounds
+    uint32_t* layer_start; // first position in `order` of each layer
+    uint32_t* order;       // valid points grouped by layer
+    uint32_t* loops[3];    // previous top, bottom, top
+};
+
+inline bool plan_reconstruct(ReconstructMemory& m, size_t count, size_t layer_limit,
+                             Arena& arena) {
+    m.bounds = arena.alloc<double>(layer_limit + 1);
+    m.layer_start = arena.alloc<uint32_t>(layer_limit + 2);
+    m.order = arena.alloc<uint32_t>(count);
+    for (uint32_t*& loop : m.loops) loop = arena.alloc<uint32_t>(count);
+    return !arena.failed;
+}
+
+// The largest scratch any phase takes on top of the plan, for `count` points.
+inline size_t reconstruct_scratch_size(size_t count) {
+    size_t total = count + 1;
+    Arena layer = Arena::measuring();
+    layer.alloc<uint32_t>(total);
+    layer.alloc<double>(2 * total);
+    size_t mark = layer.mark();
+    for (int k = 0; k < 3; ++k) layer.alloc<uint32_t>(total);  // the spatial sort
+    layer.rewind(mark);
+    Triangulation tr;
+    allocate_triangulation(tr, total, layer);
+
+    Arena band = Arena::measuring();
+    band.alloc<double>(2 * count);
+    band.alloc<double>(2);  // the second loop's alignment
+    band.alloc<unsigned char>(count);
+    band.alloc<double>(kIncircleScratch);
+
+    size_t triangles = 2 * count;
+    Arena manifold = Arena::measuring();
+    manifold.alloc<uint32_t>(count + 1);
+    manifold.alloc<uint32_t>(3 * triangles);
+    manifold.alloc<unsigned char>(triangles);
+    mark = manifold.mark();
+    manifold.alloc<uint32_t>(count);
+    manifold.rewind(mark);
+    manifold.alloc<uint64_t>(triangles);
+    for (int k = 0; k < 3; ++k) manifold.alloc<uint32_t>(triangles);
+
+    size_t most = layer.high_water;
+    if (band.high_water > most) most = band.high_water;
+    if (manifold.high_water > most) most = manifold.high_water;
+    return most;
+}
+
+inline void notify(const Options& options, Phase phase, double fraction) {
+    if (options.progress) options.progress(options.progress_user, phase, fraction);
+}
+
+inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangles,
+                                          size_t triangle_capacity, size_t* triangle_count,
+                                          void* workspace) {
+    if (!triangle_count) return Status::invalid_argument;
+    if (cloud.count > kMaxPoints - 1) return Status::too_many_points;
+    size_t scalar = cloud.scalar == Scalar::float32 ? sizeof(float)
+                  : cloud.scalar == Scalar::float64 ? sizeof(double) : 0;
+    if (scalar == 0) return Status::invalid_argument;
+    if (cloud.stride_bytes != 0 && cloud.stride_bytes < 3 * scalar)
+        return Status::invalid_argument;
+    if (cloud.count > 0 && (!cloud.xyz || !workspace)) return Status::invalid_argument;
+    if (triangle_capacity > 0 && !triangles) return Status::invalid_argument;
+    return Status::ok;
+}
+
+// Groups the valid points by layer (input order within a layer): counting sort.
+inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& frame,
+                           const LayerPlan& plan, ReconstructMemory& m) {
+    std::memset(m.layer_start, 0, sizeof(uint32_t) * (plan.count + 2));
+    for (size_t i = 0; i < count; ++i)
+        if (cloud.valid(i)) ++m.layer_start[layer_of(plan, frame.local(cloud.point(i)).h) + 2];
+    for (uint32_t k = 0; k < plan.count; ++k) m.layer_start[k + 2] += m.layer_start[k + 1];
+    for (size_t i = 0; i < count; ++i) {
+        if (!cloud.valid(i)) continue;
+        uint32_t k = layer_of(plan, frame.local(cloud.point(i)).h);
+        m.order[m.layer_start[k + 1]++] = static_cast<uint32_t>(i);
+    }
+}
+
+inline void describe_layer(const Frame& frame, const Cylinder& cyl, double bottom, double top,
+                           size_t points, size_t triangles, size_t folds, LayerInfo& info) {
+    info.bottom = bottom;
+    info.top = top;
+    double mid = (bottom + top) / 2;
+    Vec3 c = {frame.origin.x + frame.e1.x * cyl.cx + frame.e2.x * cyl.cy + frame.axis.x * mid,
+              frame.origin.y + frame.e1.y * cyl.cx + frame.e2.y * cyl.cy + frame.axis.y * mid,
+              frame.origin.z + frame.e1.z * cyl.cx + frame.e2.z * cyl.cy + frame.axis.z * mid};
+    info.centre[0] = c.x;
+    info.centre[1] = c.y;
+    info.centre[2] = c.z;
+    info.radius = cyl.radius;
+    info.point_count = static_cast<uint32_t>(points);
+    info.triangle_count = static_cast<uint32_t>(triangles);
+    info.fold_count = static_cast<uint32_t>(folds);
+}
+
+}  // namespace detail
+
+size_t reconstruct_max_triangles(size_t point_count, const Options& options) {
+    (void)options;
+    return 2 * point_count;
+}
+
+size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
+    if (point_count > detail::kMaxPoints - 1) return 0;
+    detail::Arena arena = detail::Arena::measuring();
+    detail::ReconstructMemory m;
+    detail::plan_reconstruct(m, point_count,
+                             detail::planned_layer_limit(point_count, options), arena);
+    return arena.required_bytes() + detail::reconstruct_scratch_size(point_count);
+}
+
+Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
+                   size_t workspace_bytes, uint32_t* triangles, size_t triangle_capacity,
+                   size_t* triangle_count, Report* report) {
+    using namespace detail;
+    Report local_report;
+    std::memset(&local_report, 0, sizeof local_report);
+    Report& rep = report ? *report : local_report;
+    LayerInfo* layer_infos = rep.layers;
+    size_t layer_capacity = rep.layers ? rep.layer_capacity : 0;
+    std::memset(&rep, 0, sizeof rep);
+    rep.layers = layer_infos;
+    rep.layer_capacity = layer_capacity;
+    rep.points_in = cloud.count;
+    if (triangle_count) *triangle_count = 0;
+
+    Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
+                                                triangle_count, workspace);
+    if (status != Status::ok) return status;
+    notify(options, Phase::validate, 0);
+    size_t scalar = cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double);
+    CloudReader reader = {static_cast<const unsigned char*>(cloud.xyz),
+                          cloud.stride_bytes ? cloud.stride_bytes : 3 * scalar,
+                          cloud.scalar == Scalar::float32};
+    for (size_t i = 0; i < cloud.count; ++i) {
+        if (reader.valid(i)) continue;
+        if (!(options.flags & skip_invalid_points)) {
+            rep.first_invalid_point = i;
+            rep.rejected = cloud.count;
+            rep.detail = "a point has a NaN or infinite coordinate (see first_invalid_point; "
+                         "the skip_invalid_points flag skips such points instead)";
+            return Status::invalid_point;
+        }
+        ++rep.rejected;
+    }
+    size_t valid = cloud.count - rep.rejected;
+    status = validate_layer_options(options);
+    if (status != Status::ok) return status;
+    Frame frame;
+    status = choose_frame(reader, cloud.count, options, frame);
+    if (status != Status::ok) return status;
+    rep.axis[0] = frame.axis.x;
+    rep.axis[1] = frame.axis.y;
+    rep.axis[2] = frame.axis.z;
+    rep.axis_origin[0] = frame.origin.x;
+    rep.axis_origin[1] = frame.origin.y;
+    rep.axis_origin[2] = frame.origin.z;
+    rep.unused = valid;
+    if (valid < 3) return Status::too_few_points;
+
+    double lo = DBL_MAX, hi = -DBL_MAX, radius_sum = 0;
+    for (size_t i = 0; i < cloud.count; ++i) {
+        if (!reader.valid(i)) continue;
+        Local p = frame.local(reader.point(i));
+        if (p.h < lo) lo = p.h;
+        if (p.h > hi) hi = p.h;
+        radius_sum += std::sqrt(p.x * p.x + p.y * p.y);
+    }
+    if (!(hi > lo)) {
+        rep.detail = "every point has the same height along the axis";
+        return Status::flat_cloud;
+    }
+
+    Arena arena = Arena::over(workspace, workspace_bytes);
+    ReconstructMemory m;
+    size_t layer_limit = planned_layer_limit(cloud.count, options);
+    if (!plan_reconstruct(m, cloud.count, layer_limit, arena)) return Status::out_of_memory;
+    notify(options, Phase::layers, 0);
+    LayerPlan plan = {m.bounds, 0};
+    plan_layers(options, lo, hi, radius_sum / static_cast<double>(valid), cloud.count, plan);
+    group_by_layer(reader, cloud.count, frame, plan, m);
+
+    notify(options, Phase::triangulate, 0);
+    TriangleSink sink = {triangles, triangle_capacity, 0, 0, &reader, &frame};
+    uint32_t* previous_top = m.loops[0];
+    uint32_t previous_top_count = 0;
+    Cylinder previous = {0, 0, 0, 0, 0};
+    size_t collisions = 0, swaps = 0, trailing = 0;
+    uint32_t first = 0;
+    while (first < plan.count) {
+        uint32_t last = first;
+        LayerLoops loops = {m.loops[1], 0, m.loops[2], 0};
+        LayerCounts counts = {0, 0};
+        Cylinder cyl = {0, 0, 0, 0, 0};
+        size_t before = sink.count, folds_before = sink.folds;
+        for (;;) {
+            const uint32_t* ids = m.order + m.layer_start[first];
+            size_t n = m.layer_start[last + 1] - m.layer_start[first];
+            status = Status::not_columnar;
+            if (n >= 3) {
+                cyl = fit_cylinder(reader, frame, ids, n, plan.bounds[first],
+                                   plan.bounds[last + 1]);
+                status = triangulate_layer(reader, frame, cyl, ids, n, arena, sink, loops,
+                                           counts);
+            }
+            if (status == Status::ok) break;
+            if (status != Status::not_columnar) return status;
+            if (last + 1 == plan.count) {
+                trailing = n;
+                break;
+            }
+            ++last;
+        }
+        if (status != Status::ok) break;
+        if (previous_top_count > 0 &&
+            !stitch_layers(reader, frame, previous, previous_top, previous_top_count, cyl,
+                           loops.bottom, loops.bottom_count, arena, sink, &swaps))
+            return Status::out_of_memory;
+        size_t points = m.layer_start[last + 1] - m.layer_start[first];
+        rep.duplicates += counts.duplicates;
+        collisions += counts.collisions;
+        if (rep.layer_count < layer_capacity)
+            describe_layer(frame, cyl, plan.bounds[first], plan.bounds[last + 1],
+                           points - counts.duplicates, sink.count - before,
+                           sink.folds - folds_before, layer_infos[rep.layer_count]);
+        ++rep.layer_count;
+        // This layer's top loop is the next one's "previous": rotate the buffers.
+        uint32_t* spare = previous_top;
+        previous_top = loops.top;
+        previous_top_count = loops.top_count;
+        m.loops[2] = spare;
+        previous = cyl;
+        first = last + 1;
+        notify(options, Phase::triangulate, static_cast<double>(first) / plan.count);
+    }
+    if (rep.layer_count == 0) {
+        rep.detail = "no layer's points surround the axis: the cloud is not columnar around "
+                     "it (try another axis)";
+        return Status::not_columnar;
+    }
+    notify(options, Phase::stitch, 1);
+    if (sink.count > triangle_capacity) {
+        *triangle_count = sink.count;
+        rep.triangle_count = sink.count;
+        rep.detail = "the triangle array is too small; triangle_count says how many are needed";
+        return Status::triangle_capacity;
+    }
+
+    notify(options, Phase::manifold, 0);
+    size_t count = sink.count, used = 0;
+    size_t removed = enforce_manifold(triangles, count, cloud.count, arena, &used);
+    if (removed == SIZE_MAX) return Status::out_of_memory;
+    *triangle_count = count;
+    rep.triangle_count = count;
+    rep.illegal_removed = removed;
+    rep.folds = sink.folds;
+    rep.points_used = used;
+    rep.unused = valid - rep.duplicates - used;
+    if (trailing > 0)
+        rep.detail = "the points of the last layers do not surround the axis: they are not "
+                     "vertices";
+    else if (collisions > 0)
+        rep.detail = "some points share their place on the unrolled layer with another point "
+                     "(the layer is not star-shaped around its centre there): not vertices";
+    else if (rep.unused > 0)
+        rep.detail = "the manifold safety net removed the triangles of some points";
+    (void)swaps;
+    notify(options, Phase::done, 1);
     return Status::ok;
 }
 

@@ -50,7 +50,13 @@
 // arrays it is given, whatever the input.
 //
 // delaunay_2d needs 72 bytes per point plus about 10 KiB; its output is at most
-// 2n - 5 triangles (24 bytes per point).
+// 2n - 5 triangles (24 bytes per point). reconstruct needs about 88 bytes per point
+// (the triangulation of its largest possible layer, plus the layer grouping and
+// boundary loops); its output is at most 2n triangles.
+//
+// Stack: no recursion anywhere. The deepest frames hold a few hundred bytes, except the
+// exact incircle, whose expansions (about 8 KiB) live in the workspace when called from
+// the triangulation and on the stack only when you call incircle() yourself.
 //
 // ==== Errors ===============================================================================
 //
@@ -79,7 +85,14 @@
 //   the coordinates: not on the input order, not on the architecture. Exact duplicates
 //   are not triangulated twice: each is mapped to the lowest index with the same
 //   coordinates. Every other point is a vertex of the output.
-// - NaN or infinite coordinates are refused (Status::invalid_point, with the index).
+// - NaN or infinite coordinates are refused (Status::invalid_point, with the index), or
+//   skipped and counted with the skip_invalid_points flag of reconstruct.
+// - reconstruct's output is edge- and vertex-manifold and consistently oriented for every
+//   input it accepts: the layers and the bands between them form one annulus by
+//   construction, and a final safety net removes (and counts) any triangle that would
+//   break that. The output is not guaranteed free of self-intersections where a layer is
+//   not star-shaped around its centre (Report::folds counts the triangles facing the
+//   axis there).
 
 #ifndef STRATMESH_H
 #define STRATMESH_H
@@ -171,7 +184,8 @@ size_t delaunay_2d_max_triangles(size_t point_count);
 // info            optional; receives counts (see Delaunay2dInfo).
 // duplicate_of    optional array of point_count entries: receives, for each point, the
 //                 index of the lowest-indexed point with the same coordinates (itself if
-//                 it has no lower twin). Written on ok.
+//                 it has no lower twin; -0.0 and +0.0 are the same). Meaningful on ok;
+//                 unspecified otherwise.
 //
 // Returns ok; invalid_argument; too_many_points; invalid_point; too_few_points (fewer
 // than 3 distinct points); collinear (no triangle exists); out_of_memory;
@@ -218,9 +232,13 @@ enum class Phase : uint32_t { validate = 0, layers, triangulate, stitch, manifol
 struct Options {
     Axis axis;
     double direction[3];     // for Axis::direction; any non-zero length
-    // Layers, first match wins: explicit cut positions along the axis (any order,
-    // repeats and cuts outside the cloud are ignored); else layer_count equal-height
-    // layers; else layers of about layer_height; else automatic.
+    // Layers, first match wins: explicit cut positions along the axis, as the coordinate
+    // dot(point, axis) (with Axis::z, a cut at 68 is the plane z = 68); any order,
+    // repeats and cuts outside the cloud are ignored; else layer_count equal-height
+    // layers; else layers of about layer_height; else automatic (for now: layers about
+    // four mean radii tall). A layer with fewer than 3 points, or whose points do not
+    // surround its centre, is merged with the next one; the report lists the layers
+    // actually used.
     const double* cuts;
     size_t cut_count;
     uint32_t layer_count;
@@ -233,11 +251,12 @@ struct Options {
 };
 
 struct LayerInfo {
-    double bottom, top;      // extent along the axis
+    double bottom, top;      // extent along the axis, as dot(point, axis)
     double centre[3];        // the axis of the unrolling cylinder passes through this
-    double radius;           // the unrolling radius (see "Layers" in the docs)
+    double radius;           // the unrolling radius (see >>unroll in the implementation)
     uint32_t point_count;    // distinct valid points in the layer
-    uint32_t triangle_count; // triangles whose lowest vertex is in the layer
+    uint32_t triangle_count; // the layer's own triangles plus the band joining it to the
+                             // layer below, before the safety net
     uint32_t fold_count;     // of those, triangles facing the axis
 };
 
@@ -1462,16 +1481,17 @@ inline Status validate_layer_options(const Options& options) {
 }
 
 // Fills plan.bounds (room for planned_layer_limit + 1 entries) for heights [lo, hi];
-// `typical_radius` sets the automatic layer height.
+// `typical_radius` sets the automatic layer height; the user's cuts are coordinates along
+// the axis, frame heights plus `cut_offset`.
 inline void plan_layers(const Options& options, double lo, double hi, double typical_radius,
-                        size_t point_count, LayerPlan& plan) {
+                        size_t point_count, double cut_offset, LayerPlan& plan) {
     double* b = plan.bounds;
     uint32_t n = 0;
     b[n++] = lo;
     if (options.cuts && options.cut_count > 0) {
         // Insertion sort of the cuts inside (lo, hi]; repeats and outsiders dropped.
         for (size_t i = 0; i < options.cut_count; ++i) {
-            double c = options.cuts[i];
+            double c = options.cuts[i] - cut_offset;
             if (!(c > lo) || !(c <= hi)) continue;
             uint32_t k = n;
             while (k > 1 && b[k - 1] > c) --k;
@@ -1559,6 +1579,13 @@ inline double exp_portable(double x) {
     return p * two_k;
 }
 
+// A monotone stand-in for the polar angle of (dx, dy), in [0, 4): no trigonometry.
+inline double pseudo_angle(double dx, double dy) {
+    double sum = abs_value(dx) + abs_value(dy);
+    double t = sum > 0 ? dy / sum : 0;  // in [-1, 1]
+    return dx >= 0 ? (t < 0 ? 4 + t : t) : 2 - t;
+}
+
 struct Cylinder {
     double cx, cy;   // centre across the axis
     double radius;   // unrolling radius
@@ -1598,11 +1625,7 @@ inline Cylinder fit_cylinder(const CloudReader& cloud, const Frame& frame,
     uint32_t sn[kSectors] = {};
     for (size_t i = 0; i < count; ++i) {
         Local p = frame.local(cloud.point(ids[i]));
-        double dx = p.x - mx, dy = p.y - my;
-        double ax = abs_value(dx), ay = abs_value(dy);
-        // A monotone stand-in for the angle, in [0, 4): no trigonometry needed.
-        double t = (ax + ay) > 0 ? dy / (ax + ay) : 0;  // in [-1, 1]
-        double angle = dx >= 0 ? (t < 0 ? 4 + t : t) : 2 - t;
+        double angle = pseudo_angle(p.x - mx, p.y - my);
         uint32_t s = static_cast<uint32_t>(angle * (kSectors / 4.0));
         if (s >= kSectors) s = kSectors - 1;
         sx[s] += p.x;
@@ -1921,15 +1944,16 @@ inline Status triangulate_layer(const CloudReader& cloud, const Frame& frame,
     uint32_t* order = arena.alloc<uint32_t>(total);
     double* xy = arena.alloc<double>(2 * total);
     if (arena.failed) return Status::out_of_memory;
+    // The insertion order is taken on the unrolled strip (angle, height), where the points
+    // are spread evenly: on the annulus their density falls off with the radius squared
+    // and a curve over its bounding box would lump the inner rings together.
     xy[0] = xy[1] = 0;
-    BoundingBox2d box = {{0, 0}, {0, 0}};
+    BoundingBox2d box = {{0, 0}, {4, 0}};
     for (size_t i = 1; i < total; ++i) {
-        double* p = xy + 2 * i;
-        roll(cyl, frame.local(cloud.point(ids[i - 1])), p);
-        for (int k = 0; k < 2; ++k) {
-            if (p[k] < box.min[k]) box.min[k] = p[k];
-            if (p[k] > box.max[k]) box.max[k] = p[k];
-        }
+        Local p = frame.local(cloud.point(ids[i - 1]));
+        xy[2 * i] = pseudo_angle(p.x - cyl.cx, p.y - cyl.cy);
+        xy[2 * i + 1] = (p.h - cyl.h0) * cyl.scale;
+        if (xy[2 * i + 1] > box.max[1]) box.max[1] = xy[2 * i + 1];
     }
     if (!spatial_order(reinterpret_cast<const unsigned char*>(xy), 2 * sizeof(double), total,
                        box, order, arena))
@@ -1984,8 +2008,18 @@ namespace detail {
 // one), then every fan but the largest; repeated until nothing changes, since a removal
 // can split a neighbour's fan.
 
-// In-place heap sort of (key, value) pairs by key: O(n log n), no recursion, no memory.
+// In-place sort of packed (key, value) pairs: insertion sort for the small fans of almost
+// every vertex, heap sort (O(n log n), no recursion) for large ones.
 inline void sort_pairs(uint64_t* items, size_t count) {
+    if (count <= 16) {
+        for (size_t i = 1; i < count; ++i) {
+            uint64_t item = items[i];
+            size_t j = i;
+            for (; j > 0 && items[j - 1] > item; --j) items[j] = items[j - 1];
+            items[j] = item;
+        }
+        return;
+    }
     auto sift = [items](size_t root, size_t end) {
         for (;;) {
             size_t child = 2 * root + 1;
@@ -2008,63 +2042,57 @@ inline void sort_pairs(uint64_t* items, size_t count) {
 }
 
 struct Fan {
-    uint64_t* leave;   // (leaving neighbour << 32 | triangle), sorted
-    uint32_t* arrive;  // arriving neighbour of each entry
-    uint32_t* label;   // fan component of each entry
-    uint32_t* sizes;   // entries per component
+    uint64_t* key;       // (leaving neighbour << 32 | entry), sorted by leaving neighbour
+    uint32_t* arrive;    // per entry: the arriving neighbour
+    uint32_t* triangle;  // per entry: its triangle
+    uint32_t* label;     // per sorted position: fan piece
+    uint32_t* sizes;     // entries per piece
     size_t size;
+
+    uint32_t entry(size_t position) const { return static_cast<uint32_t>(key[position]); }
+    uint32_t leaving(size_t position) const { return static_cast<uint32_t>(key[position] >> 32); }
 };
 
-// The vertices that follow and precede v in triangle t.
-inline void around(const uint32_t* tri, uint32_t t, uint32_t v, uint32_t* leave,
-                   uint32_t* arrive) {
-    const uint32_t* c = tri + 3 * static_cast<size_t>(t);
-    uint32_t k = c[0] == v ? 0u : c[1] == v ? 1u : 2u;
-    *leave = c[(k + 1) % 3];
-    *arrive = c[(k + 2) % 3];
-}
-
-// The fan entry leaving towards `neighbour` (the triangle after one arriving from it).
-inline size_t entry_leaving_to(const Fan& fan, uint32_t neighbour) {
+// The sorted position of the entry leaving towards `neighbour`, or SIZE_MAX.
+inline size_t position_leaving_to(const Fan& fan, uint32_t neighbour) {
     size_t lo = 0, hi = fan.size;
     while (lo < hi) {
         size_t mid = lo + (hi - lo) / 2;
-        if ((fan.leave[mid] >> 32) < neighbour) lo = mid + 1; else hi = mid;
+        if (fan.leaving(mid) < neighbour) lo = mid + 1; else hi = mid;
     }
-    return lo < fan.size && (fan.leave[lo] >> 32) == neighbour ? lo : SIZE_MAX;
+    return lo < fan.size && fan.leaving(lo) == neighbour ? lo : SIZE_MAX;
 }
 
-// Collects v's live triangles; drops (marks dead) those repeating a leaving edge.
+// Collects v's live triangles, sorted by leaving edge; marks dead those repeating one.
 inline size_t collect_fan(const uint32_t* tri, const uint32_t* incident, size_t begin,
                           size_t end, uint32_t v, unsigned char* dead, Fan& fan) {
     fan.size = 0;
     for (size_t k = begin; k < end; ++k) {
         uint32_t t = incident[k];
         if (dead[t]) continue;
-        uint32_t leave, arrive;
-        around(tri, t, v, &leave, &arrive);
-        fan.leave[fan.size++] = (static_cast<uint64_t>(leave) << 32) | t;
+        const uint32_t* c = tri + 3 * static_cast<size_t>(t);
+        uint32_t corner = c[0] == v ? 0u : c[1] == v ? 1u : 2u;
+        uint32_t e = static_cast<uint32_t>(fan.size++);
+        fan.arrive[e] = c[(corner + 2) % 3];
+        fan.triangle[e] = t;
+        fan.key[e] = (static_cast<uint64_t>(c[(corner + 1) % 3]) << 32) | e;
     }
-    sort_pairs(fan.leave, fan.size);
+    sort_pairs(fan.key, fan.size);
     size_t kept = 0, removed = 0;
     for (size_t k = 0; k < fan.size; ++k) {
-        if (kept > 0 && (fan.leave[kept - 1] >> 32) == (fan.leave[k] >> 32)) {
-            dead[static_cast<uint32_t>(fan.leave[k])] = 1;
+        if (kept > 0 && fan.leaving(kept - 1) == fan.leaving(k)) {
+            dead[fan.triangle[fan.entry(k)]] = 1;
             ++removed;
             continue;
         }
-        fan.leave[kept++] = fan.leave[k];
+        fan.key[kept++] = fan.key[k];
     }
     fan.size = kept;
-    for (size_t k = 0; k < fan.size; ++k) {
-        uint32_t leave;
-        around(tri, static_cast<uint32_t>(fan.leave[k]), v, &leave, &fan.arrive[k]);
-    }
     return removed;
 }
 
-// Labels the connected pieces of the fan (each entry linked to the entry after it) and
-// returns how many there are.
+// Labels the connected pieces of the fan (each triangle linked to the one leaving where
+// it arrives) and returns how many there are.
 inline uint32_t label_fan(Fan& fan) {
     const uint32_t unlabeled = kNoIndex;
     for (size_t k = 0; k < fan.size; ++k) fan.label[k] = unlabeled;
@@ -2075,12 +2103,12 @@ inline uint32_t label_fan(Fan& fan) {
         while (at != SIZE_MAX && fan.label[at] == unlabeled) {
             fan.label[at] = pieces;
             ++walked;
-            at = entry_leaving_to(fan, fan.arrive[at]);
+            at = position_leaving_to(fan, fan.arrive[fan.entry(at)]);
         }
         uint32_t joined = (at != SIZE_MAX) ? fan.label[at] : pieces;
         if (joined != pieces) {
             // This walk ran into an earlier piece: it belongs to it.
-            for (size_t w = k; w != at; w = entry_leaving_to(fan, fan.arrive[w]))
+            for (size_t w = k; w != at; w = position_leaving_to(fan, fan.arrive[fan.entry(w)]))
                 fan.label[w] = joined;
             fan.sizes[joined] += static_cast<uint32_t>(walked);
         } else {
@@ -2101,7 +2129,7 @@ inline size_t repair_fan(const uint32_t* tri, const uint32_t* incident, size_t b
         if (fan.sizes[c] > fan.sizes[best]) best = c;
     for (size_t k = 0; k < fan.size; ++k) {
         if (fan.label[k] == best) continue;
-        dead[static_cast<uint32_t>(fan.leave[k])] = 1;
+        dead[fan.triangle[fan.entry(k)]] = 1;
         ++removed;
     }
     return removed;
@@ -2135,18 +2163,28 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
         arena.rewind(inner);
     }
     Fan fan;
-    fan.leave = arena.alloc<uint64_t>(max_degree);
+    fan.key = arena.alloc<uint64_t>(max_degree);
     fan.arrive = arena.alloc<uint32_t>(max_degree);
+    fan.triangle = arena.alloc<uint32_t>(max_degree);
     fan.label = arena.alloc<uint32_t>(max_degree);
     fan.sizes = arena.alloc<uint32_t>(max_degree);
     if (arena.failed) return SIZE_MAX;
+    // Vertices are visited in the order the triangles name them, not by index: the
+    // triangles come out of the layers in spatial order, so neighbouring fans share cache
+    // lines (input indices may be in any order). `visited` holds the pass number.
+    unsigned char* visited = arena.alloc<unsigned char>(point_count);
+    if (arena.failed) return SIZE_MAX;
+    std::memset(visited, 0, point_count);
     size_t removed = 0;
-    for (size_t pass = 0; pass <= count; ++pass) {
+    for (size_t pass = 1; pass <= count; ++pass) {
         size_t before = removed;
-        for (size_t v = 0; v < point_count; ++v)
-            if (offsets[v + 1] > offsets[v])
-                removed += repair_fan(tri, incident, offsets[v], offsets[v + 1],
-                                      static_cast<uint32_t>(v), dead, fan);
+        unsigned char stamp = static_cast<unsigned char>(pass % 2 + 1);
+        for (size_t k = 0; k < 3 * count; ++k) {
+            uint32_t v = tri[k];
+            if (visited[v] == stamp) continue;
+            visited[v] = stamp;
+            removed += repair_fan(tri, incident, offsets[v], offsets[v + 1], v, dead, fan);
+        }
         if (removed == before) break;
     }
     size_t alive = 0, vertices = 0;
@@ -2223,7 +2261,8 @@ inline size_t reconstruct_scratch_size(size_t count) {
     manifold.alloc<uint32_t>(count);
     manifold.rewind(mark);
     manifold.alloc<uint64_t>(triangles);
-    for (int k = 0; k < 3; ++k) manifold.alloc<uint32_t>(triangles);
+    for (int k = 0; k < 4; ++k) manifold.alloc<uint32_t>(triangles);
+    manifold.alloc<unsigned char>(count);
 
     size_t most = layer.high_water;
     if (band.high_water > most) most = band.high_water;
@@ -2266,8 +2305,9 @@ inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& 
 
 inline void describe_layer(const Frame& frame, const Cylinder& cyl, double bottom, double top,
                            size_t points, size_t triangles, size_t folds, LayerInfo& info) {
-    info.bottom = bottom;
-    info.top = top;
+    const double offset = dot(frame.origin, frame.axis);
+    info.bottom = bottom + offset;
+    info.top = top + offset;
     double mid = (bottom + top) / 2;
     Vec3 c = {frame.origin.x + frame.e1.x * cyl.cx + frame.e2.x * cyl.cy + frame.axis.x * mid,
               frame.origin.y + frame.e1.y * cyl.cx + frame.e2.y * cyl.cy + frame.axis.y * mid,
@@ -2365,7 +2405,9 @@ Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
     if (!plan_reconstruct(m, cloud.count, layer_limit, arena)) return Status::out_of_memory;
     notify(options, Phase::layers, 0);
     LayerPlan plan = {m.bounds, 0};
-    plan_layers(options, lo, hi, radius_sum / static_cast<double>(valid), cloud.count, plan);
+    const double offset = dot(frame.origin, frame.axis);
+    plan_layers(options, lo, hi, radius_sum / static_cast<double>(valid), cloud.count, offset,
+                plan);
     group_by_layer(reader, cloud.count, frame, plan, m);
 
     notify(options, Phase::triangulate, 0);

@@ -1586,6 +1586,30 @@ inline double pseudo_angle(double dx, double dy) {
     return dx >= 0 ? (t < 0 ? 4 + t : t) : 2 - t;
 }
 
+// The polar angle of (dx, dy) in [0, 2 pi), with + - * / only (the same bits everywhere):
+// two argument reductions bring the tangent below tan(pi / 12), where the odd Taylor series
+// to x^21 is accurate to about 1e-15.
+inline double polar_angle(double dx, double dy) {
+    const double pi = 3.14159265358979323846;
+    const double sqrt3 = 1.73205080756887729353;
+    double ax = abs_value(dx), ay = abs_value(dy);
+    if (ax == 0 && ay == 0) return 0;
+    bool swapped = ay > ax;
+    double x = swapped ? ax / ay : ay / ax;  // in [0, 1]
+    bool shifted = x > 0.26794919243112270;  // tan(pi / 12)
+    if (shifted) x = (x * sqrt3 - 1) / (x + sqrt3);
+    double x2 = x * x, term = x, sum = x;
+    for (int k = 3; k <= 21; k += 2) {
+        term *= -x2;
+        sum += term / k;
+    }
+    if (shifted) sum += pi / 6;
+    if (swapped) sum = pi / 2 - sum;
+    if (dx < 0) sum = pi - sum;
+    if (dy < 0) sum = 2 * pi - sum;
+    return sum >= 2 * pi ? 0 : sum;
+}
+
 struct Cylinder {
     double cx, cy;   // centre across the axis
     double radius;   // unrolling radius
@@ -1700,31 +1724,24 @@ struct TriangleSink {
 // >>stitch ==================================================================================
 //
 // Two neighbouring layers meet at a cut: the top loop A of the lower layer and the bottom
-// loop B of the upper one are closed loops around the axis. Both are rolled onto one
-// annulus around the average of the two cylinders, with the cut on the unit circle, A
-// inside it and B outside. A zipper merges the loops by angle: each step adds a triangle
-// on the next edge of A or of B, so the band is a manifold annulus by construction. Then
-// the paper's diagonal swap: a rung shared by an A-triangle and a B-triangle is swapped
-// when the opposite vertex lies in the circumcircle (Lawson flips, which terminate in one
-// fixed plane). A swap only ever exchanges adjacent A and B steps, so the band stays a
-// band. The rung closing the loop (first A vertex to first B vertex) is kept.
+// loop B of the upper one are closed loops around the axis. Both are unrolled onto one
+// strip (u, v) = (R theta, h - cut) around the average of the two cylinders: A below the
+// cut, B above it. A zipper merges the loops by angle: each step adds a triangle on the
+// next edge of A or of B, so the band is a manifold annulus by construction. Then the
+// paper's diagonal swap: a rung shared by an A-triangle and a B-triangle is swapped when
+// the opposite vertex lies in the circumcircle (Lawson flips, which terminate in one fixed
+// plane), or when the zipper folded a sliver that the swap unfolds. A swap only ever
+// exchanges adjacent A and B steps, so the band stays a band. The strip is periodic: a
+// vertex reached again after a full turn is shifted by the circumference. The rung that
+// closes the loop (first A vertex to first B vertex) is kept. The strip, not the annulus,
+// is used here because band triangles are long and flat: on the annulus the circle's
+// curvature would flip their orientation relative to the surface.
 
-// 0 for angles in [0, pi), 1 for [pi, 2 pi).
-inline int half_turn(const double* v) { return (v[1] < 0 || (v[1] == 0 && v[0] < 0)) ? 1 : 0; }
-
-// Whether u's polar angle is strictly smaller than v's, in [0, 2 pi), exactly.
-inline bool angle_before(const double* u, const double* v) {
-    int hu = half_turn(u), hv = half_turn(v);
-    if (hu != hv) return hu < hv;
-    const double o[2] = {0, 0};
-    return orient2d_robust(o, u, v) > 0;
-}
-
-// Rotates loop[0..n) and its coordinates so the vertex of smallest angle comes first.
-inline void rotate_to_first_angle(uint32_t* loop, double* xy, uint32_t n) {
+// Rotates loop[0..n) and its strip coordinates so the smallest angle comes first.
+inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
     uint32_t first = 0;
     for (uint32_t i = 1; i < n; ++i)
-        if (angle_before(xy + 2 * i, xy + 2 * first)) first = i;
+        if (uv[2 * i] < uv[2 * first]) first = i;
     // Three reversals rotate in place.
     auto reverse = [&](uint32_t lo, uint32_t hi) {  // the range [lo, hi)
         for (; hi > lo + 1; ++lo) {
@@ -1733,9 +1750,9 @@ inline void rotate_to_first_angle(uint32_t* loop, double* xy, uint32_t n) {
             loop[lo] = loop[hi];
             loop[hi] = t;
             for (uint32_t k = 0; k < 2; ++k) {
-                double c = xy[2 * lo + k];
-                xy[2 * lo + k] = xy[2 * hi + k];
-                xy[2 * hi + k] = c;
+                double c = uv[2 * lo + k];
+                uv[2 * lo + k] = uv[2 * hi + k];
+                uv[2 * hi + k] = c;
             }
         }
     };
@@ -1746,30 +1763,42 @@ inline void rotate_to_first_angle(uint32_t* loop, double* xy, uint32_t n) {
 
 struct Band {
     const uint32_t* a;  // loop A, original indices
-    const double* xa;   // its annulus coordinates
+    const double* xa;   // its strip coordinates, angles increasing from the smallest
     uint32_t p;
     const uint32_t* b;
     const double* xb;
     uint32_t q;
+    double turn;        // the strip's period, 2 pi R
     unsigned char* steps;  // p + q: 0 = advance A, 1 = advance B
     double* scratch;       // incircle scratch
+    double corner[4][2];   // the current quad, unwrapped
 
-    const double* pa(uint32_t i) const { return xa + 2 * (i % p); }
-    const double* pb(uint32_t j) const { return xb + 2 * (j % q); }
+    // Strip coordinates of the i-th vertex of A counted from the start, i <= p.
+    const double* pa(uint32_t i, int slot) {
+        corner[slot][0] = xa[2 * (i % p)] + (i >= p ? turn : 0);
+        corner[slot][1] = xa[2 * (i % p) + 1];
+        return corner[slot];
+    }
+    const double* pb(uint32_t j, int slot) {
+        corner[slot][0] = xb[2 * (j % q)] + (j >= q ? turn : 0);
+        corner[slot][1] = xb[2 * (j % q) + 1];
+        return corner[slot];
+    }
 
     // Whether the steps at t, t+1 (state i, j before t) should be swapped. Counter-clockwise
-    // on the annulus, an A step makes (a1, a0, b0) and a B step (b0, b1, a0).
-    bool should_swap(uint32_t t, uint32_t i, uint32_t j) const {
-        const double *a0 = pa(i), *a1 = pa(i + 1), *b0 = pb(j), *b1 = pb(j + 1);
+    // on the strip, an A step makes (a0, a1, b0) and a B step (a0, b1, b0). A swap is
+    // taken when the swapped pair is proper and either the current pair is not (the
+    // zipper made a folded sliver: untangle it) or the empty-circle test asks for it.
+    bool should_swap(uint32_t t, uint32_t i, uint32_t j) {
+        const double *a0 = pa(i, 0), *a1 = pa(i + 1, 1), *b0 = pb(j, 2), *b1 = pb(j + 1, 3);
         bool a_then_b = steps[t] == 0;
-        // Both current triangles and both swapped ones must be proper, then the test.
-        if (!(orient2d_robust(a1, a0, b0) > 0 && orient2d_robust(b0, b1, a0) > 0 &&
-              orient2d_robust(b0, b1, a1) > 0 && orient2d_robust(a1, a0, b1) > 0))
-            return false;
-        if (a_then_b)  // (a1 a0 b0), (b0 b1 a1): swap for the rung a0-b1?
-            return incircle_perturbed(a1, a0, b0, b1, scratch) > 0;
-        // (b0 b1 a0), (a1 a0 b1): swap for the rung a1-b0?
-        return incircle_perturbed(b0, b1, a0, a1, scratch) > 0;
+        // A then B: (a0 a1 b0), (a1 b1 b0). B then A: (a0 b1 b0), (a0 a1 b1).
+        bool proper_ab = orient2d_robust(a0, a1, b0) > 0 && orient2d_robust(a1, b1, b0) > 0;
+        bool proper_ba = orient2d_robust(a0, b1, b0) > 0 && orient2d_robust(a0, a1, b1) > 0;
+        if (a_then_b ? !proper_ba : !proper_ab) return false;
+        if (a_then_b ? !proper_ab : !proper_ba) return true;
+        if (a_then_b) return incircle_perturbed(a0, a1, b0, b1, scratch) > 0;
+        return incircle_perturbed(a0, b1, b0, a1, scratch) > 0;
     }
 };
 
@@ -1779,9 +1808,7 @@ inline void zip_by_angle(Band& band) {
         bool take_a;
         if (i == band.p) take_a = false;
         else if (j == band.q) take_a = true;
-        else if (i + 1 == band.p) take_a = false;  // A's closing edge comes after B's last
-        else if (j + 1 == band.q) take_a = true;
-        else take_a = !angle_before(band.pb(j + 1), band.pa(i + 1));
+        else take_a = band.pa(i + 1, 0)[0] <= band.pb(j + 1, 1)[0];
         band.steps[t++] = take_a ? 0 : 1;
         if (take_a) ++i; else ++j;
     }
@@ -1828,11 +1855,18 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
     shared.radius = (ca.radius + cb.radius) / 2;
     shared.h0 = cb.h0;
     shared.scale = (ca.scale + cb.scale) / 2;
-    for (uint32_t i = 0; i < p; ++i) roll(shared, frame.local(cloud.point(a[i])), xa + 2 * i);
-    for (uint32_t j = 0; j < q; ++j) roll(shared, frame.local(cloud.point(b[j])), xb + 2 * j);
+    const double unrolled_radius = 1 / shared.scale;
+    auto unroll = [&](uint32_t id, double* uv) {
+        Local l = frame.local(cloud.point(id));
+        uv[0] = unrolled_radius * polar_angle(l.x - shared.cx, l.y - shared.cy);
+        uv[1] = l.h - shared.h0;
+    };
+    for (uint32_t i = 0; i < p; ++i) unroll(a[i], xa + 2 * i);
+    for (uint32_t j = 0; j < q; ++j) unroll(b[j], xb + 2 * j);
     rotate_to_first_angle(a, xa, p);
     rotate_to_first_angle(b, xb, q);
-    Band band = {a, xa, p, b, xb, q, steps, scratch};
+    const double two_pi = 6.28318530717958647693;
+    Band band = {a, xa, p, b, xb, q, two_pi * unrolled_radius, steps, scratch, {}};
     zip_by_angle(band);
     *swaps += swap_diagonals(band);
     uint32_t i = 0, j = 0;

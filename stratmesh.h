@@ -1681,10 +1681,6 @@ inline Cylinder fit_cylinder(const CloudReader& cloud, const Frame& frame,
     return c;
 }
 
-}  // namespace detail
-
-namespace detail {
-
 // Where reconstructed triangles go: the caller's array, filled in order. Triangles are
 // built counter-clockwise on the annulus, where the outside of the surface faces down,
 // so they are written reversed. Counting continues past the capacity so the caller can
@@ -1720,6 +1716,142 @@ struct TriangleSink {
         return n.x * rx + n.y * ry < 0;
     }
 };
+
+// >>layer triangulation =====================================================================
+
+struct LayerLoops {
+    uint32_t* bottom;  // original indices, counter-clockwise on the annulus
+    uint32_t bottom_count;
+    uint32_t* top;
+    uint32_t top_count;
+};
+
+struct LayerCounts {
+    size_t duplicates;   // same 3D coordinates as an earlier point
+    size_t collisions;   // distinct in 3D, same place on the annulus
+};
+
+// Classifies the points the layer's triangulation found on an existing vertex.
+struct LayerDuplicates {
+    const CloudReader* cloud;
+    const uint32_t* ids;    // layer-local id (1-based; 0 is the centre) -> original index
+    const uint32_t* order;  // insertion position -> layer-local id
+    LayerCounts* counts;
+
+    static void report(void* context, uint32_t point, uint32_t vertex) {
+        LayerDuplicates* d = static_cast<LayerDuplicates*>(context);
+        Vec3 p = d->cloud->point(d->ids[d->order[point] - 1]);
+        Vec3 v = d->cloud->point(d->ids[d->order[vertex] - 1]);
+        if (p.x == v.x && p.y == v.y && p.z == v.z)
+            ++d->counts->duplicates;
+        else
+            ++d->counts->collisions;
+    }
+};
+
+inline uint32_t original_id(const uint32_t* ids, const uint32_t* order, uint32_t v) {
+    return ids[order[v] - 1];
+}
+
+// Collects the link of vertex `centre` counter-clockwise into loop (original indices).
+// False if the centre touches the hull: the layer does not surround its axis.
+inline bool centre_link(const Triangulation& tr, uint32_t centre, const uint32_t* ids,
+                        const uint32_t* order, uint32_t* loop, uint32_t* count) {
+    uint32_t start = kNoIndex;
+    for (uint32_t e = 0; e < 3 * tr.triangle_count; ++e)
+        if (tr.vertex[e] == centre) {
+            start = e;
+            break;
+        }
+    if (start == kNoIndex) return false;
+    uint32_t n = 0, e = start;
+    do {
+        uint32_t u = tr.vertex[next_edge(e)];
+        if (u == kGhost || tr.vertex[prev_edge(e)] == kGhost || n > tr.triangle_count)
+            return false;
+        loop[n++] = original_id(ids, order, u);
+        e = tr.twin[prev_edge(e)];  // the next triangle counter-clockwise around the centre
+    } while (e != start);
+    *count = n;
+    return true;
+}
+
+// Collects the convex hull counter-clockwise into loop (original indices). A ghost
+// (a, b, G) holds G -> a; the twin of G -> a is a -> G in the ghost (z, a, G), whose next
+// half-edge is G -> z: the hull vertex after a.
+inline void hull_loop(const Triangulation& tr, const uint32_t* ids, const uint32_t* order,
+                      uint32_t* loop, uint32_t* count) {
+    uint32_t start = 0;
+    while (tr.vertex[start] != kGhost) ++start;
+    uint32_t n = 0, e = start;
+    do {
+        loop[n++] = original_id(ids, order, tr.vertex[next_edge(e)]);
+        e = next_edge(tr.twin[e]);
+    } while (e != start && n <= tr.triangle_count);
+    *count = n;
+}
+
+// Triangulates one layer: its points ids[0..count) rolled onto the annulus of `cyl` plus
+// the centre. Emits the surface triangles, fills the loops. Returns ok, not_columnar (the
+// layer does not surround its axis, or is degenerate: the caller merges it with the next
+// one), out_of_memory or internal_error.
+inline Status triangulate_layer(const CloudReader& cloud, const Frame& frame,
+                                const Cylinder& cyl, const uint32_t* ids, size_t count,
+                                Arena& arena, TriangleSink& sink, LayerLoops& loops,
+                                LayerCounts& counts) {
+    const size_t total = count + 1;  // local id 0 is the centre
+    size_t mark = arena.mark();
+    uint32_t* order = arena.alloc<uint32_t>(total);
+    double* xy = arena.alloc<double>(2 * total);
+    if (arena.failed) return Status::out_of_memory;
+    // The insertion order is taken on the unrolled strip (angle, height), where the points
+    // are spread evenly: on the annulus their density falls off with the radius squared
+    // and a curve over its bounding box would lump the inner rings together.
+    xy[0] = xy[1] = 0;
+    BoundingBox2d box = {{0, 0}, {4, 0}};
+    for (size_t i = 1; i < total; ++i) {
+        Local p = frame.local(cloud.point(ids[i - 1]));
+        xy[2 * i] = pseudo_angle(p.x - cyl.cx, p.y - cyl.cy);
+        xy[2 * i + 1] = (p.h - cyl.h0) * cyl.scale;
+        if (xy[2 * i + 1] > box.max[1]) box.max[1] = xy[2 * i + 1];
+    }
+    if (!spatial_order(reinterpret_cast<const unsigned char*>(xy), 2 * sizeof(double), total,
+                       box, order, arena))
+        return Status::out_of_memory;
+    // Lay the points out in insertion order, recomputed (the same bits) rather than copied.
+    uint32_t centre = 0;
+    for (size_t k = 0; k < total; ++k) {
+        if (order[k] == 0) {
+            centre = static_cast<uint32_t>(k);
+            xy[2 * k] = xy[2 * k + 1] = 0;
+        } else {
+            roll(cyl, frame.local(cloud.point(ids[order[k] - 1])), xy + 2 * k);
+        }
+    }
+    Triangulation tr;
+    tr.xy = xy;
+    if (!allocate_triangulation(tr, total, arena)) return Status::out_of_memory;
+    counts = LayerCounts{0, 0};
+    LayerDuplicates classify = {&cloud, ids, order, &counts};
+    DuplicateSink duplicates = {LayerDuplicates::report, &classify};
+    uint32_t inserted = 0;
+    Status status = triangulate_points(tr, static_cast<uint32_t>(total), duplicates, &inserted);
+    if (status == Status::internal_error) return status;
+    if (status != Status::ok ||
+        !centre_link(tr, centre, ids, order, loops.bottom, &loops.bottom_count)) {
+        arena.rewind(mark);
+        return Status::not_columnar;
+    }
+    hull_loop(tr, ids, order, loops.top, &loops.top_count);
+    for (uint32_t t = 0; t < tr.triangle_count; ++t) {
+        const uint32_t* v = tr.vertex + 3 * t;
+        if (tr.is_ghost(t) || v[0] == centre || v[1] == centre || v[2] == centre) continue;
+        sink.emit(original_id(ids, order, v[0]), original_id(ids, order, v[1]),
+                  original_id(ids, order, v[2]), cyl);
+    }
+    arena.rewind(mark);
+    return Status::ok;
+}
 
 // >>stitch ==================================================================================
 //
@@ -1882,154 +2014,6 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
     arena.rewind(mark);
     return true;
 }
-
-}  // namespace detail
-
-namespace detail {
-
-// >>layer triangulation ====================================================================
-
-struct LayerLoops {
-    uint32_t* bottom;  // original indices, counter-clockwise on the annulus
-    uint32_t bottom_count;
-    uint32_t* top;
-    uint32_t top_count;
-};
-
-struct LayerCounts {
-    size_t duplicates;   // same 3D coordinates as an earlier point
-    size_t collisions;   // distinct in 3D, same place on the annulus
-};
-
-// Classifies the points the layer's triangulation found on an existing vertex.
-struct LayerDuplicates {
-    const CloudReader* cloud;
-    const uint32_t* ids;    // layer-local id (1-based; 0 is the centre) -> original index
-    const uint32_t* order;  // insertion position -> layer-local id
-    LayerCounts* counts;
-
-    static void report(void* context, uint32_t point, uint32_t vertex) {
-        LayerDuplicates* d = static_cast<LayerDuplicates*>(context);
-        Vec3 p = d->cloud->point(d->ids[d->order[point] - 1]);
-        Vec3 v = d->cloud->point(d->ids[d->order[vertex] - 1]);
-        if (p.x == v.x && p.y == v.y && p.z == v.z)
-            ++d->counts->duplicates;
-        else
-            ++d->counts->collisions;
-    }
-};
-
-inline uint32_t original_id(const uint32_t* ids, const uint32_t* order, uint32_t v) {
-    return ids[order[v] - 1];
-}
-
-// Collects the link of vertex `centre` counter-clockwise into loop (original indices).
-// False if the centre touches the hull: the layer does not surround its axis.
-inline bool centre_link(const Triangulation& tr, uint32_t centre, const uint32_t* ids,
-                        const uint32_t* order, uint32_t* loop, uint32_t* count) {
-    uint32_t start = kNoIndex;
-    for (uint32_t e = 0; e < 3 * tr.triangle_count; ++e)
-        if (tr.vertex[e] == centre) {
-            start = e;
-            break;
-        }
-    if (start == kNoIndex) return false;
-    uint32_t n = 0, e = start;
-    do {
-        uint32_t u = tr.vertex[next_edge(e)];
-        if (u == kGhost || tr.vertex[prev_edge(e)] == kGhost || n > tr.triangle_count)
-            return false;
-        loop[n++] = original_id(ids, order, u);
-        e = tr.twin[prev_edge(e)];  // the next triangle counter-clockwise around the centre
-    } while (e != start);
-    *count = n;
-    return true;
-}
-
-// Collects the convex hull counter-clockwise into loop (original indices). A ghost
-// (a, b, G) holds G -> a; the twin of G -> a is a -> G in the ghost (z, a, G), whose next
-// half-edge is G -> z: the hull vertex after a.
-inline void hull_loop(const Triangulation& tr, const uint32_t* ids, const uint32_t* order,
-                      uint32_t* loop, uint32_t* count) {
-    uint32_t start = 0;
-    while (tr.vertex[start] != kGhost) ++start;
-    uint32_t n = 0, e = start;
-    do {
-        loop[n++] = original_id(ids, order, tr.vertex[next_edge(e)]);
-        e = next_edge(tr.twin[e]);
-    } while (e != start && n <= tr.triangle_count);
-    *count = n;
-}
-
-}  // namespace detail
-
-namespace detail {
-
-// Triangulates one layer: its points ids[0..count) rolled onto the annulus of `cyl` plus
-// the centre. Emits the surface triangles, fills the loops. Returns ok, not_columnar (the
-// layer does not surround its axis, or is degenerate: the caller merges it with the next
-// one), out_of_memory or internal_error.
-inline Status triangulate_layer(const CloudReader& cloud, const Frame& frame,
-                                const Cylinder& cyl, const uint32_t* ids, size_t count,
-                                Arena& arena, TriangleSink& sink, LayerLoops& loops,
-                                LayerCounts& counts) {
-    const size_t total = count + 1;  // local id 0 is the centre
-    size_t mark = arena.mark();
-    uint32_t* order = arena.alloc<uint32_t>(total);
-    double* xy = arena.alloc<double>(2 * total);
-    if (arena.failed) return Status::out_of_memory;
-    // The insertion order is taken on the unrolled strip (angle, height), where the points
-    // are spread evenly: on the annulus their density falls off with the radius squared
-    // and a curve over its bounding box would lump the inner rings together.
-    xy[0] = xy[1] = 0;
-    BoundingBox2d box = {{0, 0}, {4, 0}};
-    for (size_t i = 1; i < total; ++i) {
-        Local p = frame.local(cloud.point(ids[i - 1]));
-        xy[2 * i] = pseudo_angle(p.x - cyl.cx, p.y - cyl.cy);
-        xy[2 * i + 1] = (p.h - cyl.h0) * cyl.scale;
-        if (xy[2 * i + 1] > box.max[1]) box.max[1] = xy[2 * i + 1];
-    }
-    if (!spatial_order(reinterpret_cast<const unsigned char*>(xy), 2 * sizeof(double), total,
-                       box, order, arena))
-        return Status::out_of_memory;
-    // Lay the points out in insertion order, recomputed (the same bits) rather than copied.
-    uint32_t centre = 0;
-    for (size_t k = 0; k < total; ++k) {
-        if (order[k] == 0) {
-            centre = static_cast<uint32_t>(k);
-            xy[2 * k] = xy[2 * k + 1] = 0;
-        } else {
-            roll(cyl, frame.local(cloud.point(ids[order[k] - 1])), xy + 2 * k);
-        }
-    }
-    Triangulation tr;
-    tr.xy = xy;
-    if (!allocate_triangulation(tr, total, arena)) return Status::out_of_memory;
-    counts = LayerCounts{0, 0};
-    LayerDuplicates classify = {&cloud, ids, order, &counts};
-    DuplicateSink duplicates = {LayerDuplicates::report, &classify};
-    uint32_t inserted = 0;
-    Status status = triangulate_points(tr, static_cast<uint32_t>(total), duplicates, &inserted);
-    if (status == Status::internal_error) return status;
-    if (status != Status::ok ||
-        !centre_link(tr, centre, ids, order, loops.bottom, &loops.bottom_count)) {
-        arena.rewind(mark);
-        return Status::not_columnar;
-    }
-    hull_loop(tr, ids, order, loops.top, &loops.top_count);
-    for (uint32_t t = 0; t < tr.triangle_count; ++t) {
-        const uint32_t* v = tr.vertex + 3 * t;
-        if (tr.is_ghost(t) || v[0] == centre || v[1] == centre || v[2] == centre) continue;
-        sink.emit(original_id(ids, order, v[0]), original_id(ids, order, v[1]),
-                  original_id(ids, order, v[2]), cyl);
-    }
-    arena.rewind(mark);
-    return Status::ok;
-}
-
-}  // namespace detail
-
-namespace detail {
 
 // >>manifold ================================================================================
 //
@@ -2238,10 +2222,6 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
     arena.rewind(mark);
     return removed;
 }
-
-}  // namespace detail
-
-namespace detail {
 
 // >>reconstruct =============================================================================
 //

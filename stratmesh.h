@@ -72,12 +72,14 @@
 //
 // ==== Robustness contract ==================================================================
 //
-// - orient2d and incircle return values whose sign is exact for every finite double input
-//   whose intermediate products neither overflow nor underflow (coordinates with
-//   magnitudes between about 1e-70 and 1e70 are always safe). A fast floating-point
-//   filter with a proven error bound decides almost every call; expansion arithmetic
-//   decides the rest. The implementation pins floating-point contraction off (no fused
-//   multiply-add), whatever the compiler's flags.
+// - orient2d and incircle return values whose sign is exact for every finite double input,
+//   except points whose coordinates span more than about 2^700 in magnitude among
+//   themselves (say 1e-150 next to 1e+60), where products of differences cannot all be
+//   represented. A fast floating-point filter with a proven error bound decides almost
+//   every call; expansion arithmetic decides the rest, after an exact power-of-two
+//   rescaling when the points are very close together or very far apart. The
+//   implementation pins floating-point contraction off (no fused multiply-add),
+//   whatever the compiler's flags.
 // - delaunay_2d produces the Delaunay triangulation of the distinct input points. Where
 //   four or more points are cocircular, the triangulation is made unique by a symbolic
 //   perturbation (each point is lifted off the paraboloid by an infinitesimal amount that
@@ -591,6 +593,39 @@ inline double orient2d_exact(const double* a, const double* b, const double* c) 
     return expansion_top(tlen, t);
 }
 
+// The exact stages are exact only if no product underflows or overflows. Their terms are
+// products of 2 (orient) or 4 (incircle) coordinates or differences, so when points are a
+// few ulps apart near 1e-70, or very large, they are first scaled by a power of two that
+// centres the magnitudes in play: exact, and the determinant's sign does not change.
+// `values` are the coordinates and differences involved; `limit` the largest safe binary
+// exponent for the degree. Returns the factor, or 0 when no scaling is needed (or none
+// can help: magnitudes spread over more than the double range allows).
+inline double rescaling_factor(const double* values, int count, int limit) {
+    double largest = 0, smallest = DBL_MAX;
+    for (int i = 0; i < count; ++i) {
+        double v = abs_value(values[i]);
+        if (v == 0 || !is_finite(v)) continue;
+        if (v > largest) largest = v;
+        if (v < smallest) smallest = v;
+    }
+    if (largest == 0) return 0;
+    int high = 0, low = 0;
+    std::frexp(largest, &high);
+    std::frexp(smallest, &low);
+    if (high <= limit && low >= -limit) return 0;
+    if (high - low > 2 * limit) return 0;
+    return std::ldexp(1.0, -(high + low) / 2);
+}
+
+// The filters' error bounds ignore underflow, which adds an absolute error of at most a
+// few 2^-1075: a result is only trusted beyond this.
+constexpr double kUnderflowGuard = 0x1p-1000;
+
+inline void scale_point(const double* p, double factor, double* out) {
+    out[0] = p[0] * factor;
+    out[1] = p[1] * factor;
+}
+
 // Sign-exact orient2d: the filter decides unless |det| is within the rounding error, then
 // the differences are tried for exactness, then the raw coordinates are used.
 inline double orient2d_robust(const double* a, const double* b, const double* c) {
@@ -599,8 +634,19 @@ inline double orient2d_robust(const double* a, const double* b, const double* c)
     double left = acx * bcy;
     double right = acy * bcx;
     double det = left - right;
-    double bound = kOrientBoundA * (abs_value(left) + abs_value(right));
+    double bound = kOrientBoundA * (abs_value(left) + abs_value(right)) + kUnderflowGuard;
     if (det > bound || -det > bound) return det;
+    const double magnitudes[10] = {acx, bcx, acy, bcy, a[0], a[1], b[0], b[1], c[0], c[1]};
+    double factor = rescaling_factor(magnitudes, 10, 450);
+    double sa[2], sb[2], sc[2];
+    if (factor != 0) {
+        scale_point(a, factor, sa);
+        scale_point(b, factor, sb);
+        scale_point(c, factor, sc);
+        a = sa;
+        b = sb;
+        c = sc;
+    }
     double t0, t1, t2, t3;
     two_diff(a[0], c[0], acx, t0);
     two_diff(b[0], c[0], bcx, t1);
@@ -711,8 +757,22 @@ inline double incircle_robust(const double* a, const double* b, const double* c,
     double permanent = (abs_value(bdxcdy) + abs_value(cdxbdy)) * alift +
                        (abs_value(cdxady) + abs_value(adxcdy)) * blift +
                        (abs_value(adxbdy) + abs_value(bdxady)) * clift;
-    double bound = kIncircleBoundA * permanent;
+    double bound = kIncircleBoundA * permanent + kUnderflowGuard;
     if (det > bound || -det > bound) return det;
+    const double magnitudes[14] = {adx, bdx, cdx, ady, bdy, cdy, a[0], a[1],
+                                   b[0], b[1], c[0], c[1], d[0], d[1]};
+    double factor = rescaling_factor(magnitudes, 14, 220);
+    double sa[2], sb[2], sc[2], sd[2];
+    if (factor != 0) {
+        scale_point(a, factor, sa);
+        scale_point(b, factor, sb);
+        scale_point(c, factor, sc);
+        scale_point(d, factor, sd);
+        a = sa;
+        b = sb;
+        c = sc;
+        d = sd;
+    }
     double t[6];
     two_diff(a[0], d[0], adx, t[0]);
     two_diff(b[0], d[0], bdx, t[1]);

@@ -1520,12 +1520,15 @@ struct LayerPlan {
     uint32_t count;
 };
 
+const size_t kMaxAutomaticLayers = 256;
+
 // The number of layers the options can ask for, before empty layers are dropped.
 inline size_t planned_layer_limit(size_t point_count, const Options& options) {
     if (options.cuts && options.cut_count > 0) return options.cut_count + 1;
     if (options.layer_count > 0) return options.layer_count;
-    // A target height or the automatic rule: never more layers than points.
-    return point_count > 0 ? point_count : 1;
+    // A target height: never more layers than points.
+    if (options.layer_height > 0) return point_count > 0 ? point_count : 1;
+    return kMaxAutomaticLayers;
 }
 
 inline Status validate_layer_options(const Options& options) {
@@ -1572,6 +1575,8 @@ inline void plan_layers(const Options& options, double lo, double hi, double typ
             layers = std::floor(height / (4 * typical_radius));
         }
         double limit = static_cast<double>(point_count);
+        if (options.layer_count == 0 && options.layer_height == 0)
+            limit = static_cast<double>(kMaxAutomaticLayers);
         if (!(layers >= 1)) layers = 1;
         if (layers > limit) layers = limit;
         uint32_t count = static_cast<uint32_t>(layers);
@@ -2411,20 +2416,16 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
     return arena.required_bytes() + detail::reconstruct_scratch_size(point_count);
 }
 
-Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
-                   size_t workspace_bytes, uint32_t* triangles, size_t triangle_capacity,
-                   size_t* triangle_count, Report* report) {
-    using namespace detail;
-    Report local_report;
-    std::memset(&local_report, 0, sizeof local_report);
-    Report& rep = report ? *report : local_report;
+namespace detail {
+
+// The whole reconstruction; `rep` arrives zeroed but for its layer array. Report::unused
+// is left to the caller, who derives it so the counts add up on every path.
+inline Status run_reconstruction(const Cloud& cloud, const Options& options, void* workspace,
+                                 size_t workspace_bytes, uint32_t* triangles,
+                                 size_t triangle_capacity, size_t* triangle_count,
+                                 Report& rep) {
     LayerInfo* layer_infos = rep.layers;
-    size_t layer_capacity = rep.layers ? rep.layer_capacity : 0;
-    std::memset(&rep, 0, sizeof rep);
-    rep.layers = layer_infos;
-    rep.layer_capacity = layer_capacity;
-    rep.points_in = cloud.count;
-    if (triangle_count) *triangle_count = 0;
+    size_t layer_capacity = rep.layer_capacity;
 
     Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
                                                 triangle_count, workspace);
@@ -2457,7 +2458,6 @@ Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
     rep.axis_origin[0] = frame.origin.x;
     rep.axis_origin[1] = frame.origin.y;
     rep.axis_origin[2] = frame.origin.z;
-    rep.unused = valid;
     if (valid < 3) return Status::too_few_points;
 
     double lo = DBL_MAX, hi = -DBL_MAX, radius_sum = 0;
@@ -2559,18 +2559,38 @@ Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
     rep.illegal_removed = removed;
     rep.folds = sink.folds;
     rep.points_used = used;
-    rep.unused = valid - rep.duplicates - used;
     if (trailing > 0)
         rep.detail = "the points of the last layers do not surround the axis: they are not "
                      "vertices";
     else if (collisions > 0)
         rep.detail = "some points share their place on the unrolled layer with another point "
                      "(the layer is not star-shaped around its centre there): not vertices";
-    else if (rep.unused > 0)
+    else if (valid - rep.duplicates > used)
         rep.detail = "the manifold safety net removed the triangles of some points";
     (void)swaps;
     notify(options, Phase::done, 1);
     return Status::ok;
+}
+
+}  // namespace detail
+
+Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
+                   size_t workspace_bytes, uint32_t* triangles, size_t triangle_capacity,
+                   size_t* triangle_count, Report* report) {
+    Report local_report;
+    Report& rep = report ? *report : local_report;
+    LayerInfo* layers = report ? report->layers : nullptr;
+    size_t layer_capacity = layers ? report->layer_capacity : 0;
+    std::memset(&rep, 0, sizeof rep);
+    rep.layers = layers;
+    rep.layer_capacity = layer_capacity;
+    rep.points_in = cloud.count;
+    if (triangle_count) *triangle_count = 0;
+    Status status = detail::run_reconstruction(cloud, options, workspace, workspace_bytes,
+                                               triangles, triangle_capacity, triangle_count,
+                                               rep);
+    rep.unused = rep.points_in - rep.points_used - rep.duplicates - rep.rejected;
+    return status;
 }
 
 }  // namespace stratmesh

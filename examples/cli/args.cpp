@@ -1,0 +1,278 @@
+#include "args.h"
+
+#include "mesh_io.h"
+#include "text_scan.h"
+
+#include <cmath>
+#include <iterator>
+#include <string_view>
+
+namespace stratmesh_cli {
+
+namespace {
+
+const char kUsage[] =
+    "Usage: stratmesh INPUT -o OUTPUT [options]\n"
+    "\n"
+    "Reconstructs a triangle mesh through the points of a roughly columnar cloud (a head,\n"
+    "a limb, a bone, a stem): the cloud is sliced into layers along an axis and each\n"
+    "layer is unrolled from a cylinder and triangulated.\n"
+    "\n"
+    "Input, recognised by its content (the extension is only a hint):\n"
+    "  PLY      ascii, binary_little_endian or binary_big_endian; x, y, z of the vertex\n"
+    "           element (float, double or an integer type); everything else is skipped\n"
+    "  XYZ      .xyz .pts .txt .csv: 3 or more numeric columns separated by spaces, tabs\n"
+    "           or commas; '#' and '//' comments; a PTS count line is skipped\n"
+    "  OFF, OBJ their vertices; faces are ignored\n"
+    "\n"
+    "Output, by the extension of OUTPUT:\n"
+    "  .ply binary little-endian (text with --ascii)   .obj  text\n"
+    "  .stl binary (text with --ascii)                 .off  text\n"
+    "  The output vertices are the input points as read, all of them and in input order,\n"
+    "  even the points no triangle uses (duplicates, rejected, unused): vertex i of OUTPUT\n"
+    "  is point i of INPUT, so the triangles index the input unchanged. STL has no shared\n"
+    "  vertices and only lists triangles.\n"
+    "\n"
+    "Options:\n"
+    "  -o, --output FILE     the mesh to write (required)\n"
+    "  --axis x|y|z|X,Y,Z    the axis the layers are stacked along (default: automatic,\n"
+    "                        the cloud's principal direction)\n"
+    "  --cuts H1,H2,...      cut the layers at these positions along the axis, measured\n"
+    "                        as dot(point, unit axis): with --axis z, 68 is the plane z = 68\n"
+    "  --layers N            N layers of equal height\n"
+    "  --layer-height H      layers about H high\n"
+    "                        (at most one of --cuts, --layers, --layer-height; without\n"
+    "                        them the layers are chosen automatically)\n"
+    "  --report FILE.json    write counts, timings, memory and per-layer details as JSON\n"
+    "  --ascii               text PLY or STL\n"
+    "  --skip-invalid        skip points with NaN or infinite coordinates (they stay in\n"
+    "                        the output, unused) instead of refusing the input\n"
+    "  -q, --quiet           no progress and no summary on stderr (errors still are)\n"
+    "  --version             print the version and exit\n"
+    "  -h, --help            print this help and exit\n"
+    "\n"
+    "Exit status: 0 success; 1 the reconstruction refused the input; 2 usage error;\n"
+    "3 file error (cannot open, read, parse or write).\n";
+
+bool parse_finite(std::string_view text, double& value) {
+    return parse_number(text, value) && std::isfinite(value);
+}
+
+// Comma-separated finite numbers, none empty.
+bool parse_number_list(std::string_view text, std::vector<double>& values) {
+    values.clear();
+    for (;;) {
+        size_t comma = text.find(',');
+        double value = 0;
+        if (!parse_finite(text.substr(0, comma), value)) return false;
+        values.push_back(value);
+        if (comma == std::string_view::npos) return true;
+        text.remove_prefix(comma + 1);
+    }
+}
+
+bool parse_axis(std::string_view text, CommandLine& line, std::string& error) {
+    const struct {
+        const char* name;
+        stratmesh::Axis axis;
+    } names[] = {{"x", stratmesh::Axis::x},
+                 {"y", stratmesh::Axis::y},
+                 {"z", stratmesh::Axis::z},
+                 {"auto", stratmesh::Axis::automatic},
+                 {"automatic", stratmesh::Axis::automatic}};
+    for (const auto& n : names) {
+        if (text == n.name) {
+            line.axis = n.axis;
+            return true;
+        }
+    }
+    std::vector<double> v;
+    if (!parse_number_list(text, v) || v.size() != 3) {
+        error = "--axis: expected x, y, z or a direction X,Y,Z, not '" + std::string(text) + "'";
+        return false;
+    }
+    if (v[0] == 0 && v[1] == 0 && v[2] == 0) {
+        error = "--axis: the direction must not be zero";
+        return false;
+    }
+    line.axis = stratmesh::Axis::direction;
+    for (size_t k = 0; k < 3; ++k) line.direction[k] = v[k];
+    return true;
+}
+
+bool parse_layers(std::string_view text, CommandLine& line, std::string& error) {
+    uint64_t count = 0;
+    if (parse_count(text, count) != CountParse::ok || count < 1 || count > UINT32_MAX) {
+        error = "--layers: expected a whole number from 1 to 4294967295, not '" +
+                std::string(text) + "'";
+        return false;
+    }
+    line.layer_count = static_cast<uint32_t>(count);
+    return true;
+}
+
+bool parse_layer_height(std::string_view text, CommandLine& line, std::string& error) {
+    if (parse_finite(text, line.layer_height) && line.layer_height > 0) return true;
+    error = "--layer-height: expected a positive number, not '" + std::string(text) + "'";
+    return false;
+}
+
+bool parse_cuts(std::string_view text, CommandLine& line, std::string& error) {
+    if (parse_number_list(text, line.cuts)) return true;
+    error = "--cuts: expected numbers separated by commas, not '" + std::string(text) + "'";
+    return false;
+}
+
+// Applies an option that takes a value; `name` is its canonical long form.
+bool apply_valued(std::string_view name, std::string_view value, CommandLine& line,
+                  std::string& error) {
+    if (name == "--output") line.output = std::string(value);
+    if (name == "--report") line.report = std::string(value);
+    if (name == "--axis") return parse_axis(value, line, error);
+    if (name == "--cuts") return parse_cuts(value, line, error);
+    if (name == "--layers") return parse_layers(value, line, error);
+    if (name == "--layer-height") return parse_layer_height(value, line, error);
+    if (value.empty()) error = std::string(name) + ": the file name is empty";
+    return error.empty();
+}
+
+bool apply_flag(std::string_view name, CommandLine& line) {
+    if (name == "--ascii") line.ascii = true;
+    if (name == "--skip-invalid") line.skip_invalid = true;
+    if (name == "--quiet") line.quiet = true;
+    return true;
+}
+
+const char* const kValuedOptions[] = {"--output", "--report", "--axis",
+                                      "--cuts",   "--layers", "--layer-height"};
+const char* const kFlags[] = {"--ascii", "--skip-invalid", "--quiet", "--help", "--version"};
+
+std::string_view canonical_name(std::string_view name) {
+    if (name == "-o") return "--output";
+    if (name == "-q") return "--quiet";
+    if (name == "-h") return "--help";
+    return name;
+}
+
+bool is_one_of(std::string_view name, const char* const* list, size_t count) {
+    for (size_t i = 0; i < count; ++i)
+        if (name == list[i]) return true;
+    return false;
+}
+
+// Walks argv, remembering the first error but still noticing --help and --version.
+class Parser {
+public:
+    Parser(int argc, const char* const* argv, CommandLine& line)
+        : argc_(argc), argv_(argv), line_(line) {}
+
+    CommandAction run(std::string& error) {
+        for (index_ = 1; index_ < argc_; ++index_) take(argv_[index_]);
+        if (help_) return CommandAction::help;
+        if (version_) return CommandAction::version;
+        if (error_.empty()) check_complete();
+        error = error_;
+        return error_.empty() ? CommandAction::run : CommandAction::usage_error;
+    }
+
+private:
+    void fail(const std::string& message) {
+        if (error_.empty()) error_ = message;
+    }
+
+    void take(std::string_view arg) {
+        if (!options_ended_ && arg == "--") {
+            options_ended_ = true;
+        } else if (options_ended_ || arg.size() < 2 || arg[0] != '-') {
+            take_input(arg);
+        } else {
+            take_option(arg);
+        }
+    }
+
+    void take_input(std::string_view arg) {
+        if (!line_.input.empty())
+            fail("more than one input file ('" + line_.input + "' and '" + std::string(arg) + "')");
+        line_.input = std::string(arg);
+    }
+
+    void take_option(std::string_view arg) {
+        size_t equals = arg.substr(0, 2) == "--" ? arg.find('=') : std::string_view::npos;
+        std::string_view name = canonical_name(arg.substr(0, equals));
+        bool inline_value = equals != std::string_view::npos;
+        std::string_view value = inline_value ? arg.substr(equals + 1) : std::string_view();
+        if (is_one_of(name, kFlags, std::size(kFlags))) {
+            take_flag(name, inline_value);
+        } else if (is_one_of(name, kValuedOptions, std::size(kValuedOptions))) {
+            take_valued(name, inline_value, value);
+        } else {
+            fail("unknown option '" + std::string(arg) + "'");
+        }
+    }
+
+    void take_flag(std::string_view name, bool inline_value) {
+        if (inline_value) fail("option " + std::string(name) + " takes no value");
+        if (name == "--help") help_ = true;
+        if (name == "--version") version_ = true;
+        apply_flag(name, line_);
+    }
+
+    void take_valued(std::string_view name, bool inline_value, std::string_view value) {
+        if (!inline_value) {
+            if (index_ + 1 >= argc_) return fail("option " + std::string(name) + " needs a value");
+            value = argv_[++index_];
+        }
+        std::string key(name);
+        if (seen_.find(" " + key + " ") != std::string::npos)
+            return fail("option " + key + " is given more than once");
+        seen_ += " " + key + " ";
+        std::string message;
+        if (!apply_valued(name, value, line_, message)) fail(message);
+    }
+
+    void check_complete() {
+        int layer_choices = (line_.cuts.empty() ? 0 : 1) + (line_.layer_count ? 1 : 0) +
+                            (line_.layer_height > 0 ? 1 : 0);
+        if (line_.input.empty()) return fail("no input file");
+        if (line_.output.empty()) return fail("no output file (use -o OUTPUT)");
+        if (mesh_format_from_extension(line_.output) == MeshFormat::unknown)
+            return fail("cannot tell the mesh format of '" + line_.output +
+                        "' from its extension (use .ply, .obj, .off or .stl)");
+        if (layer_choices > 1) fail("give at most one of --cuts, --layers and --layer-height");
+    }
+
+    int argc_;
+    const char* const* argv_;
+    CommandLine& line_;
+    int index_ = 1;
+    bool options_ended_ = false;
+    bool help_ = false;
+    bool version_ = false;
+    std::string seen_; // " --name " for each valued option seen
+    std::string error_;
+};
+
+} // namespace
+
+CommandAction parse_command_line(int argc, const char* const* argv, CommandLine& line,
+                                 std::string& error) {
+    return Parser(argc, argv, line).run(error);
+}
+
+const char* usage_text() { return kUsage; }
+
+const char* axis_name(stratmesh::Axis axis) {
+    const struct {
+        stratmesh::Axis axis;
+        const char* name;
+    } names[] = {{stratmesh::Axis::automatic, "automatic"},
+                 {stratmesh::Axis::x, "x"},
+                 {stratmesh::Axis::y, "y"},
+                 {stratmesh::Axis::z, "z"},
+                 {stratmesh::Axis::direction, "direction"}};
+    for (const auto& n : names)
+        if (n.axis == axis) return n.name;
+    return "unknown";
+}
+
+} // namespace stratmesh_cli

@@ -1,0 +1,43 @@
+// The tool's command line.
+#ifndef STRATMESH_CLI_ARGS_H
+#define STRATMESH_CLI_ARGS_H
+
+#include "stratmesh.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace stratmesh_cli {
+
+struct CommandLine {
+    std::string input;
+    std::string output;
+    std::string report; // --report, empty if not given
+    stratmesh::Axis axis = stratmesh::Axis::automatic;
+    double direction[3] = {0, 0, 0}; // with Axis::direction
+    std::vector<double> cuts;        // --cuts
+    uint32_t layer_count = 0;        // --layers, 0 if not given
+    double layer_height = 0;         // --layer-height, 0 if not given
+    bool ascii = false;
+    bool skip_invalid = false;
+    bool quiet = false;
+};
+
+enum class CommandAction { run, help, version, usage_error };
+
+// Parses argv. --help and --version win over any error; otherwise an error (unknown
+// option, missing value or -o, bad number, unknown output extension...) gives
+// usage_error with the message in `error`.
+CommandAction parse_command_line(int argc, const char* const* argv, CommandLine& line,
+                                 std::string& error);
+
+// The --help text.
+const char* usage_text();
+
+// "automatic", "x", "y", "z" or "direction".
+const char* axis_name(stratmesh::Axis axis);
+
+} // namespace stratmesh_cli
+
+#endif

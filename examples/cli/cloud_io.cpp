@@ -1,0 +1,142 @@
+#include "cloud_io.h"
+
+#include "cloud_readers.h"
+#include "path_util.h"
+#include "text_scan.h"
+
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string_view>
+
+namespace stratmesh_cli {
+
+namespace {
+
+bool starts_with(std::string_view text, std::string_view prefix) {
+    return text.substr(0, prefix.size()) == prefix;
+}
+
+// OBJ statements other than "v" that may come before the first vertex.
+bool is_obj_keyword(std::string_view word) {
+    for (const char* k : {"vn", "vt", "vp", "f", "l", "p", "o", "g", "s", "mtllib", "usemtl"})
+        if (word == k) return true;
+    return false;
+}
+
+// Looks at the first lines only: enough for any header, cheap for a huge file.
+CloudFormat detect_text_format(std::string_view text) {
+    const size_t kLinesToLook = 200;
+    LineCursor lines(text);
+    std::string_view line, word;
+    bool first_content = true;
+    while (lines.next(line) && lines.line_number() <= kLinesToLook) {
+        std::string_view rest = strip_comment(line, false);
+        if (!next_field(rest, word, false)) continue;
+        if (first_content && is_off_keyword(word)) return CloudFormat::off;
+        first_content = false;
+        if (word == "v") return CloudFormat::obj;
+        double number = 0;
+        if (!is_obj_keyword(word) && parse_number(word, number)) return CloudFormat::xyz;
+    }
+    return CloudFormat::xyz;
+}
+
+bool dispatch(std::string_view text, CloudFormat format, std::vector<double>& xyz,
+              std::string& error, std::string& encoding) {
+    encoding = "text";
+    switch (format) {
+    case CloudFormat::ply: return read_ply(text, xyz, error, encoding);
+    case CloudFormat::off: return read_off(text, xyz, error);
+    case CloudFormat::obj: return read_obj(text, xyz, error);
+    case CloudFormat::xyz:
+    case CloudFormat::automatic: break;
+    }
+    return read_xyz(text, xyz, error);
+}
+
+// The file's size as the file system reports it, to allocate the buffer once; 0 if
+// unknown. Only a hint: reading stops at the real end whatever it says.
+size_t size_hint(const std::string& path) {
+    std::error_code error;
+    uintmax_t size = std::filesystem::file_size(path, error);
+    return error || size > SIZE_MAX / 2 ? 0 : static_cast<size_t>(size);
+}
+
+} // namespace
+
+const char* cloud_format_name(CloudFormat format) {
+    switch (format) {
+    case CloudFormat::ply: return "PLY";
+    case CloudFormat::xyz: return "XYZ";
+    case CloudFormat::off: return "OFF";
+    case CloudFormat::obj: return "OBJ";
+    case CloudFormat::automatic: break;
+    }
+    return "automatic";
+}
+
+CloudFormat cloud_format_from_extension(const std::string& path) {
+    std::string ext = lowercase_extension(path);
+    if (ext == "ply") return CloudFormat::ply;
+    if (ext == "off") return CloudFormat::off;
+    if (ext == "obj") return CloudFormat::obj;
+    for (const char* text : {"xyz", "pts", "txt", "csv", "asc"})
+        if (ext == text) return CloudFormat::xyz;
+    return CloudFormat::automatic;
+}
+
+CloudFormat detect_cloud_format(const char* data, size_t size) {
+    std::string_view text(data, data ? size : 0);
+    if (starts_with(text, "ply\n") || starts_with(text, "ply\r\n")) return CloudFormat::ply;
+    return detect_text_format(text);
+}
+
+bool read_cloud_from_memory(const char* data, size_t size, CloudFormat format,
+                            std::vector<double>& xyz, std::string& error, CloudInfo* info) {
+    if (!data || size == 0) {
+        error = "the file is empty";
+        return false;
+    }
+    if (format == CloudFormat::automatic) format = detect_cloud_format(data, size);
+    std::string encoding;
+    bool ok = dispatch(std::string_view(data, size), format, xyz, error, encoding);
+    if (info) {
+        info->format = format;
+        info->encoding = encoding;
+    }
+    return ok;
+}
+
+bool read_file_bytes(const std::string& path, std::vector<char>& bytes, std::string& error) {
+    bytes.clear();
+    std::FILE* file = std::fopen(path.c_str(), "rb");
+    if (!file) {
+        error = "cannot open: " + std::string(std::strerror(errno));
+        return false;
+    }
+    bytes.reserve(size_hint(path));
+    char chunk[1 << 16];
+    while (size_t got = std::fread(chunk, 1, sizeof chunk, file))
+        bytes.insert(bytes.end(), chunk, chunk + got);
+    bool failed = std::ferror(file) != 0;
+    int failure = errno;
+    std::fclose(file);
+    if (!failed) return true;
+    error = "cannot read: " + std::string(std::strerror(failure));
+    return false;
+}
+
+bool read_cloud_file(const std::string& path, std::vector<double>& xyz, std::string& error,
+                     CloudInfo* info) {
+    std::vector<char> bytes;
+    bool ok = read_file_bytes(path, bytes, error) &&
+              read_cloud_from_memory(bytes.data(), bytes.size(), CloudFormat::automatic, xyz, error,
+                                     info);
+    if (!ok) error = path + ": " + error;
+    return ok;
+}
+
+} // namespace stratmesh_cli

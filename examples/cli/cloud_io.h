@@ -1,0 +1,55 @@
+// Reading point clouds for the stratmesh tool.
+//
+// Formats: PLY (ascii, binary_little_endian, binary_big_endian), XYZ/PTS/TXT numeric
+// columns, OFF and OBJ (their vertices are the cloud; faces are ignored). Points come out
+// as doubles, x y z packed, in file order. Float data converts to double exactly.
+//
+// Every reader parses from a memory buffer and trusts nothing in it: counts are checked
+// against the bytes actually present before anything is reserved, vectors otherwise grow
+// only as data arrives, and every failure is an error message, never a crash. The message
+// says where: "line N" in text, "byte N" (offset from the start) in binary data.
+#ifndef STRATMESH_CLI_CLOUD_IO_H
+#define STRATMESH_CLI_CLOUD_IO_H
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace stratmesh_cli {
+
+enum class CloudFormat { automatic, ply, xyz, off, obj };
+
+// "PLY", "XYZ", "OFF", "OBJ" ("automatic" for automatic).
+const char* cloud_format_name(CloudFormat format);
+
+// From the file name's extension, case-insensitively: .ply; .xyz .pts .txt .csv .asc;
+// .off; .obj. Anything else: automatic.
+CloudFormat cloud_format_from_extension(const std::string& path);
+
+// From the content: "ply" magic line, an OFF header keyword, OBJ "v" lines; anything
+// else is taken for numeric columns (XYZ).
+CloudFormat detect_cloud_format(const char* data, size_t size);
+
+struct CloudInfo {
+    CloudFormat format = CloudFormat::automatic; // the format actually read
+    std::string encoding; // PLY: "ascii", "binary_little_endian", "binary_big_endian"
+};
+
+// Parses a whole file image. `format` automatic detects it from the content; any other
+// value forces that reader. On success `xyz` holds 3 * point_count doubles; on failure
+// `error` says what and where, and `xyz` is unspecified.
+bool read_cloud_from_memory(const char* data, size_t size, CloudFormat format,
+                            std::vector<double>& xyz, std::string& error,
+                            CloudInfo* info = nullptr);
+
+// Reads a file's bytes, growing the buffer as they arrive.
+bool read_file_bytes(const std::string& path, std::vector<char>& bytes, std::string& error);
+
+// read_file_bytes + read_cloud_from_memory with the format detected from the content (the
+// content wins over a misleading extension). Errors start with the path.
+bool read_cloud_file(const std::string& path, std::vector<double>& xyz, std::string& error,
+                     CloudInfo* info = nullptr);
+
+} // namespace stratmesh_cli
+
+#endif

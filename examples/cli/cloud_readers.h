@@ -1,0 +1,23 @@
+// The individual cloud readers behind read_cloud_from_memory (internal to the tool).
+#ifndef STRATMESH_CLI_CLOUD_READERS_H
+#define STRATMESH_CLI_CLOUD_READERS_H
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace stratmesh_cli {
+
+// `encoding` receives the PLY format line's encoding name.
+bool read_ply(std::string_view data, std::vector<double>& xyz, std::string& error,
+              std::string& encoding);
+bool read_xyz(std::string_view data, std::vector<double>& xyz, std::string& error);
+bool read_off(std::string_view data, std::vector<double>& xyz, std::string& error);
+bool read_obj(std::string_view data, std::vector<double>& xyz, std::string& error);
+
+// True for OFF header keywords: OFF with the optional prefixes ST, C, N, 4, n.
+bool is_off_keyword(std::string_view token);
+
+} // namespace stratmesh_cli
+
+#endif

@@ -1,0 +1,244 @@
+// stratmesh: the command-line tool. Reads a point cloud, reconstructs a mesh with
+// stratmesh::reconstruct and writes it; see usage_text() in args.cpp for the options.
+//
+// The output's vertices are the input points as read, all of them, in input order (unused
+// points are kept), so the library's triangle indices, which index the input, are written
+// unchanged. See mesh_io.h.
+#include "args.h"
+#include "cloud_io.h"
+#include "mesh_io.h"
+#include "progress.h"
+#include "report_json.h"
+#include "stratmesh.h"
+#include "summary.h"
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#ifdef _WIN32
+#include <io.h>
+#define STRATMESH_CLI_STDERR_IS_TERMINAL() (_isatty(_fileno(stderr)) != 0)
+#else
+#include <unistd.h>
+#define STRATMESH_CLI_STDERR_IS_TERMINAL() (isatty(fileno(stderr)) != 0)
+#endif
+
+namespace {
+
+using namespace stratmesh_cli;
+
+const int kExitOk = 0;
+const int kExitRefused = 1;
+const int kExitUsage = 2;
+const int kExitFile = 3;
+
+// Progress is drawn for inputs this large, when stderr is a terminal.
+const size_t kProgressPoints = 200000;
+// Per-layer details are kept for at most this many layers unless the options say more.
+const size_t kDefaultLayerCapacity = 65536;
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+struct FreeDeleter {
+    void operator()(void* p) const { std::free(p); }
+};
+
+// Uninitialised memory (no zero-filling of a large workspace), or null.
+template <class T> std::unique_ptr<T, FreeDeleter> allocate(size_t count) {
+    if (count > SIZE_MAX / sizeof(T)) return nullptr;
+    size_t bytes = count * sizeof(T);
+    return std::unique_ptr<T, FreeDeleter>(static_cast<T*>(std::malloc(bytes ? bytes : 1)));
+}
+
+void record_command_line(const CommandLine& line, RunRecord& record) {
+    MeshFormat format = mesh_format_from_extension(line.output);
+    record.input_path = line.input;
+    record.output_path = line.output;
+    record.output_format = mesh_format_name(format);
+    record.output_ascii = line.ascii && (format == MeshFormat::ply || format == MeshFormat::stl);
+    record.axis = axis_name(line.axis);
+    for (size_t k = 0; k < 3; ++k) record.direction[k] = line.direction[k];
+    record.cuts = line.cuts;
+    record.layer_count = line.layer_count;
+    record.layer_height = line.layer_height;
+    record.skip_invalid = line.skip_invalid;
+}
+
+stratmesh::Options make_options(const CommandLine& line, ProgressMonitor& monitor) {
+    stratmesh::Options options = {};
+    options.axis = line.axis;
+    for (size_t k = 0; k < 3; ++k) options.direction[k] = line.direction[k];
+    options.cuts = line.cuts.empty() ? nullptr : line.cuts.data();
+    options.cut_count = line.cuts.size();
+    options.layer_count = line.layer_count;
+    options.layer_height = line.layer_height;
+    options.flags = line.skip_invalid ? stratmesh::skip_invalid_points : 0u;
+    options.progress = &ProgressMonitor::callback;
+    options.progress_user = &monitor;
+    return options;
+}
+
+// Room for the per-layer details: layers hold at least 3 points each.
+size_t layer_capacity(const CommandLine& line, size_t points) {
+    size_t most = points / 3 + 1;
+    size_t asked = kDefaultLayerCapacity;
+    if (!line.cuts.empty()) asked = line.cuts.size() + 1;
+    if (line.layer_count > 0) asked = line.layer_count;
+    return asked < most ? asked : most;
+}
+
+bool read_input(const CommandLine& line, std::vector<double>& xyz, RunRecord& record) {
+    Clock::time_point start = Clock::now();
+    CloudInfo info;
+    std::string error;
+    if (!read_cloud_file(line.input, xyz, error, &info)) {
+        std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
+        return false;
+    }
+    record.read_seconds = seconds_since(start);
+    record.input_format = cloud_format_name(info.format);
+    record.input_encoding = info.encoding;
+    CloudFormat named = cloud_format_from_extension(line.input);
+    if (!line.quiet && named != CloudFormat::automatic && named != info.format)
+        std::fprintf(stderr, "stratmesh: note: %s holds %s, not %s; read as %s\n",
+                     line.input.c_str(), cloud_format_name(info.format), cloud_format_name(named),
+                     cloud_format_name(info.format));
+    return true;
+}
+
+// What reconstruct() produced: triangles indexing the input points.
+struct Reconstruction {
+    std::unique_ptr<uint32_t, FreeDeleter> triangles;
+    size_t triangle_count = 0;
+};
+
+bool allocate_buffers(size_t workspace_bytes, size_t max_triangles,
+                      std::unique_ptr<unsigned char, FreeDeleter>& workspace,
+                      Reconstruction& result) {
+    workspace = allocate<unsigned char>(workspace_bytes);
+    result.triangles =
+        allocate<uint32_t>(max_triangles <= SIZE_MAX / 3 ? 3 * max_triangles : SIZE_MAX);
+    if (workspace && result.triangles) return true;
+    std::fprintf(stderr, "stratmesh: cannot allocate %zu bytes of workspace and %zu triangles\n",
+                 workspace_bytes, max_triangles);
+    return false;
+}
+
+// Moves the library's report, the filled layer details and the phase times into the record.
+void record_outcome(stratmesh::Report report, std::vector<stratmesh::LayerInfo>& layers,
+                    const ProgressMonitor& monitor, RunRecord& record) {
+    record.reconstructed = true;
+    record.reconstruct_seconds = monitor.total_seconds();
+    for (size_t p = 0; p < kTimedPhases; ++p) record.phase_seconds[p] = monitor.phase_seconds(p);
+    if (report.layer_count < layers.size()) layers.resize(report.layer_count);
+    record.layers = std::move(layers);
+    report.layers = nullptr; // it pointed into `layers`
+    report.layer_capacity = 0;
+    record.report = report;
+}
+
+// Runs reconstruct() and records its outcome; false if the buffers cannot be allocated.
+bool reconstruct_points(const std::vector<double>& xyz, const CommandLine& line,
+                        Reconstruction& result, RunRecord& record) {
+    size_t count = xyz.size() / 3;
+    bool show = !line.quiet && count >= kProgressPoints && STRATMESH_CLI_STDERR_IS_TERMINAL();
+    ProgressMonitor monitor(show, stderr);
+    stratmesh::Options options = make_options(line, monitor);
+    record.workspace_bytes = stratmesh::reconstruct_workspace_size(count, options);
+    size_t max_triangles = stratmesh::reconstruct_max_triangles(count, options);
+    record.triangle_buffer_bytes = max_triangles <= SIZE_MAX / 12 ? 12 * max_triangles : SIZE_MAX;
+    std::unique_ptr<unsigned char, FreeDeleter> workspace;
+    if (!allocate_buffers(record.workspace_bytes, max_triangles, workspace, result)) return false;
+
+    std::vector<stratmesh::LayerInfo> layers(layer_capacity(line, count));
+    stratmesh::Report report = {};
+    report.layers = layers.data();
+    report.layer_capacity = layers.size();
+    stratmesh::Cloud cloud = {xyz.data(), count, 0, stratmesh::Scalar::float64};
+    monitor.begin();
+    record.status = stratmesh::reconstruct(cloud, options, workspace.get(), record.workspace_bytes,
+                                           result.triangles.get(), max_triangles,
+                                           &result.triangle_count, &report);
+    monitor.end();
+    record_outcome(report, layers, monitor, record);
+    return true;
+}
+
+void explain_refusal(const CommandLine& line, const RunRecord& record) {
+    std::fprintf(stderr, "stratmesh: cannot reconstruct %s: %s\n", line.input.c_str(),
+                 stratmesh::status_string(record.status));
+    if (record.status == stratmesh::Status::invalid_point)
+        std::fprintf(stderr,
+                     "stratmesh: point %zu (counting from 0) has a NaN or infinite coordinate; "
+                     "--skip-invalid skips such points\n",
+                     record.report.first_invalid_point);
+    if (record.report.detail) std::fprintf(stderr, "stratmesh: %s\n", record.report.detail);
+}
+
+bool write_report(const CommandLine& line, const RunRecord& record) {
+    if (line.report.empty()) return true;
+    std::string error;
+    if (write_text_file(line.report, run_record_json(record), error)) return true;
+    std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
+    return false;
+}
+
+bool write_output(const CommandLine& line, const std::vector<double>& xyz,
+                  const Reconstruction& result, RunRecord& record) {
+    Clock::time_point start = Clock::now();
+    MeshView mesh = {xyz.data(), xyz.size() / 3, result.triangles.get(), result.triangle_count};
+    std::string error;
+    if (!write_mesh_file(line.output, mesh_format_from_extension(line.output), mesh, line.ascii,
+                         error)) {
+        std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
+        return false;
+    }
+    record.write_seconds = seconds_since(start);
+    record.output_written = true;
+    return true;
+}
+
+int run(const CommandLine& line) {
+    RunRecord record;
+    record_command_line(line, record);
+    std::vector<double> xyz;
+    Reconstruction result;
+    if (!read_input(line, xyz, record)) return kExitFile;
+    if (!reconstruct_points(xyz, line, result, record)) return kExitRefused;
+    if (record.status != stratmesh::Status::ok) {
+        explain_refusal(line, record);
+        write_report(line, record);
+        return kExitRefused;
+    }
+    if (!write_output(line, xyz, result, record)) return kExitFile;
+    if (!line.quiet) print_summary(stderr, record);
+    return write_report(line, record) ? kExitOk : kExitFile;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    CommandLine line;
+    std::string error;
+    switch (parse_command_line(argc, argv, line, error)) {
+    case CommandAction::help: std::fputs(usage_text(), stdout); return kExitOk;
+    case CommandAction::version:
+        std::printf("stratmesh %s\n", STRATMESH_VERSION_STRING);
+        return kExitOk;
+    case CommandAction::usage_error:
+        std::fprintf(stderr, "stratmesh: %s\nTry 'stratmesh --help'.\n", error.c_str());
+        return kExitUsage;
+    case CommandAction::run: break;
+    }
+    return run(line);
+}

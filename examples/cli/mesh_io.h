@@ -1,0 +1,47 @@
+// Writing the reconstructed mesh.
+//
+// The vertex rule: the output vertices are the input points as read, all of them, in
+// input order, including points the reconstruction did not use (duplicates, rejected
+// NaN/Inf points, unused points). So the triangle indices returned by the library, which
+// index the input, are written unchanged, and vertex i of the output is point i of the
+// input. STL has no shared vertices: it only lists the triangles' corners.
+//
+// Coordinates are written exactly. Text formats use the shortest digits that read back as
+// the same double (which also read back as the same float when the value is one). Binary
+// PLY stores float when every coordinate is exactly a float (as after reading float
+// data), double otherwise. Binary STL is float by definition.
+#ifndef STRATMESH_CLI_MESH_IO_H
+#define STRATMESH_CLI_MESH_IO_H
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace stratmesh_cli {
+
+enum class MeshFormat { unknown, ply, obj, off, stl };
+
+// "PLY", "OBJ", "OFF", "STL" ("unknown").
+const char* mesh_format_name(MeshFormat format);
+
+// From the extension, case-insensitively: .ply, .obj, .off, .stl; else unknown.
+MeshFormat mesh_format_from_extension(const std::string& path);
+
+struct MeshView {
+    const double* xyz; // 3 * vertex_count coordinates
+    size_t vertex_count;
+    const uint32_t* triangles; // 3 * triangle_count indices below vertex_count
+    size_t triangle_count;
+};
+
+// True if every coordinate converts to float and back unchanged (NaN and infinities too).
+bool all_coordinates_are_floats(const double* xyz, size_t count);
+
+// Writes the mesh; `ascii` selects text PLY and text STL (OBJ and OFF are always text).
+// On failure the partial file is removed and `error` names the file and the cause.
+bool write_mesh_file(const std::string& path, MeshFormat format, const MeshView& mesh, bool ascii,
+                     std::string& error);
+
+} // namespace stratmesh_cli
+
+#endif

@@ -1,0 +1,519 @@
+// PLY reader: ascii, binary_little_endian and binary_big_endian. Only the vertex element's
+// x, y and z are kept; every other property and element is stepped over, so normals,
+// colours, intensities and faces (before or after the vertices) do no harm.
+#include "cloud_readers.h"
+#include "text_scan.h"
+
+#include <cstdint>
+#include <cstring>
+
+namespace stratmesh_cli {
+
+namespace {
+
+enum class PlyType : uint8_t { int8, uint8, int16, uint16, int32, uint32, float32, float64 };
+
+struct TypeName {
+    const char* name;
+    PlyType type;
+};
+
+const TypeName kTypeNames[] = {
+    {"char", PlyType::int8},      {"int8", PlyType::int8},       {"uchar", PlyType::uint8},
+    {"uint8", PlyType::uint8},    {"short", PlyType::int16},     {"int16", PlyType::int16},
+    {"ushort", PlyType::uint16},  {"uint16", PlyType::uint16},   {"int", PlyType::int32},
+    {"int32", PlyType::int32},    {"uint", PlyType::uint32},     {"uint32", PlyType::uint32},
+    {"float", PlyType::float32},  {"float32", PlyType::float32}, {"double", PlyType::float64},
+    {"float64", PlyType::float64}};
+
+bool type_from_name(std::string_view name, PlyType& type) {
+    for (const TypeName& t : kTypeNames) {
+        if (name == t.name) {
+            type = t.type;
+            return true;
+        }
+    }
+    return false;
+}
+
+size_t type_size(PlyType type) {
+    switch (type) {
+    case PlyType::int8:
+    case PlyType::uint8: return 1;
+    case PlyType::int16:
+    case PlyType::uint16: return 2;
+    case PlyType::int32:
+    case PlyType::uint32:
+    case PlyType::float32: return 4;
+    case PlyType::float64: return 8;
+    }
+    return 8;
+}
+
+bool is_integral(PlyType type) { return type != PlyType::float32 && type != PlyType::float64; }
+
+struct PlyProperty {
+    std::string name;
+    PlyType type = PlyType::float32;     // the item type for a list
+    PlyType count_type = PlyType::uint8; // lists only
+    bool is_list = false;
+};
+
+struct PlyElement {
+    std::string name;
+    uint64_t count = 0;
+    std::vector<PlyProperty> properties;
+};
+
+enum class PlyEncoding { none, ascii, little_endian, big_endian };
+
+struct PlyHeader {
+    PlyEncoding encoding = PlyEncoding::none;
+    std::vector<PlyElement> elements;
+    size_t data_offset = 0; // first byte after "end_header\n"
+    size_t data_line = 0;   // the line number there, for ascii messages
+};
+
+// Where x, y, z are: the vertex element's index and, per property, which coordinate it
+// holds (-1 for none).
+struct VertexLayout {
+    size_t element = 0;
+    std::vector<int> coordinate_of;
+};
+
+const char* encoding_name(PlyEncoding encoding) {
+    switch (encoding) {
+    case PlyEncoding::ascii: return "ascii";
+    case PlyEncoding::little_endian: return "binary_little_endian";
+    case PlyEncoding::big_endian: return "binary_big_endian";
+    case PlyEncoding::none: break;
+    }
+    return "none";
+}
+
+std::string at_line(size_t line) { return "line " + std::to_string(line) + ": "; }
+std::string at_byte(size_t offset) { return "byte " + std::to_string(offset) + ": "; }
+
+// ---- header ------------------------------------------------------------------------------
+
+// A header line's words; only the first kMaxWords are kept, but all are counted.
+struct Words {
+    static const size_t kMaxWords = 8;
+    std::string_view word[kMaxWords];
+    size_t count = 0;
+};
+
+Words split_words(std::string_view line) {
+    Words words;
+    std::string_view field;
+    while (next_field(line, field, false)) {
+        if (words.count < Words::kMaxWords) words.word[words.count] = field;
+        ++words.count;
+    }
+    return words;
+}
+
+std::string unknown_type_message(std::string_view name) {
+    return "unknown property type " + quote(name) +
+           " (expected char, uchar, short, ushort, int, uint, float, double or int8, uint8, "
+           "int16, uint16, int32, uint32, float32, float64)";
+}
+
+bool parse_format_line(const Words& words, PlyHeader& header, std::string& error) {
+    if (header.encoding != PlyEncoding::none) {
+        error = "a second 'format' line";
+        return false;
+    }
+    if (words.count != 3) {
+        error = "expected 'format <encoding> 1.0'";
+        return false;
+    }
+    std::string_view name = words.word[1];
+    if (name == "ascii") header.encoding = PlyEncoding::ascii;
+    if (name == "binary_little_endian") header.encoding = PlyEncoding::little_endian;
+    if (name == "binary_big_endian") header.encoding = PlyEncoding::big_endian;
+    if (header.encoding == PlyEncoding::none) {
+        error = "unknown encoding " + quote(name);
+        return false;
+    }
+    return true;
+}
+
+bool parse_element_line(const Words& words, PlyHeader& header, std::string& error) {
+    if (words.count != 3) {
+        error = "expected 'element <name> <count>'";
+        return false;
+    }
+    PlyElement element;
+    element.name = std::string(words.word[1]);
+    CountParse parsed = parse_count(words.word[2], element.count);
+    if (parsed != CountParse::ok) {
+        error = "the count of element " + quote(element.name) + ", " + quote(words.word[2]) + ", " +
+                count_problem(parsed);
+        return false;
+    }
+    header.elements.push_back(std::move(element));
+    return true;
+}
+
+bool parse_list_property(const Words& words, PlyProperty& property, std::string& error) {
+    if (words.count != 5) {
+        error = "expected 'property list <count type> <item type> <name>'";
+        return false;
+    }
+    property.is_list = true;
+    property.name = std::string(words.word[4]);
+    if (!type_from_name(words.word[2], property.count_type)) {
+        error = unknown_type_message(words.word[2]);
+        return false;
+    }
+    if (!is_integral(property.count_type)) {
+        error = "the count type of list " + quote(property.name) + " must be an integer type";
+        return false;
+    }
+    if (!type_from_name(words.word[3], property.type)) {
+        error = unknown_type_message(words.word[3]);
+        return false;
+    }
+    return true;
+}
+
+bool parse_property_line(const Words& words, PlyHeader& header, std::string& error) {
+    if (header.elements.empty()) {
+        error = "a 'property' line before any 'element' line";
+        return false;
+    }
+    PlyProperty property;
+    if (words.count >= 2 && words.word[1] == "list") {
+        if (!parse_list_property(words, property, error)) return false;
+    } else {
+        if (words.count != 3) {
+            error = "expected 'property <type> <name>'";
+            return false;
+        }
+        if (!type_from_name(words.word[1], property.type)) {
+            error = unknown_type_message(words.word[1]);
+            return false;
+        }
+        property.name = std::string(words.word[2]);
+    }
+    header.elements.back().properties.push_back(std::move(property));
+    return true;
+}
+
+bool parse_header_line(const Words& words, PlyHeader& header, std::string& error) {
+    std::string_view keyword = words.word[0];
+    if (keyword == "comment" || keyword == "obj_info") return true;
+    if (keyword == "format") return parse_format_line(words, header, error);
+    if (keyword == "element") return parse_element_line(words, header, error);
+    if (keyword == "property") return parse_property_line(words, header, error);
+    error = "unknown header keyword " + quote(keyword);
+    return false;
+}
+
+bool parse_header(std::string_view data, PlyHeader& header, std::string& error) {
+    LineCursor lines(data);
+    std::string_view line;
+    if (!lines.next(line) || line != "ply") {
+        error = "line 1: not a PLY file (the first line is not 'ply')";
+        return false;
+    }
+    while (lines.next(line)) {
+        Words words = split_words(line);
+        if (words.count == 0) continue;
+        if (words.word[0] == "end_header") {
+            header.data_offset = lines.offset();
+            header.data_line = lines.line_number() + 1;
+            if (header.encoding != PlyEncoding::none) return true;
+            error = at_line(lines.line_number()) + "the header has no 'format' line";
+            return false;
+        }
+        if (!parse_header_line(words, header, error)) {
+            error = at_line(lines.line_number()) + error;
+            return false;
+        }
+    }
+    error = "the header never ends (no 'end_header' line)";
+    return false;
+}
+
+bool find_vertex_layout(const PlyHeader& header, VertexLayout& layout, std::string& error) {
+    size_t e = 0;
+    while (e < header.elements.size() && header.elements[e].name != "vertex") ++e;
+    if (e == header.elements.size()) {
+        error = "the header declares no 'vertex' element";
+        return false;
+    }
+    const std::vector<PlyProperty>& properties = header.elements[e].properties;
+    layout.element = e;
+    layout.coordinate_of.assign(properties.size(), -1);
+    const char* const names[3] = {"x", "y", "z"};
+    for (int c = 0; c < 3; ++c) {
+        size_t p = 0;
+        while (p < properties.size() && properties[p].name != names[c]) ++p;
+        if (p == properties.size()) {
+            error = std::string("the vertex element has no '") + names[c] + "' property";
+            return false;
+        }
+        if (properties[p].is_list) {
+            error = std::string("the vertex property '") + names[c] + "' is a list";
+            return false;
+        }
+        layout.coordinate_of[p] = c;
+    }
+    return true;
+}
+
+// ---- binary body -------------------------------------------------------------------------
+
+bool host_is_little_endian() {
+    const uint16_t probe = 1;
+    unsigned char first = 0;
+    std::memcpy(&first, &probe, 1);
+    return first == 1;
+}
+
+template <class T> T load_as(const unsigned char* bytes) {
+    T value;
+    std::memcpy(&value, bytes, sizeof value);
+    return value;
+}
+
+// Reads the binary body from a start offset; never reads past the end.
+class ByteReader {
+public:
+    ByteReader(std::string_view data, size_t start, bool big_endian)
+        : data_(reinterpret_cast<const unsigned char*>(data.data())), size_(data.size()),
+          pos_(start), swap_(big_endian == host_is_little_endian()) {}
+
+    size_t offset() const { return pos_; }
+    uint64_t remaining() const { return size_ - pos_; }
+
+    bool skip(uint64_t bytes) {
+        if (bytes > remaining()) return false;
+        pos_ += static_cast<size_t>(bytes);
+        return true;
+    }
+
+    bool scalar(PlyType type, double& value) {
+        unsigned char bytes[8];
+        if (!take(type_size(type), bytes)) return false;
+        value = decode(type, bytes);
+        return true;
+    }
+
+private:
+    bool take(size_t n, unsigned char* out) {
+        if (n > remaining()) return false;
+        for (size_t i = 0; i < n; ++i) out[i] = data_[pos_ + (swap_ ? n - 1 - i : i)];
+        pos_ += n;
+        return true;
+    }
+
+    static double decode(PlyType type, const unsigned char* bytes) {
+        switch (type) {
+        case PlyType::int8: return load_as<int8_t>(bytes);
+        case PlyType::uint8: return load_as<uint8_t>(bytes);
+        case PlyType::int16: return load_as<int16_t>(bytes);
+        case PlyType::uint16: return load_as<uint16_t>(bytes);
+        case PlyType::int32: return load_as<int32_t>(bytes);
+        case PlyType::uint32: return load_as<uint32_t>(bytes);
+        case PlyType::float32: return static_cast<double>(load_as<float>(bytes));
+        case PlyType::float64: return load_as<double>(bytes);
+        }
+        return 0;
+    }
+
+    const unsigned char* data_;
+    size_t size_;
+    size_t pos_;
+    bool swap_;
+};
+
+std::string record_place(const PlyElement& element, uint64_t record) {
+    return "element " + quote(element.name) + " record " + std::to_string(record) + " of " +
+           std::to_string(element.count);
+}
+
+std::string truncated_in(const ByteReader& in, const PlyElement& element, uint64_t record) {
+    return at_byte(in.offset()) + "the file ends inside " + record_place(element, record);
+}
+
+bool skip_binary_list(ByteReader& in, const PlyElement& element, const PlyProperty& property,
+                      uint64_t record, std::string& error) {
+    size_t at = in.offset();
+    double length = 0;
+    if (!in.scalar(property.count_type, length)) {
+        error = truncated_in(in, element, record);
+        return false;
+    }
+    if (length < 0) {
+        error = at_byte(at) + "list " + quote(property.name) + " has a negative length (" +
+                record_place(element, record) + ")";
+        return false;
+    }
+    // The count type is an integer of at most 32 bits: the product cannot overflow.
+    if (in.skip(static_cast<uint64_t>(length) * type_size(property.type))) return true;
+    error = truncated_in(in, element, record);
+    return false;
+}
+
+// Reads one record; scalars whose coordinate_of entry is 0..2 land in xyz[that].
+bool read_binary_record(ByteReader& in, const PlyElement& element,
+                        const std::vector<int>& coordinate_of, double* xyz, uint64_t record,
+                        std::string& error) {
+    for (size_t p = 0; p < element.properties.size(); ++p) {
+        const PlyProperty& property = element.properties[p];
+        if (property.is_list) {
+            if (!skip_binary_list(in, element, property, record, error)) return false;
+            continue;
+        }
+        bool ok = coordinate_of[p] >= 0 ? in.scalar(property.type, xyz[coordinate_of[p]])
+                                        : in.skip(type_size(property.type));
+        if (!ok) {
+            error = truncated_in(in, element, record);
+            return false;
+        }
+    }
+    return true;
+}
+
+// The size of one record if the element has no list property; 0 otherwise.
+uint64_t fixed_record_size(const PlyElement& element) {
+    uint64_t size = 0;
+    for (const PlyProperty& property : element.properties) {
+        if (property.is_list) return 0;
+        size += type_size(property.type);
+    }
+    return size;
+}
+
+// For fixed-size records: are all the claimed bytes really there?
+bool check_claimed_size(const ByteReader& in, const PlyElement& element, std::string& error) {
+    uint64_t size = fixed_record_size(element);
+    if (size == 0 || element.count <= in.remaining() / size) return true;
+    error = at_byte(in.offset()) + "element " + quote(element.name) + " declares " +
+            std::to_string(element.count) + " records of " + std::to_string(size) +
+            " bytes, but only " + std::to_string(in.remaining()) + " bytes follow";
+    return false;
+}
+
+bool skip_binary_element(ByteReader& in, const PlyElement& element, std::string& error) {
+    if (element.properties.empty()) return true;
+    if (!check_claimed_size(in, element, error)) return false;
+    uint64_t size = fixed_record_size(element);
+    if (size > 0) return in.skip(element.count * size);
+    std::vector<int> none(element.properties.size(), -1);
+    double unused[3];
+    for (uint64_t r = 0; r < element.count; ++r)
+        if (!read_binary_record(in, element, none, unused, r, error)) return false;
+    return true;
+}
+
+bool read_binary_vertices(ByteReader& in, const PlyElement& element, const VertexLayout& layout,
+                          std::vector<double>& xyz, std::string& error) {
+    if (!check_claimed_size(in, element, error)) return false;
+    if (fixed_record_size(element) > 0) xyz.reserve(static_cast<size_t>(3 * element.count));
+    for (uint64_t r = 0; r < element.count; ++r) {
+        double point[3] = {0, 0, 0};
+        if (!read_binary_record(in, element, layout.coordinate_of, point, r, error)) return false;
+        xyz.insert(xyz.end(), point, point + 3);
+    }
+    return true;
+}
+
+bool read_binary_body(std::string_view data, const PlyHeader& header, const VertexLayout& layout,
+                      std::vector<double>& xyz, std::string& error) {
+    ByteReader in(data, header.data_offset, header.encoding == PlyEncoding::big_endian);
+    for (size_t e = 0; e < layout.element; ++e)
+        if (!skip_binary_element(in, header.elements[e], error)) return false;
+    return read_binary_vertices(in, header.elements[layout.element], layout, xyz, error);
+}
+
+// ---- ascii body --------------------------------------------------------------------------
+
+bool next_ascii_value(TokenCursor& in, const PlyElement& element, uint64_t record, double& value,
+                      std::string& error) {
+    std::string_view token;
+    if (!in.next(token)) {
+        error = at_line(in.line_number()) + "the file ends inside " + record_place(element, record);
+        return false;
+    }
+    if (parse_number(token, value)) return true;
+    error = at_line(in.line_number()) + quote(token) + " is not a number (" +
+            record_place(element, record) + ")";
+    return false;
+}
+
+bool next_ascii_list_length(TokenCursor& in, const PlyElement& element, uint64_t record,
+                            uint64_t& count, std::string& error) {
+    std::string_view token;
+    if (!in.next(token)) {
+        error = at_line(in.line_number()) + "the file ends inside " + record_place(element, record);
+        return false;
+    }
+    CountParse parsed = parse_count(token, count);
+    if (parsed == CountParse::ok) return true;
+    error = at_line(in.line_number()) + "list length " + quote(token) + " " +
+            count_problem(parsed) + " (" + record_place(element, record) + ")";
+    return false;
+}
+
+bool read_ascii_record(TokenCursor& in, const PlyElement& element,
+                       const std::vector<int>& coordinate_of, double* xyz, uint64_t record,
+                       std::string& error) {
+    for (size_t p = 0; p < element.properties.size(); ++p) {
+        double value = 0;
+        if (element.properties[p].is_list) {
+            uint64_t count = 0;
+            if (!next_ascii_list_length(in, element, record, count, error)) return false;
+            for (uint64_t i = 0; i < count; ++i)
+                if (!next_ascii_value(in, element, record, value, error)) return false;
+            continue;
+        }
+        if (!next_ascii_value(in, element, record, value, error)) return false;
+        if (coordinate_of[p] >= 0) xyz[coordinate_of[p]] = value;
+    }
+    return true;
+}
+
+bool read_ascii_element(TokenCursor& in, const PlyElement& element,
+                        const std::vector<int>& coordinate_of, std::vector<double>* xyz,
+                        std::string& error) {
+    if (element.properties.empty()) return true;
+    for (uint64_t r = 0; r < element.count; ++r) {
+        double point[3] = {0, 0, 0};
+        if (!read_ascii_record(in, element, coordinate_of, point, r, error)) return false;
+        if (xyz) xyz->insert(xyz->end(), point, point + 3);
+    }
+    return true;
+}
+
+bool read_ascii_body(std::string_view data, const PlyHeader& header, const VertexLayout& layout,
+                     std::vector<double>& xyz, std::string& error) {
+    TokenCursor in(data.substr(header.data_offset), header.data_line);
+    for (size_t e = 0; e < layout.element; ++e) {
+        const PlyElement& element = header.elements[e];
+        std::vector<int> none(element.properties.size(), -1);
+        if (!read_ascii_element(in, element, none, nullptr, error)) return false;
+    }
+    return read_ascii_element(in, header.elements[layout.element], layout.coordinate_of, &xyz,
+                              error);
+}
+
+} // namespace
+
+bool read_ply(std::string_view data, std::vector<double>& xyz, std::string& error,
+              std::string& encoding) {
+    PlyHeader header;
+    VertexLayout layout;
+    if (!parse_header(data, header, error)) return false;
+    if (!find_vertex_layout(header, layout, error)) return false;
+    encoding = encoding_name(header.encoding);
+    xyz.clear();
+    if (header.encoding == PlyEncoding::ascii)
+        return read_ascii_body(data, header, layout, xyz, error);
+    return read_binary_body(data, header, layout, xyz, error);
+}
+
+} // namespace stratmesh_cli

@@ -1,0 +1,171 @@
+// Text readers: numeric columns (XYZ, PTS, TXT, CSV), OFF and OBJ. All are line based,
+// keep the first three numbers of each point line and name the line of any error.
+#include "cloud_readers.h"
+#include "text_scan.h"
+
+#include <cstdint>
+
+namespace stratmesh_cli {
+
+namespace {
+
+std::string at_line(size_t line) { return "line " + std::to_string(line) + ": "; }
+
+bool is_letter(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); }
+
+// The fields of one line, all expected to be numbers.
+struct NumberRow {
+    size_t fields = 0; // fields seen
+    double first[3] = {0, 0, 0};
+    std::string_view bad; // the first field that is not a number, if any
+    bool all_start_with_letters = true;
+};
+
+NumberRow scan_numbers(std::string_view content, bool commas) {
+    NumberRow row;
+    std::string_view field;
+    while (next_field(content, field, commas)) {
+        double value = 0;
+        bool numeric = parse_number(field, value);
+        if (!numeric && row.bad.empty()) row.bad = field;
+        if (numeric && row.fields < 3) row.first[row.fields] = value;
+        row.all_start_with_letters = row.all_start_with_letters && !numeric && is_letter(field[0]);
+        ++row.fields;
+    }
+    return row;
+}
+
+// A point row: every field a number, at least three of them. False with a message if not.
+bool take_point(const NumberRow& row, size_t line, std::vector<double>& xyz, std::string& error) {
+    if (!row.bad.empty()) {
+        error = at_line(line) + quote(row.bad) + " is not a number";
+        return false;
+    }
+    if (row.fields < 3) {
+        error = at_line(line) + "expected at least 3 numbers (x y z), found " +
+                std::to_string(row.fields);
+        return false;
+    }
+    xyz.insert(xyz.end(), row.first, row.first + 3);
+    return true;
+}
+
+// A PTS count line: a single whole number.
+bool is_count_line(std::string_view content) {
+    std::string_view field, rest = content;
+    if (!next_field(rest, field, true)) return false;
+    std::string_view extra;
+    uint64_t count = 0;
+    return !next_field(rest, extra, true) && parse_count(field, count) == CountParse::ok;
+}
+
+// Advances to the next line with something other than blanks and '#' comments.
+bool next_content_line(LineCursor& lines, std::string_view& content) {
+    std::string_view line, field;
+    while (lines.next(line)) {
+        content = strip_comment(line, false);
+        std::string_view probe = content;
+        if (next_field(probe, field, false)) return true;
+    }
+    return false;
+}
+
+bool read_off_vertices(LineCursor& lines, uint64_t count, std::vector<double>& xyz,
+                       std::string& error) {
+    std::string_view content;
+    for (uint64_t v = 0; v < count; ++v) {
+        if (!next_content_line(lines, content)) {
+            error = at_line(lines.line_number()) + "the file ends after " + std::to_string(v) +
+                    " of the " + std::to_string(count) + " vertices the header announces";
+            return false;
+        }
+        if (!take_point(scan_numbers(content, false), lines.line_number(), xyz, error))
+            return false;
+    }
+    return true;
+}
+
+// The keyword line of an OFF file, and the vertex count (on that line or the next).
+bool read_off_header(LineCursor& lines, uint64_t& vertex_count, std::string& error) {
+    std::string_view rest, keyword, count;
+    if (!next_content_line(lines, rest) || !next_field(rest, keyword, false) ||
+        !is_off_keyword(keyword)) {
+        error = at_line(lines.line_number()) + "not an OFF file (no OFF keyword)";
+        return false;
+    }
+    if (keyword.find_first_of("4n") != std::string_view::npos) {
+        error = at_line(lines.line_number()) + quote(keyword) + " files are not supported";
+        return false;
+    }
+    std::string_view probe = rest;
+    if (!next_field(probe, count, false) && !next_content_line(lines, rest)) {
+        error = at_line(lines.line_number()) + "the vertex count is missing";
+        return false;
+    }
+    next_field(rest, count, false);
+    if (count == "BINARY") {
+        error = at_line(lines.line_number()) + "binary OFF files are not supported";
+        return false;
+    }
+    CountParse parsed = parse_count(count, vertex_count);
+    if (parsed == CountParse::ok) return true;
+    error = at_line(lines.line_number()) + "the vertex count " + quote(count) + " " +
+            count_problem(parsed);
+    return false;
+}
+
+} // namespace
+
+bool is_off_keyword(std::string_view token) {
+    const std::string_view suffix = "OFF";
+    if (token.size() < suffix.size() || token.substr(token.size() - suffix.size()) != suffix)
+        return false;
+    std::string_view prefix = token.substr(0, token.size() - suffix.size());
+    if (prefix.substr(0, 2) == "ST") prefix.remove_prefix(2);
+    for (char optional : {'C', 'N', '4', 'n'})
+        if (!prefix.empty() && prefix[0] == optional) prefix.remove_prefix(1);
+    return prefix.empty();
+}
+
+bool read_xyz(std::string_view data, std::vector<double>& xyz, std::string& error) {
+    LineCursor lines(data);
+    std::string_view line;
+    bool first_content = true;
+    xyz.clear();
+    while (lines.next(line)) {
+        std::string_view content = strip_comment(line, true);
+        NumberRow row = scan_numbers(content, true);
+        if (row.fields == 0) continue;
+        bool column_names = first_content && row.all_start_with_letters;
+        first_content = false;
+        if (column_names || is_count_line(content)) continue;
+        if (!take_point(row, lines.line_number(), xyz, error)) return false;
+    }
+    if (!xyz.empty()) return true;
+    error = "no points found (no line with 3 numbers)";
+    return false;
+}
+
+bool read_off(std::string_view data, std::vector<double>& xyz, std::string& error) {
+    LineCursor lines(data);
+    uint64_t vertex_count = 0;
+    xyz.clear();
+    if (!read_off_header(lines, vertex_count, error)) return false;
+    return read_off_vertices(lines, vertex_count, xyz, error);
+}
+
+bool read_obj(std::string_view data, std::vector<double>& xyz, std::string& error) {
+    LineCursor lines(data);
+    std::string_view line, keyword;
+    xyz.clear();
+    while (lines.next(line)) {
+        std::string_view rest = strip_comment(line, false);
+        if (!next_field(rest, keyword, false) || keyword != "v") continue;
+        if (!take_point(scan_numbers(rest, false), lines.line_number(), xyz, error)) return false;
+    }
+    if (!xyz.empty()) return true;
+    error = "no vertices found (no 'v' line)";
+    return false;
+}
+
+} // namespace stratmesh_cli

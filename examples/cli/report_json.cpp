@@ -1,0 +1,358 @@
+#include "report_json.h"
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+
+namespace stratmesh_cli {
+
+namespace {
+
+// Length of the valid UTF-8 sequence starting at s (n bytes available), 0 if invalid.
+size_t utf8_length(const unsigned char* s, size_t n) {
+    unsigned char c = s[0];
+    size_t length = 0;
+    unsigned char low = 0x80, high = 0xbf; // allowed range of the second byte
+    if (c < 0x80) return 1;
+    if (c >= 0xc2 && c <= 0xdf) length = 2;
+    if (c >= 0xe0 && c <= 0xef) length = 3;
+    if (c >= 0xf0 && c <= 0xf4) length = 4;
+    if (c == 0xe0) low = 0xa0;
+    if (c == 0xed) high = 0x9f;
+    if (c == 0xf0) low = 0x90;
+    if (c == 0xf4) high = 0x8f;
+    if (length == 0 || length > n) return 0;
+    if (s[1] < low || s[1] > high) return 0;
+    for (size_t i = 2; i < length; ++i)
+        if (s[i] < 0x80 || s[i] > 0xbf) return 0;
+    return length;
+}
+
+void append_escaped_control(std::string& out, unsigned char c) {
+    const char* hex = "0123456789abcdef";
+    switch (c) {
+    case '\n': out += "\\n"; return;
+    case '\r': out += "\\r"; return;
+    case '\t': out += "\\t"; return;
+    case '\b': out += "\\b"; return;
+    case '\f': out += "\\f"; return;
+    default: break;
+    }
+    out += "\\u00";
+    out += hex[c >> 4];
+    out += hex[c & 15];
+}
+
+// A pretty-printing JSON builder: it places commas, newlines and indentation.
+class JsonWriter {
+public:
+    void begin_object() { open('{'); }
+    void end_object() { close('}'); }
+    void begin_array() { open('['); }
+    void end_array() { close(']'); }
+
+    void key(std::string_view name) {
+        before_value();
+        out_ += json_string(name);
+        out_ += ": ";
+        after_key_ = true;
+    }
+
+    void number(double value) {
+        before_value();
+        append_number(value);
+    }
+
+    void integer(uint64_t value) { literal(std::to_string(value)); }
+    void boolean(bool value) { literal(value ? "true" : "false"); }
+    void null() { literal("null"); }
+    void string(std::string_view text) { literal(json_string(text)); }
+
+    // A short array of numbers, on one line.
+    void numbers(const double* values, size_t count) {
+        before_value();
+        out_ += '[';
+        for (size_t i = 0; i < count; ++i) {
+            if (i > 0) out_ += ", ";
+            append_number(values[i]);
+        }
+        out_ += ']';
+    }
+
+    // key + value in one call.
+    void text_field(std::string_view name, std::string_view value) {
+        key(name);
+        string(value);
+    }
+    void number_field(std::string_view name, double value) {
+        key(name);
+        number(value);
+    }
+    void count_field(std::string_view name, uint64_t value) {
+        key(name);
+        integer(value);
+    }
+    void flag_field(std::string_view name, bool value) {
+        key(name);
+        boolean(value);
+    }
+    void numbers_field(std::string_view name, const double* values, size_t count) {
+        key(name);
+        numbers(values, count);
+    }
+
+    const std::string& text() const { return out_; }
+
+private:
+    // Shortest text that reads back as the same double; null for NaN and infinities.
+    void append_number(double value) {
+        if (!std::isfinite(value)) {
+            out_ += "null";
+            return;
+        }
+        char text[64];
+        std::to_chars_result r = std::to_chars(text, text + sizeof text, value);
+        out_.append(text, r.ptr);
+    }
+
+    void literal(const std::string& text) {
+        before_value();
+        out_ += text;
+    }
+
+    void before_value() {
+        if (after_key_) {
+            after_key_ = false;
+            return;
+        }
+        if (!has_items_.empty()) {
+            if (has_items_.back()) out_ += ',';
+            has_items_.back() = true;
+            newline();
+        }
+    }
+
+    void open(char bracket) {
+        before_value();
+        out_ += bracket;
+        has_items_.push_back(false);
+    }
+
+    void close(char bracket) {
+        bool had_items = has_items_.back();
+        has_items_.pop_back();
+        if (had_items) newline();
+        out_ += bracket;
+        if (has_items_.empty()) out_ += '\n';
+    }
+
+    void newline() {
+        out_ += '\n';
+        out_.append(2 * has_items_.size(), ' ');
+    }
+
+    std::string out_;
+    std::vector<bool> has_items_; // per open container: has it a member yet?
+    bool after_key_ = false;
+};
+
+// ---- sections ----------------------------------------------------------------------------
+
+void write_files(JsonWriter& j, const RunRecord& r) {
+    j.key("input");
+    j.begin_object();
+    j.text_field("path", r.input_path);
+    j.text_field("format", r.input_format);
+    j.text_field("encoding", r.input_encoding);
+    j.end_object();
+    j.key("output");
+    j.begin_object();
+    j.text_field("path", r.output_path);
+    j.text_field("format", r.output_format);
+    j.flag_field("ascii", r.output_ascii);
+    j.flag_field("written", r.output_written);
+    j.end_object();
+}
+
+void write_options(JsonWriter& j, const RunRecord& r) {
+    j.key("options");
+    j.begin_object();
+    j.text_field("axis", r.axis);
+    j.key("direction");
+    if (r.axis == "direction")
+        j.numbers(r.direction, 3);
+    else
+        j.null();
+    j.key("cuts");
+    j.numbers(r.cuts.data(), r.cuts.size());
+    j.key("layers");
+    if (r.layer_count > 0)
+        j.integer(r.layer_count);
+    else
+        j.null();
+    j.key("layer_height");
+    j.number(r.layer_height > 0 ? r.layer_height : std::numeric_limits<double>::quiet_NaN());
+    j.flag_field("skip_invalid", r.skip_invalid);
+    j.end_object();
+}
+
+void write_status(JsonWriter& j, const RunRecord& r) {
+    const char* message = stratmesh::status_string(r.status);
+    const char* colon = std::strchr(message, ':');
+    std::string_view name = colon ? std::string_view(message, size_t(colon - message)) : message;
+    j.text_field("status", name);
+    j.text_field("status_message", message);
+    j.key("detail");
+    if (r.report.detail)
+        j.string(r.report.detail);
+    else
+        j.null();
+}
+
+void write_counts(JsonWriter& j, const stratmesh::Report& rep, stratmesh::Status status) {
+    j.key("points");
+    j.begin_object();
+    j.count_field("in", rep.points_in);
+    j.count_field("used", rep.points_used);
+    j.count_field("duplicates", rep.duplicates);
+    j.count_field("rejected", rep.rejected);
+    j.count_field("unused", rep.unused);
+    j.key("first_invalid");
+    if (status == stratmesh::Status::invalid_point)
+        j.integer(rep.first_invalid_point);
+    else
+        j.null();
+    j.end_object();
+    j.count_field("triangles", rep.triangle_count);
+    j.count_field("illegal_removed", rep.illegal_removed);
+    j.count_field("folds", rep.folds);
+    j.key("axis");
+    j.begin_object();
+    j.numbers_field("direction", rep.axis, 3);
+    j.numbers_field("origin", rep.axis_origin, 3);
+    j.end_object();
+    j.count_field("layer_count", rep.layer_count);
+}
+
+void write_layer(JsonWriter& j, const stratmesh::LayerInfo& layer) {
+    j.begin_object();
+    j.number_field("bottom", layer.bottom);
+    j.number_field("top", layer.top);
+    j.numbers_field("centre", layer.centre, 3);
+    j.number_field("radius", layer.radius);
+    j.count_field("points", layer.point_count);
+    j.count_field("triangles", layer.triangle_count);
+    j.count_field("folds", layer.fold_count);
+    j.end_object();
+}
+
+void write_layers(JsonWriter& j, const RunRecord& r) {
+    j.key("layers");
+    j.begin_array();
+    for (const stratmesh::LayerInfo& layer : r.layers) write_layer(j, layer);
+    j.end_array();
+    j.flag_field("layers_complete", r.layers.size() == r.report.layer_count);
+}
+
+void write_costs(JsonWriter& j, const RunRecord& r) {
+    j.key("seconds");
+    j.begin_object();
+    j.number_field("read", r.read_seconds);
+    j.number_field("reconstruct", r.reconstruct_seconds);
+    j.number_field("write", r.write_seconds);
+    j.key("phases");
+    j.begin_object();
+    for (size_t p = 0; p < kTimedPhases; ++p)
+        j.number_field(phase_name(static_cast<stratmesh::Phase>(p)), r.phase_seconds[p]);
+    j.end_object();
+    j.end_object();
+    double points = static_cast<double>(r.report.points_in);
+    j.key("memory");
+    j.begin_object();
+    j.count_field("workspace_bytes", r.workspace_bytes);
+    j.key("workspace_bytes_per_point");
+    j.number(static_cast<double>(r.workspace_bytes) / points);
+    j.count_field("triangle_buffer_bytes", r.triangle_buffer_bytes);
+    j.end_object();
+}
+
+} // namespace
+
+const char* phase_name(stratmesh::Phase phase) {
+    // A table rather than a switch: a phase added to the library is simply unnamed here.
+    const struct {
+        stratmesh::Phase phase;
+        const char* name;
+    } names[] = {
+        {stratmesh::Phase::validate, "validate"},       {stratmesh::Phase::layers, "layers"},
+        {stratmesh::Phase::triangulate, "triangulate"}, {stratmesh::Phase::stitch, "stitch"},
+        {stratmesh::Phase::manifold, "manifold"},       {stratmesh::Phase::done, "done"}};
+    for (const auto& n : names)
+        if (n.phase == phase) return n.name;
+    return nullptr;
+}
+
+RunRecord::RunRecord() {
+    const double unknown = std::numeric_limits<double>::quiet_NaN();
+    read_seconds = reconstruct_seconds = write_seconds = unknown;
+    for (double& s : phase_seconds) s = unknown;
+}
+
+std::string json_string(std::string_view text) {
+    std::string out = "\"";
+    const unsigned char* s = reinterpret_cast<const unsigned char*>(text.data());
+    for (size_t i = 0; i < text.size();) {
+        size_t length = utf8_length(s + i, text.size() - i);
+        if (length == 0) {
+            out += "\\ufffd";
+            i += 1;
+        } else if (s[i] < 0x20) {
+            append_escaped_control(out, s[i++]);
+        } else if (s[i] == '"' || s[i] == '\\') {
+            out += '\\';
+            out += static_cast<char>(s[i++]);
+        } else {
+            out.append(text.data() + i, length);
+            i += length;
+        }
+    }
+    return out + "\"";
+}
+
+std::string run_record_json(const RunRecord& record) {
+    JsonWriter j;
+    j.begin_object();
+    j.text_field("tool", "stratmesh");
+    j.text_field("version", STRATMESH_VERSION_STRING);
+    write_files(j, record);
+    write_options(j, record);
+    j.flag_field("reconstructed", record.reconstructed);
+    write_status(j, record);
+    write_counts(j, record.report, record.status);
+    write_layers(j, record);
+    write_costs(j, record);
+    j.end_object();
+    return j.text();
+}
+
+bool write_text_file(const std::string& path, const std::string& text, std::string& error) {
+    std::FILE* file = std::fopen(path.c_str(), "wb");
+    if (!file) {
+        error = path + ": cannot create: " + std::strerror(errno);
+        return false;
+    }
+    bool ok = std::fwrite(text.data(), 1, text.size(), file) == text.size();
+    int failure = errno;
+    if (std::fclose(file) != 0 && ok) {
+        ok = false;
+        failure = errno;
+    }
+    if (ok) return true;
+    error = path + ": cannot write: " + std::strerror(failure);
+    return false;
+}
+
+} // namespace stratmesh_cli

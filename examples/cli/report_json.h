@@ -1,0 +1,60 @@
+// What one run of the tool did, and its machine-readable form (--report FILE.json).
+#ifndef STRATMESH_CLI_REPORT_JSON_H
+#define STRATMESH_CLI_REPORT_JSON_H
+
+#include "stratmesh.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace stratmesh_cli {
+
+// The library phases that are timed; later ones (if the library gains any) are not.
+const size_t kTimedPhases = 5; // validate, layers, triangulate, stitch, manifold
+
+// The phase's name ("validate", ...), or nullptr for a value this tool does not know.
+const char* phase_name(stratmesh::Phase phase);
+
+struct RunRecord {
+    // Input and output.
+    std::string input_path, input_format, input_encoding;
+    std::string output_path, output_format;
+    bool output_ascii = false;
+    bool output_written = false;
+    // The options given.
+    std::string axis = "automatic"; // "automatic", "x", "y", "z" or "direction"
+    double direction[3] = {0, 0, 0};
+    std::vector<double> cuts;
+    uint32_t layer_count = 0; // --layers, 0 if not given
+    double layer_height = 0;  // --layer-height, 0 if not given
+    bool skip_invalid = false;
+    // The outcome. report.layers is not used: the filled entries are copied to `layers`.
+    bool reconstructed = false; // reconstruct() ran (the input could be read)
+    stratmesh::Status status = stratmesh::Status::ok;
+    stratmesh::Report report = {};
+    std::vector<stratmesh::LayerInfo> layers;
+    // The cost; seconds are NaN when unknown (written as null).
+    double read_seconds, reconstruct_seconds, write_seconds;
+    double phase_seconds[kTimedPhases];
+    size_t workspace_bytes = 0;
+    size_t triangle_buffer_bytes = 0;
+
+    RunRecord();
+};
+
+// The record as a JSON document (UTF-8, numbers round-trip exactly, NaN/Inf as null).
+std::string run_record_json(const RunRecord& record);
+
+// `text` as a JSON string literal, quotes included. Bytes that are not valid UTF-8 become
+// U+FFFD, so the result is always valid JSON.
+std::string json_string(std::string_view text);
+
+// Writes `text` to `path`; false with a message naming the file on failure.
+bool write_text_file(const std::string& path, const std::string& text, std::string& error);
+
+} // namespace stratmesh_cli
+
+#endif

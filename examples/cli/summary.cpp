@@ -1,0 +1,76 @@
+#include "summary.h"
+
+#include <cmath>
+#include <string>
+
+namespace stratmesh_cli {
+
+namespace {
+
+std::string seconds_text(double seconds) {
+    if (!std::isfinite(seconds)) return "-";
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3f s", seconds);
+    return text;
+}
+
+std::string bytes_text(size_t bytes) {
+    const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB"};
+    double value = static_cast<double>(bytes);
+    size_t unit = 0;
+    while (value >= 1024 && unit + 1 < sizeof units / sizeof units[0]) {
+        value /= 1024;
+        ++unit;
+    }
+    char text[32];
+    if (unit == 0)
+        std::snprintf(text, sizeof text, "%zu bytes", bytes);
+    else
+        std::snprintf(text, sizeof text, "%.1f %s", value, units[unit]);
+    return text;
+}
+
+std::string phase_times_text(const RunRecord& r) {
+    std::string text;
+    for (size_t p = 0; p < kTimedPhases; ++p) {
+        if (!std::isfinite(r.phase_seconds[p])) continue;
+        char item[64];
+        std::snprintf(item, sizeof item, "%s%s %.3f", text.empty() ? "" : ", ",
+                      phase_name(static_cast<stratmesh::Phase>(p)), r.phase_seconds[p]);
+        text += item;
+    }
+    return text.empty() ? text : " (" + text + ")";
+}
+
+void print_counts(std::FILE* out, const stratmesh::Report& rep) {
+    std::fprintf(out, "  points     %zu read: %zu used, %zu duplicates, %zu rejected, %zu unused\n",
+                 rep.points_in, rep.points_used, rep.duplicates, rep.rejected, rep.unused);
+    std::fprintf(out, "  layers     %zu\n", rep.layer_count);
+    std::fprintf(out, "  triangles  %zu (%zu illegal removed, %zu folds)\n", rep.triangle_count,
+                 rep.illegal_removed, rep.folds);
+}
+
+void print_costs(std::FILE* out, const RunRecord& r) {
+    std::fprintf(out, "  time       read %s, reconstruct %s%s, write %s\n",
+                 seconds_text(r.read_seconds).c_str(), seconds_text(r.reconstruct_seconds).c_str(),
+                 phase_times_text(r).c_str(), seconds_text(r.write_seconds).c_str());
+    double per_point = r.report.points_in ? static_cast<double>(r.workspace_bytes) /
+                                                static_cast<double>(r.report.points_in)
+                                          : 0.0;
+    std::fprintf(out, "  memory     workspace %s (%zu bytes, %.0f bytes/point), triangles %s\n",
+                 bytes_text(r.workspace_bytes).c_str(), r.workspace_bytes, per_point,
+                 bytes_text(r.triangle_buffer_bytes).c_str());
+}
+
+} // namespace
+
+void print_summary(std::FILE* out, const RunRecord& record) {
+    std::fprintf(out, "stratmesh: %s (%s %s) -> %s (%s%s)\n", record.input_path.c_str(),
+                 record.input_format.c_str(), record.input_encoding.c_str(),
+                 record.output_path.c_str(), record.output_format.c_str(),
+                 record.output_ascii ? " text" : "");
+    print_counts(out, record.report);
+    print_costs(out, record);
+}
+
+} // namespace stratmesh_cli

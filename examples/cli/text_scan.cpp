@@ -1,0 +1,137 @@
+#include "text_scan.h"
+
+#include <charconv>
+#include <cstdlib>
+
+namespace stratmesh_cli {
+
+namespace {
+
+bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+bool is_field_separator(char c, bool commas) {
+    return is_blank(c) || (commas && (c == ',' || c == ';'));
+}
+
+bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+} // namespace
+
+bool LineCursor::next(std::string_view& line) {
+    if (pos_ >= text_.size()) return false;
+    size_t end = text_.find('\n', pos_);
+    size_t stop = end == std::string_view::npos ? text_.size() : end;
+    line = text_.substr(pos_, stop - pos_);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    pos_ = end == std::string_view::npos ? text_.size() : end + 1;
+    ++line_number_;
+    return true;
+}
+
+bool TokenCursor::next(std::string_view& token) {
+    size_t line_of_last_token = line_;
+    while (pos_ < text_.size() && (is_blank(text_[pos_]) || text_[pos_] == '\n')) {
+        if (text_[pos_] == '\n') ++line_;
+        ++pos_;
+    }
+    if (pos_ >= text_.size()) {
+        line_ = line_of_last_token; // report the end on the last line with anything
+        return false;
+    }
+    size_t start = pos_;
+    while (pos_ < text_.size() && !is_blank(text_[pos_]) && text_[pos_] != '\n') ++pos_;
+    token = text_.substr(start, pos_ - start);
+    return true;
+}
+
+std::string_view strip_comment(std::string_view line, bool slashes) {
+    size_t cut = line.find('#');
+    if (slashes) {
+        size_t slash = line.find("//");
+        if (slash < cut) cut = slash;
+    }
+    return cut == std::string_view::npos ? line : line.substr(0, cut);
+}
+
+bool next_field(std::string_view& rest, std::string_view& field, bool commas) {
+    size_t start = 0;
+    while (start < rest.size() && is_field_separator(rest[start], commas)) ++start;
+    if (start == rest.size()) {
+        rest = std::string_view();
+        return false;
+    }
+    size_t stop = start;
+    while (stop < rest.size() && !is_field_separator(rest[stop], commas)) ++stop;
+    field = rest.substr(start, stop - start);
+    rest.remove_prefix(stop);
+    return true;
+}
+
+bool parse_number(std::string_view token, double& value) {
+    // from_chars takes no leading '+'; allow one before a digit or a point.
+    if (token.size() > 1 && token[0] == '+' && (is_digit(token[1]) || token[1] == '.'))
+        token.remove_prefix(1);
+    if (token.empty()) return false;
+    const char* first = token.data();
+    const char* last = first + token.size();
+    std::from_chars_result r = std::from_chars(first, last, value);
+    if (r.ec == std::errc::result_out_of_range && r.ptr == last) {
+        // Beyond a double's range (or subnormal, for some libraries): strtod rounds to
+        // infinity, zero or the subnormal. The tool never changes the C locale.
+        std::string copy(token);
+        value = std::strtod(copy.c_str(), nullptr);
+        return true;
+    }
+    return r.ec == std::errc() && r.ptr == last;
+}
+
+CountParse parse_count(std::string_view token, uint64_t& value) {
+    if (token.empty()) return CountParse::not_a_number;
+    if (token[0] == '-') {
+        bool numeric = token.size() > 1;
+        for (size_t i = 1; i < token.size(); ++i) numeric = numeric && is_digit(token[i]);
+        return numeric ? CountParse::negative : CountParse::not_a_number;
+    }
+    if (token[0] == '+') token.remove_prefix(1);
+    if (token.empty()) return CountParse::not_a_number;
+    uint64_t v = 0;
+    for (char c : token) {
+        if (!is_digit(c)) return CountParse::not_a_number;
+        uint64_t digit = static_cast<uint64_t>(c - '0');
+        if (v > (UINT64_MAX - digit) / 10) return CountParse::too_large;
+        v = v * 10 + digit;
+    }
+    value = v;
+    return CountParse::ok;
+}
+
+const char* count_problem(CountParse result) {
+    switch (result) {
+    case CountParse::ok: return "is fine";
+    case CountParse::negative: return "is negative";
+    case CountParse::not_a_number: return "is not a whole number";
+    case CountParse::too_large: return "is too large";
+    }
+    return "is invalid";
+}
+
+std::string quote(std::string_view token) {
+    const size_t kShown = 32;
+    std::string out = "'";
+    for (size_t i = 0; i < token.size() && i < kShown; ++i) {
+        unsigned char c = static_cast<unsigned char>(token[i]);
+        if (c >= 0x20 && c < 0x7f) {
+            out += static_cast<char>(c);
+        } else {
+            const char* hex = "0123456789abcdef";
+            out += "\\x";
+            out += hex[c >> 4];
+            out += hex[c & 15];
+        }
+    }
+    if (token.size() > kShown) out += "...";
+    out += "'";
+    return out;
+}
+
+} // namespace stratmesh_cli

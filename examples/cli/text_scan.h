@@ -1,0 +1,72 @@
+// Small helpers for scanning text point files: lines, fields, numbers, error quoting.
+// Everything works on string_views into the caller's buffer; nothing here allocates
+// except the quoting of a token for an error message.
+#ifndef STRATMESH_CLI_TEXT_SCAN_H
+#define STRATMESH_CLI_TEXT_SCAN_H
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace stratmesh_cli {
+
+// Walks a buffer line by line. Lines end at '\n'; a '\r' before it is dropped.
+class LineCursor {
+public:
+    explicit LineCursor(std::string_view text) : text_(text) {}
+
+    // The next line, without its terminator; false at the end of the buffer.
+    bool next(std::string_view& line);
+    // 1-based number of the line last returned by next() (0 before the first).
+    size_t line_number() const { return line_number_; }
+    // Offset of the first byte after the line last returned (its terminator included).
+    size_t offset() const { return pos_; }
+
+private:
+    std::string_view text_;
+    size_t pos_ = 0;
+    size_t line_number_ = 0;
+};
+
+// Walks whitespace-separated tokens across lines, counting lines for error messages.
+class TokenCursor {
+public:
+    TokenCursor(std::string_view text, size_t first_line) : text_(text), line_(first_line) {}
+
+    bool next(std::string_view& token);
+    // The line of the token last returned (or where the text ended).
+    size_t line_number() const { return line_; }
+
+private:
+    std::string_view text_;
+    size_t pos_ = 0;
+    size_t line_;
+};
+
+// Cuts `line` at the first comment marker: '#' always, "//" when `slashes` is set.
+std::string_view strip_comment(std::string_view line, bool slashes);
+
+// Pops the next field off `rest`. Fields are separated by runs of spaces, tabs, '\r',
+// '\v', '\f', and also of ',' and ';' when `commas` is set. False when none is left.
+bool next_field(std::string_view& rest, std::string_view& field, bool commas);
+
+// The whole token as a double (decimal or scientific, optional sign, "nan", "inf").
+// Locale-independent. False if any character is left over.
+bool parse_number(std::string_view token, double& value);
+
+enum class CountParse { ok, negative, not_a_number, too_large };
+
+// A non-negative decimal integer that fits in 64 bits.
+CountParse parse_count(std::string_view token, uint64_t& value);
+
+// An error-message phrase for a bad count, e.g. "is negative".
+const char* count_problem(CountParse result);
+
+// The token in single quotes for a message: at most 32 characters, control and
+// non-ASCII bytes shown as \xHH.
+std::string quote(std::string_view token);
+
+} // namespace stratmesh_cli
+
+#endif

@@ -1,0 +1,215 @@
+// stratmesh_cli_check: helper for the tool's end-to-end tests (no Python needed).
+//
+//   stratmesh_cli_check make-inputs DIR
+//       writes small good and bad input files into DIR (see make_inputs below)
+//   stratmesh_cli_check json FILE [ASSERTION...]
+//       FILE must be valid JSON; each ASSERTION must hold:
+//         a.b=c.d+e+12   sums of numbers at dotted paths (keys, or indices into arrays:
+//                        layers.0.top) and number literals are equal
+//         #a.b           (as a term) the length of the array at a.b
+//         a.b:text       the string at a.b is `text` (or true, false, null)
+//   stratmesh_cli_check mesh FILE VERTICES [REPORT.json]
+//       the mesh (.ply .obj .off .stl) reads back, has VERTICES vertices (not checked for
+//       STL), at least one triangle, indices in range, and as many triangles as the
+//       report says
+#include "mini_json.h"
+#include "mini_mesh.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+const double kPi = 3.14159265358979323846;
+
+bool write_file(const std::string& path, const std::string& bytes) {
+    std::ofstream out(path, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    return static_cast<bool>(out);
+}
+
+std::string number_text(double v) {
+    char text[40];
+    std::snprintf(text, sizeof text, "%.9g", v);
+    return text;
+}
+
+// A wavy cylinder, radius about 20, height 100, points on a golden-angle spiral.
+std::vector<double> cylinder_points(size_t count) {
+    std::vector<double> xyz;
+    const double golden = kPi * (3 - std::sqrt(5.0));
+    for (size_t i = 0; i < count; ++i) {
+        double t = static_cast<double>(i);
+        double angle = golden * t;
+        double z = 100 * (t + 0.5) / static_cast<double>(count);
+        double r = 20 + 2 * std::sin(z / 9) + 0.8 * std::cos(3 * angle);
+        xyz.insert(xyz.end(), {r * std::cos(angle), r * std::sin(angle), z});
+    }
+    return xyz;
+}
+
+std::string as_xyz(const std::vector<double>& xyz, size_t nan_every) {
+    std::string text = "# a wavy cylinder\n";
+    for (size_t i = 0; i < xyz.size() / 3; ++i) {
+        if (nan_every && i % nan_every == nan_every / 2) text += "nan nan nan\n";
+        text += number_text(xyz[3 * i]) + " " + number_text(xyz[3 * i + 1]) + " " +
+                number_text(xyz[3 * i + 2]) + "\n";
+    }
+    return text;
+}
+
+std::string as_obj(const std::vector<double>& xyz) {
+    std::string text = "# a wavy cylinder\no cylinder\n";
+    for (size_t i = 0; i < xyz.size() / 3; ++i)
+        text += "v " + number_text(xyz[3 * i]) + " " + number_text(xyz[3 * i + 1]) + " " +
+                number_text(xyz[3 * i + 2]) + "\n";
+    return text;
+}
+
+std::string truncated_ply() {
+    std::string text = "ply\nformat binary_little_endian 1.0\nelement vertex 100\n"
+                       "property float x\nproperty float y\nproperty float z\nend_header\n";
+    return text + std::string(10 * 12, '\x01');
+}
+
+int make_inputs(const std::string& dir) {
+    std::error_code ignored;
+    std::filesystem::create_directories(dir, ignored);
+    std::vector<double> cylinder = cylinder_points(3000);
+    bool ok = write_file(dir + "/garbage.xyz", "1 2 3\n4 5 6\n7 eight 9\n") &&
+              write_file(dir + "/truncated.ply", truncated_ply()) &&
+              write_file(dir + "/lying.ply",
+                         "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\n"
+                         "property float y\nproperty float z\nend_header\n1 2 3\n") &&
+              write_file(dir + "/empty.xyz", "") &&
+              write_file(dir + "/two_points.xyz", "0 0 0\n1 1 1\n") &&
+              write_file(dir + "/cylinder.xyz", as_xyz(cylinder, 0)) &&
+              write_file(dir + "/cylinder_nan.xyz", as_xyz(cylinder, 500)) &&
+              write_file(dir + "/cylinder_obj.ply", as_obj(cylinder));
+    if (!ok) std::fprintf(stderr, "cannot write the inputs into %s\n", dir.c_str());
+    return ok ? 0 : 1;
+}
+
+// ---- json --------------------------------------------------------------------------------
+
+bool term_value(const mini_json::Value& root, const std::string& term, double& value) {
+    bool is_length = !term.empty() && term[0] == '#';
+    const mini_json::Value* v = root.at(is_length ? term.substr(1) : term);
+    if (is_length) {
+        if (v && v->kind == mini_json::Value::array) value = static_cast<double>(v->items.size());
+        return v && v->kind == mini_json::Value::array;
+    }
+    if (v) {
+        value = v->num;
+        return v->kind == mini_json::Value::number;
+    }
+    char* end = nullptr;
+    value = std::strtod(term.c_str(), &end);
+    return !term.empty() && *end == '\0';
+}
+
+bool sum_of(const mini_json::Value& root, const std::string& side, double& sum) {
+    sum = 0;
+    size_t start = 0;
+    for (;;) {
+        size_t plus = side.find('+', start);
+        double value = 0;
+        std::string term = side.substr(start, plus == std::string::npos ? plus : plus - start);
+        if (!term_value(root, term, value)) {
+            std::fprintf(stderr, "  '%s' is not a number in the report\n", term.c_str());
+            return false;
+        }
+        sum += value;
+        if (plus == std::string::npos) return true;
+        start = plus + 1;
+    }
+}
+
+// Strings as they are; true, false and null as those words.
+std::string text_of(const mini_json::Value& v) {
+    if (v.kind == mini_json::Value::string) return v.text;
+    if (v.kind == mini_json::Value::boolean) return v.flag ? "true" : "false";
+    if (v.kind == mini_json::Value::null) return "null";
+    return "(not text)";
+}
+
+bool holds(const mini_json::Value& root, const std::string& assertion) {
+    size_t colon = assertion.find(':'), equals = assertion.find('=');
+    if (colon != std::string::npos && colon < equals) {
+        const mini_json::Value* v = root.at(assertion.substr(0, colon));
+        return v && text_of(*v) == assertion.substr(colon + 1);
+    }
+    double left = 0, right = 0;
+    if (equals == std::string::npos || !sum_of(root, assertion.substr(0, equals), left) ||
+        !sum_of(root, assertion.substr(equals + 1), right))
+        return false;
+    if (left != right) std::fprintf(stderr, "  %.17g != %.17g\n", left, right);
+    return left == right;
+}
+
+bool load_json(const std::string& path, mini_json::Value& root) {
+    std::string text, error;
+    if (!mini_mesh::load(path, text)) {
+        std::fprintf(stderr, "cannot read %s\n", path.c_str());
+        return false;
+    }
+    if (mini_json::parse(text, root, error)) return true;
+    std::fprintf(stderr, "%s is not valid JSON: %s\n", path.c_str(), error.c_str());
+    return false;
+}
+
+int check_json(int argc, char** argv) {
+    mini_json::Value root;
+    if (!load_json(argv[2], root)) return 1;
+    int failures = 0;
+    for (int i = 3; i < argc; ++i) {
+        if (holds(root, argv[i])) continue;
+        std::fprintf(stderr, "assertion failed: %s\n", argv[i]);
+        ++failures;
+    }
+    return failures ? 1 : 0;
+}
+
+// ---- mesh --------------------------------------------------------------------------------
+
+int check_mesh(int argc, char** argv) {
+    std::string path = argv[2];
+    size_t vertices = std::strtoull(argv[3], nullptr, 10);
+    mini_mesh::Mesh mesh;
+    if (!mini_mesh::read(path, mesh)) {
+        std::fprintf(stderr, "cannot read the mesh %s\n", path.c_str());
+        return 1;
+    }
+    bool stl = path.size() > 4 && path.substr(path.size() - 4) == ".stl";
+    size_t have = mesh.xyz.size() / 3, triangles = mesh.tris.size() / 3;
+    bool ok = triangles > 0 && (stl || have == vertices);
+    for (uint32_t index : mesh.tris) ok = ok && index < have;
+    mini_json::Value report;
+    if (argc > 4 && load_json(argv[4], report)) {
+        const mini_json::Value* t = report.at("triangles");
+        ok = ok && t && t->num == static_cast<double>(triangles);
+    } else if (argc > 4) {
+        ok = false;
+    }
+    if (!ok)
+        std::fprintf(stderr, "%s: %zu vertices (expected %zu), %zu triangles\n", path.c_str(), have,
+                     vertices, triangles);
+    return ok ? 0 : 1;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    std::string command = argc > 1 ? argv[1] : "";
+    if (command == "make-inputs" && argc == 3) return make_inputs(argv[2]);
+    if (command == "json" && argc >= 3) return check_json(argc, argv);
+    if (command == "mesh" && (argc == 4 || argc == 5)) return check_mesh(argc, argv);
+    std::fprintf(stderr, "usage: stratmesh_cli_check make-inputs DIR | json FILE [ASSERTION...] |"
+                         " mesh FILE VERTICES [REPORT.json]\n");
+    return 2;
+}

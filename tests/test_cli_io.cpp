@@ -1,0 +1,716 @@
+// Tests of the stratmesh tool's file handling: cloud readers (round trips, malformed
+// input, format detection), mesh writers (read back with independent mini readers), the
+// JSON report and the command line.
+#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
+#include <doctest/doctest.h>
+
+#include "args.h"
+#include "cloud_io.h"
+#include "mesh_io.h"
+#include "report_json.h"
+
+#include "cli/mini_json.h"
+#include "cli/mini_mesh.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+using namespace stratmesh_cli;
+
+namespace {
+
+// ---- helpers -----------------------------------------------------------------------------
+
+// A fresh directory for the test's files, removed afterwards.
+struct TempDir {
+    std::filesystem::path path;
+
+    TempDir() {
+        auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
+        path = std::filesystem::temp_directory_path() /
+               ("stratmesh_cli_io_" + std::to_string(std::random_device{}()) + "_" +
+                std::to_string(stamp));
+        std::filesystem::create_directories(path);
+    }
+    ~TempDir() {
+        std::error_code ignored;
+        std::filesystem::remove_all(path, ignored);
+    }
+    std::string file(const std::string& name) const { return (path / name).string(); }
+};
+
+void save(const std::string& path, const std::string& bytes) {
+    std::ofstream out(path, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+// Points with awkward values: fractions no float holds, large and tiny magnitudes.
+std::vector<double> test_points(size_t count) {
+    std::vector<double> xyz;
+    for (size_t i = 0; i < count; ++i) {
+        double t = static_cast<double>(i);
+        xyz.push_back(0.1 * t - 3.7);
+        xyz.push_back(std::sqrt(t + 2.0) * 1234.5678);
+        xyz.push_back(-1e-7 * t * t + 1e5 / (t + 3));
+    }
+    return xyz;
+}
+
+std::vector<double> rounded_to_float(const std::vector<double>& xyz) {
+    std::vector<double> out;
+    for (double v : xyz) out.push_back(static_cast<double>(static_cast<float>(v)));
+    return out;
+}
+
+std::string exact_text(double v) {
+    char text[40];
+    std::snprintf(text, sizeof text, "%.17g", v);
+    return text;
+}
+
+// Binary encoder for test files, in either byte order.
+struct Bytes {
+    bool big_endian;
+    std::string data;
+
+    template <class T> Bytes& put(T value) {
+        unsigned char raw[sizeof(T)];
+        std::memcpy(raw, &value, sizeof value);
+        uint16_t probe = 1;
+        unsigned char first;
+        std::memcpy(&first, &probe, 1);
+        bool host_little = first == 1;
+        for (size_t i = 0; i < sizeof(T); ++i)
+            data += static_cast<char>(raw[host_little == !big_endian ? i : sizeof(T) - 1 - i]);
+        return *this;
+    }
+};
+
+struct ReadResult {
+    bool ok;
+    std::vector<double> xyz;
+    std::string error;
+    CloudInfo info;
+};
+
+ReadResult read_text(const std::string& bytes, CloudFormat format = CloudFormat::automatic) {
+    ReadResult r;
+    r.ok = read_cloud_from_memory(bytes.data(), bytes.size(), format, r.xyz, r.error, &r.info);
+    return r;
+}
+
+bool contains(const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+}
+
+const char* kXyz = "property float x\nproperty float y\nproperty float z\n";
+
+// ---- PLY files built by the tests --------------------------------------------------------
+
+// Binary PLY with a face element before the vertices and an edge element after, and
+// vertices interleaving x, y, z with normals, colours and an intensity.
+std::string busy_binary_ply(const std::vector<double>& xyz, bool big_endian) {
+    size_t n = xyz.size() / 3;
+    std::string header = std::string("ply\nformat ") +
+                         (big_endian ? "binary_big_endian" : "binary_little_endian") +
+                         " 1.0\ncomment busy\nelement face 2\n"
+                         "property list uchar int vertex_indices\nproperty uchar flags\n"
+                         "element vertex " +
+                         std::to_string(n) +
+                         "\n"
+                         "property float nx\nproperty float x\nproperty uchar red\n"
+                         "property float32 y\nproperty ushort label\nproperty float z\n"
+                         "property float intensity\nelement edge 1\n"
+                         "property int v1\nproperty int v2\nend_header\n";
+    Bytes b{big_endian, header};
+    b.put<uint8_t>(3).put<int32_t>(0).put<int32_t>(1).put<int32_t>(2).put<uint8_t>(7);
+    b.put<uint8_t>(4).put<int32_t>(0).put<int32_t>(1).put<int32_t>(2).put<int32_t>(3).put<uint8_t>(
+        9);
+    for (size_t i = 0; i < n; ++i) {
+        b.put<float>(0.5f).put(static_cast<float>(xyz[3 * i])).put<uint8_t>(200);
+        b.put(static_cast<float>(xyz[3 * i + 1])).put<uint16_t>(65535);
+        b.put(static_cast<float>(xyz[3 * i + 2])).put<float>(0.25f);
+    }
+    b.put<int32_t>(0).put<int32_t>(1);
+    return b.data;
+}
+
+// Binary PLY of doubles with a list property inside the vertex element.
+std::string double_binary_ply(const std::vector<double>& xyz, bool big_endian) {
+    size_t n = xyz.size() / 3;
+    std::string header = std::string("ply\nformat ") +
+                         (big_endian ? "binary_big_endian" : "binary_little_endian") +
+                         " 1.0\nelement vertex " + std::to_string(n) +
+                         "\nproperty double x\nproperty list ushort short extra\n"
+                         "property float64 y\nproperty double z\nend_header\n";
+    Bytes b{big_endian, header};
+    for (size_t i = 0; i < n; ++i) {
+        b.put(xyz[3 * i]).put<uint16_t>(static_cast<uint16_t>(i % 3));
+        for (size_t k = 0; k < i % 3; ++k) b.put<int16_t>(-5);
+        b.put(xyz[3 * i + 1]).put(xyz[3 * i + 2]);
+    }
+    return b.data;
+}
+
+std::string ascii_ply(const std::vector<double>& xyz, const char* newline) {
+    size_t n = xyz.size() / 3;
+    std::string nl = newline;
+    std::string text = "ply" + nl + "format ascii 1.0" + nl + "comment hello" + nl +
+                       "obj_info made by a test" + nl + "element face 1" + nl +
+                       "property list uchar uint vertex_indices" + nl + "element vertex " +
+                       std::to_string(n) + nl + "property double x" + nl + "property uchar r" + nl +
+                       "property double y" + nl + "property double z" + nl + "end_header" + nl +
+                       "3 0 1 2" + nl;
+    for (size_t i = 0; i < n; ++i)
+        text += exact_text(xyz[3 * i]) + " 17 " + exact_text(xyz[3 * i + 1]) + " " +
+                exact_text(xyz[3 * i + 2]) + nl;
+    return text;
+}
+
+std::string little_ply_header(const std::string& elements) {
+    return "ply\nformat binary_little_endian 1.0\n" + elements + "end_header\n";
+}
+
+} // namespace
+
+// ==== cloud readers: round trips ==========================================================
+
+TEST_CASE("binary PLY, float, other properties and elements skipped, both byte orders") {
+    std::vector<double> xyz = test_points(40);
+    for (bool big : {false, true}) {
+        ReadResult r = read_text(busy_binary_ply(xyz, big));
+        REQUIRE_MESSAGE(r.ok, r.error);
+        CHECK(r.info.format == CloudFormat::ply);
+        CHECK(r.info.encoding == (big ? "binary_big_endian" : "binary_little_endian"));
+        CHECK(r.xyz == rounded_to_float(xyz));
+    }
+}
+
+TEST_CASE("binary PLY, double, with a list inside the vertex element, both byte orders") {
+    std::vector<double> xyz = test_points(25);
+    for (bool big : {false, true}) {
+        ReadResult r = read_text(double_binary_ply(xyz, big));
+        REQUIRE_MESSAGE(r.ok, r.error);
+        CHECK(r.xyz == xyz);
+    }
+}
+
+TEST_CASE("binary PLY with integer coordinates") {
+    Bytes b{false, little_ply_header("element vertex 2\nproperty short x\nproperty int y\n"
+                                     "property uchar z\n")};
+    b.put<int16_t>(-300).put<int32_t>(70000).put<uint8_t>(255);
+    b.put<int16_t>(5).put<int32_t>(-1).put<uint8_t>(0);
+    ReadResult r = read_text(b.data);
+    REQUIRE_MESSAGE(r.ok, r.error);
+    CHECK(r.xyz == std::vector<double>{-300, 70000, 255, 5, -1, 0});
+}
+
+TEST_CASE("ascii PLY, LF and CRLF line ends") {
+    std::vector<double> xyz = test_points(30);
+    for (const char* newline : {"\n", "\r\n"}) {
+        ReadResult r = read_text(ascii_ply(xyz, newline));
+        REQUIRE_MESSAGE(r.ok, r.error);
+        CHECK(r.info.encoding == "ascii");
+        CHECK(r.xyz == xyz);
+    }
+}
+
+TEST_CASE("PLY with zero vertices is an empty cloud, not an error") {
+    ReadResult r = read_text(little_ply_header(std::string("element vertex 0\n") + kXyz));
+    REQUIRE_MESSAGE(r.ok, r.error);
+    CHECK(r.xyz.empty());
+}
+
+TEST_CASE("XYZ columns: spaces, tabs, commas, comments, blank lines, extra columns") {
+    std::vector<double> xyz = test_points(20);
+    std::string text = "# scanner export\nX,Y,Z,R,G,B\n\n";
+    for (size_t i = 0; i < 20; ++i) {
+        const char* separators[] = {" ", "\t", ",", ", "};
+        std::string sep = separators[i % 4];
+        text += exact_text(xyz[3 * i]) + sep + exact_text(xyz[3 * i + 1]) + sep +
+                exact_text(xyz[3 * i + 2]);
+        text += i % 2 ? sep + "255" + sep + "0" + sep + "12" : "";
+        text += i % 3 == 0 ? "  // a comment\r\n" : "\n";
+        if (i == 7) text += "   \n// a line comment\n";
+    }
+    ReadResult r = read_text(text);
+    REQUIRE_MESSAGE(r.ok, r.error);
+    CHECK(r.info.format == CloudFormat::xyz);
+    CHECK(r.xyz == xyz);
+}
+
+TEST_CASE("PTS with a count line, and a leading plus sign") {
+    ReadResult r = read_text("3\n1 2 3 -50 255 255 255\n+4 5e0 6 10 1 2 3\n.5 -0 7\n");
+    REQUIRE_MESSAGE(r.ok, r.error);
+    CHECK(r.xyz == std::vector<double>{1, 2, 3, 4, 5, 6, 0.5, 0, 7});
+}
+
+TEST_CASE("XYZ keeps NaN and infinite coordinates for the library to judge") {
+    ReadResult r = read_text("1 2 3\nnan nan nan\n4 inf -inf\n");
+    REQUIRE_MESSAGE(r.ok, r.error);
+    REQUIRE(r.xyz.size() == 9);
+    CHECK(std::isnan(r.xyz[3]));
+    CHECK(r.xyz[7] == std::numeric_limits<double>::infinity());
+}
+
+TEST_CASE("OFF: comments, counts on the keyword line or the next, extra vertex columns") {
+    std::vector<double> xyz = test_points(12);
+    std::string body;
+    for (size_t i = 0; i < 12; ++i)
+        body += exact_text(xyz[3 * i]) + " " + exact_text(xyz[3 * i + 1]) + " " +
+                exact_text(xyz[3 * i + 2]) + (i % 2 ? " 0 0 1\n" : "\n");
+    body += "3 0 1 2\n3 2 3 4\n";
+    for (const std::string& head :
+         {std::string("OFF\n# comment\n\n12 2 0\n"), std::string("NOFF 12 2 0\n"),
+          std::string("# leading comment\nCOFF\r\n12 2 0\r\n")}) {
+        ReadResult r = read_text(head + body);
+        REQUIRE_MESSAGE(r.ok, r.error);
+        CHECK(r.info.format == CloudFormat::off);
+        CHECK(r.xyz == xyz);
+    }
+}
+
+TEST_CASE("OBJ: v lines only, with vn, vt, f, groups and comments ignored") {
+    std::vector<double> xyz = test_points(10);
+    std::string text = "# exported\nmtllib a.mtl\no thing\n";
+    for (size_t i = 0; i < 10; ++i) {
+        text += "v " + exact_text(xyz[3 * i]) + " " + exact_text(xyz[3 * i + 1]) + " " +
+                exact_text(xyz[3 * i + 2]) + (i % 2 ? " 1.0\n" : "\n");
+        text += "vn 0 0 1\nvt 0.5 0.5\n";
+    }
+    text += "g side\nf 1/1/1 2/2/2 3/3/3\nf 1//1 3//3 4//4\n";
+    ReadResult r = read_text(text);
+    REQUIRE_MESSAGE(r.ok, r.error);
+    CHECK(r.info.format == CloudFormat::obj);
+    CHECK(r.xyz == xyz);
+}
+
+// ==== cloud readers: malformed input ======================================================
+
+namespace {
+
+void check_fails(const std::string& bytes, const std::vector<std::string>& parts) {
+    ReadResult r = read_text(bytes);
+    CHECK_FALSE(r.ok);
+    for (const std::string& part : parts) CHECK_MESSAGE(contains(r.error, part), r.error);
+}
+
+} // namespace
+
+TEST_CASE("truncated binary PLY") {
+    std::string whole = busy_binary_ply(test_points(10), false);
+    check_fails(whole.substr(0, whole.size() - 20), {"byte", "vertex"});
+    std::string header = little_ply_header(std::string("element vertex 10\n") + kXyz);
+    check_fails(header + std::string(12 * 5, '\0'), {"byte", "declares 10 records of 12 bytes"});
+}
+
+TEST_CASE("a list running past the end of the file") {
+    Bytes b{false, little_ply_header("element face 1\nproperty list uint int v\n"
+                                     "element vertex 1\n" +
+                                     std::string(kXyz))};
+    b.put<uint32_t>(4000000000u).put<int32_t>(1);
+    check_fails(b.data, {"byte", "ends inside element 'face' record 0"});
+}
+
+TEST_CASE("a negative list length in a signed count type") {
+    Bytes b{false, little_ply_header("element face 1\nproperty list char int v\n"
+                                     "element vertex 1\n" +
+                                     std::string(kXyz))};
+    b.put<int8_t>(-1);
+    check_fails(b.data, {"byte", "negative length"});
+}
+
+TEST_CASE("a vertex count of 4000000000 is caught before any allocation") {
+    std::string lie = std::string("element vertex 4000000000\n") + kXyz;
+    check_fails(little_ply_header(lie) + std::string(36, '\0'), {"declares 4000000000"});
+    check_fails("ply\nformat ascii 1.0\n" + lie + "end_header\n1 2 3\n",
+                {"line 8", "ends inside element 'vertex' record 1 of 4000000000"});
+}
+
+TEST_CASE("element counts that overflow") {
+    std::string fixed = "element face 18446744073709551615\nproperty uchar a\nproperty double b\n";
+    check_fails(little_ply_header(fixed + "element vertex 1\n" + kXyz) + std::string(64, '\0'),
+                {"declares 18446744073709551615"});
+    std::string lists = "element face 18446744073709551615\nproperty list uchar int v\n";
+    check_fails(little_ply_header(lists + "element vertex 1\n" + kXyz) + std::string(64, '\0'),
+                {"ends inside element 'face'"});
+    check_fails(little_ply_header("element vertex 99999999999999999999\n"), {"is too large"});
+}
+
+TEST_CASE("bad counts and types in a PLY header") {
+    check_fails(little_ply_header("element vertex -5\n"), {"line 3", "is negative"});
+    check_fails(little_ply_header("element vertex lots\n"), {"line 3", "not a whole number"});
+    check_fails(little_ply_header("element vertex 1\nproperty float128 x\n"),
+                {"line 4", "unknown property type 'float128'"});
+    check_fails(little_ply_header("element face 1\nproperty list float int v\n"),
+                {"line 4", "must be an integer type"});
+    check_fails(little_ply_header("property float x\n"), {"before any 'element'"});
+    check_fails(little_ply_header("elephant vertex 1\n"), {"unknown header keyword"});
+    check_fails("ply\nformat binary_middle_endian 1.0\nend_header\n", {"unknown encoding"});
+    check_fails("ply\nelement vertex 0\nend_header\n", {"no 'format' line"});
+    check_fails("ply\nformat ascii 1.0\nelement vertex 1\n", {"no 'end_header'"});
+}
+
+TEST_CASE("missing or unusable x, y, z") {
+    check_fails(little_ply_header("element vertex 1\nproperty float x\nproperty float y\n"),
+                {"no 'z' property"});
+    check_fails(little_ply_header("element vertex 1\nproperty float x\nproperty float y\n"
+                                  "property list uchar float z\n"),
+                {"'z' is a list"});
+    check_fails(little_ply_header("element face 0\n"), {"no 'vertex' element"});
+}
+
+TEST_CASE("a file that is only a header") {
+    check_fails(little_ply_header(std::string("element vertex 3\n") + kXyz),
+                {"byte", "declares 3 records"});
+    check_fails("ply\nformat ascii 1.0\nelement vertex 3\n" + std::string(kXyz) + "end_header\n",
+                {"ends inside element 'vertex' record 0 of 3"});
+}
+
+TEST_CASE("garbage in text files names the line") {
+    check_fails("1 2 3\n4 5 6\n7 x 9\n", {"line 3", "'x' is not a number"});
+    check_fails("1 2 3\n4 5\n", {"line 2", "expected at least 3 numbers"});
+    check_fails("1 2 3\n4 5 6 7 8 9 oops\n", {"line 2", "'oops'"});
+    check_fails("ply\nformat ascii 1.0\nelement vertex 2\n" + std::string(kXyz) +
+                    "end_header\n1 2 3\n4 five 6\n",
+                {"line 9", "'five' is not a number"});
+    check_fails("OFF\n2 0 0\n1 2 3\n1 2\n", {"line 4", "expected at least 3"});
+    check_fails("v 1 2 3\nv 1 2\n", {"line 2", "expected at least 3"});
+    check_fails(std::string("1 2 3\n\x01\x02\xff 5 6\n", 14), {"line 2", "\\x01\\x02\\xff"});
+}
+
+TEST_CASE("empty and pointless files") {
+    check_fails("", {"empty"});
+    check_fails("# nothing here\n\n", {"no points"});
+    check_fails("OFF\n4000000000 0 0\n1 2 3\n", {"line 3", "after 1 of the 4000000000 vertices"});
+    check_fails("OFF\n-4 0 0\n", {"line 2", "is negative"});
+    check_fails("OFF BINARY\n", {"binary OFF"});
+    check_fails("4OFF\n1 0 0\n1 2 3 4\n", {"'4OFF' files are not supported"});
+    check_fails("OFF\n", {"vertex count is missing"});
+    ReadResult forced = read_text("1 2 3\n", CloudFormat::obj);
+    CHECK_FALSE(forced.ok);
+    CHECK(contains(forced.error, "no 'v' line"));
+}
+
+TEST_CASE("every truncation and many corruptions of valid files fail cleanly") {
+    // Under the sanitizers this is a small deterministic fuzz run of all the readers.
+    std::vector<double> xyz = test_points(6);
+    std::vector<std::string> files = {
+        busy_binary_ply(xyz, false),   double_binary_ply(xyz, true),
+        ascii_ply(xyz, "\n"),          "OFF\n3 1 0\n1 2 3\n4 5 6\n7 8 9\n3 0 1 2\n",
+        "v 1 2 3\nv 4 5 6\nf 1 2 3\n", "3\n1 2 3\n4 5 6\n7 8 9\n"};
+    std::mt19937 random(12345);
+    for (const std::string& file : files) {
+        for (size_t length = 0; length <= file.size(); ++length) read_text(file.substr(0, length));
+        for (int round = 0; round < 300; ++round) {
+            std::string bent = file;
+            bent[random() % bent.size()] = static_cast<char>(random() & 0xff);
+            ReadResult r = read_text(bent);
+            CHECK((r.ok || !r.error.empty()));
+        }
+    }
+}
+
+// ==== format detection ====================================================================
+
+TEST_CASE("the content decides the format") {
+    auto detect = [](const std::string& s) { return detect_cloud_format(s.data(), s.size()); };
+    CHECK(detect("ply\nformat ascii 1.0\n") == CloudFormat::ply);
+    CHECK(detect("ply\r\nformat ascii 1.0\r\n") == CloudFormat::ply);
+    CHECK(detect("OFF\n3 1 0\n") == CloudFormat::off);
+    CHECK(detect("# c\nSTCNOFF\n") == CloudFormat::off);
+    CHECK(detect("# obj\nmtllib x.mtl\no a\nv 1 2 3\n") == CloudFormat::obj);
+    CHECK(detect("1 2 3\n") == CloudFormat::xyz);
+    CHECK(detect("x,y,z\n1,2,3\n") == CloudFormat::xyz);
+    CHECK(detect("plywood 1 2\n") == CloudFormat::xyz);
+    CHECK(detect("") == CloudFormat::xyz);
+}
+
+TEST_CASE("a misleading extension does not matter") {
+    TempDir dir;
+    std::vector<double> xyz = test_points(8);
+    save(dir.file("scan.xyz"), busy_binary_ply(xyz, false));
+    save(dir.file("scan.ply"), "v 1 2 3\nv 4 5 6\n");
+    save(dir.file("scan.off"), "1 2 3\n");
+    save(dir.file("scan.obj"), "OFF\n1 0 0\n1 2 3\n");
+    const struct {
+        const char* name;
+        CloudFormat format;
+        size_t points;
+    } cases[] = {{"scan.xyz", CloudFormat::ply, 8},
+                 {"scan.ply", CloudFormat::obj, 2},
+                 {"scan.off", CloudFormat::xyz, 1},
+                 {"scan.obj", CloudFormat::off, 1}};
+    for (const auto& c : cases) {
+        std::vector<double> got;
+        std::string error;
+        CloudInfo info;
+        REQUIRE_MESSAGE(read_cloud_file(dir.file(c.name), got, error, &info), error);
+        CHECK(info.format == c.format);
+        CHECK(got.size() == 3 * c.points);
+    }
+}
+
+TEST_CASE("file errors name the file") {
+    TempDir dir;
+    std::vector<double> xyz;
+    std::string error;
+    CHECK_FALSE(read_cloud_file(dir.file("missing.ply"), xyz, error));
+    CHECK(contains(error, dir.file("missing.ply") + ": cannot open"));
+    save(dir.file("bad.xyz"), "1 2 3\nfour 5 6\n");
+    CHECK_FALSE(read_cloud_file(dir.file("bad.xyz"), xyz, error));
+    CHECK(contains(error, dir.file("bad.xyz") + ": line 2"));
+    CHECK_FALSE(read_cloud_file(dir.path.string(), xyz, error));
+    CHECK(contains(error, "cannot read"));
+}
+
+TEST_CASE("extensions") {
+    CHECK(cloud_format_from_extension("a/b.PLY") == CloudFormat::ply);
+    CHECK(cloud_format_from_extension("scan.pts") == CloudFormat::xyz);
+    CHECK(cloud_format_from_extension("x.y/noext") == CloudFormat::automatic);
+    CHECK(mesh_format_from_extension("out.Stl") == MeshFormat::stl);
+    CHECK(mesh_format_from_extension("out.xyz") == MeshFormat::unknown);
+}
+
+// ==== mesh writers ========================================================================
+
+namespace {
+
+struct WrittenMesh {
+    std::vector<double> xyz;
+    std::vector<uint32_t> tris;
+};
+
+// Six points, four triangles; point 5 is used by none and must still be written.
+WrittenMesh small_mesh(bool float_exact) {
+    WrittenMesh m;
+    m.xyz = test_points(6);
+    if (float_exact) m.xyz = rounded_to_float(m.xyz);
+    m.tris = {0, 1, 2, 0, 2, 3, 0, 3, 4, 1, 4, 2};
+    return m;
+}
+
+mini_mesh::Mesh write_and_read(const WrittenMesh& m, const std::string& path, bool ascii) {
+    MeshView view = {m.xyz.data(), m.xyz.size() / 3, m.tris.data(), m.tris.size() / 3};
+    std::string error;
+    REQUIRE_MESSAGE(write_mesh_file(path, mesh_format_from_extension(path), view, ascii, error),
+                    error);
+    mini_mesh::Mesh back;
+    REQUIRE(mini_mesh::read(path, back));
+    return back;
+}
+
+} // namespace
+
+TEST_CASE("PLY, OBJ and OFF output: every vertex in input order, exact, triangles unchanged") {
+    TempDir dir;
+    for (bool float_exact : {false, true}) {
+        WrittenMesh m = small_mesh(float_exact);
+        const std::pair<const char*, bool> outputs[] = {
+            {"m.ply", false}, {"m.ply", true}, {"m.obj", false}, {"m.off", false}};
+        for (const auto& out : outputs) {
+            CAPTURE(out.first);
+            CAPTURE(out.second);
+            mini_mesh::Mesh back = write_and_read(m, dir.file(out.first), out.second);
+            CHECK(back.xyz == m.xyz);
+            CHECK(back.tris == m.tris);
+        }
+    }
+}
+
+TEST_CASE("binary PLY uses float when every coordinate is a float, double otherwise") {
+    TempDir dir;
+    std::string bytes;
+    write_and_read(small_mesh(true), dir.file("f.ply"), false);
+    REQUIRE(mini_mesh::load(dir.file("f.ply"), bytes));
+    CHECK(contains(bytes, "property float x\n"));
+    write_and_read(small_mesh(false), dir.file("d.ply"), false);
+    REQUIRE(mini_mesh::load(dir.file("d.ply"), bytes));
+    CHECK(contains(bytes, "property double x\n"));
+}
+
+TEST_CASE("STL output: triangle corners to float precision, unit normals facing the winding") {
+    TempDir dir;
+    WrittenMesh m = small_mesh(false);
+    for (bool ascii : {false, true}) {
+        mini_mesh::Mesh back = write_and_read(m, dir.file("m.stl"), ascii);
+        REQUIRE(back.xyz.size() == 3 * m.tris.size());
+        REQUIRE(back.normals.size() == m.tris.size());
+        for (size_t c = 0; c < m.tris.size(); ++c)
+            for (size_t k = 0; k < 3; ++k)
+                CHECK(static_cast<float>(back.xyz[3 * c + k]) ==
+                      static_cast<float>(m.xyz[3 * m.tris[c] + k]));
+        for (size_t t = 0; t < m.tris.size() / 3; ++t) {
+            const double* a = &m.xyz[3 * m.tris[3 * t]];
+            const double* b = &m.xyz[3 * m.tris[3 * t + 1]];
+            const double* c = &m.xyz[3 * m.tris[3 * t + 2]];
+            double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+            double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+            double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                           u[0] * v[1] - u[1] * v[0]};
+            const float* got = &back.normals[3 * t];
+            double dot = n[0] * double(got[0]) + n[1] * double(got[1]) + n[2] * double(got[2]);
+            double len =
+                std::sqrt(double(got[0]) * double(got[0]) + double(got[1]) * double(got[1]) +
+                          double(got[2]) * double(got[2]));
+            CHECK(len == doctest::Approx(1.0).epsilon(1e-6));
+            CHECK(dot > 0);
+        }
+    }
+}
+
+TEST_CASE("the tool reads back what it writes, exactly") {
+    TempDir dir;
+    WrittenMesh m = small_mesh(false);
+    for (const char* name : {"r.ply", "r.obj", "r.off"}) {
+        write_and_read(m, dir.file(name), false);
+        std::vector<double> xyz;
+        std::string error;
+        REQUIRE_MESSAGE(read_cloud_file(dir.file(name), xyz, error), error);
+        CHECK(xyz == m.xyz);
+    }
+}
+
+TEST_CASE("writer errors: bad indices, unwritable path") {
+    TempDir dir;
+    WrittenMesh m = small_mesh(false);
+    m.tris[4] = 6;
+    MeshView view = {m.xyz.data(), 6, m.tris.data(), 4};
+    std::string error;
+    CHECK_FALSE(write_mesh_file(dir.file("bad.ply"), MeshFormat::ply, view, false, error));
+    CHECK(contains(error, "refers to vertex 6"));
+    CHECK_FALSE(std::filesystem::exists(dir.file("bad.ply")));
+    view.triangle_count = 1;
+    std::string nowhere = dir.file("no/such/dir/m.obj");
+    CHECK_FALSE(write_mesh_file(nowhere, MeshFormat::obj, view, false, error));
+    CHECK(contains(error, nowhere + ": cannot create"));
+}
+
+// ==== JSON report =========================================================================
+
+TEST_CASE("json_string escapes quotes, controls and broken UTF-8") {
+    CHECK(json_string("a\"b\\c") == "\"a\\\"b\\\\c\"");
+    CHECK(json_string(std::string("\n\t\x01", 3)) == "\"\\n\\t\\u0001\"");
+    CHECK(json_string("caf\xc3\xa9") == "\"caf\xc3\xa9\"");
+    CHECK(json_string("bad\xff\xc3") == "\"bad\\ufffd\\ufffd\"");
+    CHECK(json_string("\xed\xa0\x80") == "\"\\ufffd\\ufffd\\ufffd\""); // a UTF-16 surrogate
+}
+
+TEST_CASE("the report is valid JSON, with null for unknowns and exact numbers") {
+    RunRecord r;
+    r.input_path = "in \"quoted\"\\dir\n\xff.ply";
+    r.output_path = "out.ply";
+    r.status = stratmesh::Status::not_columnar;
+    r.report.points_in = 10;
+    r.report.points_used = 6;
+    r.report.duplicates = 2;
+    r.report.rejected = 1;
+    r.report.unused = 1;
+    r.report.axis[2] = 1;
+    r.report.axis_origin[0] = 0.1;
+    r.report.detail = "a \"static\" sentence";
+    r.report.layer_count = 1;
+    stratmesh::LayerInfo layer = {};
+    layer.top = std::numeric_limits<double>::infinity();
+    layer.radius = 1.0 / 3.0;
+    r.layers.push_back(layer);
+    r.read_seconds = 0.25;
+    r.workspace_bytes = 1000;
+    mini_json::Value v;
+    std::string error;
+    REQUIRE_MESSAGE(mini_json::parse(run_record_json(r), v, error), error);
+    CHECK(v.at("status")->text == "not_columnar");
+    CHECK(v.at("detail")->text == "a \"static\" sentence");
+    CHECK(v.at("points.in")->num == 10);
+    CHECK(v.at("points.first_invalid")->kind == mini_json::Value::null);
+    CHECK(v.at("seconds.read")->num == 0.25);
+    CHECK(v.at("seconds.write")->kind == mini_json::Value::null);
+    CHECK(v.at("axis.origin")->items[0].num == 0.1);
+    CHECK(v.at("memory.workspace_bytes_per_point")->num == 100);
+    const mini_json::Value& first = v.at("layers")->items.at(0);
+    CHECK(first.member("top")->kind == mini_json::Value::null);
+    CHECK(first.member("radius")->num == 1.0 / 3.0);
+}
+
+// ==== command line ========================================================================
+
+namespace {
+
+CommandAction parse(std::vector<const char*> args, CommandLine& line, std::string& error) {
+    args.insert(args.begin(), "stratmesh");
+    return parse_command_line(static_cast<int>(args.size()), args.data(), line, error);
+}
+
+std::string usage_error(std::vector<const char*> args) {
+    CommandLine line;
+    std::string error;
+    CHECK(parse(args, line, error) == CommandAction::usage_error);
+    return error;
+}
+
+} // namespace
+
+TEST_CASE("command line: every option") {
+    CommandLine line;
+    std::string error;
+    REQUIRE(parse({"in.xyz", "-o", "out.stl", "--axis", "1,-2,0.5", "--cuts=3,-1.5,1e2", "--report",
+                   "r.json", "--ascii", "--skip-invalid", "-q"},
+                  line, error) == CommandAction::run);
+    CHECK(line.input == "in.xyz");
+    CHECK(line.output == "out.stl");
+    CHECK(line.axis == stratmesh::Axis::direction);
+    CHECK(line.direction[1] == -2);
+    CHECK(line.cuts == std::vector<double>{3, -1.5, 100});
+    CHECK(line.report == "r.json");
+    CHECK((line.ascii && line.skip_invalid && line.quiet));
+    CommandLine other;
+    REQUIRE(parse({"--layers", "12", "--axis=z", "--output=m.obj", "--", "-odd name.ply"}, other,
+                  error) == CommandAction::run);
+    CHECK(other.layer_count == 12);
+    CHECK(other.axis == stratmesh::Axis::z);
+    CHECK(other.input == "-odd name.ply");
+}
+
+TEST_CASE("command line: help and version win over errors") {
+    CommandLine line;
+    std::string error;
+    CHECK(parse({"--bogus", "--help"}, line, error) == CommandAction::help);
+    CHECK(parse({"-h"}, line, error) == CommandAction::help);
+    CHECK(parse({"--version", "in.ply"}, line, error) == CommandAction::version);
+    CHECK(contains(usage_text(), "Usage: stratmesh INPUT -o OUTPUT"));
+}
+
+TEST_CASE("command line: usage errors") {
+    CHECK(contains(usage_error({}), "no input file"));
+    CHECK(contains(usage_error({"in.ply"}), "no output file"));
+    CHECK(contains(usage_error({"in.ply", "-o", "out.xyz"}), "cannot tell the mesh format"));
+    CHECK(contains(usage_error({"in.ply", "-o", "m.ply", "--frobnicate"}),
+                   "unknown option '--frobnicate'"));
+    CHECK(contains(usage_error({"in.ply", "-o"}), "needs a value"));
+    CHECK(contains(usage_error({"a.ply", "b.ply", "-o", "m.ply"}), "more than one input"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "-o", "n.ply"}), "more than once"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--layers", "abc"}), "--layers"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--layers", "0"}), "--layers"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--layers", "-3"}), "--layers"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--layers", "4294967296"}), "--layers"));
+    CHECK(
+        contains(usage_error({"a.ply", "-o", "m.ply", "--layer-height", "-1"}), "--layer-height"));
+    CHECK(
+        contains(usage_error({"a.ply", "-o", "m.ply", "--layer-height", "nan"}), "--layer-height"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--cuts", "1,,2"}), "--cuts"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--cuts", "1,inf"}), "--cuts"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--axis", "w"}), "--axis"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--axis", "0,0,0"}), "must not be zero"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--axis", "1,2"}), "--axis"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--ascii=yes"}), "takes no value"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--layers", "3", "--cuts", "1"}),
+                   "at most one of"));
+}

@@ -13,16 +13,29 @@
 //     #define STRATMESH_IMPLEMENTATION    // in exactly one .cpp file
 //     #include "stratmesh.h"
 //
-//     // 2D Delaunay triangulation of n points stored as x0,y0,x1,y1,...
-//     std::vector<unsigned char> work(stratmesh::delaunay_2d_workspace_size(n));
-//     std::vector<uint32_t> tris(3 * stratmesh::delaunay_2d_max_triangles(n));
-//     stratmesh::Delaunay2dInfo info;
-//     stratmesh::Status s = stratmesh::delaunay_2d(xy, n, 2 * sizeof(double),
-//                                                  work.data(), work.size(),
-//                                                  tris.data(), tris.size() / 3, &info,
-//                                                  nullptr);
+//     // A mesh through n scanned points stored as x, y, z floats.
+//     stratmesh::Options options = {};               // all zero: defaults
+//     options.axis = stratmesh::Axis::z;
+//     options.layer_count = 6;
+//     stratmesh::Cloud cloud = {xyz, n, 0, stratmesh::Scalar::float32};  // 0: packed
+//     std::vector<unsigned char> work(stratmesh::reconstruct_workspace_size(n, options));
+//     std::vector<uint32_t> tris(3 * stratmesh::reconstruct_max_triangles(n, options));
+//     stratmesh::Report report = {};
+//     size_t count = 0;
+//     stratmesh::Status s = stratmesh::reconstruct(cloud, options, work.data(), work.size(),
+//                                                  tris.data(), tris.size() / 3, &count,
+//                                                  &report);
 //     if (s != stratmesh::Status::ok) puts(stratmesh::status_string(s));
-//     // tris[0 .. 3 * info.triangle_count) are counter-clockwise index triples.
+//     // tris[0 .. 3 * count) index the cloud, counter-clockwise seen from outside.
+//
+//     // The 2D Delaunay triangulation on its own, of points stored as x0, y0, x1, y1, ...
+//     std::vector<unsigned char> work2(stratmesh::delaunay_2d_workspace_size(m));
+//     std::vector<uint32_t> tris2(3 * stratmesh::delaunay_2d_max_triangles(m));
+//     stratmesh::Delaunay2dInfo info;
+//     s = stratmesh::delaunay_2d(xy, m, 2 * sizeof(double), work2.data(), work2.size(),
+//                                tris2.data(), tris2.size() / 3, &info, nullptr);
+//
+// (std::vector is only the caller's choice here: any buffer will do, static or stack.)
 //
 // ==== Integration ==========================================================================
 //
@@ -31,8 +44,10 @@
 // that, and link it (CMake: target stratmesh::stratmesh). Including the header several
 // times, with or without the macro, is safe.
 //
-// Only freestanding-friendly C++17 headers are used: <cstddef>, <cstdint>, <cstring>,
-// <cfloat>, <climits>. Builds with -fno-exceptions -fno-rtti.
+// Only C++17 headers that need no runtime support are used: <cstddef>, <cstdint>,
+// <cstring>, <cfloat>, <climits> and <cmath> (for sqrt, floor, ceil, frexp and ldexp, which
+// IEEE-754 defines exactly, so every platform computes the same bits). Builds with
+// -fno-exceptions -fno-rtti; the library never allocates and never throws.
 //
 // ==== Configuration macros =================================================================
 //
@@ -1106,6 +1121,7 @@ inline Location locate(const Triangulation& tr, const double* p, uint32_t& edge)
 }
 
 inline bool push_edge(Triangulation& tr, uint32_t& top, uint32_t e) {
+    STRATMESH_ASSERT(top < tr.stack_capacity);
     if (top >= tr.stack_capacity) return false;
     tr.stack[top++] = e;
     return true;
@@ -1262,6 +1278,7 @@ inline Status triangulate_points(Triangulation& tr, uint32_t count, DuplicateSin
             sink.report(sink.context, k, v);
     }
     *inserted = n_inserted;
+    STRATMESH_ASSERT(tr.triangle_count == 2 * n_inserted - 2);
     return tr.triangle_count == 2 * n_inserted - 2 ? Status::ok : Status::internal_error;
 }
 

@@ -2016,7 +2016,37 @@ struct Band {
     }
 };
 
+// A step sequence is a band only if no rung repeats: walking all of A while B stands
+// still (or all of B) would return to the rung it started from. That happens exactly when
+// the cyclic sequence has a single run of A steps, so a band needs at least two.
+inline bool starts_a_run(const unsigned char* steps, uint32_t length, uint32_t k) {
+    return steps[k % length] == 0 && steps[(k + length - 1) % length] == 1;
+}
+
+inline uint32_t count_a_runs(const unsigned char* steps, uint32_t length) {
+    uint32_t runs = 0;
+    for (uint32_t k = 0; k < length; ++k) runs += starts_a_run(steps, length, k);
+    return runs;
+}
+
+// Whether swapping steps t and t + 1 keeps at least two runs of A (only the run starts at
+// t, t + 1 and t + 2 can change).
+inline bool swap_keeps_band(unsigned char* steps, uint32_t length, uint32_t t, uint32_t runs) {
+    uint32_t before = 0, after = 0;
+    for (uint32_t k = t; k < t + 3; ++k) before += starts_a_run(steps, length, k);
+    unsigned char s = steps[t];
+    steps[t] = steps[t + 1];
+    steps[t + 1] = s;
+    for (uint32_t k = t; k < t + 3; ++k) after += starts_a_run(steps, length, k);
+    steps[t + 1] = steps[t];
+    steps[t] = s;
+    return runs - before + after >= 2;
+}
+
+// Merges the loops by angle; if that walks one loop in a single run (tiny or skewed
+// loops), one boundary step is swapped so the band is a band.
 inline void zip_by_angle(Band& band) {
+    const uint32_t length = band.p + band.q;
     uint32_t i = 0, j = 0, t = 0;
     while (i < band.p || j < band.q) {
         bool take_a;
@@ -2026,19 +2056,33 @@ inline void zip_by_angle(Band& band) {
         band.steps[t++] = take_a ? 0 : 1;
         if (take_a) ++i; else ++j;
     }
+    if (count_a_runs(band.steps, length) >= 2) return;
+    for (t = 0; t + 1 < length; ++t) {
+        if (band.steps[t] == band.steps[t + 1]) continue;
+        unsigned char s = band.steps[t];
+        band.steps[t] = band.steps[t + 1];
+        band.steps[t + 1] = s;
+        return;
+    }
 }
 
 // Lawson flips over the step sequence; returns the number of swaps.
 inline size_t swap_diagonals(Band& band) {
     const uint32_t length = band.p + band.q;
     const size_t limit = 16 * static_cast<size_t>(length) + 64;
+    uint32_t runs = count_a_runs(band.steps, length);
     size_t swaps = 0;
     uint32_t t = 0, i = 0, j = 0;
     while (t + 1 < length) {
-        if (band.steps[t] != band.steps[t + 1] && swaps < limit && band.should_swap(t, i, j)) {
+        if (band.steps[t] != band.steps[t + 1] && swaps < limit && band.should_swap(t, i, j) &&
+            swap_keeps_band(band.steps, length, t, runs)) {
+            uint32_t before = 0, after = 0;
+            for (uint32_t k = t; k < t + 3; ++k) before += starts_a_run(band.steps, length, k);
             unsigned char s = band.steps[t];
             band.steps[t] = band.steps[t + 1];
             band.steps[t + 1] = s;
+            for (uint32_t k = t; k < t + 3; ++k) after += starts_a_run(band.steps, length, k);
+            runs = runs - before + after;
             ++swaps;
             if (t > 0) {
                 --t;
@@ -2238,65 +2282,79 @@ inline size_t repair_fan(const uint32_t* tri, const uint32_t* incident, size_t b
 // Removes triangles until the mesh is edge- and vertex-manifold and consistently oriented.
 // Compacts the survivors in place (keeping their order); returns the number removed, or
 // SIZE_MAX if the arena is too small. *used receives the number of vertices left.
+//
+// The work runs on relabelled triangles: vertices numbered in the order the triangles
+// first name them (input indices are restored at the end). The triangles come out of the
+// layers in spatial order, so relabelled fans and their triangles sit close together in
+// memory whatever order the input points had; only the relabelling itself reads the input
+// indices at random.
 inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count, Arena& arena,
                                size_t* used) {
     size_t mark = arena.mark();
-    uint32_t* offsets = arena.alloc<uint32_t>(point_count + 1);
-    uint32_t* incident = arena.alloc<uint32_t>(3 * count);
+    uint32_t* original = arena.alloc<uint32_t>(point_count);  // label -> input index
     unsigned char* dead = arena.alloc<unsigned char>(count);
+    size_t relabel_mark = arena.mark();
+    uint32_t* label = arena.alloc<uint32_t>(point_count);     // input index -> label
     if (arena.failed) return SIZE_MAX;
-    std::memset(offsets, 0, sizeof(uint32_t) * (point_count + 1));
+    for (size_t v = 0; v < point_count; ++v) label[v] = kNoIndex;
     std::memset(dead, 0, count);
-    for (size_t k = 0; k < 3 * count; ++k) ++offsets[tri[k] + 1];
+    uint32_t labels = 0;
+    for (size_t k = 0; k < 3 * count; ++k) {
+        uint32_t& l = label[tri[k]];
+        if (l == kNoIndex) {
+            original[labels] = tri[k];
+            l = labels++;
+        }
+        tri[k] = l;
+    }
+    arena.rewind(relabel_mark);
+    uint32_t* local = tri;
+    auto give_up = [&]() {  // out of workspace: hand back the input indices untouched
+        for (size_t k = 0; k < 3 * count; ++k) tri[k] = original[tri[k]];
+        return SIZE_MAX;
+    };
+    uint32_t* offsets = arena.alloc<uint32_t>(static_cast<size_t>(labels) + 1);
+    uint32_t* incident = arena.alloc<uint32_t>(3 * count);
+    if (arena.failed) return give_up();
+    std::memset(offsets, 0, sizeof(uint32_t) * (static_cast<size_t>(labels) + 1));
+    for (size_t k = 0; k < 3 * count; ++k) ++offsets[local[k] + 1];
     size_t max_degree = 0;
-    for (size_t v = 0; v < point_count; ++v) {
+    for (uint32_t v = 0; v < labels; ++v) {
         if (offsets[v + 1] > max_degree) max_degree = offsets[v + 1];
         offsets[v + 1] += offsets[v];
     }
-    {
-        size_t inner = arena.mark();
-        uint32_t* fill = arena.alloc<uint32_t>(point_count);
-        if (arena.failed) return SIZE_MAX;
-        std::memcpy(fill, offsets, sizeof(uint32_t) * point_count);
-        for (size_t k = 0; k < 3 * count; ++k)
-            incident[fill[tri[k]]++] = static_cast<uint32_t>(k / 3);
-        arena.rewind(inner);
-    }
+    // Incidences in triangle order: a forward pass that bumps each vertex's write cursor,
+    // kept in `incident`'s own slots by filling from the end of each range.
+    for (size_t k = 3 * count; k-- > 0;)
+        incident[--offsets[local[k] + 1]] = static_cast<uint32_t>(k / 3);
+    // Now offsets[v + 1] is the start of v's range; shift back to the usual layout.
+    for (uint32_t v = 0; v < labels; ++v) offsets[v] = offsets[v + 1];
+    offsets[labels] = static_cast<uint32_t>(3 * count);
     Fan fan;
     fan.key = arena.alloc<uint64_t>(max_degree);
     fan.arrive = arena.alloc<uint32_t>(max_degree);
     fan.triangle = arena.alloc<uint32_t>(max_degree);
     fan.label = arena.alloc<uint32_t>(max_degree);
     fan.sizes = arena.alloc<uint32_t>(max_degree);
-    if (arena.failed) return SIZE_MAX;
-    // Vertices are visited in the order the triangles name them, not by index: the
-    // triangles come out of the layers in spatial order, so neighbouring fans share cache
-    // lines (input indices may be in any order). `visited` holds the pass number.
-    unsigned char* visited = arena.alloc<unsigned char>(point_count);
-    if (arena.failed) return SIZE_MAX;
-    std::memset(visited, 0, point_count);
+    if (arena.failed) return give_up();
     size_t removed = 0;
-    for (size_t pass = 1; pass <= count; ++pass) {
+    for (size_t pass = 0; pass <= count; ++pass) {
         size_t before = removed;
-        unsigned char stamp = static_cast<unsigned char>(pass % 2 + 1);
-        for (size_t k = 0; k < 3 * count; ++k) {
-            uint32_t v = tri[k];
-            if (visited[v] == stamp) continue;
-            visited[v] = stamp;
-            removed += repair_fan(tri, incident, offsets[v], offsets[v + 1], v, dead, fan);
-        }
+        for (uint32_t v = 0; v < labels; ++v)
+            removed += repair_fan(local, incident, offsets[v], offsets[v + 1], v, dead, fan);
         if (removed == before) break;
     }
-    size_t alive = 0, vertices = 0;
-    for (size_t v = 0; v < point_count; ++v) {
+    size_t vertices = 0;
+    for (uint32_t v = 0; v < labels; ++v) {
         bool touched = false;
         for (size_t k = offsets[v]; k < offsets[v + 1] && !touched; ++k)
             touched = !dead[incident[k]];
         vertices += touched;
     }
+    size_t alive = 0;
     for (size_t t = 0; t < count; ++t) {
         if (dead[t]) continue;
-        for (size_t k = 0; k < 3; ++k) tri[3 * alive + k] = tri[3 * t + k];
+        for (size_t k = 0; k < 3; ++k) tri[3 * alive + k] = original[tri[3 * t + k]];
         ++alive;
     }
     count = alive;
@@ -2350,15 +2408,15 @@ inline size_t reconstruct_scratch_size(size_t count) {
 
     size_t triangles = 2 * count;
     Arena manifold = Arena::measuring();
-    manifold.alloc<uint32_t>(count + 1);
-    manifold.alloc<uint32_t>(3 * triangles);
+    manifold.alloc<uint32_t>(count);
     manifold.alloc<unsigned char>(triangles);
     mark = manifold.mark();
     manifold.alloc<uint32_t>(count);
     manifold.rewind(mark);
+    manifold.alloc<uint32_t>(count + 1);
+    manifold.alloc<uint32_t>(3 * triangles);
     manifold.alloc<uint64_t>(triangles);
     for (int k = 0; k < 4; ++k) manifold.alloc<uint32_t>(triangles);
-    manifold.alloc<unsigned char>(count);
 
     size_t most = layer.high_water;
     if (band.high_water > most) most = band.high_water;

@@ -1,0 +1,345 @@
+// Deterministic point clouds of columnar shapes with their analytic surfaces, for the
+// reconstruction tests. Written for the tests, independently of stratmesh.
+//
+// Every shape is defined in a local frame whose axis is Z: a radial surface
+// rho = radius(theta, z) for z in [z_min, z_max] (rho, theta the polar coordinates of
+// (x, y)). A pose then places it in the world: a rotation plus an offset, so that the axis
+// is along world Z, along world X, or tilted through an arbitrary point. The Z and X poses
+// are exact: world coordinates are a permutation of the local ones plus an offset (every
+// product by 0 or 1 is exact), so points generated on one local plane z = c keep exactly
+// the same world coordinate along the axis, which the tests need to place layer cuts
+// exactly on contour planes.
+//
+// Randomness comes from a private splitmix64 generator with fixed seeds, so the random
+// numbers are the same everywhere. The coordinates also go through sin, cos, log and
+// sqrt, which compilers may fold at compile time or route to different C library entry
+// points: they are the same bits run after run of one build, but not necessarily across
+// compilers (measured: the noisy tube differs in the last bits between g++ 12 and clang++
+// 14 builds; the cylinder does not). Point and triangle indices quoted in the tests are
+// from a g++ build.
+
+#ifndef STRATMESH_TESTS_SUPPORT_SHAPES_H
+#define STRATMESH_TESTS_SUPPORT_SHAPES_H
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace shapes {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// splitmix64 (Steele, Lea, Flood 2014): tiny, fast, and good enough for sampling.
+class Rng {
+public:
+    explicit Rng(uint64_t seed) : state_(seed) {}
+    uint64_t next() {
+        uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        return z ^ (z >> 31);
+    }
+    // Uniform in [0, 1), 53 random bits.
+    double uniform() { return static_cast<double>(next() >> 11) * (1.0 / 9007199254740992.0); }
+    double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
+    // Standard normal (Box-Muller; one of the pair is dropped to stay stateless).
+    double normal() {
+        double u1 = 1.0 - uniform();  // (0, 1]
+        double u2 = uniform();
+        return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
+    }
+
+private:
+    uint64_t state_;
+};
+
+enum class Pose { z, x, tilted };
+
+inline const char* pose_name(Pose pose) {
+    switch (pose) {
+    case Pose::z: return "axis Z";
+    case Pose::x: return "axis X";
+    case Pose::tilted: return "tilted";
+    }
+    return "?";
+}
+
+// world = m * local + t.
+struct Transform {
+    double m[3][3];
+    double t[3];
+
+    void apply(const double local[3], double world[3]) const {
+        for (int r = 0; r < 3; ++r)
+            world[r] = m[r][0] * local[0] + m[r][1] * local[1] + m[r][2] * local[2] + t[r];
+    }
+    void unapply(const double world[3], double local[3]) const {
+        double d[3] = {world[0] - t[0], world[1] - t[1], world[2] - t[2]};
+        for (int c = 0; c < 3; ++c) local[c] = m[0][c] * d[0] + m[1][c] * d[1] + m[2][c] * d[2];
+    }
+};
+
+inline Transform transform_for(Pose pose) {
+    Transform tr = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {0.25, -0.5, 2.0}};
+    if (pose == Pose::x) {
+        // local z -> world x, local x -> world y, local y -> world z (a rotation).
+        tr = {{{0, 0, 1}, {1, 0, 0}, {0, 1, 0}}, {-3.0, 0.75, 0.5}};
+    } else if (pose == Pose::tilted) {
+        // Rotation by 0.9 rad about the unit vector along (1, 2, 3) (Rodrigues), then an
+        // offset well away from the origin.
+        double k[3] = {1, 2, 3};
+        double len = std::sqrt(k[0] * k[0] + k[1] * k[1] + k[2] * k[2]);
+        for (double& v : k) v /= len;
+        double a = 0.9, c = std::cos(a), s = std::sin(a), C = 1 - c;
+        double m[3][3] = {{c + k[0] * k[0] * C, k[0] * k[1] * C - k[2] * s, k[0] * k[2] * C + k[1] * s},
+                          {k[1] * k[0] * C + k[2] * s, c + k[1] * k[1] * C, k[1] * k[2] * C - k[0] * s},
+                          {k[2] * k[0] * C - k[1] * s, k[2] * k[1] * C + k[0] * s, c + k[2] * k[2] * C}};
+        for (int r = 0; r < 3; ++r)
+            for (int col = 0; col < 3; ++col) tr.m[r][col] = m[r][col];
+        tr.t[0] = 12.5;
+        tr.t[1] = -7.25;
+        tr.t[2] = 30.0;
+    }
+    return tr;
+}
+
+using RadiusFunction = std::function<double(double theta, double z)>;
+
+struct Shape {
+    std::string name;
+    Pose pose = Pose::z;
+    Transform transform = transform_for(Pose::z);
+    RadiusFunction radius;       // the analytic surface, in the local frame
+    double z_min = 0, z_max = 0; // its height range, local
+    double spacing = 0;          // typical distance between neighbouring points
+    double noise = 0;            // standard deviation of the Gaussian noise, 0 if exact
+    std::vector<double> xyz;     // world coordinates, packed
+    std::vector<double> planes;  // local heights of the contour planes or grid rows, if any
+
+    size_t size() const { return xyz.size() / 3; }
+    const double* point(size_t i) const { return xyz.data() + 3 * i; }
+
+    // The world axis: a point on it and its unit direction (the local +Z).
+    void axis_point(double out[3]) const { out[0] = transform.t[0], out[1] = transform.t[1], out[2] = transform.t[2]; }
+    void axis_direction(double out[3]) const {
+        for (int r = 0; r < 3; ++r) out[r] = transform.m[r][2];
+    }
+    // The world coordinate along the axis, dot(P, axis), of the plane at local height z,
+    // computed from the world point on the axis at that height. For the Z and X poses it
+    // equals, bit for bit, dot(p, axis) of every point generated on that plane.
+    double along_axis(double z) const {
+        double local[3] = {0, 0, z}, world[3], a[3];
+        transform.apply(local, world);
+        axis_direction(a);
+        return world[0] * a[0] + world[1] * a[1] + world[2] * a[2];
+    }
+    // Signed radial deviation of a world point from the surface: rho - radius(theta, z) in
+    // the local frame (positive outside). For the slopes used here it is within a factor
+    // of about 1.5 of the Euclidean distance.
+    double deviation(const double* p) const {
+        double local[3];
+        transform.unapply(p, local);
+        double rho = std::sqrt(local[0] * local[0] + local[1] * local[1]);
+        return rho - radius(std::atan2(local[1], local[0]), local[2]);
+    }
+    // Appends the world point at local (theta, z, rho).
+    void add_local(double theta, double z, double rho) {
+        double local[3] = {rho * std::cos(theta), rho * std::sin(theta), z}, world[3];
+        transform.apply(local, world);
+        xyz.insert(xyz.end(), world, world + 3);
+    }
+};
+
+namespace detail {
+
+// |dP/dtheta x dP/dz| for P = (r cos t, r sin t, z): sqrt(r^2 + r_t^2 + r^2 r_z^2).
+inline double area_element(const RadiusFunction& radius, double theta, double z) {
+    const double h = 1e-5;
+    double r = radius(theta, z);
+    double rt = (radius(theta + h, z) - radius(theta - h, z)) / (2 * h);
+    double rz = (radius(theta, z + h) - radius(theta, z - h)) / (2 * h);
+    return std::sqrt(r * r + rt * rt + r * r * rz * rz);
+}
+
+// Surface area and the largest area element, on a fine grid.
+inline std::pair<double, double> surface_area(const RadiusFunction& radius, double z0, double z1) {
+    const int nt = 128, nz = 128;
+    double area = 0, peak = 0;
+    double dt = 2 * kPi / nt, dz = (z1 - z0) / nz;
+    for (int i = 0; i < nt; ++i)
+        for (int j = 0; j < nz; ++j) {
+            double e = area_element(radius, (i + 0.5) * dt, z0 + (j + 0.5) * dz);
+            area += e * dt * dz;
+            if (e > peak) peak = e;
+        }
+    return {area, peak};
+}
+
+inline Shape start(const char* name, Pose pose, RadiusFunction radius, double z0, double z1) {
+    Shape s;
+    s.name = std::string(name) + " (" + pose_name(pose) + ")";
+    s.pose = pose;
+    s.transform = transform_for(pose);
+    s.radius = std::move(radius);
+    s.z_min = z0;
+    s.z_max = z1;
+    return s;
+}
+
+// The angle difference a - b wrapped to (-pi, pi].
+inline double angle_between(double a, double b) {
+    double d = std::fmod(a - b, 2 * kPi);
+    if (d > kPi) d -= 2 * kPi;
+    if (d <= -kPi) d += 2 * kPi;
+    return d;
+}
+
+inline double smoothstep(double t) {
+    if (t <= 0) return 0;
+    if (t >= 1) return 1;
+    return t * t * (3 - 2 * t);
+}
+
+}  // namespace detail
+
+// n points uniformly distributed over the area of a radial surface (rejection sampling),
+// with theta in [theta0, theta1) and optional isotropic Gaussian noise of standard
+// deviation `noise`.
+inline Shape radial_random(const char* name, Pose pose, RadiusFunction radius, double z0,
+                           double z1, size_t n, uint64_t seed, double noise = 0,
+                           double theta0 = 0, double theta1 = 2 * kPi) {
+    Shape s = detail::start(name, pose, std::move(radius), z0, z1);
+    std::pair<double, double> area = detail::surface_area(s.radius, z0, z1);
+    double fraction = (theta1 - theta0) / (2 * kPi);
+    s.spacing = std::sqrt(area.first * fraction / static_cast<double>(n));
+    s.noise = noise;
+    double bound = 1.05 * area.second;
+    Rng rng(seed);
+    s.xyz.reserve(3 * n);
+    while (s.size() < n) {
+        double theta = rng.uniform(theta0, theta1);
+        double z = rng.uniform(z0, z1);
+        if (rng.uniform() * bound > detail::area_element(s.radius, theta, z)) continue;
+        double rho = s.radius(theta, z);
+        s.add_local(theta, z, rho);
+        if (noise > 0) {
+            double* p = &s.xyz[s.xyz.size() - 3];
+            for (int k = 0; k < 3; ++k) p[k] += noise * rng.normal();
+        }
+    }
+    return s;
+}
+
+// Radius functions of the shapes (local frame).
+inline double cylinder_radius(double, double) { return 1.0; }
+inline double ellipse_radius(double theta, double) {
+    const double a = 1.5, b = 0.8;
+    double c = std::cos(theta), s = std::sin(theta);
+    return a * b / std::sqrt(b * b * c * c + a * a * s * s);
+}
+inline double bumpy_radius(double theta, double z) { return 1 + 0.25 * std::sin(5 * theta) * std::cos(z); }
+inline double cone_radius(double, double z) { return 1.5 - 0.2 * z; }
+inline double vase_radius(double, double z) { return 1 + 0.5 * std::sin(1.5 * z); }
+
+// A head-like column over z in [0, 2.4]: a neck (radius 0.45), a wider skull (about 0.9),
+// slightly longer front to back, narrowing a little at the crown (left open), and a nose
+// bump facing local +x between about z = 1.35 and 1.75.
+inline double head_radius(double theta, double z) {
+    double base = 0.45 + 0.45 * detail::smoothstep((z - 0.6) / 0.7) -
+                  0.12 * detail::smoothstep((z - 2.0) / 0.4);
+    double shape = 1 + 0.08 * std::cos(2 * theta);
+    double dt = detail::angle_between(theta, 0) / 0.22, dz = (z - 1.55) / 0.13;
+    double nose = 0.2 * std::exp(-dt * dt - dz * dz);
+    return base * shape + nose;
+}
+
+inline Shape cylinder(size_t n, Pose pose, uint64_t seed = 11) {
+    return radial_random("cylinder", pose, cylinder_radius, -3, 3, n, seed);
+}
+inline Shape elliptic_tube(size_t n, Pose pose, uint64_t seed = 12) {
+    return radial_random("elliptic tube", pose, ellipse_radius, -3, 3, n, seed);
+}
+inline Shape bumpy_tube(size_t n, Pose pose, uint64_t seed = 13) {
+    return radial_random("bumpy tube", pose, bumpy_radius, -3, 3, n, seed);
+}
+inline Shape cone(size_t n, Pose pose, uint64_t seed = 14) {
+    return radial_random("cone", pose, cone_radius, -3, 3, n, seed);
+}
+inline Shape vase(size_t n, Pose pose, uint64_t seed = 15) {
+    return radial_random("vase", pose, vase_radius, -3, 3, n, seed);
+}
+// Uniform sampling of the bumpy tube with isotropic Gaussian noise of standard deviation
+// `relative_noise` times the point spacing.
+inline Shape noisy_tube(size_t n, Pose pose, double relative_noise = 0.05, uint64_t seed = 16) {
+    double spacing = std::sqrt(detail::surface_area(bumpy_radius, -3, 3).first / static_cast<double>(n));
+    return radial_random("noisy bumpy tube", pose, bumpy_radius, -3, 3, n, seed,
+                         relative_noise * spacing);
+}
+// A cylinder of small radius over z in [-3, 3]: very tall for its width.
+inline Shape thin_tube(size_t n, Pose pose, double radius, uint64_t seed = 21) {
+    return radial_random("thin tube", pose, [radius](double, double) { return radius; }, -3, 3, n, seed);
+}
+inline Shape head(size_t n, Pose pose, uint64_t seed = 17) {
+    return radial_random("head", pose, head_radius, 0, 2.4, n, seed);
+}
+// A cylinder with theta in [0, pi] only: it does not surround its axis.
+inline Shape half_cylinder(size_t n, Pose pose, uint64_t seed = 18) {
+    return radial_random("half cylinder", pose, cylinder_radius, -3, 3, n, seed, 0, 0, kPi);
+}
+// A cylinder with a slit: theta in [0, 2 pi - gap).
+inline Shape slit_cylinder(size_t n, Pose pose, double gap, uint64_t seed = 19) {
+    return radial_random("slit cylinder", pose, cylinder_radius, -3, 3, n, seed, 0, 0,
+                         2 * kPi - gap);
+}
+
+// A cylindrical range scan: a regular (theta, z) grid on the unit cylinder over
+// z in [-3, 3], with about n points in rows of equal angular and vertical spacing. Every
+// grid cell is a rectangle: four cocircular points, everywhere.
+inline Shape scan_grid(size_t n, Pose pose) {
+    Shape s = detail::start("cylindrical range scan grid", pose, cylinder_radius, -3, 3);
+    const double height = 6, circumference = 2 * kPi;
+    // columns * rows ~ n with circumference / columns ~ height / (rows - 1).
+    size_t columns = static_cast<size_t>(std::lround(std::sqrt(static_cast<double>(n) * circumference / height)));
+    if (columns < 8) columns = 8;
+    size_t rows = (n + columns - 1) / columns;
+    if (rows < 2) rows = 2;
+    s.spacing = std::fmax(circumference / static_cast<double>(columns),
+                          height / static_cast<double>(rows - 1));
+    for (size_t j = 0; j < rows; ++j) {
+        double z = -3 + height * static_cast<double>(j) / static_cast<double>(rows - 1);
+        s.planes.push_back(z);
+        for (size_t i = 0; i < columns; ++i)
+            s.add_local(2 * kPi * static_cast<double>(i) / static_cast<double>(columns), z, 1.0);
+    }
+    return s;
+}
+
+// A stack of planar contours, like CT or MRI slices: `slices` equally spaced planes over
+// z in [-3, 3] through the vase, each cut by a contour of about n / slices points at equal
+// angles from a random phase. Many points share each height.
+inline Shape ct_slices(size_t n, Pose pose, size_t slices = 20, uint64_t seed = 20) {
+    Shape s = detail::start("CT slice stack (vase)", pose, vase_radius, -3, 3);
+    Rng rng(seed);
+    size_t per_slice = n / slices;
+    double gap = 6.0 / static_cast<double>(slices - 1);
+    s.spacing = std::fmax(gap, 2 * kPi * 1.5 / static_cast<double>(per_slice));
+    for (size_t j = 0; j < slices; ++j) {
+        double z = -3 + gap * static_cast<double>(j);
+        if (j + 1 == slices) z = 3;
+        s.planes.push_back(z);
+        double phase = rng.uniform();
+        for (size_t i = 0; i < per_slice; ++i) {
+            double theta = 2 * kPi * (static_cast<double>(i) + phase) / static_cast<double>(per_slice);
+            s.add_local(theta, z, vase_radius(theta, z));
+        }
+    }
+    return s;
+}
+
+}  // namespace shapes
+
+#endif  // STRATMESH_TESTS_SUPPORT_SHAPES_H

@@ -1,0 +1,1387 @@
+// reconstruct: every mesh is verified by the independent checker in support/mesh_check.h
+// (edges, fans, components, boundary loops, Euler characteristic, orientation against the
+// true axis, deviation from the analytic surface, self-intersections through a grid) on the
+// clouds of support/shapes.h, each along Z, along X and tilted, at two sizes and with every
+// way of choosing layers; plus the documented contract of the API: report counts, layer
+// details, statuses for bad data, workspace and triangle capacity, strides and float input,
+// duplicates, invalid points and determinism.
+//
+// Measured behaviour the tolerances rest on (g++ 12 -O2, x86-64, library at commit
+// aa58fe1; the numbers in the comments below are from that run):
+//   - one layer: every property holds exactly for every shape, pose and size, including all
+//     triangles facing outward and no self-intersection;
+//   - several layers: the bands between layers hold a few triangles facing the axis (at
+//     most 2 a run in the matrix below, some of them strongly: normals up to 155 degrees
+//     from the outward direction), Report::folds counting them within 2, and some of those
+//     folds intersect their neighbours. The strict properties are asserted in test cases
+//     marked may_fail (a library defect: these layers are star-shaped about their centres,
+//     where the header promises outward normals), the bounded counts in passing ones;
+//   - deviation from the true surface, in point spacings: at most 2.64 with one layer (the
+//     boundary loops are coarser than the spacing: the hull and the centre's link on the
+//     annulus skip points slightly inside them) and 1.3 off the boundary; up to 3.22
+//     through the bands with several layers (noisy tube, 2000 points).
+#include "stratmesh.h"
+#include "support/mesh_check.h"
+#include "support/shapes.h"
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using stratmesh::Axis;
+using stratmesh::Cloud;
+using stratmesh::LayerInfo;
+using stratmesh::Options;
+using stratmesh::Report;
+using stratmesh::Scalar;
+using stratmesh::Status;
+using shapes::Pose;
+using shapes::Shape;
+
+const size_t kSmall = 2000;
+const size_t kLarge = 20000;
+const unsigned char kGuardByte = 0xA5;
+const size_t kGuardBytes = 64;
+const uint32_t kSentinel = 0xDEADBEEFu;
+const size_t kGuardTriangles = 8;
+const size_t kLayerCapacity = 256;
+
+// ---- running reconstruct with guarded buffers ---------------------------------------------
+
+struct Run {
+    Status status = Status::internal_error;
+    std::vector<uint32_t> triangles;  // 3 * count indices
+    size_t count = 0;
+    Report report{};
+    std::vector<LayerInfo> layers;    // report.layer_count of them (at most kLayerCapacity)
+    size_t workspace_bytes = 0;
+    size_t max_triangles = 0;
+    bool workspace_guard_intact = true;  // nothing written past the workspace
+    bool triangle_guard_intact = true;   // nothing written past the capacity
+};
+
+// reconstruct() with reconstruct_workspace_size() bytes of workspace starting `misalign`
+// bytes into a buffer, reconstruct_max_triangles() triangles, and guard zones after both.
+Run reconstruct_guarded(const Cloud& cloud, const Options& options, size_t misalign = 0) {
+    Run run;
+    run.workspace_bytes = stratmesh::reconstruct_workspace_size(cloud.count, options);
+    run.max_triangles = stratmesh::reconstruct_max_triangles(cloud.count, options);
+    std::vector<unsigned char> workspace(misalign + run.workspace_bytes + kGuardBytes, kGuardByte);
+    std::vector<uint32_t> triangles(3 * (run.max_triangles + kGuardTriangles), kSentinel);
+    std::vector<LayerInfo> layers(kLayerCapacity);
+    run.report.layers = layers.data();
+    run.report.layer_capacity = layers.size();
+    run.status = stratmesh::reconstruct(cloud, options, workspace.data() + misalign,
+                                        run.workspace_bytes, triangles.data(), run.max_triangles,
+                                        &run.count, &run.report);
+    for (size_t i = misalign + run.workspace_bytes; i < workspace.size(); ++i)
+        if (workspace[i] != kGuardByte) run.workspace_guard_intact = false;
+    for (size_t i = 3 * run.max_triangles; i < triangles.size(); ++i)
+        if (triangles[i] != kSentinel) run.triangle_guard_intact = false;
+    if (run.status == Status::ok && run.count <= run.max_triangles)
+        run.triangles.assign(triangles.begin(), triangles.begin() + static_cast<std::ptrdiff_t>(3 * run.count));
+    layers.resize(std::min(run.report.layer_count, kLayerCapacity));
+    run.layers = layers;
+    run.report.layers = nullptr;  // the array it pointed to is gone
+    return run;
+}
+
+Cloud cloud_of(const Shape& s) { return Cloud{s.xyz.data(), s.size(), 0, Scalar::float64}; }
+
+// The stacking axis of a shape as the library is told it.
+Options axis_options(const Shape& s) {
+    Options o = {};
+    switch (s.pose) {
+    case Pose::z: o.axis = Axis::z; break;
+    case Pose::x: o.axis = Axis::x; break;
+    case Pose::tilted:
+        o.axis = Axis::direction;
+        s.axis_direction(o.direction);
+        break;
+    }
+    return o;
+}
+
+mesh_check::Result check_mesh(const Shape& s, const uint32_t* triangles, size_t count,
+                              bool self_intersections,
+                              const std::vector<char>* expected_used = nullptr) {
+    mesh_check::Input in;
+    in.points = s.xyz.data();
+    in.point_count = s.size();
+    in.triangles = triangles;
+    in.triangle_count = count;
+    s.axis_point(in.axis_point);
+    s.axis_direction(in.axis_direction);
+    in.expected_used = expected_used;
+    in.surface = [&s](const double* p) { return s.deviation(p); };
+    in.self_intersections = self_intersections;
+    return mesh_check::check(in);
+}
+
+// ---- the shapes and the ways of choosing layers -------------------------------------------
+
+struct ShapeKind {
+    const char* name;
+    std::function<Shape(size_t, Pose)> make;
+};
+
+const std::vector<ShapeKind>& shape_kinds() {
+    static const std::vector<ShapeKind> kinds = {
+        {"cylinder", [](size_t n, Pose p) { return shapes::cylinder(n, p); }},
+        {"elliptic tube", [](size_t n, Pose p) { return shapes::elliptic_tube(n, p); }},
+        {"bumpy tube", [](size_t n, Pose p) { return shapes::bumpy_tube(n, p); }},
+        {"cone", [](size_t n, Pose p) { return shapes::cone(n, p); }},
+        {"vase", [](size_t n, Pose p) { return shapes::vase(n, p); }},
+        {"scan grid", [](size_t n, Pose p) { return shapes::scan_grid(n, p); }},
+        {"CT slices", [](size_t n, Pose p) { return shapes::ct_slices(n, p); }},
+        {"noisy tube", [](size_t n, Pose p) { return shapes::noisy_tube(n, p); }},
+        {"head", [](size_t n, Pose p) { return shapes::head(n, p); }},
+    };
+    return kinds;
+}
+
+enum class Layering { single, equal, cuts, height, uneven, automatic };
+const Layering kLayerings[] = {Layering::single, Layering::equal, Layering::cuts,
+                               Layering::height, Layering::uneven, Layering::automatic};
+
+const char* layering_name(Layering l) {
+    switch (l) {
+    case Layering::single: return "one layer (layer_count 1)";
+    case Layering::equal: return "6 equal layers (layer_count 6)";
+    case Layering::cuts: return "explicit cuts";
+    case Layering::height: return "layer_height H/8";
+    case Layering::uneven: return "uneven cuts (3%, 3%, 79%, 15% of the height)";
+    case Layering::automatic: return "automatic layers";
+    }
+    return "?";
+}
+
+// Options for a shape and a layering; explicit cuts are stored in `cuts`, which must
+// outlive the options. Cuts are positions along the axis, dot(point, axis). Cuts on contour
+// planes are exact for the Z and X poses (see shapes.h); for the tilted pose they are
+// placed half-way between planes (cuts on planes there are the subject of their own test).
+Options layered_options(const Shape& s, Layering layering, std::vector<double>& cuts) {
+    Options o = axis_options(s);
+    cuts.clear();
+    const double height = s.z_max - s.z_min;
+    switch (layering) {
+    case Layering::single: o.layer_count = 1; break;
+    case Layering::equal: o.layer_count = 6; break;
+    case Layering::height: o.layer_height = height / 8; break;
+    case Layering::automatic: break;
+    case Layering::uneven:
+        for (double f : {0.85, 0.03, 0.06}) cuts.push_back(s.along_axis(s.z_min + f * height));
+        break;
+    case Layering::cuts:
+        if (!s.planes.empty()) {
+            const std::vector<double>& p = s.planes;
+            if (s.pose == Pose::tilted) {
+                for (size_t j = 1; j + 1 < p.size(); j += 3) cuts.push_back(s.along_axis((p[j] + p[j + 1]) / 2));
+            } else {
+                // Every third plane, the top plane (a last layer holding only the top
+                // contour), the bottom plane (no layer below it: ignored), a repeat.
+                for (size_t j = 1; j < p.size(); j += 3) cuts.push_back(s.along_axis(p[j]));
+                cuts.push_back(s.along_axis(p.back()));
+                cuts.push_back(s.along_axis(p.front()));
+                cuts.push_back(s.along_axis(p[4]));
+            }
+        } else {
+            // Unsorted, with a repeat and two cuts outside the cloud.
+            for (double f : {0.5, 0.3, 0.8, 0.1, 0.5, 1.7, -0.4}) cuts.push_back(s.along_axis(s.z_min + f * height));
+        }
+        break;
+    }
+    if (!cuts.empty()) {
+        o.cuts = cuts.data();
+        o.cut_count = cuts.size();
+    }
+    return o;
+}
+
+bool is_single_layer(Layering l) { return l == Layering::single; }
+
+// ---- the property checks shared by the shape matrix ---------------------------------------
+
+// Deviation tolerances in point spacings (plus four standard deviations of noise); measured
+// maxima in the header comment.
+const double kSingleLayerDeviation = 3.0;
+const double kSingleLayerInteriorDeviation = 1.5;
+const double kLayeredDeviation = 4.0;
+
+// Several layers: at most this many triangles facing the axis (measured: at most 2 in a run
+// of the matrix; the bound allows 3 per band plus 0.1% of the triangles).
+size_t fold_allowance(const Run& run) {
+    size_t bands = run.report.layer_count > 0 ? run.report.layer_count - 1 : 0;
+    return 3 * bands + run.count / 1000;
+}
+
+struct Case {
+    std::string name;
+    Layering layering = Layering::single;
+    size_t points = 0;
+    double spacing = 0, noise = 0;
+    Run run;
+    mesh_check::Result mesh;
+    bool checked_intersections = false;
+    double ms_reconstruct = 0, ms_check = 0;
+};
+
+double elapsed_ms(std::chrono::steady_clock::time_point since) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
+}
+
+Case run_case(const Shape& s, Layering layering, bool self_intersections) {
+    Case c;
+    c.name = s.name + ", " + std::to_string(s.size()) + " points, " + layering_name(layering);
+    c.layering = layering;
+    c.points = s.size();
+    c.spacing = s.spacing;
+    c.noise = s.noise;
+    std::vector<double> cuts;
+    Options o = layered_options(s, layering, cuts);
+    auto t0 = std::chrono::steady_clock::now();
+    c.run = reconstruct_guarded(cloud_of(s), o);
+    c.ms_reconstruct = elapsed_ms(t0);
+    auto t1 = std::chrono::steady_clock::now();
+    c.mesh = check_mesh(s, c.run.triangles.data(), c.run.count, self_intersections);
+    c.ms_check = elapsed_ms(t1);
+    c.checked_intersections = self_intersections;
+    return c;
+}
+
+// The report and layer details, against the documented contract.
+void check_report(const Case& c) {
+    const Run& run = c.run;
+    const Report& r = run.report;
+    CHECK(r.points_in == c.points);
+    CHECK(r.points_in == r.points_used + r.duplicates + r.rejected + r.unused);
+    CHECK(r.unused == 0);
+    CHECK(r.duplicates == 0);
+    CHECK(r.rejected == 0);
+    CHECK(r.points_used == c.points);
+    CHECK(r.triangle_count == run.count);
+    CHECK(r.illegal_removed == 0);  // "on sound input this removes nothing"
+    CHECK(run.count <= run.max_triangles);
+    CHECK(run.workspace_guard_intact);
+    CHECK(run.triangle_guard_intact);
+    REQUIRE(r.layer_count >= 1);
+    REQUIRE(run.layers.size() == r.layer_count);
+    // Layers tile the extent along the axis, in order, and add up.
+    size_t points = 0, triangles = 0, folds = 0;
+    for (size_t l = 0; l < run.layers.size(); ++l) {
+        const LayerInfo& info = run.layers[l];
+        CHECK(info.bottom <= info.top);
+        if (l > 0) CHECK(info.bottom == run.layers[l - 1].top);
+        CHECK(info.radius > 0);
+        points += info.point_count;
+        triangles += info.triangle_count;
+        folds += info.fold_count;
+    }
+    CHECK(points == r.points_used + r.unused);
+    CHECK(triangles == run.count + r.illegal_removed);
+    CHECK(folds == r.folds);
+}
+
+// Topology and coverage: one oriented manifold annulus through every point.
+void check_topology(const Case& c) {
+    const mesh_check::Result& m = c.mesh;
+    CHECK(m.bad_indices == 0);
+    CHECK(m.degenerate == 0);
+    CHECK(m.zero_area == 0);
+    CHECK(m.nonmanifold_edges == 0);
+    CHECK(m.inconsistent_edges == 0);
+    CHECK(m.nonmanifold_vertices == 0);
+    CHECK(m.components == 1);
+    CHECK(m.boundary_loops == 2);
+    CHECK(m.simple_boundary);
+    CHECK(m.euler == 0);
+    CHECK(m.vertices_used == c.points);
+    CHECK(m.unused_expected == 0);
+}
+
+void check_deviation(const Case& c) {
+    const mesh_check::Result& m = c.mesh;
+    double noise = 4 * c.noise;
+    if (is_single_layer(c.layering)) {
+        CHECK(m.max_deviation() <= kSingleLayerDeviation * c.spacing + noise);
+        CHECK(m.max_interior_deviation <= kSingleLayerInteriorDeviation * c.spacing + noise);
+    } else {
+        CHECK(m.max_deviation() <= kLayeredDeviation * c.spacing + noise);
+    }
+}
+
+// Orientation with the measured tolerance (strict with one layer), and the report's folds
+// agreeing with the checker's count of triangles facing the true axis.
+void check_orientation_bounded(const Case& c) {
+    const mesh_check::Result& m = c.mesh;
+    if (is_single_layer(c.layering)) {
+        CHECK(m.inward == 0);
+        CHECK(c.run.report.folds == 0);
+    } else {
+        CHECK(m.inward <= fold_allowance(c.run));
+        size_t diff = m.inward > c.run.report.folds ? m.inward - c.run.report.folds : c.run.report.folds - m.inward;
+        CHECK(diff <= 2 + m.inward / 10);
+    }
+}
+
+std::string describe(const Case& c) {
+    std::ostringstream s;
+    s << c.name << ": status " << stratmesh::status_string(c.run.status) << ", " << c.run.count
+      << " triangles, " << c.run.report.layer_count << " layers, folds " << c.run.report.folds
+      << ", removed " << c.run.report.illegal_removed << ", unused " << c.run.report.unused
+      << ", spacing " << c.spacing << "; " << c.mesh.summary();
+    return s.str();
+}
+
+// ---- the shape matrix, computed once per shape and process ------------------------------
+
+// For each shape: every pose and layering at kSmall points with the full check
+// (self-intersections included); at kLarge points one pose (rotating through the poses from
+// one shape to the next) with one layer, 6 equal layers and explicit cuts, self-
+// intersections on the single-layer run only (the grid test costs about 60 ms a run there).
+// Each shape has its own test case, so that ctest, which runs every test case in a process
+// of its own, computes each shape once; the strict test cases for the library defects
+// compute them all again.
+struct ShapeRuns {
+    std::vector<Case> small, large;
+    double seconds = 0;
+};
+
+const ShapeRuns& shape_runs(size_t kind) {
+    static std::vector<std::unique_ptr<ShapeRuns>> cache(shape_kinds().size());
+    std::unique_ptr<ShapeRuns>& slot = cache.at(kind);
+    if (!slot) {
+        slot.reset(new ShapeRuns);
+        auto t0 = std::chrono::steady_clock::now();
+        const Pose poses[] = {Pose::z, Pose::x, Pose::tilted};
+        for (Pose pose : poses) {
+            Shape s = shape_kinds()[kind].make(kSmall, pose);
+            for (Layering l : kLayerings) slot->small.push_back(run_case(s, l, true));
+        }
+        Shape big = shape_kinds()[kind].make(kLarge, poses[kind % 3]);
+        slot->large.push_back(run_case(big, Layering::single, true));
+        slot->large.push_back(run_case(big, Layering::equal, false));
+        slot->large.push_back(run_case(big, Layering::cuts, false));
+        slot->seconds = elapsed_ms(t0) / 1000;
+    }
+    return *slot;
+}
+
+template <class F> void for_each_case(size_t kind, F&& check, bool layered_only = false) {
+    const ShapeRuns& runs = shape_runs(kind);
+    for (const std::vector<Case>* list : {&runs.small, &runs.large})
+        for (const Case& c : *list) {
+            if (layered_only && is_single_layer(c.layering)) continue;
+            if (layered_only && c.run.report.layer_count < 2) continue;
+            std::string context = describe(c);
+            INFO(context);
+            REQUIRE(c.run.status == Status::ok);
+            check(c);
+        }
+}
+
+// Everything that must hold for every run of a shape: status, report and layers, one
+// manifold annulus through every point, bounded deviation, orientation (strict with one
+// layer, the measured tolerance with several), no self-intersection with one layer.
+void check_shape(size_t kind) {
+    for_each_case(kind, [](const Case& c) {
+        check_report(c);
+        check_topology(c);
+        check_deviation(c);
+        check_orientation_bounded(c);
+        if (c.checked_intersections && is_single_layer(c.layering)) {
+            CHECK(c.mesh.intersecting_pairs == 0);
+            CHECK(c.mesh.vertex_overlaps == 0);
+        }
+    });
+    const ShapeRuns& runs = shape_runs(kind);
+    double small_rec = 0, small_check = 0, large_rec = 0, large_check = 0;
+    for (const Case& c : runs.small) small_rec += c.ms_reconstruct, small_check += c.ms_check;
+    for (const Case& c : runs.large) large_rec += c.ms_reconstruct, large_check += c.ms_check;
+    MESSAGE(std::string(shape_kinds()[kind].name) << ": " << runs.small.size() << " runs at " << kSmall
+                                     << " points (reconstruct " << small_rec << " ms, check " << small_check
+                                     << " ms), " << runs.large.size() << " at " << kLarge << " points (reconstruct "
+                                     << large_rec << " ms, check " << large_check << " ms); "
+                                     << runs.seconds << " s with the clouds");
+}
+
+// ---- helpers for the contract tests -------------------------------------------------------
+
+// A Z-pose cylinder whose reconstruction is the reference of several contract tests.
+const Shape& reference_cylinder() {
+    static const Shape s = shapes::cylinder(kSmall, Pose::z, 101);
+    return s;
+}
+
+std::vector<double> copy_points(const Shape& s) { return s.xyz; }
+
+Shape with_points(const Shape& s, std::vector<double> xyz, const std::string& suffix) {
+    Shape out = s;
+    out.xyz = std::move(xyz);
+    out.name += suffix;
+    return out;
+}
+
+}  // namespace
+
+// ===========================================================================================
+// The checker itself, on hand-made meshes.
+// ===========================================================================================
+
+namespace {
+
+// A regular tube: columns x rows points on the unit cylinder, z in [0, rows - 1], outward
+// counter-clockwise triangles.
+void tube_mesh(size_t columns, size_t rows, double z0, std::vector<double>& xyz, std::vector<uint32_t>& tris) {
+    size_t base = xyz.size() / 3;
+    for (size_t j = 0; j < rows; ++j)
+        for (size_t i = 0; i < columns; ++i) {
+            double t = 2 * shapes::kPi * static_cast<double>(i) / static_cast<double>(columns);
+            xyz.push_back(std::cos(t));
+            xyz.push_back(std::sin(t));
+            xyz.push_back(z0 + static_cast<double>(j) * 0.5);
+        }
+    auto id = [&](size_t i, size_t j) { return static_cast<uint32_t>(base + j * columns + i % columns); };
+    for (size_t j = 0; j + 1 < rows; ++j)
+        for (size_t i = 0; i < columns; ++i) {
+            tris.insert(tris.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+            tris.insert(tris.end(), {id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+        }
+}
+
+mesh_check::Result check_plain(const std::vector<double>& xyz, const std::vector<uint32_t>& tris,
+                               const std::vector<char>* expected = nullptr) {
+    mesh_check::Input in;
+    in.points = xyz.data();
+    in.point_count = xyz.size() / 3;
+    in.triangles = tris.data();
+    in.triangle_count = tris.size() / 3;
+    in.expected_used = expected;
+    in.surface = [](const double* p) { return std::sqrt(p[0] * p[0] + p[1] * p[1]) - 1; };
+    return mesh_check::check(in);
+}
+
+}  // namespace
+
+TEST_CASE("mesh checker: a regular tube is one oriented manifold annulus, outward, on the surface") {
+    std::vector<double> xyz;
+    std::vector<uint32_t> tris;
+    tube_mesh(24, 10, 0, xyz, tris);
+    mesh_check::Result r = check_plain(xyz, tris);
+    INFO(r.summary());
+    CHECK(r.manifold());
+    CHECK(r.components == 1);
+    CHECK(r.boundary_loops == 2);
+    CHECK(r.simple_boundary);
+    CHECK(r.loop_sizes == std::vector<size_t>{24, 24});
+    CHECK(r.euler == 0);
+    CHECK(r.inward == 0);
+    CHECK(r.outward == tris.size() / 3);
+    CHECK(r.unused_expected == 0);
+    CHECK(r.intersecting_pairs == 0);
+    CHECK(r.vertex_overlaps == 0);
+    CHECK(r.pairs_tested > 0);
+    // Chord midpoints of 24 columns sag by 1 - cos(pi / 24), centroids (two vertices on one
+    // generatrix) by 1 - |e0 + 2 e1| / 3.
+    CHECK(r.max_midpoint_deviation == doctest::Approx(1 - std::cos(shapes::kPi / 24)).epsilon(1e-9));
+    CHECK(r.max_centroid_deviation ==
+          doctest::Approx(1 - std::sqrt(5 + 4 * std::cos(shapes::kPi / 12)) / 3).epsilon(1e-9));
+}
+
+TEST_CASE("mesh checker: flipped, repeated, non-manifold and disconnected pieces are counted") {
+    std::vector<double> xyz;
+    std::vector<uint32_t> tris;
+    tube_mesh(16, 6, 0, xyz, tris);
+    SUBCASE("a flipped triangle: inconsistent edges and one inward triangle") {
+        std::swap(tris[1], tris[2]);  // its third edge is on the boundary
+        mesh_check::Result r = check_plain(xyz, tris);
+        CHECK(r.inconsistent_edges == 2);
+        CHECK(!r.oriented());
+        CHECK(r.inward == 1);
+    }
+    SUBCASE("a repeated index and an index out of range") {
+        tris.insert(tris.end(), {0, 0, 1, 0, 1, 999});
+        mesh_check::Result r = check_plain(xyz, tris);
+        CHECK(r.degenerate == 1);
+        CHECK(r.bad_indices == 1);
+        CHECK(r.manifold());
+    }
+    SUBCASE("an edge in three triangles") {
+        xyz.insert(xyz.end(), {0.5, 0.5, 10});
+        uint32_t extra = static_cast<uint32_t>(xyz.size() / 3 - 1);
+        tris.insert(tris.end(), {tris[0], tris[2], extra});  // on a quad's diagonal
+        mesh_check::Result r = check_plain(xyz, tris);
+        CHECK(r.nonmanifold_edges == 1);
+    }
+    SUBCASE("two fans at one vertex (a bowtie) and a second component") {
+        // A second tube above the first, sharing one vertex: its triangles around that
+        // vertex form a second fan.
+        std::vector<uint32_t> more;
+        tube_mesh(16, 3, 10, xyz, more);
+        for (uint32_t& v : more)
+            if (v == 16 * 6) v = 0;  // glue the new tube's first point onto point 0
+        tris.insert(tris.end(), more.begin(), more.end());
+        mesh_check::Result r = check_plain(xyz, tris);
+        CHECK(r.nonmanifold_vertices == 1);
+        CHECK(r.components == 2);
+        CHECK(r.boundary_loops == 3);  // the glued vertex joins two loops into one piece
+        CHECK(!r.simple_boundary);
+        CHECK(r.unused_expected == 1);  // the point glued away
+    }
+    SUBCASE("an expected-use mask") {
+        xyz.insert(xyz.end(), {5, 5, 5});
+        std::vector<char> mask(xyz.size() / 3, 1);
+        mask.back() = 0;
+        mask[3] = 0;
+        mesh_check::Result r = check_plain(xyz, tris, &mask);
+        CHECK(r.unused_expected == 0);
+        CHECK(r.used_unexpected == 1);
+    }
+}
+
+TEST_CASE("mesh checker: triangle-triangle intersection test") {
+    using mesh_check::detail::V3;
+    using mesh_check::detail::triangles_intersect;
+    const V3 a[3] = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};
+    SUBCASE("crossing") {
+        const V3 b[3] = {{0.5, 0.5, -1}, {0.5, 0.5, 1}, {1.5, -1, 0}};
+        CHECK(triangles_intersect(a, b));
+        CHECK(triangles_intersect(b, a));
+    }
+    SUBCASE("separated, and near misses") {
+        const V3 b[3] = {{0, 0, 0.1}, {2, 0, 0.1}, {0, 2, 0.1}};
+        CHECK(!triangles_intersect(a, b));
+        const V3 c[3] = {{1.1, 1.1, -1}, {1.1, 1.1, 1}, {3, 3, 0}};  // beyond the hypotenuse
+        CHECK(!triangles_intersect(a, c));
+    }
+    SUBCASE("touching in one point does not count") {
+        const V3 b[3] = {{0.5, 0.5, 0}, {0.5, 0.5, 1}, {1, 1, 1}};  // a vertex on a's face
+        CHECK(!triangles_intersect(a, b));
+    }
+    SUBCASE("coplanar: overlapping area counts, touching along an edge does not") {
+        const V3 b[3] = {{0.5, 0.5, 0}, {3, 0.5, 0}, {0.5, 3, 0}};
+        CHECK(triangles_intersect(a, b));
+        const V3 c[3] = {{2, 0, 0}, {0, 2, 0}, {2, 2, 0}};
+        CHECK(!triangles_intersect(a, c));
+        const V3 d[3] = {{1, 1, 0}, {3, 1, 0}, {1, 3, 0}};  // a's hypotenuse touched at a point
+        CHECK(!triangles_intersect(a, d));
+    }
+    SUBCASE("a shared vertex: overlap beyond it counts") {
+        const V3 b[3] = {{0, 0, 0}, {1, 1, -1}, {1, 1, 1}};  // through a's interior from its corner
+        CHECK(triangles_intersect(a, b, 0, 0));
+        const V3 c[3] = {{0, 0, 0}, {-1, -1, -1}, {-1, -1, 1}};  // only the corner in common
+        CHECK(!triangles_intersect(a, c, 0, 0));
+    }
+    SUBCASE("found through the grid in a mesh: a triangle piercing a tube") {
+        std::vector<double> xyz;
+        std::vector<uint32_t> tris;
+        tube_mesh(32, 12, 0, xyz, tris);
+        xyz.insert(xyz.end(), {0, 0, 2.6, 3, 0.1, 2.6, 3, -0.1, 2.7});
+        uint32_t first = static_cast<uint32_t>(xyz.size() / 3 - 3);
+        tris.insert(tris.end(), {first, first + 1, first + 2});
+        mesh_check::Result r = check_plain(xyz, tris);
+        CHECK(r.intersecting_pairs >= 1);
+        CHECK(r.intersection_examples.size() >= 1);
+    }
+}
+
+// ===========================================================================================
+// The shape matrix.
+// ===========================================================================================
+
+TEST_CASE("reconstruction of the cylinder, every pose, size and layering") { check_shape(0); }
+TEST_CASE("reconstruction of the elliptic tube, every pose, size and layering") { check_shape(1); }
+TEST_CASE("reconstruction of the bumpy tube, every pose, size and layering") { check_shape(2); }
+TEST_CASE("reconstruction of the cone, every pose, size and layering") { check_shape(3); }
+TEST_CASE("reconstruction of the vase, every pose, size and layering") { check_shape(4); }
+TEST_CASE("reconstruction of the cylindrical scan grid, every pose, size and layering") { check_shape(5); }
+TEST_CASE("reconstruction of the CT slice stack, every pose, size and layering") { check_shape(6); }
+TEST_CASE("reconstruction of the noisy tube, every pose, size and layering") { check_shape(7); }
+TEST_CASE("reconstruction of the head, every pose, size and layering") { check_shape(8); }
+
+// Library defect, kept strict: with several layers, the zipper bands hold triangles facing
+// the axis (16 several-layer runs of the matrix at 2000 points and 1 at 20000 points,
+// one or two triangles each). A band joins two loops coarser than the point spacing
+// (the lower layer's hull and the upper layer's centre link skip points close to the cut)
+// and some of its triangles stay clockwise on the unrolled strip: the diagonal swap cannot
+// untangle them when the swapped pair is not proper either. Example: cone, 2000 points,
+// axis X, layer_height 0.75: triangle 2305 (points 1702, 270, 773, two below the cut at
+// local height -0.7477, one above, spanning 0.23 rad) faces the axis, cosine -0.91.
+// Some of those folds intersect their neighbours. Example: noisy tube, 2000 points, tilted,
+// the explicit cuts of layered_options(): triangles 2988 (580, 1790, 1720) and 3960 (1026,
+// 1794, 1355) share no vertex and cross (confirmed by an independent edge-triangle test).
+TEST_CASE("reconstruction with several layers: every triangle faces outward, no self-intersection" * doctest::may_fail()) {
+    for (size_t kind = 0; kind < shape_kinds().size(); ++kind)
+        for_each_case(kind, [](const Case& c) {
+            CHECK(c.mesh.inward == 0);
+            CHECK(c.run.report.folds == 0);
+            if (!c.checked_intersections) return;
+            CHECK(c.mesh.intersecting_pairs == 0);
+            CHECK(c.mesh.vertex_overlaps == 0);
+        }, true);
+}
+
+// ===========================================================================================
+// Layers.
+// ===========================================================================================
+
+TEST_CASE("explicit cuts are positions dot(point, axis), in any order, repeats and outsiders ignored") {
+    for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
+        Shape s = shapes::vase(kSmall, pose);
+        CAPTURE(s.name);
+        const double fractions[] = {0.2, 0.45, 0.7};
+        std::vector<double> sorted, shuffled;
+        for (double f : fractions) sorted.push_back(s.along_axis(s.z_min + f * (s.z_max - s.z_min)));
+        shuffled = {sorted[2], sorted[0], 1e9, sorted[1], sorted[0], -1e9, sorted[2]};
+        Options a = axis_options(s), b = axis_options(s);
+        a.cuts = sorted.data();
+        a.cut_count = sorted.size();
+        b.cuts = shuffled.data();
+        b.cut_count = shuffled.size();
+        Run ra = reconstruct_guarded(cloud_of(s), a), rb = reconstruct_guarded(cloud_of(s), b);
+        REQUIRE(ra.status == Status::ok);
+        REQUIRE(rb.status == Status::ok);
+        CHECK(ra.triangles == rb.triangles);
+        REQUIRE(ra.report.layer_count == 4);
+        for (size_t l = 0; l < 3; ++l) {
+            CHECK(ra.layers[l].top == doctest::Approx(sorted[l]).epsilon(1e-12));
+        }
+        CHECK(std::fabs(ra.layers.front().bottom - s.along_axis(s.z_min)) < 0.05);
+        CHECK(std::fabs(ra.layers.back().top - s.along_axis(s.z_max)) < 0.05);
+        CHECK(ra.report.axis[0] * ra.layers[0].centre[0] + ra.report.axis[1] * ra.layers[0].centre[1] +
+                  ra.report.axis[2] * ra.layers[0].centre[2] ==
+              doctest::Approx((ra.layers[0].bottom + ra.layers[0].top) / 2));
+    }
+}
+
+TEST_CASE("a cut on every contour plane: layers of one contour each") {
+    for (Pose pose : {Pose::z, Pose::x}) {
+        Shape s = shapes::ct_slices(kSmall, pose);
+        std::vector<double> cuts;
+        for (double z : s.planes) cuts.push_back(s.along_axis(z));
+        Options o = axis_options(s);
+        o.cuts = cuts.data();
+        o.cut_count = cuts.size();
+        Case c;
+        c.name = s.name + ", a cut on each of the " + std::to_string(s.planes.size()) + " planes";
+        c.points = s.size();
+        c.spacing = s.spacing;
+        c.layering = Layering::cuts;
+        c.run = reconstruct_guarded(cloud_of(s), o);
+        c.mesh = check_mesh(s, c.run.triangles.data(), c.run.count, true);
+        INFO(describe(c));
+        REQUIRE(c.run.status == Status::ok);
+        CHECK(c.run.report.layer_count == s.planes.size());
+        for (const LayerInfo& info : c.run.layers) CHECK(info.point_count == s.size() / s.planes.size());
+        check_report(c);
+        check_topology(c);
+        check_deviation(c);
+        CHECK(c.mesh.inward == 0);
+        CHECK(c.mesh.intersecting_pairs == 0);
+        CHECK(c.mesh.vertex_overlaps == 0);
+    }
+}
+
+// Library defect: with a tilted axis, dot(point, axis) of the points of one contour differs
+// in the last bits, so a cut placed on a contour plane (the natural choice for CT data)
+// splits the contour between two layers. The lower layer's top loop and the upper layer's
+// bottom loop then interleave on one circle, every band vertex at the same height: the
+// band is made of flat chord triangles in the contour plane (normals along the axis, so
+// "facing the axis" by a sign of about 1e-12) that overlap each other. Measured (2000
+// points, 20 contours of 100): one cut on plane 12: 7 such triangles, 55 intersecting pairs
+// and 154 pairs overlapping beyond a shared vertex; a cut on each plane: 51, 293 and 748;
+// layer_count 19 (cuts on the planes up to rounding): 118, 713 and 1356; the 44-row scan
+// grid with a cut on each row: 15, 142 and 461. With the Z and X axes the same cuts are
+// exact and everything holds (see "a cut on every contour plane").
+TEST_CASE("cuts on contour planes with a tilted axis" * doctest::may_fail()) {
+    struct Variant {
+        const char* name;
+        Shape shape;
+        std::vector<double> cuts;
+        uint32_t layer_count;
+    };
+    std::vector<Variant> variants;
+    {
+        Shape s = shapes::ct_slices(kSmall, Pose::tilted);
+        variants.push_back({"one cut on plane 12", s, {s.along_axis(s.planes[12])}, 0});
+        std::vector<double> all;
+        for (double z : s.planes) all.push_back(s.along_axis(z));
+        variants.push_back({"a cut on every plane", s, all, 0});
+        variants.push_back({"layer_count 19: the planes up to rounding", s, {}, 19});
+        Shape g = shapes::scan_grid(kSmall, Pose::tilted);
+        std::vector<double> rows;
+        for (double z : g.planes) rows.push_back(g.along_axis(z));
+        variants.push_back({"scan grid, a cut on every row", g, rows, 0});
+    }
+    for (const Variant& v : variants) {
+        Options o = axis_options(v.shape);
+        o.cuts = v.cuts.empty() ? nullptr : v.cuts.data();
+        o.cut_count = v.cuts.size();
+        o.layer_count = v.layer_count;
+        Run run = reconstruct_guarded(cloud_of(v.shape), o);
+        mesh_check::Result m = check_mesh(v.shape, run.triangles.data(), run.count, true);
+        INFO(v.shape.name << ", " << std::string(v.name) << ": " << run.report.layer_count << " layers, folds "
+                          << run.report.folds << "; " << m.summary());
+        REQUIRE(run.status == Status::ok);
+        CHECK(m.manifold());  // holds
+        CHECK(m.euler == 0);  // holds
+        CHECK(m.inward == 0);
+        CHECK(m.intersecting_pairs == 0);
+        CHECK(m.vertex_overlaps == 0);
+    }
+}
+
+TEST_CASE("a layer with fewer than 3 points is merged with the next one") {
+    Shape s = reference_cylinder();
+    // Heights along the axis, sorted: a cut just above the second lowest point leaves two
+    // points in the bottom layer.
+    std::vector<double> h;
+    for (size_t i = 0; i < s.size(); ++i) h.push_back(s.point(i)[2]);
+    std::sort(h.begin(), h.end());
+    std::vector<double> cuts = {(h[1] + h[2]) / 2, s.along_axis(0.0)};
+    Options o = axis_options(s);
+    o.cuts = cuts.data();
+    o.cut_count = cuts.size();
+    Run run = reconstruct_guarded(cloud_of(s), o);
+    REQUIRE(run.status == Status::ok);
+    CHECK(run.report.layer_count == 2);  // three planned, the first merged
+    REQUIRE(run.layers.size() == 2);
+    CHECK(run.layers[0].bottom == doctest::Approx(h.front()).epsilon(1e-12));
+    CHECK(run.layers[0].top == doctest::Approx(cuts[1]).epsilon(1e-12));
+    mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, false);
+    INFO(m.summary());
+    CHECK(m.manifold());
+    CHECK(m.boundary_loops == 2);
+    CHECK(m.euler == 0);
+    CHECK(m.unused_expected == 0);
+}
+
+// Layers of a few points each (many layers, or the automatic rule on a thin tube, whose
+// layers are four radii tall): every layer is little more than its two loops and the bands
+// do most of the work.
+namespace {
+
+struct ThinCase {
+    const char* name;
+    Shape shape;
+    uint32_t layer_count;  // 0: automatic
+};
+
+std::vector<ThinCase> thin_layer_cases() {
+    return {
+        {"cylinder, layer_count 100 (20 points a layer)", shapes::cylinder(kSmall, Pose::z), 100},
+        {"cylinder, layer_count 400", shapes::cylinder(kSmall, Pose::tilted), 400},
+        {"vase, layer_count 200", shapes::vase(kSmall, Pose::z), 200},
+        {"vase, layer_count 400", shapes::vase(kSmall, Pose::x), 400},
+        {"thin tube (radius 0.01, seed 7), automatic layers", shapes::thin_tube(kSmall, Pose::z, 0.01, 7), 0},
+    };
+}
+
+Run run_thin(const ThinCase& t) {
+    Options o = axis_options(t.shape);
+    o.layer_count = t.layer_count;
+    return reconstruct_guarded(cloud_of(t.shape), o);
+}
+
+}  // namespace
+
+TEST_CASE("many thin layers: the documented guarantees hold (manifold, oriented, counts add up)") {
+    for (const ThinCase& t : thin_layer_cases()) {
+        Run run = run_thin(t);
+        mesh_check::Result m = check_mesh(t.shape, run.triangles.data(), run.count, false);
+        INFO(std::string(t.name) << ": " << run.report.layer_count << " layers, removed " << run.report.illegal_removed
+                    << ", unused " << run.report.unused << ", folds " << run.report.folds << "; " << m.summary());
+        REQUIRE(run.status == Status::ok);
+        CHECK(m.manifold());
+        CHECK(m.degenerate == 0);
+        CHECK(m.bad_indices == 0);
+        CHECK(run.report.points_in == run.report.points_used + run.report.duplicates + run.report.rejected + run.report.unused);
+        CHECK(m.vertices_used == run.report.points_used);
+        CHECK(run.workspace_guard_intact);
+        CHECK(run.triangle_guard_intact);
+    }
+}
+
+// Library defect: with layers of a few points, the bands fold and intersect, and the
+// safety net has to remove triangles, which opens holes. Measured at 2000 points:
+// cylinder with layer_count 100: 21 triangles facing the axis (cosine down to -0.97), 2
+// overlaps at a shared vertex; layer_count 400 (tilted): 346 layers, 219 facing the axis,
+// 94 intersecting pairs; vase with layer_count 200: 2 points unused, 97 facing the axis;
+// layer_count 400: 6 triangles removed, 2 points unused, 3 boundary loops, Euler 1; thin
+// tube of radius 0.01 (seed 7) with the automatic layers (149 layers): 2 triangles
+// removed, leaving a 4-edge hole (3 boundary loops, Euler -1), 23 facing the axis.
+TEST_CASE("many thin layers: one annulus through every point, outward, no self-intersection" * doctest::may_fail()) {
+    for (const ThinCase& t : thin_layer_cases()) {
+        Run run = run_thin(t);
+        mesh_check::Result m = check_mesh(t.shape, run.triangles.data(), run.count, true);
+        INFO(std::string(t.name) << ": " << run.report.layer_count << " layers, removed " << run.report.illegal_removed
+                    << ", unused " << run.report.unused << ", folds " << run.report.folds << "; " << m.summary());
+        REQUIRE(run.status == Status::ok);
+        CHECK(run.report.illegal_removed == 0);
+        CHECK(run.report.unused == 0);
+        CHECK(m.components == 1);
+        CHECK(m.boundary_loops == 2);
+        CHECK(m.euler == 0);
+        CHECK(m.inward == 0);
+        CHECK(m.intersecting_pairs == 0);
+        CHECK(m.vertex_overlaps == 0);
+    }
+}
+
+// A layer of a handful of points that surround the axis is kept as a layer of its own: its
+// bottom and top loops are those few points, so the surface there is coarse. Measured at
+// 2000 points (cut at 0.2% of the height: 4 to 6 points): topology intact, deviation 5 to
+// 10 point spacings next to that layer.
+TEST_CASE("a layer of a few points surrounding the axis is kept, and the surface stays a manifold annulus") {
+    for (Pose pose : {Pose::z, Pose::tilted}) {
+        Shape s = shapes::elliptic_tube(kSmall, pose);
+        std::vector<double> cuts;
+        for (double f : {0.002, 0.05, 0.5}) cuts.push_back(s.along_axis(s.z_min + f * (s.z_max - s.z_min)));
+        Options o = axis_options(s);
+        o.cuts = cuts.data();
+        o.cut_count = cuts.size();
+        Case c;
+        c.name = s.name + ", a layer of 0.2% of the height";
+        c.points = s.size();
+        c.spacing = s.spacing;
+        c.layering = Layering::cuts;
+        c.run = reconstruct_guarded(cloud_of(s), o);
+        c.mesh = check_mesh(s, c.run.triangles.data(), c.run.count, true);
+        INFO(describe(c));
+        REQUIRE(c.run.status == Status::ok);
+        check_report(c);
+        check_topology(c);
+        REQUIRE(!c.run.layers.empty());
+        CHECK(c.run.layers[0].point_count < 10);
+        MESSAGE(c.name << ": bottom layer of " << c.run.layers[0].point_count
+                       << " points, max deviation " << c.mesh.max_deviation() / c.spacing
+                       << " point spacings");
+    }
+}
+
+TEST_CASE("automatic axis: the principal direction of an elongated cloud") {
+    for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
+        Shape s = shapes::bumpy_tube(kSmall, pose);
+        Options o = {};
+        o.layer_count = 1;
+        Run run = reconstruct_guarded(cloud_of(s), o);
+        REQUIRE(run.status == Status::ok);
+        double axis[3];
+        s.axis_direction(axis);
+        double d = axis[0] * run.report.axis[0] + axis[1] * run.report.axis[1] + axis[2] * run.report.axis[2];
+        CHECK(std::fabs(d) > 0.999);
+        Case c;
+        c.name = s.name + ", automatic axis";
+        c.points = s.size();
+        c.spacing = s.spacing;
+        c.run = run;
+        c.mesh = check_mesh(s, run.triangles.data(), run.count, true);
+        INFO(describe(c));
+        check_report(c);
+        check_topology(c);
+        check_deviation(c);
+        CHECK(c.mesh.inward == 0);
+        CHECK(c.mesh.intersecting_pairs == 0);
+    }
+}
+
+// ===========================================================================================
+// The paper's experiment: a head-like column cut at anatomical heights.
+// ===========================================================================================
+
+namespace {
+
+// Cuts like the paper's: base of the neck, under the jaw, under the nose, over the nose, at
+// the eyes, on the forehead (local heights of shapes::head_radius).
+Case head_case(Pose pose, size_t n) {
+    Shape s = shapes::head(n, pose);
+    std::vector<double> cuts;
+    for (double z : {0.35, 0.8, 1.38, 1.72, 1.9, 2.15}) cuts.push_back(s.along_axis(z));
+    Options o = axis_options(s);
+    o.cuts = cuts.data();
+    o.cut_count = cuts.size();
+    Case c;
+    c.name = s.name + ", " + std::to_string(n) + " points, anatomical cuts";
+    c.points = s.size();
+    c.spacing = s.spacing;
+    c.layering = Layering::cuts;
+    c.run = reconstruct_guarded(cloud_of(s), o);
+    c.mesh = check_mesh(s, c.run.triangles.data(), c.run.count, true);
+    return c;
+}
+
+}  // namespace
+
+TEST_CASE("head: neck, skull and nose with the paper's anatomical cuts") {
+    for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
+        Case c = head_case(pose, 6000);
+        INFO(describe(c));
+        REQUIRE(c.run.status == Status::ok);
+        CHECK(c.run.report.layer_count == 7);
+        check_report(c);
+        check_topology(c);
+        check_deviation(c);
+        check_orientation_bounded(c);
+        // Measured: no fold and no self-intersection here, at 2000 to 20000 points.
+        CHECK(c.mesh.inward == 0);
+        CHECK(c.run.report.folds == 0);
+        CHECK(c.mesh.intersecting_pairs == 0);
+        CHECK(c.mesh.vertex_overlaps == 0);
+    }
+}
+
+// ===========================================================================================
+// The contract: determinism, input formats, duplicates, invalid points, statuses, memory.
+// ===========================================================================================
+
+TEST_CASE("determinism: repeated runs, and any workspace alignment, give identical triangles") {
+    struct Item {
+        Shape shape;
+        Layering layering;
+    };
+    std::vector<Item> items = {
+        {shapes::bumpy_tube(kSmall, Pose::tilted), Layering::equal},
+        {shapes::scan_grid(kSmall, Pose::z), Layering::single},
+        {shapes::ct_slices(kSmall, Pose::x), Layering::cuts},
+        {shapes::noisy_tube(kSmall, Pose::x), Layering::height},
+        {shapes::vase(kLarge, Pose::tilted), Layering::uneven},
+    };
+    for (const Item& item : items) {
+        std::vector<double> cuts;
+        Options o = layered_options(item.shape, item.layering, cuts);
+        CAPTURE(item.shape.name);
+        Run first = reconstruct_guarded(cloud_of(item.shape), o, 0);
+        REQUIRE(first.status == Status::ok);
+        for (size_t misalign : {size_t{0}, size_t{1}, size_t{3}, size_t{8}}) {
+            CAPTURE(misalign);
+            Run again = reconstruct_guarded(cloud_of(item.shape), o, misalign);
+            REQUIRE(again.status == Status::ok);
+            CHECK(again.triangles == first.triangles);
+            CHECK(again.report.folds == first.report.folds);
+            CHECK(again.report.layer_count == first.report.layer_count);
+            CHECK(std::memcmp(again.report.axis_origin, first.report.axis_origin, sizeof first.report.axis_origin) == 0);
+        }
+    }
+}
+
+TEST_CASE("float32 records with a stride of 7 floats give the triangles of the same points as packed doubles") {
+    for (Pose pose : {Pose::z, Pose::tilted}) {
+        Shape s = shapes::noisy_tube(kSmall, pose);
+        const size_t n = s.size();
+        std::vector<float> records(7 * n);
+        std::vector<double> doubles(3 * n);
+        for (size_t i = 0; i < n; ++i) {
+            for (size_t k = 0; k < 3; ++k) {
+                float f = static_cast<float>(s.xyz[3 * i + k]);
+                records[7 * i + k] = f;
+                doubles[3 * i + k] = static_cast<double>(f);
+            }
+            records[7 * i + 3] = 0.6f;  // normal
+            records[7 * i + 4] = -0.8f;
+            records[7 * i + 5] = 0.0f;
+            records[7 * i + 6] = static_cast<float>(i % 255);  // intensity
+        }
+        for (Layering layering : {Layering::single, Layering::equal}) {
+            std::vector<double> cuts;
+            Options o = layered_options(s, layering, cuts);
+            Run packed = reconstruct_guarded(Cloud{doubles.data(), n, 0, Scalar::float64}, o);
+            Run strided = reconstruct_guarded(Cloud{records.data(), n, 7 * sizeof(float), Scalar::float32}, o);
+            CAPTURE(s.name);
+            INFO("layering: " << std::string(layering_name(layering)));
+            REQUIRE(packed.status == Status::ok);
+            REQUIRE(strided.status == Status::ok);
+            CHECK(strided.triangles == packed.triangles);
+            CHECK(strided.report.points_used == n);
+            // And doubles with the same stride of 56 bytes (7 doubles) read the same.
+            std::vector<double> wide(7 * n, 0.0);
+            for (size_t i = 0; i < n; ++i)
+                for (size_t k = 0; k < 3; ++k) wide[7 * i + k] = doubles[3 * i + k];
+            Run wide_run = reconstruct_guarded(Cloud{wide.data(), n, 7 * sizeof(double), Scalar::float64}, o);
+            REQUIRE(wide_run.status == Status::ok);
+            CHECK(wide_run.triangles == packed.triangles);
+        }
+    }
+}
+
+TEST_CASE("duplicates are merged into the lowest index and counted") {
+    const Shape& base = reference_cylinder();
+    // Interleave exact copies: every 37th point twice more right after itself, every 101st
+    // point once at the end, and a point with x = +0.0 followed by its twin with x = -0.0.
+    std::vector<double> xyz;
+    std::vector<char> first_of_group;
+    size_t copies = 0;
+    auto push = [&](const double* p, bool first) {
+        xyz.insert(xyz.end(), p, p + 3);
+        first_of_group.push_back(first ? 1 : 0);
+    };
+    for (size_t i = 0; i < base.size(); ++i) {
+        push(base.point(i), true);
+        if (i % 37 == 0) {
+            push(base.point(i), false);
+            push(base.point(i), false);
+            copies += 2;
+        }
+    }
+    for (size_t i = 0; i < base.size(); i += 101) {
+        push(base.point(i), false);
+        ++copies;
+    }
+    // On the cylinder of axis (0.25, -0.5): x = 0 at y = -0.5 + sqrt(1 - 0.0625).
+    const double on_axis_side[3] = {0.0, -0.5 + std::sqrt(0.9375), 1.5};
+    const double negative_zero[3] = {-0.0, on_axis_side[1], on_axis_side[2]};
+    push(on_axis_side, true);
+    push(negative_zero, false);
+    ++copies;
+    Shape s = with_points(base, xyz, ", with duplicates");
+    for (Layering layering : {Layering::single, Layering::equal}) {
+        std::vector<double> cuts;
+        Options o = layered_options(s, layering, cuts);
+        Run run = reconstruct_guarded(cloud_of(s), o);
+        INFO("layering: " << std::string(layering_name(layering)));
+        REQUIRE(run.status == Status::ok);
+        CHECK(run.report.duplicates == copies);
+        CHECK(run.report.points_used == s.size() - copies);
+        CHECK(run.report.unused == 0);
+        CHECK(run.report.points_in == run.report.points_used + run.report.duplicates + run.report.rejected + run.report.unused);
+        mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, false, &first_of_group);
+        INFO(m.summary());
+        CHECK(m.unused_expected == 0);   // every first occurrence is a vertex
+        CHECK(m.used_unexpected == 0);   // no later copy is
+        CHECK(m.manifold());
+        CHECK(m.components == 1);
+        CHECK(m.boundary_loops == 2);
+        CHECK(m.euler == 0);
+        CHECK(m.degenerate == 0);
+        CHECK(m.zero_area == 0);
+    }
+}
+
+// "points_in = points_used + duplicates + rejected + unused, always", also when reconstruct
+// stops after the layers were built. Found failing at commit aa58fe1 (the 2000-point
+// reference cylinder plus 200 exact copies, one layer, a capacity of 10 triangles:
+// points_in 2200, points_used 0, duplicates 200, unused 2200; six layers with 40% of the
+// workspace bound: out_of_memory with the same counts); holds since commit 3d26d49.
+TEST_CASE("report counts add up on every status, with duplicates") {
+    const Shape& base = reference_cylinder();
+    std::vector<double> xyz = copy_points(base);
+    for (size_t i = 0; i < base.size(); i += 10) xyz.insert(xyz.end(), base.point(i), base.point(i) + 3);
+    const size_t n = xyz.size() / 3;
+    const Cloud cloud = {xyz.data(), n, 0, Scalar::float64};
+    for (uint32_t layers : {1u, 6u}) {
+        Options o = axis_options(base);
+        o.layer_count = layers;
+        const size_t bound = stratmesh::reconstruct_workspace_size(n, o);
+        const size_t capacity = stratmesh::reconstruct_max_triangles(n, o);
+        std::vector<uint32_t> tris(3 * capacity);
+        auto check_sum = [&](size_t bytes, size_t triangle_capacity) {
+            std::unique_ptr<unsigned char[]> work(new unsigned char[bytes]);
+            size_t count = 0;
+            Report r{};
+            Status status = stratmesh::reconstruct(cloud, o, work.get(), bytes, tris.data(), triangle_capacity, &count, &r);
+            INFO(layers << " layers, " << bytes << " of " << bound << " workspace bytes, capacity " << triangle_capacity
+                        << ": " << std::string(stratmesh::status_string(status)) << "; in " << r.points_in << ", used "
+                        << r.points_used << ", duplicates " << r.duplicates << ", rejected " << r.rejected
+                        << ", unused " << r.unused);
+            CHECK(r.points_in == n);
+            CHECK(r.points_in == r.points_used + r.duplicates + r.rejected + r.unused);
+            return status;
+        };
+        CHECK(check_sum(bound, capacity) == Status::ok);
+        CHECK(check_sum(bound, 10) == Status::triangle_capacity);
+        for (size_t fifths = 1; fifths < 5; ++fifths) check_sum(bound * fifths / 5, capacity);
+        check_sum(bound * 19 / 20, capacity);
+    }
+}
+
+TEST_CASE("NaN and infinite points: invalid_point with the first index, or skipped and counted") {
+    const Shape& base = reference_cylinder();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double inf = std::numeric_limits<double>::infinity();
+    struct Bad {
+        size_t index;
+        size_t coordinate;
+        double value;
+    };
+    const std::vector<Bad> bads = {{777, 0, nan}, {123, 2, inf}, {1999, 1, -inf}, {0, 1, nan}};
+    std::vector<double> xyz = copy_points(base);
+    for (const Bad& b : bads) xyz[3 * b.index + b.coordinate] = b.value;
+    Shape s = with_points(base, xyz, ", with NaN and infinite points");
+
+    SUBCASE("refused by default: invalid_point, first index, nothing written") {
+        Options o = axis_options(s);
+        o.layer_count = 3;
+        Run run = reconstruct_guarded(cloud_of(s), o);
+        CHECK(run.status == Status::invalid_point);
+        CHECK(run.report.first_invalid_point == 0);
+        CHECK(run.count == 0);
+        CHECK(run.triangle_guard_intact);
+        CHECK(run.report.points_in == run.report.points_used + run.report.duplicates + run.report.rejected + run.report.unused);
+        CHECK(run.report.detail != nullptr);
+        // Without the point at index 0, the first is 123.
+        std::vector<double> later = xyz;
+        for (size_t k = 0; k < 3; ++k) later[k] = base.xyz[k];
+        Run run2 = reconstruct_guarded(Cloud{later.data(), base.size(), 0, Scalar::float64}, o);
+        CHECK(run2.status == Status::invalid_point);
+        CHECK(run2.report.first_invalid_point == 123);
+        // float32 NaN in a strided record.
+        std::vector<float> records(4 * base.size(), 0.0f);
+        for (size_t i = 0; i < base.size(); ++i)
+            for (size_t k = 0; k < 3; ++k) records[4 * i + k] = static_cast<float>(base.xyz[3 * i + k]);
+        records[4 * 500 + 2] = std::numeric_limits<float>::quiet_NaN();
+        Run run3 = reconstruct_guarded(Cloud{records.data(), base.size(), 4 * sizeof(float), Scalar::float32}, o);
+        CHECK(run3.status == Status::invalid_point);
+        CHECK(run3.report.first_invalid_point == 500);
+    }
+    SUBCASE("skipped with skip_invalid_points: counted as rejected, never a vertex") {
+        for (uint32_t layers : {1u, 6u}) {
+            Options o = axis_options(s);
+            o.layer_count = layers;
+            o.flags = stratmesh::skip_invalid_points;
+            Run run = reconstruct_guarded(cloud_of(s), o);
+            CAPTURE(layers);
+            REQUIRE(run.status == Status::ok);
+            CHECK(run.report.rejected == bads.size());
+            CHECK(run.report.unused == 0);
+            CHECK(run.report.points_used == s.size() - bads.size());
+            CHECK(run.report.points_in == run.report.points_used + run.report.duplicates + run.report.rejected + run.report.unused);
+            std::vector<char> mask(s.size(), 1);
+            for (const Bad& b : bads) mask[b.index] = 0;
+            // The checker needs finite coordinates: check the mesh on the clean copy.
+            mesh_check::Result m = check_mesh(base, run.triangles.data(), run.count, false, &mask);
+            INFO(m.summary());
+            CHECK(m.used_unexpected == 0);
+            CHECK(m.unused_expected == 0);
+            CHECK(m.manifold());
+            CHECK(m.components == 1);
+            CHECK(m.boundary_loops == 2);
+            CHECK(m.euler == 0);
+        }
+    }
+}
+
+TEST_CASE("a flat cloud gives flat_cloud") {
+    shapes::Rng rng(5);
+    std::vector<double> xyz;
+    for (size_t i = 0; i < 500; ++i) {
+        double t = rng.uniform(0, 2 * shapes::kPi), r = rng.uniform(0.5, 1.5);
+        xyz.insert(xyz.end(), {r * std::cos(t), r * std::sin(t), 4.25});
+    }
+    Options o = {};
+    o.axis = Axis::z;
+    Run run = reconstruct_guarded(Cloud{xyz.data(), 500, 0, Scalar::float64}, o);
+    CHECK(run.status == Status::flat_cloud);
+    CHECK(run.count == 0);
+    CHECK(run.triangle_guard_intact);
+    CHECK(run.report.unused == 500);
+    CHECK(run.report.points_in == run.report.points_used + run.report.duplicates + run.report.rejected + run.report.unused);
+    CHECK(run.report.detail != nullptr);
+    // The same disc stood on its edge (axis X across the disc) is not flat.
+    o.axis = Axis::x;
+    Run across = reconstruct_guarded(Cloud{xyz.data(), 500, 0, Scalar::float64}, o);
+    CHECK(across.status != Status::flat_cloud);
+}
+
+// Measured: the unrolling centre of a layer is fitted to its points (the mean of
+// per-sector means around their centroid), so a half-cylinder (theta in [0, pi]) is
+// surrounded by its points as seen from that centre: reconstruct returns ok and closes the
+// tube with a strip across the open side (60 of 3973 triangles there face the true axis at
+// 2000 points, one layer). Only a cloud whose points cannot surround any centre (a plane
+// through the axis, or points on the axis) gives not_columnar.
+TEST_CASE("clouds that do not surround the axis: not_columnar, or ok with a manifold annulus") {
+    SUBCASE("half-cylinder: ok, one manifold annulus through every point") {
+        for (uint32_t layers : {1u, 6u}) {
+            Shape s = shapes::half_cylinder(kSmall, Pose::z);
+            Options o = axis_options(s);
+            o.layer_count = layers;
+            Run run = reconstruct_guarded(cloud_of(s), o);
+            CAPTURE(layers);
+            REQUIRE((run.status == Status::ok || run.status == Status::not_columnar));
+            CHECK(run.status == Status::ok);  // measured
+            if (run.status != Status::ok) continue;
+            mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, false);
+            INFO(m.summary());
+            CHECK(m.manifold());
+            CHECK(m.components == 1);
+            CHECK(m.boundary_loops == 2);
+            CHECK(m.euler == 0);
+            CHECK(m.unused_expected == 0);
+            CHECK(run.report.unused == 0);
+        }
+    }
+    SUBCASE("a plane through the axis: not_columnar, nothing written") {
+        shapes::Rng rng(9);
+        std::vector<double> xyz;
+        for (size_t i = 0; i < 1000; ++i) xyz.insert(xyz.end(), {rng.uniform(-1, 1), 0.0, rng.uniform(-3, 3)});
+        Options o = {};
+        o.axis = Axis::z;
+        for (uint32_t layers : {1u, 6u}) {
+            o.layer_count = layers;
+            Run run = reconstruct_guarded(Cloud{xyz.data(), 1000, 0, Scalar::float64}, o);
+            CHECK(run.status == Status::not_columnar);
+            CHECK(run.count == 0);
+            CHECK(run.report.layer_count == 0);
+            CHECK(run.report.unused == 1000);
+            CHECK(run.report.detail != nullptr);
+        }
+    }
+    SUBCASE("points on the axis: not_columnar") {
+        std::vector<double> xyz;
+        for (size_t i = 0; i < 20; ++i) xyz.insert(xyz.end(), {1.0, 2.0, static_cast<double>(i)});
+        Options o = {};
+        o.axis = Axis::z;
+        Run run = reconstruct_guarded(Cloud{xyz.data(), 20, 0, Scalar::float64}, o);
+        CHECK(run.status == Status::not_columnar);
+    }
+}
+
+TEST_CASE("statuses for bad arguments and options") {
+    const Shape& s = reference_cylinder();
+    Cloud cloud = cloud_of(s);
+    SUBCASE("zero or NaN axis direction: invalid_axis") {
+        Options o = {};
+        o.axis = Axis::direction;
+        CHECK(reconstruct_guarded(cloud, o).status == Status::invalid_axis);
+        o.direction[2] = std::numeric_limits<double>::quiet_NaN();
+        CHECK(reconstruct_guarded(cloud, o).status == Status::invalid_axis);
+    }
+    SUBCASE("NaN cut, negative layer height: invalid_layers") {
+        Options o = axis_options(s);
+        double cut = std::numeric_limits<double>::quiet_NaN();
+        o.cuts = &cut;
+        o.cut_count = 1;
+        CHECK(reconstruct_guarded(cloud, o).status == Status::invalid_layers);
+        Options p = axis_options(s);
+        p.layer_height = -1;
+        CHECK(reconstruct_guarded(cloud, p).status == Status::invalid_layers);
+    }
+    SUBCASE("a stride too small, a null triangle count: invalid_argument") {
+        Options o = axis_options(s);
+        Cloud narrow = cloud;
+        narrow.stride_bytes = 2 * sizeof(double);
+        CHECK(reconstruct_guarded(narrow, o).status == Status::invalid_argument);
+        std::vector<unsigned char> work(stratmesh::reconstruct_workspace_size(s.size(), o));
+        std::vector<uint32_t> tris(3 * stratmesh::reconstruct_max_triangles(s.size(), o));
+        CHECK(stratmesh::reconstruct(cloud, o, work.data(), work.size(), tris.data(), tris.size() / 3, nullptr, nullptr) ==
+              Status::invalid_argument);
+    }
+    SUBCASE("fewer than 3 points: too_few_points") {
+        Options o = axis_options(s);
+        CHECK(reconstruct_guarded(Cloud{s.xyz.data(), 2, 0, Scalar::float64}, o).status == Status::too_few_points);
+    }
+}
+
+TEST_CASE("progress: every phase in order, fractions in [0, 1]") {
+    struct Log {
+        std::vector<stratmesh::Phase> phases;
+        bool fractions_ok = true;
+    } log;
+    Options o = axis_options(reference_cylinder());
+    o.layer_count = 4;
+    o.progress = [](void* user, stratmesh::Phase phase, double fraction) {
+        Log* l = static_cast<Log*>(user);
+        if (!(fraction >= 0 && fraction <= 1)) l->fractions_ok = false;
+        l->phases.push_back(phase);
+    };
+    o.progress_user = &log;
+    Run run = reconstruct_guarded(cloud_of(reference_cylinder()), o);
+    REQUIRE(run.status == Status::ok);
+    CHECK(log.fractions_ok);
+    REQUIRE(!log.phases.empty());
+    CHECK(std::is_sorted(log.phases.begin(), log.phases.end()));
+    CHECK(log.phases.front() == stratmesh::Phase::validate);
+    CHECK(log.phases.back() == stratmesh::Phase::done);
+    for (stratmesh::Phase p : {stratmesh::Phase::layers, stratmesh::Phase::triangulate, stratmesh::Phase::stitch,
+                               stratmesh::Phase::manifold})
+        CHECK(std::find(log.phases.begin(), log.phases.end(), p) != log.phases.end());
+}
+
+TEST_CASE("reconstruct_workspace_size suffices, and smaller workspaces give out_of_memory or the same triangles") {
+    // Measured (2000-point cylinder): one layer needs 94% to 97% of the bound depending on
+    // the library version, six layers 52% (the bound assumes every point in one layer);
+    // any size from there up succeeds, so sizes just under the bound need not fail. Every
+    // size below the bound must either fail with out_of_memory or give exactly the
+    // triangles of the full workspace; sizes that cannot hold the triangulation of the
+    // largest layer (72 bytes a point) must fail.
+    const Shape& s = reference_cylinder();
+    for (uint32_t layers : {1u, 6u}) {
+        Options o = axis_options(s);
+        o.layer_count = layers;
+        Run reference = reconstruct_guarded(cloud_of(s), o);
+        REQUIRE(reference.status == Status::ok);
+        const size_t bound = stratmesh::reconstruct_workspace_size(s.size(), o);
+        CHECK(bound == reference.workspace_bytes);
+        CAPTURE(layers);
+        CAPTURE(bound);
+        std::vector<size_t> sizes = {0, 1, 15, 16, 17, 100, 4096, bound / 8, bound / 4, bound / 3};
+        if (layers == 1) sizes.insert(sizes.end(), {bound / 2, bound * 3 / 4, bound * 9 / 10});
+        for (size_t k = 1; k <= 12; ++k) sizes.push_back(bound - bound * k / 50);  // 76% .. 98%
+        sizes.push_back(bound - 1);
+        for (size_t bytes : sizes) {
+            CAPTURE(bytes);
+            // A fresh heap buffer of exactly this size (new[0] is a valid, empty buffer).
+            std::unique_ptr<unsigned char[]> buffer(new unsigned char[bytes]);
+            const size_t capacity = stratmesh::reconstruct_max_triangles(s.size(), o);
+            std::vector<uint32_t> tris(3 * capacity);
+            size_t count = 12345;
+            Report report{};
+            Status status = stratmesh::reconstruct(cloud_of(s), o, buffer.get(), bytes, tris.data(), capacity, &count, &report);
+            CHECK(report.points_in == report.points_used + report.duplicates + report.rejected + report.unused);
+            if (status == Status::ok) {
+                tris.resize(3 * count);
+                CHECK(tris == reference.triangles);
+            } else {
+                CHECK(status == Status::out_of_memory);
+                CHECK(count == 0);
+            }
+            bool must_fail = bytes < bound / 3 || (layers == 1 && bytes <= bound / 2);
+            if (must_fail) CHECK(status == Status::out_of_memory);
+        }
+    }
+}
+
+TEST_CASE("a too-small triangle array gives triangle_capacity with the needed count, nothing written past it") {
+    for (uint32_t layers : {1u, 6u}) {
+        const Shape& s = reference_cylinder();
+        Options o = axis_options(s);
+        o.layer_count = layers;
+        Run reference = reconstruct_guarded(cloud_of(s), o);
+        REQUIRE(reference.status == Status::ok);
+        const size_t needed = reference.count + reference.report.illegal_removed;
+        CAPTURE(layers);
+        CAPTURE(needed);
+        std::vector<unsigned char> work(stratmesh::reconstruct_workspace_size(s.size(), o));
+        for (size_t capacity : {size_t{0}, size_t{1}, needed / 2, needed - 1, needed}) {
+            CAPTURE(capacity);
+            std::vector<uint32_t> tris(3 * (capacity + kGuardTriangles), kSentinel);
+            size_t count = 0;
+            Report report{};
+            Status status = stratmesh::reconstruct(cloud_of(s), o, work.data(), work.size(),
+                                                   capacity ? tris.data() : nullptr, capacity, &count, &report);
+            bool guard = true;
+            for (size_t i = 3 * capacity; i < tris.size(); ++i) guard = guard && tris[i] == kSentinel;
+            CHECK(guard);
+            if (capacity >= needed) {
+                CHECK(status == Status::ok);
+                tris.resize(3 * count);
+                CHECK(tris == reference.triangles);
+            } else {
+                CHECK(status == Status::triangle_capacity);
+                CHECK(count == needed);
+                CHECK(report.triangle_count == needed);
+                CHECK(report.points_in == report.points_used + report.duplicates + report.rejected + report.unused);
+            }
+        }
+    }
+}

@@ -59,10 +59,11 @@
 // ==== Memory ===============================================================================
 //
 // Every function that needs working memory takes (void* workspace, size_t workspace_bytes)
-// and has a *_workspace_size() companion that returns a size that is always sufficient.
-// The workspace needs no particular alignment. A smaller workspace returns
-// Status::out_of_memory; the library never writes outside the workspace and the output
-// arrays it is given, whatever the input.
+// and has a *_workspace_size() companion that returns a size that is always sufficient
+// (a bound: a given input may need less). The workspace needs no particular alignment.
+// A workspace smaller than the call turns out to need returns Status::out_of_memory; the
+// library never writes outside the workspace and the output arrays it is given, whatever
+// the input.
 //
 // delaunay_2d needs 72 bytes per point plus about 10 KiB; its output is at most
 // 2n - 5 triangles (24 bytes per point). reconstruct needs about 88 bytes per point
@@ -253,9 +254,9 @@ struct Options {
     // dot(point, axis) (with Axis::z, a cut at 68 is the plane z = 68); any order,
     // repeats and cuts outside the cloud are ignored; else layer_count equal-height
     // layers; else layers of about layer_height; else automatic (for now: layers about
-    // four mean radii tall). A layer with fewer than 3 points, or whose points do not
-    // surround its centre, is merged with the next one; the report lists the layers
-    // actually used.
+    // four mean radii tall, at most 256). A layer with fewer than 16 points, or whose
+    // points do not surround its centre, is merged with the next one; the report lists
+    // the layers actually used.
     const double* cuts;
     size_t cut_count;
     uint32_t layer_count;
@@ -1538,6 +1539,8 @@ struct LayerPlan {
 };
 
 const size_t kMaxAutomaticLayers = 256;
+// A layer with fewer points is merged with the next one (the last layer only needs 3).
+const size_t kMinLayerPoints = 16;
 
 // The number of layers the options can ask for, before empty layers are dropped.
 inline size_t planned_layer_limit(size_t point_count, const Options& options) {
@@ -2576,7 +2579,8 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
             const uint32_t* ids = m.order + m.layer_start[first];
             size_t n = m.layer_start[last + 1] - m.layer_start[first];
             status = Status::not_columnar;
-            if (n >= 3) {
+            // Tiny layers make coarse, folding bands: they join the next layer if any.
+            if (n >= 3 && (n >= kMinLayerPoints || last + 1 == plan.count)) {
                 cyl = fit_cylinder(reader, frame, ids, n, plan.bounds[first],
                                    plan.bounds[last + 1]);
                 status = triangulate_layer(reader, frame, cyl, ids, n, arena, sink, loops,
@@ -2618,6 +2622,11 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
         return Status::not_columnar;
     }
     notify(options, Phase::stitch, 1);
+    if (sink.count == 0) {
+        rep.detail = "every point lies on the boundary of its layer: too few points to span a "
+                     "surface";
+        return Status::too_few_points;
+    }
     if (sink.count > triangle_capacity) {
         *triangle_count = sink.count;
         rep.triangle_count = sink.count;

@@ -722,35 +722,71 @@ inline double incircle_exact(const double* a, const double* b, const double* c,
     return expansion_top(acc_len, acc);
 }
 
+// An expansion rounded to a double-double hi + lo, |lo| <= eps |hi|: the components are
+// summed smallest first with error-free sums, so the result is off by a few eps^2 of the
+// value. (Taking the expansion's two largest components instead is not enough: a
+// nonoverlapping expansion may hold a lone high bit followed by a component nearly as
+// large.)
+inline void to_double_double(const double* e, int len, double* hi, double* lo) {
+    double h = 0, l = 0;
+    for (int k = 0; k < len; ++k) {
+        double s, err;
+        two_sum(h, e[k], s, err);
+        h = s;
+        l += err;
+    }
+    two_sum(h, l, *hi, *lo);
+}
+
 // incircle when the six coordinate differences are exact doubles: the 3x3 determinant of
-// (dx, dy, dx^2 + dy^2) rows, exactly. Needs 256 doubles of scratch.
-inline double incircle_exact_differences(double adx, double ady, double bdx, double bdy,
-                                         double cdx, double cdy, double* scratch) {
-    const double rows[3][2] = {{adx, ady}, {bdx, bdy}, {cdx, cdy}};
-    double* det = scratch;          // 96
-    double* det2 = scratch + 96;    // 96
-    double* x1 = scratch + 192;     // 8
-    double* x2 = scratch + 200;     // 16
-    double* y1 = scratch + 216;     // 8
-    double* y2 = scratch + 224;     // 16
-    double* sum = scratch + 240;    // 32 (ends at 272)
-    int det_len = 0;
+// rows (dx, dy, L = dx^2 + dy^2), expanded along L. Each lift L and minor M = u x v is
+// formed exactly (cheap). First the three products L M are summed in double-double
+// arithmetic from the lifts and minors rounded to double-doubles (each off by a few
+// eps^2): each product is then off by about 12 eps^2 |L M| and the sum adds about 6 eps^2
+// per term, so a result beyond 64 eps^2 sum |L M| has the right sign. That settles
+// near-cocircular points whose determinant is not zero (rings, rounded grids); exact
+// zeros (integer grids, axis-aligned rectangles) take the exact products. Needs 264
+// doubles of scratch.
+inline double incircle_from_differences(const double rows[3][2], double* scratch) {
+    double lift[3][4], minor[3][4];
+    int lift_len[3], minor_len[3];
+    double hi = 0, lo = 0, magnitude = 0;
     for (int i = 0; i < 3; ++i) {
         const double* u = rows[(i + 1) % 3];
         const double* v = rows[(i + 2) % 3];
-        double minor[4];
-        cross_exact(u[0], u[1], v[0], v[1], minor);
-        int mlen = compress_zeros(4, minor);
-        int l1 = expansion_scale(mlen, minor, rows[i][0], x1);
-        int l2 = expansion_scale(l1, x1, rows[i][0], x2);
-        int l3 = expansion_scale(mlen, minor, rows[i][1], y1);
-        int l4 = expansion_scale(l3, y1, rows[i][1], y2);
-        int slen = expansion_sum(l2, x2, l4, y2, sum);
+        cross_exact(u[0], u[1], v[0], v[1], minor[i]);
+        minor_len[i] = compress_zeros(4, minor[i]);
+        double sx[2], sy[2];
+        two_product(rows[i][0], rows[i][0], sx[1], sx[0]);
+        two_product(rows[i][1], rows[i][1], sy[1], sy[0]);
+        lift_len[i] = expansion_sum(2, sx, 2, sy, lift[i]);
+        double l1, l0, m1, m0, t1, t0, s, e;
+        to_double_double(lift[i], lift_len[i], &l1, &l0);
+        to_double_double(minor[i], minor_len[i], &m1, &m0);
+        two_product(l1, m1, t1, t0);
+        double cross = l1 * m0 + l0 * m1 + t0;
+        two_sum(hi, t1, s, e);
+        hi = s;
+        lo += e + cross;
+        magnitude += abs_value(l1) * abs_value(m1);
+    }
+    double approximate = hi + lo;
+    double bound = 64 * kEps * kEps * magnitude + kUnderflowGuard;
+    if (approximate > bound || -approximate > bound) return approximate;
+    double* det = scratch;            // 96
+    double* det2 = scratch + 96;      // 96
+    double* product = scratch + 192;  // 32
+    double* tmp = scratch + 224;      // 32
+    double* scaled = scratch + 256;   // 8
+    int det_len = 0;
+    for (int i = 0; i < 3; ++i) {
+        int len = expansion_product(minor_len[i], minor[i], lift_len[i], lift[i], product, tmp,
+                                    scaled);
         if (det_len == 0) {
-            std::memcpy(det, sum, sizeof(double) * static_cast<size_t>(slen));
-            det_len = slen;
+            std::memcpy(det, product, sizeof(double) * static_cast<size_t>(len));
+            det_len = len;
         } else {
-            det_len = expansion_sum(det_len, det, slen, sum, det2);
+            det_len = expansion_sum(det_len, det, len, product, det2);
             std::memcpy(det, det2, sizeof(double) * static_cast<size_t>(det_len));
         }
     }
@@ -796,8 +832,10 @@ inline double incircle_robust(const double* a, const double* b, const double* c,
     two_diff(a[1], d[1], ady, t[3]);
     two_diff(b[1], d[1], bdy, t[4]);
     two_diff(c[1], d[1], cdy, t[5]);
-    if (t[0] == 0 && t[1] == 0 && t[2] == 0 && t[3] == 0 && t[4] == 0 && t[5] == 0)
-        return incircle_exact_differences(adx, ady, bdx, bdy, cdx, cdy, scratch);
+    if (t[0] == 0 && t[1] == 0 && t[2] == 0 && t[3] == 0 && t[4] == 0 && t[5] == 0) {
+        const double rows[3][2] = {{adx, ady}, {bdx, bdy}, {cdx, cdy}};
+        return incircle_from_differences(rows, scratch);
+    }
     return incircle_exact(a, b, c, d, scratch);
 }
 

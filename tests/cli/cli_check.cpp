@@ -21,6 +21,8 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 namespace {
@@ -177,6 +179,54 @@ int check_json(int argc, char** argv) {
 
 // ---- mesh --------------------------------------------------------------------------------
 
+// Whether the triangles form an oriented 2-manifold: no directed edge twice (so at most
+// two triangles per edge, consistently oriented) and, around every vertex, the triangles
+// form a single fan (one chain or one cycle).
+bool is_oriented_manifold(const std::vector<uint32_t>& tris, std::string& why) {
+    std::unordered_set<uint64_t> directed;
+    std::unordered_map<uint32_t, std::vector<std::pair<uint32_t, uint32_t>>> fans;
+    for (size_t t = 0; t + 2 < tris.size(); t += 3) {
+        for (size_t k = 0; k < 3; ++k) {
+            uint32_t a = tris[t + k], b = tris[t + (k + 1) % 3], c = tris[t + (k + 2) % 3];
+            if (!directed.insert((static_cast<uint64_t>(a) << 32) | b).second) {
+                why = "edge " + std::to_string(a) + "->" + std::to_string(b) + " repeats";
+                return false;
+            }
+            fans[a].push_back({b, c});  // around a: leaves towards b, arrives from c
+        }
+    }
+    for (const auto& entry : fans) {
+        const auto& fan = entry.second;
+        // Triangle k links to the one leaving towards where k arrives from; a chain starts
+        // at a triangle no other arrives into (its leaving edge is a boundary edge).
+        std::unordered_map<uint32_t, size_t> leaving;
+        std::unordered_set<uint32_t> arriving;
+        for (size_t k = 0; k < fan.size(); ++k) {
+            leaving[fan[k].first] = k;
+            arriving.insert(fan[k].second);
+        }
+        size_t starts = 0, start = 0;
+        for (size_t k = 0; k < fan.size(); ++k)
+            if (!arriving.count(fan[k].first)) {
+                ++starts;
+                start = k;
+            }
+        size_t walked = 0;
+        for (size_t at = start; walked <= fan.size();) {
+            ++walked;
+            auto next = leaving.find(fan[at].second);
+            if (next == leaving.end() || next->second == start) break;
+            at = next->second;
+        }
+        if (starts > 1 || walked != fan.size()) {
+            why = "the triangles around vertex " + std::to_string(entry.first) +
+                  " form more than one fan";
+            return false;
+        }
+    }
+    return true;
+}
+
 int check_mesh(int argc, char** argv) {
     std::string path = argv[2];
     size_t vertices = std::strtoull(argv[3], nullptr, 10);
@@ -193,6 +243,22 @@ int check_mesh(int argc, char** argv) {
     if (argc > 4 && load_json(argv[4], report)) {
         const mini_json::Value* t = report.at("triangles");
         ok = ok && t && t->num == static_cast<double>(triangles);
+        // With a report the mesh must be an oriented manifold through every point the
+        // report calls used, and the report must leave no valid point unused.
+        std::string why;
+        if (!stl && !is_oriented_manifold(mesh.tris, why)) {
+            std::fprintf(stderr, "%s: not an oriented manifold: %s\n", path.c_str(), why.c_str());
+            ok = false;
+        }
+        std::unordered_set<uint32_t> used(mesh.tris.begin(), mesh.tris.end());
+        const mini_json::Value* reported = report.at("points.used");
+        const mini_json::Value* unused = report.at("points.unused");
+        if (!stl && (!reported || reported->num != static_cast<double>(used.size()) ||
+                     !unused || unused->num != 0)) {
+            std::fprintf(stderr, "%s: %zu vertices used; the report disagrees or has unused points\n",
+                         path.c_str(), used.size());
+            ok = false;
+        }
     } else if (argc > 4) {
         ok = false;
     }

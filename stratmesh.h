@@ -1755,14 +1755,12 @@ inline void roll(const Cylinder& c, const Local& p, double* out) {
     }
 }
 
-// Centre and radius of the points ids[0..count) (all valid), for heights [h0, h1].
-inline Cylinder fit_cylinder(const CloudReader& cloud, const Frame& frame,
-                             const uint32_t* ids, size_t count, double h0, double h1) {
+// Centre and radius of a layer's points (frame coordinates) for heights [h0, h1].
+inline Cylinder fit_cylinder(const Local* points, size_t count, double h0, double h1) {
     double mx = 0, my = 0;
     for (size_t i = 0; i < count; ++i) {
-        Local p = frame.local(cloud.point(ids[i]));
-        mx += p.x;
-        my += p.y;
+        mx += points[i].x;
+        my += points[i].y;
     }
     double inv = count ? 1.0 / static_cast<double>(count) : 0.0;
     mx *= inv;
@@ -1771,7 +1769,7 @@ inline Cylinder fit_cylinder(const CloudReader& cloud, const Frame& frame,
     double sx[kSectors] = {}, sy[kSectors] = {};
     uint32_t sn[kSectors] = {};
     for (size_t i = 0; i < count; ++i) {
-        Local p = frame.local(cloud.point(ids[i]));
+        const Local& p = points[i];
         double angle = pseudo_angle(p.x - mx, p.y - my);
         uint32_t s = static_cast<uint32_t>(angle * (kSectors / 4.0));
         if (s >= kSectors) s = kSectors - 1;
@@ -1792,8 +1790,7 @@ inline Cylinder fit_cylinder(const CloudReader& cloud, const Frame& frame,
     c.cy = used ? cy / used : my;
     double rsum = 0;
     for (size_t i = 0; i < count; ++i) {
-        Local p = frame.local(cloud.point(ids[i]));
-        double dx = p.x - c.cx, dy = p.y - c.cy;
+        double dx = points[i].x - c.cx, dy = points[i].y - c.cy;
         rsum += std::sqrt(dx * dx + dy * dy);
     }
     c.radius = rsum * inv;
@@ -1802,6 +1799,17 @@ inline Cylinder fit_cylinder(const CloudReader& cloud, const Frame& frame,
     double r = c.radius > floor_radius ? c.radius : floor_radius;
     c.scale = r > 0 && is_finite(r) ? 1.0 / r : 1.0;
     return c;
+}
+
+// Whether triangle abc (counter-clockwise seen from outside) has its normal pointing
+// towards the cylinder's axis: a fold.
+inline bool faces_axis(const Local& pa, const Local& pb, const Local& pc, const Cylinder& cyl) {
+    Vec3 u = {pb.x - pa.x, pb.y - pa.y, pb.h - pa.h};
+    Vec3 v = {pc.x - pa.x, pc.y - pa.y, pc.h - pa.h};
+    Vec3 n = cross(u, v);
+    double rx = (pa.x + pb.x + pc.x) / 3 - cyl.cx;
+    double ry = (pa.y + pb.y + pc.y) / 3 - cyl.cy;
+    return n.x * rx + n.y * ry < 0;
 }
 
 // Where reconstructed triangles go: the caller's array, filled in order. Triangles are
@@ -1813,30 +1821,18 @@ struct TriangleSink {
     size_t capacity;
     size_t count;
     size_t folds;
-    const CloudReader* cloud;
-    const Frame* frame;
 
-    void emit(uint32_t a, uint32_t b, uint32_t c, const Cylinder& cyl) {
+    // Emits abc, given counter-clockwise on the annulus (so written reversed), with the
+    // vertices' frame coordinates for the fold count.
+    void emit(uint32_t a, uint32_t b, uint32_t c, const Local& pa, const Local& pb,
+              const Local& pc, const Cylinder& cyl) {
         if (count < capacity) {
             triangles[3 * count] = a;
             triangles[3 * count + 1] = c;
             triangles[3 * count + 2] = b;
         }
         ++count;
-        if (faces_axis(a, c, b, cyl)) ++folds;
-    }
-
-    // Whether the triangle's normal points towards the cylinder's axis: a fold.
-    bool faces_axis(uint32_t a, uint32_t b, uint32_t c, const Cylinder& cyl) const {
-        Local pa = frame->local(cloud->point(a));
-        Local pb = frame->local(cloud->point(b));
-        Local pc = frame->local(cloud->point(c));
-        Vec3 u = {pb.x - pa.x, pb.y - pa.y, pb.h - pa.h};
-        Vec3 v = {pc.x - pa.x, pc.y - pa.y, pc.h - pa.h};
-        Vec3 n = cross(u, v);
-        double rx = (pa.x + pb.x + pc.x) / 3 - cyl.cx;
-        double ry = (pa.y + pb.y + pc.y) / 3 - cyl.cy;
-        return n.x * rx + n.y * ry < 0;
+        if (faces_axis(pa, pc, pb, cyl)) ++folds;
     }
 };
 
@@ -1914,26 +1910,33 @@ inline void hull_loop(const Triangulation& tr, const uint32_t* ids, const uint32
     *count = n;
 }
 
-// Triangulates one layer: its points ids[0..count) rolled onto the annulus of `cyl` plus
-// the centre. Emits the surface triangles, fills the loops. Returns ok, not_columnar (the
-// layer does not surround its axis, or is degenerate: the caller merges it with the next
-// one), out_of_memory or internal_error.
+// Triangulates one layer: its points ids[0..count) (heights [h0, h1]) rolled onto the
+// annulus of the cylinder fitted to them (*cyl) plus the centre. Emits the surface
+// triangles, fills the loops. Returns ok, not_columnar (the layer does not surround its
+// axis, or is degenerate: the caller merges it with the next one), out_of_memory or
+// internal_error.
 inline Status triangulate_layer(const CloudReader& cloud, const Frame& frame,
-                                const Cylinder& cyl, const uint32_t* ids, size_t count,
+                                const uint32_t* ids, size_t count, double h0, double h1,
                                 Arena& arena, TriangleSink& sink, LayerLoops& loops,
-                                LayerCounts& counts) {
+                                LayerCounts& counts, Cylinder* cylinder) {
     const size_t total = count + 1;  // local id 0 is the centre
     size_t mark = arena.mark();
+    // The layer's frame coordinates, read from the cloud once: every later pass, and the
+    // triangles' fold test, reads this compact array instead of the cloud at random.
+    Local* points = arena.alloc<Local>(count);
     uint32_t* order = arena.alloc<uint32_t>(total);
     double* xy = arena.alloc<double>(2 * total);
     if (arena.failed) return Status::out_of_memory;
+    for (size_t i = 0; i < count; ++i) points[i] = frame.local(cloud.point(ids[i]));
+    const Cylinder cyl = fit_cylinder(points, count, h0, h1);
+    *cylinder = cyl;
     // The insertion order is taken on the unrolled strip (angle, height), where the points
     // are spread evenly: on the annulus their density falls off with the radius squared
     // and a curve over its bounding box would lump the inner rings together.
     xy[0] = xy[1] = 0;
     BoundingBox2d box = {{0, 0}, {4, 0}};
     for (size_t i = 1; i < total; ++i) {
-        Local p = frame.local(cloud.point(ids[i - 1]));
+        const Local& p = points[i - 1];
         xy[2 * i] = pseudo_angle(p.x - cyl.cx, p.y - cyl.cy);
         xy[2 * i + 1] = (p.h - cyl.h0) * cyl.scale;
         if (xy[2 * i + 1] > box.max[1]) box.max[1] = xy[2 * i + 1];
@@ -1941,14 +1944,13 @@ inline Status triangulate_layer(const CloudReader& cloud, const Frame& frame,
     if (!spatial_order(reinterpret_cast<const unsigned char*>(xy), 2 * sizeof(double), total,
                        box, order, arena))
         return Status::out_of_memory;
-    // Lay the points out in insertion order, recomputed (the same bits) rather than copied.
     uint32_t centre = 0;
     for (size_t k = 0; k < total; ++k) {
         if (order[k] == 0) {
             centre = static_cast<uint32_t>(k);
             xy[2 * k] = xy[2 * k + 1] = 0;
         } else {
-            roll(cyl, frame.local(cloud.point(ids[order[k] - 1])), xy + 2 * k);
+            roll(cyl, points[order[k] - 1], xy + 2 * k);
         }
     }
     Triangulation tr;
@@ -1970,7 +1972,8 @@ inline Status triangulate_layer(const CloudReader& cloud, const Frame& frame,
         const uint32_t* v = tr.vertex + 3 * t;
         if (tr.is_ghost(t) || v[0] == centre || v[1] == centre || v[2] == centre) continue;
         sink.emit(original_id(ids, order, v[0]), original_id(ids, order, v[1]),
-                  original_id(ids, order, v[2]), cyl);
+                  original_id(ids, order, v[2]), points[order[v[0]] - 1],
+                  points[order[v[1]] - 1], points[order[v[2]] - 1], cyl);
     }
     arena.rewind(mark);
     return Status::ok;
@@ -2170,13 +2173,16 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
     *swaps += swap_diagonals(band);
     uint32_t i = 0, j = 0;
     for (uint32_t t = 0; t < p + q; ++t) {
+        uint32_t x, y, z;  // counter-clockwise on the annulus
         if (steps[t] == 0) {
-            sink.emit(a[(i + 1) % p], a[i % p], b[j % q], shared);
+            x = a[(i + 1) % p], y = a[i % p], z = b[j % q];
             ++i;
         } else {
-            sink.emit(b[j % q], b[(j + 1) % q], a[i % p], shared);
+            x = b[j % q], y = b[(j + 1) % q], z = a[i % p];
             ++j;
         }
+        sink.emit(x, y, z, frame.local(cloud.point(x)), frame.local(cloud.point(y)),
+                  frame.local(cloud.point(z)), shared);
     }
     arena.rewind(mark);
     return true;
@@ -2433,6 +2439,7 @@ inline bool plan_reconstruct(ReconstructMemory& m, size_t count, size_t layer_li
 inline size_t reconstruct_scratch_size(size_t count) {
     size_t total = count + 1;
     Arena layer = Arena::measuring();
+    layer.alloc<Local>(count);
     layer.alloc<uint32_t>(total);
     layer.alloc<double>(2 * total);
     size_t mark = layer.mark();
@@ -2601,7 +2608,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     group_by_layer(reader, cloud.count, frame, plan, m);
 
     notify(options, Phase::triangulate, 0);
-    TriangleSink sink = {triangles, triangle_capacity, 0, 0, &reader, &frame};
+    TriangleSink sink = {triangles, triangle_capacity, 0, 0};
     uint32_t* previous_top = m.loops[0];
     uint32_t previous_top_count = 0;
     Cylinder previous = {0, 0, 0, 0, 0};
@@ -2619,10 +2626,9 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
             status = Status::not_columnar;
             // Tiny layers make coarse, folding bands: they join the next layer if any.
             if (n >= 3 && (n >= kMinLayerPoints || last + 1 == plan.count)) {
-                cyl = fit_cylinder(reader, frame, ids, n, plan.bounds[first],
-                                   plan.bounds[last + 1]);
-                status = triangulate_layer(reader, frame, cyl, ids, n, arena, sink, loops,
-                                           counts);
+                status = triangulate_layer(reader, frame, ids, n, plan.bounds[first],
+                                           plan.bounds[last + 1], arena, sink, loops, counts,
+                                           &cyl);
             }
             if (status == Status::ok) break;
             if (status != Status::not_columnar) return status;

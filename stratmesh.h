@@ -66,9 +66,9 @@
 // the input.
 //
 // delaunay_2d needs 72 bytes per point plus about 10 KiB; its output is at most
-// 2n - 5 triangles (24 bytes per point). reconstruct needs about 88 bytes per point
-// (the triangulation of its largest possible layer, plus the layer grouping and
-// boundary loops); its output is at most 2n triangles.
+// 2n - 5 triangles (24 bytes per point). reconstruct needs about 112 bytes per point
+// (the triangulation of its largest possible layer with the layer's coordinates, plus the
+// layer grouping and boundary loops); its output is at most 2n triangles.
 //
 // Stack: no recursion anywhere. The deepest frames hold a few hundred bytes, except the
 // exact incircle, whose expansions (about 8 KiB) live in the workspace when called from

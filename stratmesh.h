@@ -243,7 +243,9 @@ enum Flags : uint32_t {
     skip_invalid_points = 1u << 0,
 };
 
-// Phases reported to Options::progress, in the order they run.
+// Phases reported to Options::progress, in the order they run. Each layer is stitched to
+// the one below as soon as it is triangulated, so stitching time falls within
+// `triangulate`; `stitch` is announced once, when the last band is done.
 enum class Phase : uint32_t { validate = 0, layers, triangulate, stitch, manifold, done };
 
 // All zero means defaults: `Options options = {};` is always valid.
@@ -306,11 +308,33 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options);
 // The most triangles reconstruct() can produce for point_count points.
 size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 
-// Reconstructs a triangle mesh through the points of a columnar cloud.
+// Reconstructs a triangle mesh through the points of a columnar cloud: one surface,
+// edge- and vertex-manifold, consistently oriented, an open tube (two boundary loops) on
+// columnar input, with every valid distinct point a vertex unless the report says why not.
 //
+// cloud           the points (see Cloud), at most 2^32 - 3. They are only read.
+// options         see Options; `Options options = {};` gives the defaults.
+// workspace       at least reconstruct_workspace_size(cloud.count, options) bytes; any
+//                 alignment.
 // triangles       receives 3 * (*triangle_count) indices into the cloud, each triangle
 //                 counter-clockwise seen from outside (normals point away from the axis).
-// report          optional; see Report. Filled on every status.
+//                 Triangles come layer by layer, bottom to top, each layer's band to the
+//                 layer below just before it. The order is deterministic.
+// triangle_capacity  triangles that fit in `triangles`; reconstruct_max_triangles() always
+//                 suffices. When too small: Status::triangle_capacity and *triangle_count
+//                 says how many are needed (the array's contents are then unspecified;
+//                 nothing is written past the capacity).
+// triangle_count  required; receives the number of triangles (0 on failure).
+// report          optional; see Report. Filled on every status, counts adding up.
+//
+// Returns ok; invalid_argument (a null pointer with a non-zero count, a stride smaller
+// than one point, an unknown Scalar, cut_count without cuts, a null triangle_count);
+// too_many_points; invalid_point (Report::first_invalid_point, unless
+// skip_invalid_points); invalid_axis (Axis::direction of zero length, NaN or infinite);
+// invalid_layers (a NaN or infinite cut, a negative or non-finite layer_height);
+// too_few_points (fewer than 3 valid points, or no surface spans them); flat_cloud (no
+// extent along the axis); not_columnar (no layer's points surround its centre: try
+// another axis); out_of_memory; triangle_capacity; internal_error.
 Status reconstruct(const Cloud& cloud, const Options& options,
                    void* workspace, size_t workspace_bytes,
                    uint32_t* triangles, size_t triangle_capacity, size_t* triangle_count,

@@ -661,9 +661,16 @@ inline double rescaling_factor(const double* values, int count, int limit) {
 // few 2^-1075: a result is only trusted beyond this.
 constexpr double kUnderflowGuard = 0x1p-1000;
 
-inline void scale_point(const double* p, double factor, double* out) {
-    out[0] = p[0] * factor;
-    out[1] = p[1] * factor;
+// Points the first `count` entries of `points` at scaled copies in `storage`, unless
+// factor is 0 (no scaling needed).
+inline void rescale_points(double factor, const double** points, double (*storage)[2],
+                           int count) {
+    if (factor == 0) return;
+    for (int k = 0; k < count; ++k) {
+        storage[k][0] = points[k][0] * factor;
+        storage[k][1] = points[k][1] * factor;
+        points[k] = storage[k];
+    }
 }
 
 // Sign-exact orient2d: the filter decides unless |det| is within the rounding error, then
@@ -678,15 +685,12 @@ inline double orient2d_robust(const double* a, const double* b, const double* c)
     if (det > bound || -det > bound) return det;
     const double magnitudes[10] = {acx, bcx, acy, bcy, a[0], a[1], b[0], b[1], c[0], c[1]};
     double factor = rescaling_factor(magnitudes, 10, 450);
-    double sa[2], sb[2], sc[2];
-    if (factor != 0) {
-        scale_point(a, factor, sa);
-        scale_point(b, factor, sb);
-        scale_point(c, factor, sc);
-        a = sa;
-        b = sb;
-        c = sc;
-    }
+    const double* points[3] = {a, b, c};
+    double scaled[3][2];
+    rescale_points(factor, points, scaled, 3);
+    a = points[0];
+    b = points[1];
+    c = points[2];
     double t0, t1, t2, t3;
     two_diff(a[0], c[0], acx, t0);
     two_diff(b[0], c[0], bcx, t1);
@@ -838,17 +842,13 @@ inline double incircle_robust(const double* a, const double* b, const double* c,
     const double magnitudes[14] = {adx, bdx, cdx, ady, bdy, cdy, a[0], a[1],
                                    b[0], b[1], c[0], c[1], d[0], d[1]};
     double factor = rescaling_factor(magnitudes, 14, 220);
-    double sa[2], sb[2], sc[2], sd[2];
-    if (factor != 0) {
-        scale_point(a, factor, sa);
-        scale_point(b, factor, sb);
-        scale_point(c, factor, sc);
-        scale_point(d, factor, sd);
-        a = sa;
-        b = sb;
-        c = sc;
-        d = sd;
-    }
+    const double* points[4] = {a, b, c, d};
+    double scaled[4][2];
+    rescale_points(factor, points, scaled, 4);
+    a = points[0];
+    b = points[1];
+    c = points[2];
+    d = points[3];
     double t[6];
     two_diff(a[0], d[0], adx, t[0]);
     two_diff(b[0], d[0], bdx, t[1]);

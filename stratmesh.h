@@ -2019,11 +2019,11 @@ inline Status triangulate_layer(const CloudReader& cloud, const Frame& frame,
 // is used here because band triangles are long and flat: on the annulus the circle's
 // curvature would flip their orientation relative to the surface.
 
-// Rotates loop[0..n) and its strip coordinates so the smallest angle comes first.
-inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
-    uint32_t first = 0;
-    for (uint32_t i = 1; i < n; ++i)
-        if (uv[2 * i] < uv[2 * first]) first = i;
+// Rotates loop[0..n) and its strip coordinates so that entry `first` comes first; the
+// entries moved to the end are shifted by `turn` (one period of the strip), so angles
+// keep increasing along the loop.
+inline void rotate_loop(uint32_t* loop, double* uv, uint32_t n, uint32_t first, double turn) {
+    for (uint32_t i = 0; i < first; ++i) uv[2 * i] += turn;
     // Three reversals rotate in place.
     auto reverse = [&](uint32_t lo, uint32_t hi) {  // the range [lo, hi)
         for (; hi > lo + 1; ++lo) {
@@ -2041,6 +2041,14 @@ inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
     reverse(0, first);
     reverse(first, n);
     reverse(0, n);
+}
+
+// Rotates loop[0..n) so its smallest angle comes first (angles in [0, turn)).
+inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
+    uint32_t first = 0;
+    for (uint32_t i = 1; i < n; ++i)
+        if (uv[2 * i] < uv[2 * first]) first = i;
+    rotate_loop(loop, uv, n, first, 0);
 }
 
 struct Band {
@@ -2195,6 +2203,27 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
     Band band = {a, xa, p, b, xb, q, two_pi * unrolled_radius, steps, scratch, {}};
     zip_by_angle(band);
     *swaps += swap_diagonals(band);
+    // The closing rung was held fixed: restart the band half-way round and swap again, so
+    // the quads around it get their test too.
+    const uint32_t length = p + q, half = length / 2;
+    uint32_t i_half = 0, j_half = 0;
+    for (uint32_t t = 0; t < half; ++t) (steps[t] == 0 ? i_half : j_half) += 1;
+    if (i_half > 0 && i_half < p && j_half > 0 && j_half < q) {
+        rotate_loop(a, xa, p, i_half, band.turn);
+        rotate_loop(b, xb, q, j_half, band.turn);
+        auto reverse = [steps](uint32_t lo, uint32_t hi) {  // the range [lo, hi)
+            for (; hi > lo + 1; ++lo) {
+                --hi;
+                unsigned char c = steps[lo];
+                steps[lo] = steps[hi];
+                steps[hi] = c;
+            }
+        };
+        reverse(0, half);
+        reverse(half, length);
+        reverse(0, length);
+        *swaps += swap_diagonals(band);
+    }
     uint32_t i = 0, j = 0;
     for (uint32_t t = 0; t < p + q; ++t) {
         uint32_t x, y, z;  // counter-clockwise on the annulus

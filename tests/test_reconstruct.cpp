@@ -612,16 +612,15 @@ TEST_CASE("reconstruction of the noisy tube, every pose, size and layering") { c
 TEST_CASE("reconstruction of the head, every pose, size and layering") { check_shape(8); }
 
 // Library defect, kept strict: with several layers, the zipper bands hold triangles facing
-// the axis (16 several-layer runs of the matrix at 2000 points and 1 at 20000 points,
-// one or two triangles each). A band joins two loops coarser than the point spacing
-// (the lower layer's hull and the upper layer's centre link skip points close to the cut)
-// and some of its triangles stay clockwise on the unrolled strip: the diagonal swap cannot
-// untangle them when the swapped pair is not proper either. Example: cone, 2000 points,
-// axis X, layer_height 0.75: triangle 2305 (points 1702, 270, 773, two below the cut at
-// local height -0.7477, one above, spanning 0.23 rad) faces the axis, cosine -0.91.
-// Some of those folds intersect their neighbours. Example: noisy tube, 2000 points, tilted,
-// the explicit cuts of layered_options(): triangles 2988 (580, 1790, 1720) and 3960 (1026,
-// 1794, 1355) share no vertex and cross (confirmed by an independent edge-triangle test).
+// the axis. Originally 16 several-layer runs of the matrix at 2000 points and 1 at 20000
+// points, one or two triangles each; untangling folded slivers and a second swap pass
+// around the band's closing rung brought it down to the cone alone (6 runs, one triangle
+// each). A band joins two loops coarser than the point spacing (the lower layer's hull and
+// the upper layer's centre link skip points close to the cut) and some of its triangles
+// stay clockwise on the unrolled strip when the swapped pair is not proper either.
+// Example (before the fixes): cone, 2000 points, axis X, layer_height 0.75: triangle 2305
+// (points 1702, 270, 773, two below the cut at local height -0.7477, one above, spanning
+// 0.23 rad) faced the axis, cosine -0.91.
 TEST_CASE("reconstruction with several layers: every triangle faces outward, no self-intersection" * doctest::may_fail()) {
     for (size_t kind = 0; kind < shape_kinds().size(); ++kind)
         for_each_case(kind, [](const Case& c) {

@@ -70,9 +70,12 @@
 // (the triangulation of its largest possible layer with the layer's coordinates, plus the
 // layer grouping and boundary loops); its output is at most 2n triangles.
 //
-// Stack: no recursion anywhere. The deepest frames hold a few hundred bytes, except the
-// exact incircle, whose expansions (about 8 KiB) live in the workspace when called from
-// the triangulation and on the stack only when you call incircle() yourself.
+// Stack: no recursion anywhere. The exact incircle's expansions (about 8 KiB) live in the
+// workspace when called from the triangulation, and on the stack only when you call
+// incircle() yourself. Measured worst cases (CI checks them): reconstruct 2.3 KiB and
+// delaunay_2d 1.5 KiB on a Cortex-M7 (GCC -Os, call graph of -fstack-usage, libm and
+// your progress callback not included); painted-stack high-water marks on x86-64 of
+// 4.7 KiB (g++ -O2) and 3.5 KiB (clang); incircle() called directly 9.1 KiB.
 //
 // ==== Errors ===============================================================================
 //

@@ -181,6 +181,7 @@ struct Delaunay2dInfo {
     size_t duplicate_count;     // points that repeat an earlier point's coordinates
     size_t hull_vertex_count;   // points on the convex hull boundary, collinear ones too
     size_t first_invalid_point; // index of the first NaN/Inf point, on invalid_point
+    size_t workspace_used;      // peak workspace bytes, from the start of the buffer
 };
 
 // A size in bytes that is always enough workspace for delaunay_2d of point_count points.
@@ -302,10 +303,16 @@ struct Report {
     LayerInfo* layers;
     size_t layer_capacity;
     const char* detail;      // a static sentence on why, when something failed or was dropped
+    // The workspace bytes this call used at its peak, counted from the start of the
+    // buffer: a buffer of exactly this size at the same address suffices for the same
+    // input, one byte less does not. Compare with reconstruct_workspace_size().
+    size_t workspace_used;
 };
 
 // A size in bytes that is always enough workspace for reconstruct() of point_count
-// points with these options.
+// points with these options. It assumes the worst layout (every point in one layer);
+// Report::workspace_used tells what a run really needed (measured on 2000-point tubes:
+// the bound is the peak for one layer, 2.1 to 2.3 times it with six or more layers).
 size_t reconstruct_workspace_size(size_t point_count, const Options& options);
 
 // The most triangles reconstruct() can produce for point_count points.
@@ -429,21 +436,26 @@ struct Arena {
     size_t used;
     size_t high_water;
     bool failed;
+    size_t pad;  // bytes skipped at the start of the caller's buffer to align `base`
 
     static Arena over(void* buffer, size_t bytes) {
-        Arena a = {nullptr, 0, 0, 0, false};
+        Arena a = {nullptr, 0, 0, 0, false, 0};
         if (!buffer) return a;
         uintptr_t start = reinterpret_cast<uintptr_t>(buffer);
-        size_t pad = (kAlign - start % kAlign) % kAlign;
-        if (bytes < pad) {
+        a.pad = (kAlign - start % kAlign) % kAlign;
+        if (bytes < a.pad) {
             a.base = static_cast<unsigned char*>(buffer);
             return a;
         }
-        a.base = static_cast<unsigned char*>(buffer) + pad;
-        a.capacity = bytes - pad;
+        a.base = static_cast<unsigned char*>(buffer) + a.pad;
+        a.capacity = bytes - a.pad;
         return a;
     }
-    static Arena measuring() { return Arena{nullptr, SIZE_MAX, 0, 0, false}; }
+    static Arena measuring() { return Arena{nullptr, SIZE_MAX, 0, 0, false, 0}; }
+
+    // The peak, counted from the start of the caller's buffer: a buffer of this size at
+    // the same address would have been enough.
+    size_t peak_from_buffer() const { return high_water ? pad + high_water : 0; }
 
     bool is_measuring() const { return base == nullptr && capacity == SIZE_MAX; }
 
@@ -1403,7 +1415,7 @@ Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
                    void* workspace, size_t workspace_bytes,
                    uint32_t* triangles, size_t triangle_capacity,
                    Delaunay2dInfo* info, uint32_t* duplicate_of) {
-    Delaunay2dInfo local = {0, 0, 0, 0};
+    Delaunay2dInfo local = {0, 0, 0, 0, 0};
     Delaunay2dInfo& out = info ? *info : local;
     out = local;
     if (point_count > detail::kMaxPoints) return Status::too_many_points;
@@ -1430,7 +1442,10 @@ Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
     detail::Arena arena = detail::Arena::over(workspace, workspace_bytes);
     detail::Delaunay2dMemory m;
     if (!detail::plan_delaunay_2d(m, point_count, arena, base, stride_bytes, &box))
+        {
+        out.workspace_used = arena.peak_from_buffer();
         return Status::out_of_memory;
+    }
     for (size_t k = 0; k < point_count; ++k) {
         const unsigned char* p = base + m.order[k] * stride_bytes;
         m.xy[2 * k] = detail::read_double(p);
@@ -1444,6 +1459,7 @@ Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
     uint32_t inserted = 0;
     Status status = detail::triangulate_points(m.tr, static_cast<uint32_t>(point_count),
                                                sink, &inserted);
+    out.workspace_used = arena.peak_from_buffer();
     if (status != Status::ok) return status;
 
     size_t ghosts = 0;
@@ -2653,9 +2669,14 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     }
 
     Arena arena = Arena::over(workspace, workspace_bytes);
+    // Every exit from here records the peak workspace.
+    auto finish = [&](Status result) {
+        rep.workspace_used = arena.peak_from_buffer();
+        return result;
+    };
     ReconstructMemory m;
     size_t layer_limit = planned_layer_limit(cloud.count, options);
-    if (!plan_reconstruct(m, cloud.count, layer_limit, arena)) return Status::out_of_memory;
+    if (!plan_reconstruct(m, cloud.count, layer_limit, arena)) return finish(Status::out_of_memory);
     notify(options, Phase::layers, 0);
     LayerPlan plan = {m.bounds, 0};
     const double offset = dot(frame.origin, frame.axis);
@@ -2687,7 +2708,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
                                            &cyl);
             }
             if (status == Status::ok) break;
-            if (status != Status::not_columnar) return status;
+            if (status != Status::not_columnar) return finish(status);
             if (last + 1 == plan.count) {
                 trailing = n;
                 break;
@@ -2698,7 +2719,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
         if (previous_top_count > 0 &&
             !stitch_layers(reader, frame, previous, previous_top, previous_top_count, cyl,
                            loops.bottom, loops.bottom_count, arena, sink, &swaps))
-            return Status::out_of_memory;
+            return finish(Status::out_of_memory);
         size_t points = m.layer_start[last + 1] - m.layer_start[first];
         rep.duplicates += counts.duplicates;
         collisions += counts.collisions;
@@ -2719,25 +2740,25 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     if (rep.layer_count == 0) {
         rep.detail = "no layer's points surround the axis: the cloud is not columnar around "
                      "it (try another axis)";
-        return Status::not_columnar;
+        return finish(Status::not_columnar);
     }
     notify(options, Phase::stitch, 1);
     if (sink.count == 0) {
         rep.detail = "every point lies on the boundary of its layer: too few points to span a "
                      "surface";
-        return Status::too_few_points;
+        return finish(Status::too_few_points);
     }
     if (sink.count > triangle_capacity) {
         *triangle_count = sink.count;
         rep.triangle_count = sink.count;
         rep.detail = "the triangle array is too small; triangle_count says how many are needed";
-        return Status::triangle_capacity;
+        return finish(Status::triangle_capacity);
     }
 
     notify(options, Phase::manifold, 0);
     size_t count = sink.count, used = 0;
     size_t removed = enforce_manifold(triangles, count, cloud.count, arena, &used);
-    if (removed == SIZE_MAX) return Status::out_of_memory;
+    if (removed == SIZE_MAX) return finish(Status::out_of_memory);
     *triangle_count = count;
     rep.triangle_count = count;
     rep.illegal_removed = removed;
@@ -2753,7 +2774,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
         rep.detail = "the manifold safety net removed the triangles of some points";
     (void)swaps;
     notify(options, Phase::done, 1);
-    return Status::ok;
+    return finish(Status::ok);
 }
 
 }  // namespace detail

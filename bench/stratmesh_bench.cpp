@@ -403,7 +403,7 @@ bool measure_delaunay_2d(const std::string& name, const std::vector<double>& xy,
     std::memset(triangles.get(), 0xA5, triangle_bytes + sizeof(uint32_t));
 
     stratmesh::Status status = stratmesh::Status::ok;
-    stratmesh::Delaunay2dInfo info = {0, 0, 0, 0};
+    stratmesh::Delaunay2dInfo info = {};
     std::vector<double> times;
     for (int run = 0; run < runs; ++run) {
         Clock::time_point start = Clock::now();
@@ -532,7 +532,7 @@ public:
 
     // One timed call; returns its seconds.
     double run() {
-        stratmesh::Delaunay2dInfo info = {0, 0, 0, 0};
+        stratmesh::Delaunay2dInfo info = {};
         Clock::time_point start = Clock::now();
         stratmesh::Status s = stratmesh::delaunay_2d(xy_.data(), n_, 2 * sizeof(double),
                                                      workspace_.get(), workspace_bytes_,

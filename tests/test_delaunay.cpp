@@ -119,7 +119,7 @@ struct Run {
 };
 
 Delaunay2dInfo sentinel_info() {
-    return Delaunay2dInfo{kInfoSentinel, kInfoSentinel, kInfoSentinel, kInfoSentinel};
+    return Delaunay2dInfo{kInfoSentinel, kInfoSentinel, kInfoSentinel, kInfoSentinel, kInfoSentinel};
 }
 
 // Runs delaunay_2d on compact points with exactly-sized heap buffers (so AddressSanitizer
@@ -944,4 +944,30 @@ TEST_CASE("one million uniform points") {
     CHECK(r.count() == 2 * n - report.hull_points - 2);
     // The grid keeps the circumcircle test near-linear: a few dozen points per triangle.
     CHECK(report.incircle_tests < 40 * r.count());
+}
+
+// The reported peak is exact: a buffer of that many bytes works, one byte less does not
+// (fresh heap buffers of exactly those sizes, so AddressSanitizer sees any overrun).
+TEST_CASE("workspace: the reported peak suffices and one byte less is out_of_memory") {
+    std::vector<double> xy;
+    for (int i = 0; i < 2000; ++i) {
+        xy.push_back(std::sin(i * 1.7) * 10 + i % 7);
+        xy.push_back(std::cos(i * 2.3) * 10 + i % 11);
+    }
+    const size_t n = xy.size() / 2;
+    std::vector<uint32_t> triangles(3 * stratmesh::delaunay_2d_max_triangles(n));
+    auto run = [&](size_t bytes, stratmesh::Delaunay2dInfo& info) {
+        std::unique_ptr<unsigned char[]> workspace(new unsigned char[bytes ? bytes : 1]);
+        return stratmesh::delaunay_2d(xy.data(), n, 2 * sizeof(double), workspace.get(), bytes,
+                                      triangles.data(), triangles.size() / 3, &info, nullptr);
+    };
+    stratmesh::Delaunay2dInfo full = {};
+    REQUIRE(run(stratmesh::delaunay_2d_workspace_size(n), full) == stratmesh::Status::ok);
+    REQUIRE(full.workspace_used > 0);
+    CHECK(full.workspace_used <= stratmesh::delaunay_2d_workspace_size(n));
+    stratmesh::Delaunay2dInfo exact = {};
+    CHECK(run(full.workspace_used, exact) == stratmesh::Status::ok);
+    CHECK(exact.triangle_count == full.triangle_count);
+    stratmesh::Delaunay2dInfo short_by_one = {};
+    CHECK(run(full.workspace_used - 1, short_by_one) == stratmesh::Status::out_of_memory);
 }

@@ -1381,3 +1381,68 @@ TEST_CASE("a too-small triangle array gives triangle_capacity with the needed co
         }
     }
 }
+
+// The workspace bound against what runs really use: the bound always suffices, the report's
+// peak is exact (a buffer of that many bytes works, one byte less returns out_of_memory and
+// writes nothing outside it: fresh heap buffers of exactly those sizes, so AddressSanitizer
+// sees any overrun), and the bound stays within a small factor of the peak. Adversarial
+// layouts included: every point in one layer, (almost) one point per layer, heavy
+// duplication.
+TEST_CASE("workspace: the bound suffices, the reported peak is exact, one byte short is out_of_memory") {
+    struct Setup {
+        const char* name;
+        Shape shape;
+        Options options;
+    };
+    std::vector<Setup> setups;
+    {
+        Shape s = shapes::bumpy_tube(kSmall, Pose::z);
+        Options one = axis_options(s);
+        one.layer_count = 1;
+        setups.push_back({"one layer", s, one});
+        Options many = axis_options(s);
+        many.layer_count = static_cast<uint32_t>(s.size());  // one point per layer, before merging
+        setups.push_back({"a layer per point", s, many});
+        Options six = axis_options(s);
+        six.layer_count = 6;
+        setups.push_back({"six layers", s, six});
+    }
+    {
+        Shape s = shapes::cylinder(kSmall, Pose::tilted);
+        const size_t distinct = s.size() / 10;  // every point repeated about ten times
+        for (size_t i = distinct; i < s.size(); ++i)
+            for (size_t k = 0; k < 3; ++k) s.xyz[3 * i + k] = s.xyz[3 * (i % distinct) + k];
+        setups.push_back({"heavy duplicates", s, axis_options(s)});
+    }
+    for (const Setup& setup : setups) {
+        INFO(setup.name);
+        const Cloud cloud = cloud_of(setup.shape);
+        const size_t bound = stratmesh::reconstruct_workspace_size(cloud.count, setup.options);
+        const size_t capacity = stratmesh::reconstruct_max_triangles(cloud.count, setup.options);
+        std::vector<uint32_t> triangles(3 * capacity);
+        auto run = [&](size_t bytes, Report& report) {
+            // new[] memory is aligned for any scalar, so the arena skips no padding: the peak
+            // does not depend on where the buffer lands.
+            std::unique_ptr<unsigned char[]> workspace(new unsigned char[bytes ? bytes : 1]);
+            size_t count = 0;
+            return stratmesh::reconstruct(cloud, setup.options, workspace.get(), bytes,
+                                          triangles.data(), capacity, &count, &report);
+        };
+        Report full = {};
+        REQUIRE(run(bound, full) == Status::ok);
+        const size_t peak = full.workspace_used;
+        REQUIRE(peak > 0);
+        CHECK(peak <= bound);
+        Report exact = {};
+        CHECK(run(peak, exact) == Status::ok);
+        CHECK(exact.triangle_count == full.triangle_count);
+        Report short_by_one = {};
+        CHECK(run(peak - 1, short_by_one) == Status::out_of_memory);
+        CHECK(short_by_one.points_in == short_by_one.points_used + short_by_one.duplicates +
+                                           short_by_one.rejected + short_by_one.unused);
+        const double ratio = static_cast<double>(bound) / static_cast<double>(peak);
+        CHECK(ratio < 3.0);
+        MESSAGE(std::string(setup.name) << ": bound " << bound << " B, peak " << peak << " B, bound / peak "
+                           << ratio);
+    }
+}

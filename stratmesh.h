@@ -184,10 +184,13 @@ struct Delaunay2dInfo {
     size_t workspace_used;      // peak workspace bytes, from the start of the buffer
 };
 
-// A size in bytes that is always enough workspace for delaunay_2d of point_count points.
+// A size in bytes that is always enough workspace for delaunay_2d of point_count points;
+// 0 if no workspace can serve that many (more than 2^32 - 2 points, or more bytes than
+// this platform's size_t can count, as on 32-bit targets near 2^32 points).
 size_t delaunay_2d_workspace_size(size_t point_count);
 
-// The most triangles delaunay_2d can produce for point_count points: 2n - 5 for n >= 3.
+// The most triangles delaunay_2d can produce for point_count points: 2n - 5 for n >= 3
+// (0 if that does not fit in size_t).
 size_t delaunay_2d_max_triangles(size_t point_count);
 
 // Delaunay triangulation of 2D points.
@@ -313,9 +316,11 @@ struct Report {
 // points with these options. It assumes the worst layout (every point in one layer);
 // Report::workspace_used tells what a run really needed (measured on 2000-point tubes:
 // the bound is the peak for one layer, 2.1 to 2.3 times it with six or more layers).
+// 0 if no workspace can serve that many points (as for delaunay_2d_workspace_size).
 size_t reconstruct_workspace_size(size_t point_count, const Options& options);
 
-// The most triangles reconstruct() can produce for point_count points.
+// The most triangles reconstruct() can produce for point_count points: 2n (0 if that does
+// not fit in size_t).
 size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 
 // Reconstructs a triangle mesh through the points of a columnar cloud: one surface,
@@ -1404,10 +1409,11 @@ size_t delaunay_2d_workspace_size(size_t point_count) {
     detail::Arena arena = detail::Arena::measuring();
     detail::Delaunay2dMemory m;
     detail::plan_delaunay_2d(m, point_count, arena, nullptr, 0, nullptr);
-    return arena.required_bytes();
+    return arena.failed ? 0 : arena.required_bytes();
 }
 
 size_t delaunay_2d_max_triangles(size_t point_count) {
+    if (point_count > SIZE_MAX / 2) return 0;
     return point_count >= 3 ? 2 * point_count - 5 : 0;
 }
 
@@ -2507,7 +2513,8 @@ inline bool plan_reconstruct(ReconstructMemory& m, size_t count, size_t layer_li
     return !arena.failed;
 }
 
-// The largest scratch any phase takes on top of the plan, for `count` points.
+// The largest scratch any phase takes on top of the plan, for `count` points; 0 if that
+// is beyond what size_t can count.
 inline size_t reconstruct_scratch_size(size_t count) {
     size_t total = count + 1;
     Arena layer = Arena::measuring();
@@ -2538,6 +2545,7 @@ inline size_t reconstruct_scratch_size(size_t count) {
     manifold.alloc<uint64_t>(triangles);
     for (int k = 0; k < 4; ++k) manifold.alloc<uint32_t>(triangles);
 
+    if (layer.failed || band.failed || manifold.failed) return 0;  // beyond size_t
     size_t most = layer.high_water;
     if (band.high_water > most) most = band.high_water;
     if (manifold.high_water > most) most = manifold.high_water;
@@ -2599,7 +2607,7 @@ inline void describe_layer(const Frame& frame, const Cylinder& cyl, double botto
 
 size_t reconstruct_max_triangles(size_t point_count, const Options& options) {
     (void)options;
-    return 2 * point_count;
+    return point_count > SIZE_MAX / 2 ? 0 : 2 * point_count;
 }
 
 size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
@@ -2608,7 +2616,9 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
     detail::ReconstructMemory m;
     detail::plan_reconstruct(m, point_count,
                              detail::planned_layer_limit(point_count, options), arena);
-    return arena.required_bytes() + detail::reconstruct_scratch_size(point_count);
+    size_t scratch = detail::reconstruct_scratch_size(point_count);
+    if (arena.failed || scratch == 0 || scratch > SIZE_MAX - arena.required_bytes()) return 0;
+    return arena.required_bytes() + scratch;
 }
 
 namespace detail {

@@ -1,0 +1,299 @@
+// fuzz_reconstruct: stratmesh::reconstruct on clouds built from the fuzzer's bytes.
+//
+// The cloud: float32 or float64, a stride with padding (or 0: packed), up to a few
+// thousand points, each either raw bit patterns (NaN, Inf, denormals) or snapped to a
+// coarse grid (degenerate layers), optionally repeating an earlier point. Its buffer ends
+// exactly after the last point's z, the workspace is exactly reconstruct_workspace_size()
+// and the triangle array ends where its allocation ends, so any overrun trips
+// AddressSanitizer. Options: every axis (direction with zero/NaN components too), cuts
+// with NaN, unsorted and repeated values, layer_count, layer_height, skip_invalid_points,
+// a layer array to fill.
+//
+// Checked after each run: the status is a documented one; the report's counts add up on
+// every status; on ok, every index < n, no repeated index in a triangle, at most
+// reconstruct_max_triangles triangles, the mesh an oriented edge- and vertex-manifold
+// (tests/support/mesh_check.h), vertices only distinct valid points and points_used equal
+// to the vertices used; a second run on a differently-filled workspace gives the same bits.
+#include "fuzz_common.h"
+#include "known_bugs.h"
+
+#include "stratmesh.h"
+#include "support/mesh_check.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+namespace {
+
+using stratmesh_fuzz::Bytes;
+
+struct Run {
+    stratmesh::Status status;
+    size_t count;
+    stratmesh::Report report;
+    std::vector<uint32_t> triangles;
+    std::vector<stratmesh::LayerInfo> layers;
+};
+
+Run run(const stratmesh::Cloud& cloud, const stratmesh::Options& options, size_t capacity,
+        size_t layer_capacity, unsigned char fill) {
+    Run r;
+    const size_t work_bytes = stratmesh::reconstruct_workspace_size(cloud.count, options);
+    std::vector<unsigned char> work(work_bytes, fill);
+    r.triangles.assign(3 * capacity, 0xDEADBEEFu);
+    r.layers.resize(layer_capacity);
+    std::memset(static_cast<void*>(&r.report), fill, sizeof r.report);
+    r.report.layers = layer_capacity ? r.layers.data() : nullptr;
+    r.report.layer_capacity = layer_capacity;
+    r.count = 12345;
+    r.status = stratmesh::reconstruct(cloud, options, work.empty() ? nullptr : work.data(),
+                                      work_bytes, capacity ? r.triangles.data() : nullptr,
+                                      capacity, &r.count, &r.report);
+    return r;
+}
+
+bool same_double(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    Bytes in(data, size);
+
+    // ---- the cloud
+    const bool strict = stratmesh_fuzz::strict();
+    const bool raw_extreme = stratmesh_fuzz::raw_extreme();
+    const uint8_t cfg = in.u8();
+    const bool f32 = cfg & 1;
+    const size_t scalar_size = f32 ? 4 : 8;
+    const size_t pad = (cfg >> 1) & 7;  // 0: packed (stride 0)
+    const size_t stride = pad ? 3 * scalar_size + pad : 0;
+    const size_t step = stride ? stride : 3 * scalar_size;
+    const uint8_t point_mode = in.u8();  // 0..63 grid-ish, 64..127 mixed per point, else raw
+    const size_t n = in.below(3000);
+    const double grid = std::ldexp(1.0, in.centered(8));
+    const uint32_t grid_range = 1u + in.below(24);
+
+    std::vector<double> xyz(3 * n);  // the cloud as doubles, for checks
+    const size_t cloud_bytes = n ? (n - 1) * step + 3 * scalar_size : 0;
+    std::vector<unsigned char> buffer(cloud_bytes);
+    for (size_t i = 0; i < n; ++i) {
+        uint8_t kind = point_mode < 64 ? 0 : point_mode < 128 ? in.u8() % 4 : 3;
+        if (kind == 1 && i > 0) {  // repeat an earlier point
+            size_t j = in.below(static_cast<uint32_t>(i));
+            std::memcpy(&xyz[3 * i], &xyz[3 * j], 3 * sizeof(double));
+        } else if (kind == 3) {  // raw bits
+            for (size_t k = 0; k < 3; ++k) {
+                double v = f32 ? static_cast<double>(in.raw_float()) : in.raw_double();
+                xyz[3 * i + k] = raw_extreme ? v : stratmesh_fuzz::bug_c_steer(v);
+            }
+        } else {  // a coarse grid on (and inside) a cylinder-ish column
+            int32_t a = in.centered(grid_range), b = in.centered(grid_range);
+            int32_t h = in.centered(4 * grid_range);
+            xyz[3 * i] = a * grid;
+            xyz[3 * i + 1] = b * grid;
+            xyz[3 * i + 2] = h * grid;
+        }
+        unsigned char* p = buffer.data() + i * step;
+        for (size_t k = 0; k < 3; ++k) {
+            if (f32) {
+                float v = static_cast<float>(xyz[3 * i + k]);
+                xyz[3 * i + k] = static_cast<double>(v);
+                std::memcpy(p + 4 * k, &v, 4);
+            } else {
+                std::memcpy(p + 8 * k, &xyz[3 * i + k], 8);
+            }
+        }
+        if (pad && i + 1 < n) std::memset(p + 3 * scalar_size, 0xEE, pad);  // NaN-ish padding
+    }
+    stratmesh::Cloud cloud = {n ? buffer.data() : nullptr, n, stride,
+                              f32 ? stratmesh::Scalar::float32 : stratmesh::Scalar::float64};
+
+    // ---- the options
+    stratmesh::Options options = {};
+    const uint8_t ocfg = in.u8();
+    options.axis = static_cast<stratmesh::Axis>(ocfg % 5);
+    if (options.axis == stratmesh::Axis::direction) {
+        for (double& d : options.direction) {
+            uint8_t m = in.u8() % 8;
+            d = m == 0 ? 0.0 : m == 1 ? in.raw_double() : static_cast<double>(in.centered(3));
+        }
+    }
+    std::vector<double> cuts;
+    switch ((ocfg >> 3) % 4) {
+    case 0: break;  // automatic layers
+    case 1: {
+        size_t cut_count = in.below(20);
+        for (size_t k = 0; k < cut_count; ++k) {
+            uint8_t m = in.u8() % 8;
+            if (m == 0) {
+                double v = in.raw_double();
+                cuts.push_back(raw_extreme ? v : stratmesh_fuzz::bug_c_steer(v));
+            }
+            else if (m == 1 && !cuts.empty()) cuts.push_back(cuts[in.below(static_cast<uint32_t>(cuts.size()))]);
+            else cuts.push_back(in.centered(4 * grid_range + 2) * grid);
+        }
+        options.cuts = cuts.empty() ? nullptr : cuts.data();
+        options.cut_count = cuts.size();
+        break;
+    }
+    case 2: options.layer_count = in.below(40); break;
+    default: {
+        uint8_t m = in.u8() % 4;
+        if (m == 0) {
+            double v = in.raw_double();
+            options.layer_height = raw_extreme ? v : stratmesh_fuzz::bug_c_steer(v);
+        } else {
+            options.layer_height = (1 + in.below(64)) * grid / 4;
+        }
+        break;
+    }
+    }
+    if (ocfg & 0x20) options.flags |= stratmesh::skip_invalid_points;
+    const size_t max_tris = stratmesh::reconstruct_max_triangles(n, options);
+    const bool small_capacity = (ocfg & 0x40) != 0;
+    const size_t capacity = small_capacity ? std::min<size_t>(max_tris, in.below(64)) : max_tris;
+    const size_t layer_capacity = in.below(8);
+
+    Run first = run(cloud, options, capacity, layer_capacity, 0xA5);
+    const stratmesh::Report& rep = first.report;
+    if (std::getenv("STRATMESH_FUZZ_VERBOSE"))
+        std::fprintf(stderr, "n %zu, %s, %zu triangles, %zu layers, used %zu dup %zu rej %zu unused %zu\n", n,
+                     stratmesh::status_string(first.status), first.count, rep.layer_count, rep.points_used,
+                     rep.duplicates, rep.rejected, rep.unused);
+
+    using stratmesh::Status;
+    switch (first.status) {
+    case Status::ok:
+    case Status::invalid_point:
+    case Status::too_few_points:
+    case Status::collinear:
+    case Status::invalid_axis:
+    case Status::invalid_layers:
+    case Status::flat_cloud:
+    case Status::not_columnar:
+    case Status::triangle_capacity:
+        break;
+    default:
+        stratmesh_fuzz::fail("reconstruct returned an unexpected status",
+                             stratmesh::status_string(first.status));
+    }
+    if (first.status == Status::triangle_capacity)
+        STRATMESH_FUZZ_CHECK(small_capacity, "triangle_capacity with reconstruct_max_triangles");
+    STRATMESH_FUZZ_CHECK(rep.points_in == n, "report.points_in != n");
+    STRATMESH_FUZZ_CHECK(rep.points_in == rep.points_used + rep.duplicates + rep.rejected + rep.unused,
+                         "report counts do not add up");
+
+    // Valid points and first occurrences (as the library converts them: to double).
+    std::vector<char> valid(n), first_of(n, 1);
+    size_t invalid = 0, first_invalid = n;
+    for (size_t i = 0; i < n; ++i) {
+        valid[i] = std::isfinite(xyz[3 * i]) && std::isfinite(xyz[3 * i + 1]) && std::isfinite(xyz[3 * i + 2]);
+        if (!valid[i]) {
+            ++invalid;
+            if (first_invalid == n) first_invalid = i;
+        }
+    }
+    if (invalid && !(options.flags & stratmesh::skip_invalid_points) && first.status != Status::invalid_axis &&
+        first.status != Status::invalid_layers) {
+        STRATMESH_FUZZ_CHECK(first.status == Status::invalid_point, "a NaN/Inf point was not refused");
+    }
+    if (first.status == Status::invalid_point)
+        STRATMESH_FUZZ_CHECK(rep.first_invalid_point == first_invalid, "wrong first_invalid_point");
+    if (first.status != Status::ok) return 0;
+
+    // ---- ok: the mesh
+    const size_t count = first.count;
+    STRATMESH_FUZZ_CHECK(count <= max_tris, "more triangles than reconstruct_max_triangles");
+    STRATMESH_FUZZ_CHECK(count <= capacity, "more triangles than the capacity");
+    STRATMESH_FUZZ_CHECK(rep.triangle_count == count, "report.triangle_count != triangle count");
+    STRATMESH_FUZZ_CHECK(rep.rejected == invalid, "report.rejected != NaN/Inf points");
+    const uint32_t* t = first.triangles.data();
+    for (size_t k = 0; k < count; ++k) {
+        uint32_t a = t[3 * k], b = t[3 * k + 1], c = t[3 * k + 2];
+        STRATMESH_FUZZ_CHECK(a < n && b < n && c < n, "triangle index out of range");
+        STRATMESH_FUZZ_CHECK(a != b && b != c && a != c, "degenerate triangle (repeated index)");
+        STRATMESH_FUZZ_CHECK(valid[a] && valid[b] && valid[c], "a NaN/Inf point is a vertex");
+    }
+    // (Entries past 3 * count may have been written: the safety net removes triangles after
+    // they were emitted, and the documentation promises nothing about the rest of the array.)
+
+    // Duplicates: a vertex never repeats a lower-indexed point's coordinates.
+    {
+        std::vector<size_t> order;
+        for (size_t i = 0; i < n; ++i)
+            if (valid[i]) order.push_back(i);
+        std::sort(order.begin(), order.end(), [&](size_t i, size_t j) {
+            for (size_t k = 0; k < 3; ++k)
+                if (xyz[3 * i + k] != xyz[3 * j + k]) return xyz[3 * i + k] < xyz[3 * j + k];
+            return i < j;
+        });
+        size_t dups = 0;
+        for (size_t k = 1; k < order.size(); ++k) {
+            size_t i = order[k - 1], j = order[k];
+            if (xyz[3 * i] == xyz[3 * j] && xyz[3 * i + 1] == xyz[3 * j + 1] && xyz[3 * i + 2] == xyz[3 * j + 2]) {
+                first_of[j] = 0;
+                ++dups;
+                if (std::getenv("STRATMESH_FUZZ_VERBOSE"))
+                    std::fprintf(stderr, "duplicate: %zu of %zu: %a %a %a / %a %a %a\n", j, i, xyz[3 * j],
+                                 xyz[3 * j + 1], xyz[3 * j + 2], xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+            }
+        }
+        if (strict)
+            STRATMESH_FUZZ_CHECK(rep.duplicates == dups, "report.duplicates != repeated points");
+        else  // known bug E: repeats of a point that is not used count as unused
+            STRATMESH_FUZZ_CHECK(rep.duplicates <= dups && rep.duplicates + rep.unused >= dups,
+                                 "report.duplicates inconsistent with repeated points");
+        for (size_t k = 0; k < 3 * count; ++k)
+            STRATMESH_FUZZ_CHECK(first_of[t[k]], "a duplicate (not the lowest index) is a vertex");
+    }
+
+    std::vector<double> finite_xyz(xyz);
+    for (double& v : finite_xyz)
+        if (!std::isfinite(v)) v = 0;
+    mesh_check::Input mi;
+    mi.points = finite_xyz.data();
+    mi.point_count = n;
+    mi.triangles = t;
+    mi.triangle_count = count;
+    for (size_t k = 0; k < 3; ++k) {
+        mi.axis_point[k] = rep.axis_origin[k];
+        mi.axis_direction[k] = rep.axis[k];
+    }
+    std::vector<char> no_expectation(n, 0);
+    mi.expected_used = &no_expectation;
+    mi.self_intersections = false;  // not guaranteed (see the robustness contract)
+    mesh_check::Result mr = mesh_check::check(mi);
+    if (!mr.manifold() || mr.bad_indices || mr.degenerate)
+        stratmesh_fuzz::fail("the mesh is not an oriented manifold", mr.summary().c_str());
+    STRATMESH_FUZZ_CHECK(mr.vertices_used == rep.points_used, "report.points_used != vertices used");
+
+    // ---- determinism
+    Run second = run(cloud, options, capacity, layer_capacity, 0x5A);
+    STRATMESH_FUZZ_CHECK(second.status == first.status, "second run: different status");
+    STRATMESH_FUZZ_CHECK(second.count == first.count, "second run: different count");
+    STRATMESH_FUZZ_CHECK(second.triangles == first.triangles, "second run: different triangles");
+    const stratmesh::Report& r2 = second.report;
+    STRATMESH_FUZZ_CHECK(r2.points_used == rep.points_used && r2.duplicates == rep.duplicates &&
+                             r2.rejected == rep.rejected && r2.unused == rep.unused &&
+                             r2.illegal_removed == rep.illegal_removed && r2.folds == rep.folds &&
+                             r2.layer_count == rep.layer_count,
+                         "second run: different report");
+    for (size_t k = 0; k < 3; ++k)
+        STRATMESH_FUZZ_CHECK(same_double(r2.axis[k], rep.axis[k]) && same_double(r2.axis_origin[k], rep.axis_origin[k]),
+                             "second run: different axis");
+    size_t filled = std::min(rep.layer_count, layer_capacity);
+    for (size_t k = 0; k < filled; ++k) {
+        const stratmesh::LayerInfo& a = first.layers[k];
+        const stratmesh::LayerInfo& b = second.layers[k];
+        bool same = same_double(a.bottom, b.bottom) && same_double(a.top, b.top) &&
+                    same_double(a.radius, b.radius) && a.point_count == b.point_count &&
+                    a.triangle_count == b.triangle_count && a.fold_count == b.fold_count;
+        for (size_t j = 0; j < 3; ++j) same = same && same_double(a.centre[j], b.centre[j]);
+        STRATMESH_FUZZ_CHECK(same, "second run: different layers");
+    }
+    return 0;
+}

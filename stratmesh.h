@@ -91,10 +91,11 @@
 //
 // ==== Robustness contract ==================================================================
 //
-// - orient2d and incircle return values whose sign is exact for every finite double input,
-//   except points whose coordinates span more than about 2^700 in magnitude among
-//   themselves (say 1e-150 next to 1e+60), where products of differences cannot all be
-//   represented. A fast floating-point filter with a proven error bound decides almost
+// - orient2d and incircle return values whose sign is exact for every finite double input
+//   whose non-zero coordinates and coordinate differences span at most 2^320 in magnitude
+//   within one call for incircle (2^800 for orient2d): say 1e-45 next to 1e+50. Beyond
+//   that, products of differences cannot all be represented and the sign may be wrong
+//   (subnormal and tiny inputs are fine: they are rescaled). A fast floating-point filter with a proven error bound decides almost
 //   every call; expansion arithmetic decides the rest, after an exact power-of-two
 //   rescaling when the points are very close together or very far apart. The
 //   implementation pins floating-point contraction off (no fused multiply-add),
@@ -293,7 +294,8 @@ struct Report {
     size_t points_used;      // vertices of the output
     size_t duplicates;       // same coordinates as a lower-indexed point: merged into it
     size_t rejected;         // NaN/Inf (with skip_invalid_points)
-    size_t unused;           // valid and distinct, but not a vertex (see `detail`)
+    size_t unused;           // valid but not a vertex (see `detail`); repeats of a point
+                             // that is itself unused count here, not as duplicates
     size_t first_invalid_point;  // on Status::invalid_point
     size_t triangle_count;
     size_t illegal_removed;  // triangles removed by the manifold safety net
@@ -674,7 +676,12 @@ inline double rescaling_factor(const double* values, int count, int limit) {
     std::frexp(smallest, &low);
     if (high <= limit && low >= -limit) return 0;
     if (high - low > 2 * limit) return 0;
-    return std::ldexp(1.0, -(high + low) / 2);
+    // Centre the magnitudes, but never by a power of two that is itself out of range
+    // (points that are all subnormal would ask for about 2^1070).
+    int shift = -(high + low) / 2;
+    if (shift > 1000) shift = 1000;
+    if (shift < -1000) shift = -1000;
+    return std::ldexp(1.0, shift);
 }
 
 // The filters' error bounds ignore underflow, which adds an absolute error of at most a
@@ -704,7 +711,7 @@ inline double orient2d_robust(const double* a, const double* b, const double* c)
     double bound = kOrientBoundA * (abs_value(left) + abs_value(right)) + kUnderflowGuard;
     if (det > bound || -det > bound) return det;
     const double magnitudes[10] = {acx, bcx, acy, bcy, a[0], a[1], b[0], b[1], c[0], c[1]};
-    double factor = rescaling_factor(magnitudes, 10, 450);
+    double factor = rescaling_factor(magnitudes, 10, 400);
     const double* points[3] = {a, b, c};
     double scaled[3][2];
     rescale_points(factor, points, scaled, 3);
@@ -861,7 +868,7 @@ inline double incircle_robust(const double* a, const double* b, const double* c,
     if (det > bound || -det > bound) return det;
     const double magnitudes[14] = {adx, bdx, cdx, ady, bdy, cdy, a[0], a[1],
                                    b[0], b[1], c[0], c[1], d[0], d[1]};
-    double factor = rescaling_factor(magnitudes, 14, 220);
+    double factor = rescaling_factor(magnitudes, 14, 160);
     const double* points[4] = {a, b, c, d};
     double scaled[4][2];
     rescale_points(factor, points, scaled, 4);
@@ -1730,8 +1737,13 @@ const uint32_t kSectors = 32;
 // overflow and the annulus from extreme ratios in very tall, thin layers.
 const double kMaxTurns = 24.0;
 
-// e^x for |x| <= kMaxTurns + 1, with + - * only, so every platform computes the same bits.
+// e^x with + - * only, so every platform computes the same bits. Arguments are clamped to
+// [-64, 64] (a NaN counts as -64): the callers stay within kMaxTurns + 1, except for
+// clouds so extreme that a radius overflows or underflows, which must not reach the
+// float-to-integer conversion below with an out-of-range value.
 inline double exp_portable(double x) {
+    if (!(x > -64)) x = -64;
+    if (x > 64) x = 64;
     const double ln2_hi = 6.93147180369123816490e-01;
     const double ln2_lo = 1.90821492927058770002e-10;
     double k = std::floor(x * 1.44269504088896338700 + 0.5);
@@ -1847,6 +1859,7 @@ inline Cylinder fit_cylinder(const Local* points, size_t count, double h0, doubl
     double floor_radius = (h1 - h0) / kMaxTurns;
     double r = c.radius > floor_radius ? c.radius : floor_radius;
     c.scale = r > 0 && is_finite(r) ? 1.0 / r : 1.0;
+    if (!is_finite(c.scale)) c.scale = 1.0;  // a subnormal radius
     return c;
 }
 

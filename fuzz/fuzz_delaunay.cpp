@@ -124,12 +124,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         }
         out_of_contract = hi - lo > kContractSpan;
     }
-    // Known bugs A and D (fuzz/known_bugs.h): predicates on tiny coordinates (or tiny
-    // differences, which need coordinates below about 2^-127) can have the wrong sign.
-    if (all_finite && !stratmesh_fuzz::strict()) {
-        for (double v : xy)
-            if (v != 0 && std::fabs(v) < 0x1p-120) return 0;
-    }
     using stratmesh::Status;
     switch (s) {
     case Status::ok:

@@ -65,7 +65,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
 
     // ---- the cloud
     const bool strict = stratmesh_fuzz::strict();
-    const bool raw_extreme = stratmesh_fuzz::raw_extreme();
     const uint8_t cfg = in.u8();
     const bool f32 = cfg & 1;
     const size_t scalar_size = f32 ? 4 : 8;
@@ -88,7 +87,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         } else if (kind == 3) {  // raw bits
             for (size_t k = 0; k < 3; ++k) {
                 double v = f32 ? static_cast<double>(in.raw_float()) : in.raw_double();
-                xyz[3 * i + k] = raw_extreme ? v : stratmesh_fuzz::bug_c_steer(v);
+                xyz[3 * i + k] = v;
             }
         } else {  // a coarse grid on (and inside) a cylinder-ish column
             int32_t a = in.centered(grid_range), b = in.centered(grid_range);
@@ -131,7 +130,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             uint8_t m = in.u8() % 8;
             if (m == 0) {
                 double v = in.raw_double();
-                cuts.push_back(raw_extreme ? v : stratmesh_fuzz::bug_c_steer(v));
+                cuts.push_back(v);
             }
             else if (m == 1 && !cuts.empty()) cuts.push_back(cuts[in.below(static_cast<uint32_t>(cuts.size()))]);
             else cuts.push_back(in.centered(4 * grid_range + 2) * grid);
@@ -145,7 +144,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         uint8_t m = in.u8() % 4;
         if (m == 0) {
             double v = in.raw_double();
-            options.layer_height = raw_extreme ? v : stratmesh_fuzz::bug_c_steer(v);
+            options.layer_height = v;
         } else {
             options.layer_height = (1 + in.below(64)) * grid / 4;
         }

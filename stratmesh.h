@@ -312,6 +312,7 @@ struct Report {
     // buffer: a buffer of exactly this size at the same address suffices for the same
     // input, one byte less does not. Compare with reconstruct_workspace_size().
     size_t workspace_used;
+    size_t diagonal_swaps;   // band diagonals swapped when stitching layers (paper's step 4)
 };
 
 // A size in bytes that is always enough workspace for reconstruct() of point_count
@@ -746,7 +747,7 @@ inline double incircle_exact(const double* a, const double* b, const double* c,
     double* scaled = scratch + 960; // 24
     double* orient = scratch + 984; // 12
     double* cross = scratch + 996;  // 8
-    double lift[4], lp[2], lq[2], pair[8];
+    double lift[4], lp[2], lq[2];
     int acc_len = 0;
     for (int skip = 0; skip < 4; ++skip) {
         // orient2d of the other three points, in their order.
@@ -773,7 +774,6 @@ inline double incircle_exact(const double* a, const double* b, const double* c,
             std::memcpy(acc, acc2, sizeof(double) * static_cast<size_t>(acc_len));
         }
     }
-    (void)pair;
     return expansion_top(acc_len, acc);
 }
 
@@ -2795,7 +2795,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
                      "(the layer is not star-shaped around its centre there): not vertices";
     else if (valid - rep.duplicates > used)
         rep.detail = "the manifold safety net removed the triangles of some points";
-    (void)swaps;
+    rep.diagonal_swaps = swaps;
     notify(options, Phase::done, 1);
     return finish(Status::ok);
 }

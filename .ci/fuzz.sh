@@ -28,9 +28,10 @@ for harness in fuzz_predicates fuzz_delaunay fuzz_reconstruct fuzz_cloud_reader;
   cp fuzz/corpus/"$harness"/* "$work/corpus/"
   printf '\n==== %s: %ss\n' "$harness" "$seconds"
   # malloc_limit_mb: no single allocation above 64 MB (a reader reserving for a lying
-  # header fails here); rss_limit_mb: the whole process under 1 GB.
+  # header fails here); rss_limit_mb: the whole process under 1 GB. A fixed seed makes a
+  # run repeatable (FUZZ_SEED=0 asks libFuzzer for a fresh one).
   rc=0
-  "$build/fuzz/$harness" "$work/corpus" -max_total_time="$seconds" -timeout=25 \
+  "$build/fuzz/$harness" "$work/corpus" -seed="${FUZZ_SEED:-1}" -max_total_time="$seconds" -timeout=25 \
     -rss_limit_mb=1024 -malloc_limit_mb=64 -max_len=65536 -print_final_stats=1 \
     -artifact_prefix="$work/artifacts/" >"$work/log" 2>&1 || rc=$?
   tail -n 30 "$work/log"

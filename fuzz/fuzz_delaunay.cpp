@@ -29,8 +29,10 @@ const int kRing[][2] = {{25, 0},  {24, 7},   {20, 15},  {15, 20},  {7, 24},
 const uint32_t kRingSize = sizeof kRing / sizeof kRing[0];
 
 // Coordinates spanning more binary orders of magnitude than this are outside the
-// predicates' exactness contract (see the predicates harness for where it really ends).
-const int kContractSpan = 400;
+// predicates' exactness contract: the header promises exact signs while coordinates and
+// their differences span at most 2^320; differences can sit up to 53 binary orders below
+// the coordinates, so the coordinates alone may span 2^260.
+const int kContractSpan = 260;
 
 }  // namespace
 
@@ -107,7 +109,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             first_bad = i;
         }
 
-    // The exactness contract only covers coordinates spanning less than about 2^700 in
+    // The exactness contract only covers coordinates spanning less than kContractSpan in
     // magnitude; beyond it only memory safety and the status are checked, and internal_error
     // is tolerated there (wrong predicate signs can break the algorithm's invariants).
     bool out_of_contract = false;

@@ -136,7 +136,7 @@ namespace stratmesh {
     /* success */                                                                         \
     X(ok, "success")                                                                      \
     /* argument checks: a caller error, detected before any work */                      \
-    X(invalid_argument, "a null pointer with a non-zero count, or a stride too small")    \
+    X(invalid_argument, "a null pointer with a non-zero count, a stride too small, or buffers that overlap") \
     X(too_many_points, "more points than 32-bit indices can address")                    \
     /* the data */                                                                        \
     X(invalid_point, "a coordinate is NaN or infinite")                                   \
@@ -213,8 +213,10 @@ size_t delaunay_2d_max_triangles(size_t point_count);
 //                 it has no lower twin; -0.0 and +0.0 are the same). Meaningful on ok;
 //                 unspecified otherwise.
 //
-// Returns ok; invalid_argument; too_many_points; invalid_point; too_few_points (fewer
-// than 3 distinct points); collinear (no triangle exists); out_of_memory;
+// Returns ok; invalid_argument (a null pointer with a non-zero count, a stride too small,
+// or any two of the span of xy's points, the workspace, the triangle array, duplicate_of
+// and *info sharing a byte: then nothing at all is written); too_many_points; invalid_point; too_few_points (fewer than 3 distinct points);
+// collinear (no triangle exists); out_of_memory;
 // triangle_capacity. On every status but ok, triangle_count is 0 (except
 // triangle_capacity) and no triangle is written.
 Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
@@ -343,13 +345,18 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 //                 says how many are needed (the array's contents are then unspecified;
 //                 nothing is written past the capacity).
 // triangle_count  required; receives the number of triangles (0 on failure).
-// report          optional; see Report. Filled on every status, counts adding up.
+// report          optional; see Report. Filled on every status, counts adding up (except
+//                 when buffers overlap: see invalid_argument below).
 //
 // Returns ok; invalid_argument (a null pointer with a non-zero count, a stride smaller
-// than one point, an unknown Scalar, cut_count without cuts, a null triangle_count);
+// than one point, an unknown Scalar, cut_count without cuts, a null triangle_count, or any
+// two of the span of the cloud's points, the workspace, the triangle array,
+// *triangle_count, *report and the report's layer array sharing a byte: then nothing at
+// all is written, not even the report);
 // too_many_points; invalid_point (Report::first_invalid_point, unless
 // skip_invalid_points); invalid_axis (Axis::direction of zero length, NaN or infinite);
-// invalid_layers (a NaN or infinite cut, a negative or non-finite layer_height);
+// invalid_layers (a NaN or infinite cut, more than 2^32 - 2 cuts, a negative or
+// non-finite layer_height);
 // too_few_points (fewer than 3 valid points, or no surface spans them); flat_cloud (no
 // extent along the axis); not_columnar (no layer's points surround its centre: try
 // another axis); out_of_memory; triangle_capacity; internal_error.
@@ -491,6 +498,43 @@ struct Arena {
     size_t mark() const { return used; }
     void rewind(size_t m) { used = m; }
 };
+
+// The caller's buffers as address ranges, so that arguments sharing memory are refused:
+// the input is read while the workspace and outputs are written, and an overlap would
+// corrupt the result silently. Empty buffers overlap nothing; lengths that would run past
+// the end of the address space are cut there.
+struct ByteRange {
+    uintptr_t begin, end;
+};
+
+inline size_t saturating_product(size_t a, size_t b) {
+    return b != 0 && a > SIZE_MAX / b ? SIZE_MAX : a * b;
+}
+
+inline ByteRange byte_range(const void* p, size_t bytes) {
+    uintptr_t begin = reinterpret_cast<uintptr_t>(p);
+    if (!p) return {0, 0};
+    return {begin, bytes > UINTPTR_MAX - begin ? UINTPTR_MAX : begin + bytes};
+}
+
+// Bytes covered by `count` records `stride` apart whose last one is `record_bytes` long.
+inline ByteRange strided_range(const void* p, size_t count, size_t stride, size_t record_bytes) {
+    if (count == 0) return {0, 0};
+    size_t span = saturating_product(count - 1, stride);
+    return byte_range(p, span > SIZE_MAX - record_bytes ? SIZE_MAX : span + record_bytes);
+}
+
+inline bool ranges_overlap(ByteRange a, ByteRange b) {
+    return a.begin < a.end && b.begin < b.end && a.begin < b.end && b.begin < a.end;
+}
+
+// True if any two of the `count` ranges overlap.
+inline bool any_overlap(const ByteRange* ranges, size_t count) {
+    for (size_t i = 0; i < count; ++i)
+        for (size_t j = i + 1; j < count; ++j)
+            if (ranges_overlap(ranges[i], ranges[j])) return true;
+    return false;
+}
 
 // >>predicates ==============================================================================
 //
@@ -1424,10 +1468,35 @@ size_t delaunay_2d_max_triangles(size_t point_count) {
     return point_count >= 3 ? 2 * point_count - 5 : 0;
 }
 
+namespace detail {
+
+// True if any two of the caller's buffers share a byte: checked before anything is
+// written. A count beyond the limit is refused as too_many_points instead, whatever its
+// span would cover.
+inline bool delaunay_buffers_overlap(const double* xy, size_t point_count, size_t stride_bytes,
+                                     void* workspace, size_t workspace_bytes,
+                                     uint32_t* triangles, size_t triangle_capacity,
+                                     Delaunay2dInfo* info, uint32_t* duplicate_of) {
+    if (point_count > kMaxPoints) return false;
+    const ByteRange buffers[] = {
+        strided_range(xy, point_count, stride_bytes, 2 * sizeof(double)),
+        byte_range(workspace, workspace_bytes),
+        byte_range(triangles, saturating_product(triangle_capacity, 3 * sizeof(uint32_t))),
+        byte_range(duplicate_of, saturating_product(point_count, sizeof(uint32_t))),
+        byte_range(info, sizeof(Delaunay2dInfo))};
+    return any_overlap(buffers, 5);
+}
+
+}  // namespace detail
+
 Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
                    void* workspace, size_t workspace_bytes,
                    uint32_t* triangles, size_t triangle_capacity,
                    Delaunay2dInfo* info, uint32_t* duplicate_of) {
+    if (detail::delaunay_buffers_overlap(xy, point_count, stride_bytes, workspace,
+                                         workspace_bytes, triangles, triangle_capacity, info,
+                                         duplicate_of))
+        return Status::invalid_argument;
     Delaunay2dInfo local = {0, 0, 0, 0, 0};
     Delaunay2dInfo& out = info ? *info : local;
     out = local;
@@ -1541,11 +1610,27 @@ struct Local {
 
 struct Frame {
     Vec3 origin, e1, e2, axis;  // (e1, e2, axis) is right-handed and orthonormal
+    // A power of two that brings the cloud's extent near 1, so that squared distances
+    // neither overflow (a cloud at 1e200) nor underflow (at 1e-200); being a power of two,
+    // it changes no rounding and the triangles do not depend on it.
+    double scale;
     Local local(Vec3 p) const {
-        Vec3 d = p - origin;
+        Vec3 d = scaled(p - origin, scale);
         return {dot(d, e1), dot(d, e2), dot(d, axis)};
     }
+    // A frame height back as the user's coordinate along the axis, dot(point, axis).
+    double user_height(double h) const { return h / scale + dot(origin, axis); }
 };
+
+// The power of two 2^-e with 2^e just above `extent`, within [2^-1000, 2^1000].
+inline double scale_for_extent(double extent) {
+    if (!(extent > 0) || !is_finite(extent)) return 1;
+    int exponent = 0;
+    std::frexp(extent, &exponent);
+    if (exponent > 1000) exponent = 1000;
+    if (exponent < -1000) exponent = -1000;
+    return std::ldexp(1.0, -exponent);
+}
 
 inline bool normalize(Vec3& v) {
     double len = std::sqrt(dot(v, v));
@@ -1580,15 +1665,24 @@ inline Vec3 principal_direction(const double m[3][3]) {
 // The frame: centroid origin, axis from the options (or PCA), e1/e2 completing it.
 inline Status choose_frame(const CloudReader& cloud, size_t count, const Options& options,
                            Frame& frame) {
-    Vec3 sum = {0, 0, 0};
+    Vec3 sum = {0, 0, 0}, low = {DBL_MAX, DBL_MAX, DBL_MAX}, high = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
     size_t valid = 0;
     for (size_t i = 0; i < count; ++i) {
         if (!cloud.valid(i)) continue;
         Vec3 p = cloud.point(i);
         sum = {sum.x + p.x, sum.y + p.y, sum.z + p.z};
+        low = {p.x < low.x ? p.x : low.x, p.y < low.y ? p.y : low.y, p.z < low.z ? p.z : low.z};
+        high = {p.x > high.x ? p.x : high.x, p.y > high.y ? p.y : high.y, p.z > high.z ? p.z : high.z};
         ++valid;
     }
     frame.origin = valid ? scaled(sum, 1.0 / static_cast<double>(valid)) : Vec3{0, 0, 0};
+    double extent = 0;
+    if (valid) {
+        Vec3 size = high - low;
+        extent = size.x > size.y ? size.x : size.y;
+        if (size.z > extent) extent = size.z;
+    }
+    frame.scale = scale_for_extent(extent);
     Vec3 axis = {0, 0, 1};
     switch (options.axis) {
     case Axis::x: axis = {1, 0, 0}; break;
@@ -1603,7 +1697,7 @@ inline Status choose_frame(const CloudReader& cloud, size_t count, const Options
         double m[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
         for (size_t i = 0; i < count; ++i) {
             if (!cloud.valid(i)) continue;
-            Vec3 d = cloud.point(i) - frame.origin;
+            Vec3 d = scaled(cloud.point(i) - frame.origin, frame.scale);
             double c[3] = {d.x, d.y, d.z};
             for (int r = 0; r < 3; ++r)
                 for (int s = 0; s < 3; ++s) m[r][s] += c[r] * c[s];
@@ -1625,6 +1719,23 @@ inline Status choose_frame(const CloudReader& cloud, size_t count, const Options
     return Status::ok;
 }
 
+// Whether the valid points take at least three distinct positions; stops at the third.
+inline bool has_three_distinct_points(const CloudReader& cloud, size_t count) {
+    Vec3 seen[2];
+    size_t distinct = 0;
+    for (size_t i = 0; i < count; ++i) {
+        if (!cloud.valid(i)) continue;
+        Vec3 p = cloud.point(i);
+        bool repeat = false;
+        for (size_t k = 0; k < distinct; ++k)
+            repeat = repeat || (p.x == seen[k].x && p.y == seen[k].y && p.z == seen[k].z);
+        if (repeat) continue;
+        if (distinct == 2) return true;
+        seen[distinct++] = p;
+    }
+    return false;
+}
+
 // Layer boundaries: bounds[0] = lowest height, bounds[count] = highest, layer i holds the
 // heights in [bounds[i], bounds[i+1]) (the last layer includes its top).
 struct LayerPlan {
@@ -1639,7 +1750,8 @@ const size_t kMinLayerPoints = 16;
 // The number of layers the options can ask for, before empty layers are dropped.
 inline size_t planned_layer_limit(size_t point_count, const Options& options) {
     if (options.cuts && options.cut_count > 0) return options.cut_count + 1;
-    if (options.layer_count > 0) return options.layer_count;
+    if (options.layer_count > 0)
+        return options.layer_count < point_count ? options.layer_count : (point_count > 0 ? point_count : 1);
     // A target height: never more layers than points.
     if (options.layer_height > 0) return point_count > 0 ? point_count : 1;
     return kMaxAutomaticLayers;
@@ -1647,6 +1759,7 @@ inline size_t planned_layer_limit(size_t point_count, const Options& options) {
 
 inline Status validate_layer_options(const Options& options) {
     if (options.cuts && options.cut_count > 0) {
+        if (options.cut_count > kMaxPoints) return Status::invalid_layers;
         for (size_t i = 0; i < options.cut_count; ++i)
             if (!is_finite(options.cuts[i])) return Status::invalid_layers;
     } else if (options.cut_count > 0) {
@@ -1657,33 +1770,58 @@ inline Status validate_layer_options(const Options& options) {
     return Status::ok;
 }
 
+// Sorts ascending in place; heapsort, so that a million cuts cost no more than sorting
+// them should, with no recursion.
+inline void sift_down(double* v, size_t root, size_t count) {
+    for (;;) {
+        size_t child = 2 * root + 1;
+        if (child >= count) return;
+        if (child + 1 < count && v[child + 1] > v[child]) ++child;
+        if (!(v[child] > v[root])) return;
+        double t = v[root];
+        v[root] = v[child];
+        v[child] = t;
+        root = child;
+    }
+}
+
+inline void heap_sort(double* v, size_t count) {
+    for (size_t i = count / 2; i-- > 0;) sift_down(v, i, count);
+    for (size_t end = count; end-- > 1;) {
+        double t = v[0];
+        v[0] = v[end];
+        v[end] = t;
+        sift_down(v, 0, end);
+    }
+}
+
 // Fills plan.bounds (room for planned_layer_limit + 1 entries) for heights [lo, hi];
 // `typical_radius` sets the automatic layer height; the user's cuts are coordinates along
-// the axis, frame heights plus `cut_offset`.
+// the axis (Frame::user_height of frame heights), layer_height a length in the cloud's
+// units.
 inline void plan_layers(const Options& options, double lo, double hi, double typical_radius,
-                        size_t point_count, double cut_offset, LayerPlan& plan) {
+                        size_t point_count, const Frame& frame, LayerPlan& plan) {
+    const double cut_offset = dot(frame.origin, frame.axis);
     double* b = plan.bounds;
     uint32_t n = 0;
     b[n++] = lo;
     if (options.cuts && options.cut_count > 0) {
-        // Insertion sort of the cuts inside (lo, hi]; repeats and outsiders dropped.
+        // The cuts inside (lo, hi], sorted, repeats dropped.
+        size_t inside = 0;
         for (size_t i = 0; i < options.cut_count; ++i) {
-            double c = options.cuts[i] - cut_offset;
-            if (!(c > lo) || !(c <= hi)) continue;
-            uint32_t k = n;
-            while (k > 1 && b[k - 1] > c) --k;
-            if (b[k - 1] == c) continue;
-            for (uint32_t m = n; m > k; --m) b[m] = b[m - 1];
-            b[k] = c;
-            ++n;
+            double c = (options.cuts[i] - cut_offset) * frame.scale;
+            if (c > lo && c <= hi) b[1 + inside++] = c;
         }
+        heap_sort(b + 1, inside);
+        for (size_t i = 0; i < inside; ++i)
+            if (b[1 + i] > b[n - 1]) b[n++] = b[1 + i];
     } else {
         double height = hi - lo;
         double layers = 1;
         if (options.layer_count > 0) {
             layers = options.layer_count;
         } else if (options.layer_height > 0) {
-            layers = std::ceil(height / options.layer_height);
+            layers = std::ceil(height / (options.layer_height * frame.scale));
         } else if (typical_radius > 0) {
             // Automatic, for now: layers about four radii tall.
             layers = std::floor(height / (4 * typical_radius));
@@ -2569,11 +2707,37 @@ inline void notify(const Options& options, Phase phase, double fraction) {
     if (options.progress) options.progress(options.progress_user, phase, fraction);
 }
 
+// True if any two of the caller's buffers share a byte (the report and its layer array
+// included): checked before anything is written. A count beyond the limit is refused as
+// too_many_points instead.
+inline bool reconstruct_buffers_overlap(const Cloud& cloud, void* workspace,
+                                        size_t workspace_bytes, uint32_t* triangles,
+                                        size_t triangle_capacity, size_t* triangle_count,
+                                        const Report* report) {
+    if (cloud.count > kMaxPoints - 1) return false;
+    size_t point_bytes = 3 * (cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double));
+    const ByteRange buffers[] = {
+        strided_range(cloud.xyz, cloud.count, cloud.stride_bytes ? cloud.stride_bytes : point_bytes,
+                      point_bytes),
+        byte_range(workspace, workspace_bytes),
+        byte_range(triangles, saturating_product(triangle_capacity, 3 * sizeof(uint32_t))),
+        byte_range(triangle_count, sizeof(size_t)),
+        byte_range(report, sizeof(Report)),
+        byte_range(report ? report->layers : nullptr,
+                   report ? saturating_product(report->layer_capacity, sizeof(LayerInfo)) : 0)};
+    return any_overlap(buffers, 6);
+}
+
 inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangles,
                                           size_t triangle_capacity, size_t* triangle_count,
-                                          void* workspace) {
+                                          void* workspace, Report& rep) {
+    rep.detail = "an argument is invalid: a null pointer with a non-zero count, a stride "
+                 "smaller than one point, an unknown scalar type or a null triangle_count";
     if (!triangle_count) return Status::invalid_argument;
-    if (cloud.count > kMaxPoints - 1) return Status::too_many_points;
+    if (cloud.count > kMaxPoints - 1) {
+        rep.detail = "more points than 32-bit triangle indices can address";
+        return Status::too_many_points;
+    }
     size_t scalar = cloud.scalar == Scalar::float32 ? sizeof(float)
                   : cloud.scalar == Scalar::float64 ? sizeof(double) : 0;
     if (scalar == 0) return Status::invalid_argument;
@@ -2581,6 +2745,7 @@ inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangle
         return Status::invalid_argument;
     if (cloud.count > 0 && (!cloud.xyz || !workspace)) return Status::invalid_argument;
     if (triangle_capacity > 0 && !triangles) return Status::invalid_argument;
+    rep.detail = nullptr;
     return Status::ok;
 }
 
@@ -2600,17 +2765,16 @@ inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& 
 
 inline void describe_layer(const Frame& frame, const Cylinder& cyl, double bottom, double top,
                            size_t points, size_t triangles, size_t folds, LayerInfo& info) {
-    const double offset = dot(frame.origin, frame.axis);
-    info.bottom = bottom + offset;
-    info.top = top + offset;
-    double mid = (bottom + top) / 2;
-    Vec3 c = {frame.origin.x + frame.e1.x * cyl.cx + frame.e2.x * cyl.cy + frame.axis.x * mid,
-              frame.origin.y + frame.e1.y * cyl.cx + frame.e2.y * cyl.cy + frame.axis.y * mid,
-              frame.origin.z + frame.e1.z * cyl.cx + frame.e2.z * cyl.cy + frame.axis.z * mid};
+    info.bottom = frame.user_height(bottom);
+    info.top = frame.user_height(top);
+    double mid = (bottom + top) / 2 / frame.scale, cx = cyl.cx / frame.scale, cy = cyl.cy / frame.scale;
+    Vec3 c = {frame.origin.x + frame.e1.x * cx + frame.e2.x * cy + frame.axis.x * mid,
+              frame.origin.y + frame.e1.y * cx + frame.e2.y * cy + frame.axis.y * mid,
+              frame.origin.z + frame.e1.z * cx + frame.e2.z * cy + frame.axis.z * mid};
     info.centre[0] = c.x;
     info.centre[1] = c.y;
     info.centre[2] = c.z;
-    info.radius = cyl.radius;
+    info.radius = cyl.radius / frame.scale;
     info.point_count = static_cast<uint32_t>(points);
     info.triangle_count = static_cast<uint32_t>(triangles);
     info.fold_count = static_cast<uint32_t>(folds);
@@ -2646,7 +2810,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     size_t layer_capacity = rep.layer_capacity;
 
     Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
-                                                triangle_count, workspace);
+                                                triangle_count, workspace, rep);
     if (status != Status::ok) return status;
     notify(options, Phase::validate, 0);
     size_t scalar = cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double);
@@ -2676,7 +2840,10 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     rep.axis_origin[0] = frame.origin.x;
     rep.axis_origin[1] = frame.origin.y;
     rep.axis_origin[2] = frame.origin.z;
-    if (valid < 3) return Status::too_few_points;
+    if (valid < 3 || !has_three_distinct_points(reader, cloud.count)) {
+        rep.detail = "fewer than 3 distinct valid points";
+        return Status::too_few_points;
+    }
 
     double lo = DBL_MAX, hi = -DBL_MAX, radius_sum = 0;
     for (size_t i = 0; i < cloud.count; ++i) {
@@ -2702,8 +2869,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     if (!plan_reconstruct(m, cloud.count, layer_limit, arena)) return finish(Status::out_of_memory);
     notify(options, Phase::layers, 0);
     LayerPlan plan = {m.bounds, 0};
-    const double offset = dot(frame.origin, frame.axis);
-    plan_layers(options, lo, hi, radius_sum / static_cast<double>(valid), cloud.count, offset,
+    plan_layers(options, lo, hi, radius_sum / static_cast<double>(valid), cloud.count, frame,
                 plan);
     group_by_layer(reader, cloud.count, frame, plan, m);
 
@@ -2805,6 +2971,9 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
 Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
                    size_t workspace_bytes, uint32_t* triangles, size_t triangle_capacity,
                    size_t* triangle_count, Report* report) {
+    if (detail::reconstruct_buffers_overlap(cloud, workspace, workspace_bytes, triangles,
+                                            triangle_capacity, triangle_count, report))
+        return Status::invalid_argument;
     Report local_report;
     Report& rep = report ? *report : local_report;
     LayerInfo* layers = report ? report->layers : nullptr;

@@ -673,6 +673,62 @@ TEST_CASE("null pointers with non-zero counts, and strides too small: invalid_ar
                                  nullptr) == Status::ok);
 }
 
+// Every buffer is carved out of one arena so that any two can be made to share bytes:
+// each overlap is refused before anything is written; buffers laid end to end are fine.
+TEST_CASE("buffers that share memory: invalid_argument, nothing written anywhere") {
+    const size_t n = 40;
+    const std::vector<double> points = uniform_points(n, 15);
+    const size_t point_bytes = points.size() * sizeof(double);
+    const size_t work_bytes = stratmesh::delaunay_2d_workspace_size(n);
+    const size_t capacity = stratmesh::delaunay_2d_max_triangles(n);
+    const size_t tri_bytes = 3 * capacity * sizeof(uint32_t);
+    const size_t dup_bytes = n * sizeof(uint32_t);
+    const size_t info_bytes = sizeof(Delaunay2dInfo);
+    // Offsets of the five buffers laid end to end, 8-byte aligned: points, workspace,
+    // triangles, duplicate_of, info.
+    const size_t sizes[5] = {point_bytes, work_bytes, tri_bytes, dup_bytes, info_bytes};
+    size_t offsets[5];
+    size_t total = 0;
+    for (size_t k = 0; k < 5; ++k) {
+        offsets[k] = total;
+        total += (sizes[k] + 7) / 8 * 8;
+    }
+    std::vector<uint64_t> arena_words(2 * total / 8 + 8);  // room to move any buffer past the end
+    unsigned char* arena = reinterpret_cast<unsigned char*>(arena_words.data());
+
+    auto call = [&](const size_t at[5]) {
+        std::memset(arena, 0x5A, arena_words.size() * 8);
+        std::memcpy(arena + at[0], points.data(), point_bytes);
+        std::vector<unsigned char> before(arena, arena + arena_words.size() * 8);
+        Status status = stratmesh::delaunay_2d(
+            reinterpret_cast<const double*>(arena + at[0]), n, 2 * sizeof(double), arena + at[1], work_bytes,
+            reinterpret_cast<uint32_t*>(arena + at[2]), capacity, reinterpret_cast<Delaunay2dInfo*>(arena + at[4]),
+            reinterpret_cast<uint32_t*>(arena + at[3]));
+        bool unchanged = std::memcmp(before.data(), arena, before.size()) == 0;
+        return std::make_pair(status, unchanged);
+    };
+
+    std::pair<Status, bool> apart = call(offsets);
+    CHECK(apart.first == Status::ok);
+
+    const char* names[5] = {"points", "workspace", "triangles", "duplicate_of", "info"};
+    for (size_t a = 0; a < 5; ++a) {
+        for (size_t b = 0; b < 5; ++b) {
+            if (a == b) continue;
+            // Buffer b moved onto the last aligned 8 bytes of buffer a.
+            size_t moved[5];
+            std::memcpy(moved, offsets, sizeof moved);
+            moved[b] = offsets[a] + (sizes[a] - 1) / 8 * 8;
+            REQUIRE(moved[b] + sizes[b] <= arena_words.size() * 8);
+            CAPTURE(names[a]);
+            CAPTURE(names[b]);
+            std::pair<Status, bool> shared = call(moved);
+            CHECK(shared.first == Status::invalid_argument);
+            CHECK(shared.second);
+        }
+    }
+}
+
 TEST_CASE("more points than 32-bit indices: too_many_points, nothing read") {
     if (sizeof(size_t) <= 4) return;
     double xy[6] = {0, 0, 1, 0, 0, 1};

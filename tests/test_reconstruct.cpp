@@ -1446,3 +1446,268 @@ TEST_CASE("workspace: the bound suffices, the reported peak is exact, one byte s
                            << ratio);
     }
 }
+
+// ===========================================================================================
+// Malformed clouds and arguments: every case gets its documented status, counts that add
+// up, nothing written past the buffers, and a manifold annulus through every point when
+// the status is ok.
+
+namespace {
+
+bool counts_add_up(const Report& r) {
+    return r.points_in == r.points_used + r.duplicates + r.rejected + r.unused;
+}
+
+// The cylinder of reference_cylinder() scaled by `scale` about the origin and moved by
+// `offset`, with its analytic surface moved along (the radius is 1 everywhere, so the
+// scaled radius is `scale`).
+Shape moved_cylinder(double scale, const double offset[3]) {
+    Shape s = reference_cylinder();
+    for (size_t i = 0; i < s.xyz.size(); ++i) s.xyz[i] = s.xyz[i] * scale + offset[i % 3];
+    for (int k = 0; k < 3; ++k) s.transform.t[k] = s.transform.t[k] * scale + offset[k];
+    s.radius = [scale](double, double) { return scale; };
+    s.z_min *= scale;
+    s.z_max *= scale;
+    s.spacing *= scale;
+    return s;
+}
+
+// Checks the promise of an ok run: one manifold annulus, outward, every point a vertex.
+void check_annulus_through_every_point(const Shape& s, const Run& run) {
+    REQUIRE(run.status == Status::ok);
+    CHECK(run.workspace_guard_intact);
+    CHECK(run.triangle_guard_intact);
+    CHECK(counts_add_up(run.report));
+    CHECK(run.report.unused == 0);
+    mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, false);
+    INFO(m.summary());
+    CHECK(m.bad_indices == 0);
+    CHECK(m.manifold());
+    CHECK(m.components == 1);
+    CHECK(m.boundary_loops == 2);
+    CHECK(m.euler == 0);
+    CHECK(m.unused_expected == 0);
+}
+
+}  // namespace
+
+TEST_CASE("buffers that share memory: invalid_argument, nothing written, not even the report") {
+    const Shape& s = reference_cylinder();
+    Options o = axis_options(s);
+    o.layer_count = 3;
+    const size_t cloud_bytes = s.xyz.size() * sizeof(double);
+    const size_t work_bytes = stratmesh::reconstruct_workspace_size(s.size(), o);
+    const size_t capacity = stratmesh::reconstruct_max_triangles(s.size(), o);
+    const size_t tri_bytes = 3 * capacity * sizeof(uint32_t);
+    // One arena: cloud, workspace, triangles, count, layers, each 8-byte aligned.
+    const size_t layer_bytes = 4 * sizeof(LayerInfo);
+    const size_t cloud_at = 0, work_at = cloud_bytes, tri_at = (work_at + work_bytes + 7) / 8 * 8,
+                 count_at = tri_at + tri_bytes, layers_at = count_at + 8, total = layers_at + layer_bytes;
+    std::vector<uint64_t> words(total / 8 + 1);
+    unsigned char* arena = reinterpret_cast<unsigned char*>(words.data());
+
+    struct Placement {
+        const char* what;
+        size_t work, tri, count, layers;
+    };
+    const Placement placements[] = {
+        {"apart", work_at, tri_at, count_at, layers_at},
+        {"workspace over the cloud's last point", cloud_bytes - 8, tri_at, count_at, layers_at},
+        {"triangles inside the workspace", work_at, work_at + 64, count_at, layers_at},
+        {"triangle_count inside the triangles", work_at, tri_at, tri_at + 8, layers_at},
+        {"layer array inside the cloud", work_at, tri_at, count_at, 0},
+    };
+    for (const Placement& p : placements) {
+        CAPTURE(p.what);
+        std::memset(arena, 0x5A, words.size() * 8);
+        std::memcpy(arena + cloud_at, s.xyz.data(), cloud_bytes);
+        std::vector<unsigned char> before(arena, arena + words.size() * 8);
+        Report report;
+        std::memset(&report, 0x3C, sizeof report);
+        report.layers = reinterpret_cast<LayerInfo*>(arena + p.layers);
+        report.layer_capacity = 4;
+        const Report report_before = report;
+        Cloud cloud = {arena + cloud_at, s.size(), 0, Scalar::float64};
+        Status status = stratmesh::reconstruct(cloud, o, arena + p.work, work_bytes,
+                                               reinterpret_cast<uint32_t*>(arena + p.tri), capacity,
+                                               reinterpret_cast<size_t*>(arena + p.count), &report);
+        if (p.work == work_at && p.tri == tri_at && p.count == count_at && p.layers == layers_at) {
+            CHECK(status == Status::ok);
+            CHECK(report.layer_count == 3);
+            continue;
+        }
+        CHECK(status == Status::invalid_argument);
+        CHECK(std::memcmp(before.data(), arena, before.size()) == 0);
+        CHECK(std::memcmp(&report_before, &report, sizeof report) == 0);
+    }
+    SUBCASE("the report inside the workspace") {
+        std::vector<unsigned char> work(work_bytes + sizeof(Report));
+        std::vector<uint32_t> tris(3 * capacity);
+        size_t count = 7;
+        Report* inside = reinterpret_cast<Report*>(work.data() + 64);
+        CHECK(stratmesh::reconstruct(cloud_of(s), o, work.data(), work.size(), tris.data(), capacity, &count,
+                                     inside) == Status::invalid_argument);
+        CHECK(count == 7);
+    }
+}
+
+TEST_CASE("malformed clouds: the documented status, counts that add up, nothing written past the buffers") {
+    const Shape& s = reference_cylinder();
+    Options along_z = {};
+    along_z.axis = Axis::z;
+    auto check_refused = [](const Run& run, Status expected) {
+        CHECK(run.status == expected);
+        CHECK(run.count == 0);
+        CHECK(run.workspace_guard_intact);
+        CHECK(run.triangle_guard_intact);
+        CHECK(counts_add_up(run.report));
+        CHECK(run.report.detail != nullptr);
+    };
+    SUBCASE("a null cloud with a non-zero count: invalid_argument") {
+        check_refused(reconstruct_guarded(Cloud{nullptr, 100, 0, Scalar::float64}, along_z), Status::invalid_argument);
+    }
+    SUBCASE("a count beyond 32-bit indices: too_many_points, before anything is read") {
+        double three[9] = {1, 0, 0, 0, 1, 0, -1, 0, 1};
+        std::vector<unsigned char> work(256);
+        uint32_t tris[3];
+        size_t count = 5;
+        Report report = {};
+        CHECK(stratmesh::reconstruct(Cloud{three, size_t{0xFFFFFFFEu}, 0, Scalar::float64}, along_z, work.data(),
+                                     work.size(), tris, 1, &count, &report) == Status::too_many_points);
+        CHECK(count == 0);
+        CHECK(report.points_in == size_t{0xFFFFFFFEu});
+        CHECK(counts_add_up(report));
+    }
+    SUBCASE("one point repeated: too_few_points, the repeats counted as duplicates") {
+        std::vector<double> xyz;
+        for (int i = 0; i < 5; ++i) xyz.insert(xyz.end(), {1.0, 2.0, 3.0});
+        Run run = reconstruct_guarded(Cloud{xyz.data(), 5, 0, Scalar::float64}, along_z);
+        check_refused(run, Status::too_few_points);
+        CHECK(run.report.duplicates + run.report.unused == 5);
+    }
+    SUBCASE("all points on one line beside the axis, or across it: no surface") {
+        std::vector<double> beside, across;
+        for (int i = 0; i < 200; ++i) {
+            beside.insert(beside.end(), {1.0, 0.5, 0.01 * i});
+            across.insert(across.end(), {0.01 * i - 1, 0.02 * i - 2, 0.005 * i});
+        }
+        for (const std::vector<double>* line : {&beside, &across}) {
+            Run run = reconstruct_guarded(Cloud{line->data(), 200, 0, Scalar::float64}, along_z);
+            CHECK((run.status == Status::not_columnar || run.status == Status::too_few_points));
+            check_refused(run, run.status);
+            CHECK(run.report.unused == 200);
+        }
+    }
+    SUBCASE("all points in one layer: cuts all outside the cloud") {
+        double cuts[3] = {-100, 100, 1e300};
+        Options o = axis_options(s);
+        o.cuts = cuts;
+        o.cut_count = 3;
+        Run run = reconstruct_guarded(cloud_of(s), o);
+        CHECK(run.report.layer_count == 1);
+        check_annulus_through_every_point(s, run);
+    }
+    SUBCASE("an empty layer: two cuts inside a gap of the cloud") {
+        // The cylinder without the points of the middle fifth of its height.
+        std::vector<double> xyz;
+        const double low = s.z_min + 0.4 * (s.z_max - s.z_min), high = s.z_min + 0.6 * (s.z_max - s.z_min);
+        for (size_t i = 0; i < s.size(); ++i) {
+            const double z = s.point(i)[2];
+            if (z < low || z > high) xyz.insert(xyz.end(), s.point(i), s.point(i) + 3);
+        }
+        Shape gap = with_points(s, xyz, ", with a gap");
+        double cuts[2] = {low + 0.25 * (high - low), low + 0.75 * (high - low)};
+        Options o = axis_options(gap);
+        o.cuts = cuts;
+        o.cut_count = 2;
+        Run run = reconstruct_guarded(cloud_of(gap), o);
+        CHECK(run.report.layer_count >= 2);
+        for (const LayerInfo& layer : run.layers) CHECK(layer.point_count > 0);
+        check_annulus_through_every_point(gap, run);
+    }
+    SUBCASE("thousands of layers, by count and by cuts: tiny layers merge") {
+        Options by_count = axis_options(s);
+        by_count.layer_count = 5000;
+        Run counted = reconstruct_guarded(cloud_of(s), by_count);
+        check_annulus_through_every_point(s, counted);
+        CHECK(counted.report.layer_count <= s.size() / 16);
+        CHECK(stratmesh::reconstruct_workspace_size(s.size(), by_count) ==
+              stratmesh::reconstruct_workspace_size(s.size(), [&] {
+                  Options o = by_count;
+                  o.layer_count = static_cast<uint32_t>(s.size());
+                  return o;
+              }()));
+
+        std::vector<double> cuts(100000);
+        for (size_t i = 0; i < cuts.size(); ++i)  // descending, every value twice
+            cuts[i] = s.along_axis(s.z_max - (s.z_max - s.z_min) * static_cast<double>(i / 2) / 50000.0);
+        Options by_cuts = axis_options(s);
+        by_cuts.cuts = cuts.data();
+        by_cuts.cut_count = cuts.size();
+        Run cut = reconstruct_guarded(cloud_of(s), by_cuts);
+        check_annulus_through_every_point(s, cut);
+        CHECK(cut.report.layer_count <= s.size() / 16);
+    }
+    SUBCASE("a layer height far below the point spacing: layers merge until they hold enough points") {
+        Options o = axis_options(s);
+        o.layer_height = 1e-12;
+        Run run = reconstruct_guarded(cloud_of(s), o);
+        check_annulus_through_every_point(s, run);
+    }
+}
+
+TEST_CASE("extreme magnitudes: scaling by a power of two gives the same triangles; 1e30, 1e-30 and 1e7 offsets work") {
+    const double origin[3] = {0, 0, 0};
+    const Shape unit = moved_cylinder(1, origin);
+    Options o = axis_options(unit);
+    o.layer_count = 4;
+    Run reference = reconstruct_guarded(cloud_of(unit), o);
+    check_annulus_through_every_point(unit, reference);
+    for (double scale : {0x1p-600, 0x1p-100, 0x1p100, 0x1p600}) {
+        CAPTURE(scale);
+        const Shape scaled = moved_cylinder(scale, origin);
+        Run run = reconstruct_guarded(cloud_of(scaled), o);
+        check_annulus_through_every_point(scaled, run);
+        CHECK(run.triangles == reference.triangles);
+    }
+    for (double scale : {1e-30, 1e30}) {
+        CAPTURE(scale);
+        const Shape scaled = moved_cylinder(scale, origin);
+        Run run = reconstruct_guarded(cloud_of(scaled), o);
+        check_annulus_through_every_point(scaled, run);
+    }
+    SUBCASE("a georeferenced scan: a 50 mm pipe 1e7 m from the origin, millimetre spacing kept") {
+        const double far[3] = {6.5e6, 1.0e7, 350.0};
+        const Shape pipe = moved_cylinder(0.05, far);
+        Options p = axis_options(pipe);
+        p.layer_count = 4;
+        Run run = reconstruct_guarded(cloud_of(pipe), p);
+        check_annulus_through_every_point(pipe, run);
+        mesh_check::Result m = check_mesh(pipe, run.triangles.data(), run.count, true);
+        CHECK(m.inward == 0);
+        CHECK(m.intersecting_pairs == 0);
+        // The coordinates carry about 2e-9 m of rounding at 1e7: the mesh must meet the
+        // surface as well as the same pipe at the origin does, to a micrometre.
+        const Shape near = moved_cylinder(0.05, origin);
+        Run at_origin = reconstruct_guarded(cloud_of(near), p);
+        REQUIRE(at_origin.status == Status::ok);
+        mesh_check::Result n = check_mesh(near, at_origin.triangles.data(), at_origin.count, false);
+        MESSAGE("pipe deviation at 1e7: " << m.max_deviation() << " m, at the origin: " << n.max_deviation()
+                                          << " m, spacing " << pipe.spacing << " m");
+        CHECK(m.max_deviation() < n.max_deviation() + 1e-6);
+    }
+    SUBCASE("subnormal coordinates: refused with a status, or a manifold annulus") {
+        const Shape tiny = moved_cylinder(0x1p-1060, origin);
+        Run run = reconstruct_guarded(cloud_of(tiny), o);
+        MESSAGE("subnormal cylinder: " << std::string(stratmesh::status_string(run.status)));
+        CHECK(counts_add_up(run.report));
+        CHECK(run.workspace_guard_intact);
+        CHECK(run.triangle_guard_intact);
+        if (run.status == Status::ok) {
+            mesh_check::Result m = check_mesh(tiny, run.triangles.data(), run.count, false);
+            CHECK(m.manifold());
+        } else {
+            CHECK(run.report.detail != nullptr);
+        }
+    }
+}

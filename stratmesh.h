@@ -431,6 +431,31 @@ inline double abs_value(double x) { return x < 0 ? -x : x; }
 #endif
 inline bool is_finite(double x) { return x - x == 0; }
 
+// Sorts ascending in place: heapsort, O(n log n) on any input (a million cuts, a huge fan)
+// with no recursion and no memory.
+template <class T> void sift_down(T* v, size_t root, size_t count) {
+    for (;;) {
+        size_t child = 2 * root + 1;
+        if (child >= count) return;
+        if (child + 1 < count && v[child + 1] > v[child]) ++child;
+        if (!(v[child] > v[root])) return;
+        T t = v[root];
+        v[root] = v[child];
+        v[child] = t;
+        root = child;
+    }
+}
+
+template <class T> void heap_sort(T* v, size_t count) {
+    for (size_t i = count / 2; i-- > 0;) sift_down(v, i, count);
+    for (size_t end = count; end-- > 1;) {
+        T t = v[0];
+        v[0] = v[end];
+        v[end] = t;
+        sift_down(v, 0, end);
+    }
+}
+
 inline double read_double(const unsigned char* p) {
     double v;
     std::memcpy(&v, p, sizeof v);
@@ -1770,31 +1795,6 @@ inline Status validate_layer_options(const Options& options) {
     return Status::ok;
 }
 
-// Sorts ascending in place; heapsort, so that a million cuts cost no more than sorting
-// them should, with no recursion.
-inline void sift_down(double* v, size_t root, size_t count) {
-    for (;;) {
-        size_t child = 2 * root + 1;
-        if (child >= count) return;
-        if (child + 1 < count && v[child + 1] > v[child]) ++child;
-        if (!(v[child] > v[root])) return;
-        double t = v[root];
-        v[root] = v[child];
-        v[child] = t;
-        root = child;
-    }
-}
-
-inline void heap_sort(double* v, size_t count) {
-    for (size_t i = count / 2; i-- > 0;) sift_down(v, i, count);
-    for (size_t end = count; end-- > 1;) {
-        double t = v[0];
-        v[0] = v[end];
-        v[end] = t;
-        sift_down(v, 0, end);
-    }
-}
-
 // Fills plan.bounds (room for planned_layer_limit + 1 entries) for heights [lo, hi];
 // `typical_radius` sets the automatic layer height; the user's cuts are coordinates along
 // the axis (Frame::user_height of frame heights), layer_height a length in the cloud's
@@ -2440,25 +2440,7 @@ inline void sort_pairs(uint64_t* items, size_t count) {
         }
         return;
     }
-    auto sift = [items](size_t root, size_t end) {
-        for (;;) {
-            size_t child = 2 * root + 1;
-            if (child >= end) return;
-            if (child + 1 < end && items[child + 1] > items[child]) ++child;
-            if (items[root] >= items[child]) return;
-            uint64_t t = items[root];
-            items[root] = items[child];
-            items[child] = t;
-            root = child;
-        }
-    };
-    for (size_t i = count / 2; i-- > 0;) sift(i, count);
-    for (size_t end = count; end > 1; --end) {
-        uint64_t t = items[0];
-        items[0] = items[end - 1];
-        items[end - 1] = t;
-        sift(0, end - 1);
-    }
+    heap_sort(items, count);
 }
 
 struct Fan {

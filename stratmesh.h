@@ -109,6 +109,9 @@
 //   coordinates. Every other point is a vertex of the output.
 // - NaN or infinite coordinates are refused (Status::invalid_point, with the index), or
 //   skipped and counted with the skip_invalid_points flag of reconstruct.
+// - reconstruct keeps its own predicate calls inside that exact range, whatever the cloud:
+//   the frame is rescaled by a power of two and the unrolled coordinates are bounded (see
+//   >>unroll), so a far outlier or a cloud at 1e-300 cannot break a sign.
 // - reconstruct's output is edge- and vertex-manifold and consistently oriented for every
 //   input it accepts: the layers and the bands between them form one annulus by
 //   construction, and a final safety net removes (and counts) any triangle that would
@@ -1939,6 +1942,13 @@ struct Cylinder {
     double scale;    // 1 / max(radius, height / kMaxTurns)
 };
 
+// Direction components smaller than this become 0. No scan resolves angles of 1e-18
+// radians, and it keeps the annulus inside the predicates' exact range: radii in
+// [e^-64, e^64] (2^-92 to 2^92) times components in [2^-60, 1] give coordinates, and
+// coordinate differences, within a span of 2^296 < 2^320. Without it a cloud with one far
+// outlier puts components near 2^-900 on the annulus, where the signs are not exact.
+const double kSmallestDirection = 0x1p-60;
+
 // The point's place on the annulus: e^{(h - h0) * scale} times its direction from the
 // centre (points on the centre line take direction e1).
 inline void roll(const Cylinder& c, const Local& p, double* out) {
@@ -1946,8 +1956,9 @@ inline void roll(const Cylinder& c, const Local& p, double* out) {
     double r = std::sqrt(dx * dx + dy * dy);
     double rho = exp_portable((p.h - c.h0) * c.scale);
     if (r > 0 && is_finite(r)) {
-        out[0] = rho * (dx / r);
-        out[1] = rho * (dy / r);
+        double u = dx / r, v = dy / r;
+        out[0] = abs_value(u) < kSmallestDirection ? 0.0 : rho * u;
+        out[1] = abs_value(v) < kSmallestDirection ? 0.0 : rho * v;
     } else {
         out[0] = rho;
         out[1] = 0;

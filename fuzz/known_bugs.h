@@ -9,7 +9,9 @@
 // Fixed, kept as regression corpus files: A (NaN from the predicates on all-subnormal
 // points), C (undefined behaviour in reconstruct for coordinates beyond 2^511 or
 // subnormal), D (wrong incircle signs for points a few ulps apart near 2^-218), E (repeats
-// of unused points missing from Report::duplicates: no longer reproduces).
+// of unused points missing from Report::duplicates: no longer reproduces), G (reconstruct
+// made a repeated point a vertex instead of its lowest twin for a cloud with one far
+// outlier: the annulus coordinates spread beyond the predicates' exact range).
 // B: incircle has the wrong sign when the coordinates and their differences spread over
 //    more than 2^320 in magnitude: outside the documented contract (products of four terms
 //    cannot all be represented); the filter skips spreads above 300.

@@ -1772,6 +1772,10 @@ struct LayerPlan {
 };
 
 const size_t kMaxAutomaticLayers = 256;
+// Heights are divided by at least layer height / kMaxTurns when unrolled, so exp() stays
+// far from overflow and the annulus from extreme ratios in very tall, thin layers; a layer
+// up to kMaxTurns radii tall unrolls undistorted (see >>unroll).
+const double kMaxTurns = 24.0;
 // A layer with fewer points is merged with the next one (the last layer only needs 3).
 const size_t kMinLayerPoints = 16;
 
@@ -1798,12 +1802,16 @@ inline Status validate_layer_options(const Options& options) {
     return Status::ok;
 }
 
-// Fills plan.bounds (room for planned_layer_limit + 1 entries) for heights [lo, hi];
-// `typical_radius` sets the automatic layer height; the user's cuts are coordinates along
-// the axis (Frame::user_height of frame heights), layer_height a length in the cloud's
-// units.
-inline void plan_layers(const Options& options, double lo, double hi, double typical_radius,
-                        size_t point_count, const Frame& frame, LayerPlan& plan) {
+inline bool automatic_layers(const Options& options) {
+    return !(options.cuts && options.cut_count > 0) && options.layer_count == 0 &&
+           options.layer_height == 0;
+}
+
+// Fills plan.bounds (room for planned_layer_limit + 1 entries) for heights [lo, hi] from
+// the user's layer options (not automatic_layers): the cuts are coordinates along the axis
+// (Frame::user_height of frame heights), layer_height a length in the cloud's units.
+inline void plan_layers(const Options& options, double lo, double hi, size_t point_count,
+                        const Frame& frame, LayerPlan& plan) {
     const double cut_offset = dot(frame.origin, frame.axis);
     double* b = plan.bounds;
     uint32_t n = 0;
@@ -1825,13 +1833,8 @@ inline void plan_layers(const Options& options, double lo, double hi, double typ
             layers = options.layer_count;
         } else if (options.layer_height > 0) {
             layers = std::ceil(height / (options.layer_height * frame.scale));
-        } else if (typical_radius > 0) {
-            // Automatic, for now: layers about four radii tall.
-            layers = std::floor(height / (4 * typical_radius));
         }
         double limit = static_cast<double>(point_count);
-        if (options.layer_count == 0 && options.layer_height == 0)
-            limit = static_cast<double>(kMaxAutomaticLayers);
         if (!(layers >= 1)) layers = 1;
         if (layers > limit) layers = limit;
         uint32_t count = static_cast<uint32_t>(layers);
@@ -1841,6 +1844,191 @@ inline void plan_layers(const Options& options, double lo, double hi, double typ
         }
     }
     b[n] = hi;
+    plan.count = n;
+}
+
+// ---- automatic layers ----------------------------------------------------------------------
+//
+// The paper's layering rule, made mechanical. The cloud's height range is cut into equal
+// bins (about 256 points each, at most kMaxAutomaticLayers); each bin gets its centroid
+// across the axis, its mean radius around that centroid and its inner radius (the smallest
+// of kProfileSectors sector-mean radii: the cross-section holds a disc about that wide
+// around its centroid when it is star-shaped). Then, starting from one layer over
+// everything:
+//   - a layer is well unrolled when one centre line serves all its cross-sections (every
+//     bin's centroid lies within kCentreDrift inner radii of the layer's centre, the
+//     count-weighted mean of its bins' centroids, give or take three standard errors of
+//     the bin's centroid, so sampling noise alone never cuts) and it is at most kMaxTurns
+//     mean radii
+//     tall (taller layers unroll with distorted aspect);
+//   - a layer that is not is cut in two at the bin boundary where the surface changes
+//     least: the smallest sum of centroid drift and radius change between the two bins
+//     (relative to the radius), plus a penalty where the bins are denser than average, so
+//     dense detailed parts (a face, a joint) stay inside one layer. Only boundaries that
+//     leave each side a quarter of the layer's bins are candidates, so the splitting
+//     depth stays logarithmic.
+// The result is the fewest layers that pass, cut where the shape is calm; O(n) passes over
+// the points plus O(bins^2) on the profile, deterministic.
+
+const uint32_t kProfileSectors = 8;
+const double kCentreDrift = 0.5;
+const size_t kPointsPerProfileBin = 256;
+const double kDensityWeight = 0.5;
+
+struct ProfileBin {
+    uint32_t count;
+    uint32_t sectors_seen;                  // direction sectors holding a point
+    double cx, cy;                          // centroid across the axis
+    double mean_radius, inner_radius;       // around the centroid (inner: occupied sectors)
+    double square_sum;                      // sum of squared distances from the centroid
+    double sector_sum[kProfileSectors];     // sum of distances per direction sector
+    uint32_t sector_count[kProfileSectors];
+};
+
+// A range of bins [first, end) waiting to be judged.
+struct BinRange {
+    uint32_t first, end;
+};
+
+inline uint32_t profile_bin_count(size_t valid_points) {
+    size_t bins = valid_points / kPointsPerProfileBin;
+    if (bins > kMaxAutomaticLayers) bins = kMaxAutomaticLayers;
+    return bins < 1 ? 1u : static_cast<uint32_t>(bins);
+}
+
+// The scratch the automatic planner takes (released before the layers are built).
+inline void allocate_profile(Arena& arena, uint32_t bins, ProfileBin** profile, BinRange** ranges,
+                             double** cuts) {
+    *profile = arena.alloc<ProfileBin>(bins);
+    *ranges = arena.alloc<BinRange>(bins);
+    *cuts = arena.alloc<double>(bins);
+}
+
+inline uint32_t sector_of(double dx, double dy) {
+    uint32_t s = (dx < 0 ? 4u : 0u) + (dy < 0 ? 2u : 0u);
+    return s + (abs_value(dx) < abs_value(dy) ? 1u : 0u);
+}
+
+inline void build_profile(const CloudReader& cloud, size_t count, const Frame& frame, double lo,
+                          double hi, ProfileBin* profile, uint32_t bins) {
+    std::memset(static_cast<void*>(profile), 0, sizeof(ProfileBin) * bins);
+    const double per_height = static_cast<double>(bins) / (hi - lo);
+    auto bin_of = [&](double h) {
+        double b = (h - lo) * per_height;
+        return b >= static_cast<double>(bins - 1) ? bins - 1 : (b > 0 ? static_cast<uint32_t>(b) : 0u);
+    };
+    for (size_t i = 0; i < count; ++i) {
+        if (!cloud.valid(i)) continue;
+        Local p = frame.local(cloud.point(i));
+        ProfileBin& bin = profile[bin_of(p.h)];
+        ++bin.count;
+        bin.cx += p.x;
+        bin.cy += p.y;
+    }
+    for (uint32_t b = 0; b < bins; ++b) {
+        if (profile[b].count == 0) continue;
+        profile[b].cx /= profile[b].count;
+        profile[b].cy /= profile[b].count;
+    }
+    for (size_t i = 0; i < count; ++i) {
+        if (!cloud.valid(i)) continue;
+        Local p = frame.local(cloud.point(i));
+        ProfileBin& bin = profile[bin_of(p.h)];
+        double dx = p.x - bin.cx, dy = p.y - bin.cy;
+        uint32_t s = sector_of(dx, dy);
+        bin.sector_sum[s] += std::sqrt(dx * dx + dy * dy);
+        bin.square_sum += dx * dx + dy * dy;
+        ++bin.sector_count[s];
+    }
+    for (uint32_t b = 0; b < bins; ++b) {
+        ProfileBin& bin = profile[b];
+        double total = 0, inner = DBL_MAX;
+        for (uint32_t s = 0; s < kProfileSectors; ++s) {
+            total += bin.sector_sum[s];
+            if (bin.sector_count[s] == 0) continue;
+            ++bin.sectors_seen;
+            double mean = bin.sector_sum[s] / bin.sector_count[s];
+            if (mean < inner) inner = mean;
+        }
+        bin.mean_radius = bin.count ? total / bin.count : 0.0;
+        bin.inner_radius = bin.count ? inner : 0.0;
+    }
+}
+
+inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_height) {
+    double cx = 0, cy = 0, radius = 0;
+    size_t points = 0;
+    for (uint32_t b = range.first; b < range.end; ++b) {
+        cx += profile[b].cx * profile[b].count;
+        cy += profile[b].cy * profile[b].count;
+        radius += profile[b].mean_radius * profile[b].count;
+        points += profile[b].count;
+    }
+    if (points == 0) return true;
+    cx /= static_cast<double>(points);
+    cy /= static_cast<double>(points);
+    radius /= static_cast<double>(points);
+    if (bin_height * (range.end - range.first) > kMaxTurns * radius) return false;
+    for (uint32_t b = range.first; b < range.end; ++b) {
+        // Too few points, or too few directions, to say: such a bin's centroid is noise.
+        if (profile[b].count < kPointsPerProfileBin / 4 || profile[b].sectors_seen < kProfileSectors / 2)
+            continue;
+        double dx = profile[b].cx - cx, dy = profile[b].cy - cy;
+        double standard_error = std::sqrt(profile[b].square_sum / (2.0 * profile[b].count * profile[b].count));
+        double limit = kCentreDrift * profile[b].inner_radius + 3 * standard_error;
+        if (dx * dx + dy * dy > limit * limit) return false;
+    }
+    return true;
+}
+
+// How much the surface changes between bins b - 1 and b, plus the density penalty.
+inline double cut_cost(const ProfileBin* profile, uint32_t b, double mean_count) {
+    const ProfileBin& below = profile[b - 1];
+    const ProfileBin& above = profile[b];
+    double radius = below.mean_radius > above.mean_radius ? below.mean_radius : above.mean_radius;
+    if (!(radius > 0)) return 0;  // an empty stretch: the calmest place of all
+    double dx = above.cx - below.cx, dy = above.cy - below.cy;
+    double change = (std::sqrt(dx * dx + dy * dy) + abs_value(above.mean_radius - below.mean_radius)) / radius;
+    double density = (below.count + above.count) / (2 * mean_count) - 1;
+    return change + (density > 0 ? kDensityWeight * density : 0.0);
+}
+
+// Fills plan.bounds for heights [lo, hi] by the rule above; profile, ranges and cuts hold
+// `bins` entries each.
+inline void plan_automatic_layers(const CloudReader& cloud, size_t count, size_t valid,
+                                  const Frame& frame, double lo, double hi, ProfileBin* profile,
+                                  BinRange* ranges, double* cuts, uint32_t bins, LayerPlan& plan) {
+    build_profile(cloud, count, frame, lo, hi, profile, bins);
+    const double bin_height = (hi - lo) / bins;
+    const double mean_count = static_cast<double>(valid) / bins;
+    size_t pending = 0, cut_count = 0;
+    ranges[pending++] = {0, bins};
+    while (pending > 0) {
+        BinRange r = ranges[--pending];
+        uint32_t width = r.end - r.first;
+        if (width < 2 || well_unrolled(profile, r, bin_height)) continue;
+        uint32_t margin = width / 4 > 0 ? width / 4 : 1;
+        uint32_t best = r.first + margin;
+        double best_cost = DBL_MAX;
+        for (uint32_t b = r.first + margin; b <= r.end - margin; ++b) {
+            double cost = cut_cost(profile, b, mean_count);
+            if (cost < best_cost) {
+                best_cost = cost;
+                best = b;
+            }
+        }
+        cuts[cut_count++] = lo + bin_height * best;
+        // Each split turns one range into two, so at most `bins` are ever pending.
+        ranges[pending++] = {r.first, best};
+        ranges[pending++] = {best, r.end};
+    }
+    heap_sort(cuts, cut_count);
+    double* bounds = plan.bounds;
+    uint32_t n = 0;
+    bounds[n++] = lo;
+    for (size_t i = 0; i < cut_count; ++i)
+        if (cuts[i] > bounds[n - 1] && cuts[i] < hi) bounds[n++] = cuts[i];
+    bounds[n] = hi;
     plan.count = n;
 }
 
@@ -1874,9 +2062,6 @@ inline uint32_t layer_of(const LayerPlan& plan, double h) {
 // against height), so triangles are well shaped on the surface, not only in the plane.
 
 const uint32_t kSectors = 32;
-// Heights are divided by at least layer height / kMaxTurns so exp() stays far from
-// overflow and the annulus from extreme ratios in very tall, thin layers.
-const double kMaxTurns = 24.0;
 
 // e^x with + - * only, so every platform computes the same bits. Arguments are clamped to
 // [-64, 64] (a NaN counts as -64): the callers stay within kMaxTurns + 1, except for
@@ -2689,8 +2874,15 @@ inline size_t reconstruct_scratch_size(size_t count) {
     manifold.alloc<uint64_t>(triangles);
     for (int k = 0; k < 4; ++k) manifold.alloc<uint32_t>(triangles);
 
-    if (layer.failed || band.failed || manifold.failed) return 0;  // beyond size_t
+    Arena profile = Arena::measuring();
+    ProfileBin* bins = nullptr;
+    BinRange* ranges = nullptr;
+    double* cuts = nullptr;
+    allocate_profile(profile, profile_bin_count(count), &bins, &ranges, &cuts);
+
+    if (layer.failed || band.failed || manifold.failed || profile.failed) return 0;  // beyond size_t
     size_t most = layer.high_water;
+    if (profile.high_water > most) most = profile.high_water;
     if (band.high_water > most) most = band.high_water;
     if (manifold.high_water > most) most = manifold.high_water;
     return most;
@@ -2838,13 +3030,12 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
         return Status::too_few_points;
     }
 
-    double lo = DBL_MAX, hi = -DBL_MAX, radius_sum = 0;
+    double lo = DBL_MAX, hi = -DBL_MAX;
     for (size_t i = 0; i < cloud.count; ++i) {
         if (!reader.valid(i)) continue;
         Local p = frame.local(reader.point(i));
         if (p.h < lo) lo = p.h;
         if (p.h > hi) hi = p.h;
-        radius_sum += std::sqrt(p.x * p.x + p.y * p.y);
     }
     if (!(hi > lo)) {
         rep.detail = "every point has the same height along the axis";
@@ -2862,8 +3053,20 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     if (!plan_reconstruct(m, cloud.count, layer_limit, arena)) return finish(Status::out_of_memory);
     notify(options, Phase::layers, 0);
     LayerPlan plan = {m.bounds, 0};
-    plan_layers(options, lo, hi, radius_sum / static_cast<double>(valid), cloud.count, frame,
-                plan);
+    if (automatic_layers(options)) {
+        size_t mark = arena.mark();
+        uint32_t bins = profile_bin_count(valid);
+        ProfileBin* profile = nullptr;
+        BinRange* ranges = nullptr;
+        double* cuts = nullptr;
+        allocate_profile(arena, bins, &profile, &ranges, &cuts);
+        if (arena.failed) return finish(Status::out_of_memory);
+        plan_automatic_layers(reader, cloud.count, valid, frame, lo, hi, profile, ranges, cuts,
+                              bins, plan);
+        arena.rewind(mark);
+    } else {
+        plan_layers(options, lo, hi, cloud.count, frame, plan);
+    }
     group_by_layer(reader, cloud.count, frame, plan, m);
 
     notify(options, Phase::triangulate, 0);

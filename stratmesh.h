@@ -268,10 +268,12 @@ struct Options {
     // Layers, first match wins: explicit cut positions along the axis, as the coordinate
     // dot(point, axis) (with Axis::z, a cut at 68 is the plane z = 68); any order,
     // repeats and cuts outside the cloud are ignored; else layer_count equal-height
-    // layers; else layers of about layer_height; else automatic (for now: layers about
-    // four mean radii tall, at most 256). A layer with fewer than 16 points, or whose
-    // points do not surround its centre, is merged with the next one; the report lists
-    // the layers actually used.
+    // layers; else layers of about layer_height; else automatic: the fewest layers (at
+    // most 256) such that one centre line serves each layer and none is taller than 24
+    // of its radii, cut where the cross-section changes least and not through dense
+    // detail (the paper's rule; see "automatic layers" in >>layers). A layer with fewer
+    // than 16 points, or whose points do not surround its centre, is merged with the next
+    // one; the report lists the layers actually used (Report::layers: bottom and top).
     const double* cuts;
     size_t cut_count;
     uint32_t layer_count;

@@ -1711,3 +1711,112 @@ TEST_CASE("extreme magnitudes: scaling by a power of two gives the same triangle
         }
     }
 }
+
+// ===========================================================================================
+// Automatic layers (the paper's layering rule, see >>layers in the header): as few layers as
+// keep every layer well unrolled, more only where the centre line drifts or a layer would
+// be too tall for its radius.
+
+namespace {
+
+// A unit-radius tube along Z over z in [-6, 6] whose centre line bends sideways:
+// x = amplitude * sin(pi z / 12). With amplitude 2 the two ends are four radii apart, so
+// no straight line runs inside the whole tube.
+struct BentTube {
+    double amplitude;
+    std::vector<double> xyz;
+    double centre_x(double z) const { return amplitude * std::sin(shapes::kPi * z / 12); }
+};
+
+BentTube bent_tube(size_t n, double amplitude) {
+    BentTube tube{amplitude, {}};
+    shapes::Rng rng(23);
+    for (size_t i = 0; i < n; ++i) {
+        double z = rng.uniform(-6, 6), t = rng.uniform(0, 2 * shapes::kPi);
+        tube.xyz.insert(tube.xyz.end(), {tube.centre_x(z) + std::cos(t), std::sin(t), z});
+    }
+    return tube;
+}
+
+mesh_check::Result check_bent_mesh(const BentTube& tube, const Run& run) {
+    mesh_check::Input in;
+    in.points = tube.xyz.data();
+    in.point_count = tube.xyz.size() / 3;
+    in.triangles = run.triangles.data();
+    in.triangle_count = run.count;
+    in.axis_point[0] = in.axis_point[1] = in.axis_point[2] = 0;
+    in.axis_direction[0] = in.axis_direction[1] = 0;
+    in.axis_direction[2] = 1;  // the straight axis: orientation counts are not meaningful
+    in.surface = [&tube](const double* p) { return std::hypot(p[0] - tube.centre_x(p[2]), p[1]) - 1; };
+    in.self_intersections = true;
+    return mesh_check::check(in);
+}
+
+}  // namespace
+
+TEST_CASE("automatic layers: one layer where one unrolls well, with no fold") {
+    for (Pose pose : {Pose::z, Pose::tilted}) {
+        for (const Shape& s : {shapes::vase(kSmall, pose), shapes::head(kLarge, pose), shapes::ct_slices(kSmall, pose),
+                               shapes::bumpy_tube(kSmall, pose)}) {
+            CAPTURE(s.name);
+            CAPTURE(shapes::pose_name(pose));
+            Run run = reconstruct_guarded(cloud_of(s), axis_options(s));
+            check_annulus_through_every_point(s, run);
+            CHECK(run.report.layer_count == 1);
+            CHECK(run.report.folds == 0);
+            mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, true);
+            CHECK(m.inward == 0);
+            CHECK(m.intersecting_pairs == 0);
+        }
+    }
+    SUBCASE("no folds where the paper's anatomical cuts give none, with fewer layers") {
+        Case anatomical = head_case(Pose::z, kLarge);
+        Shape s = shapes::head(kLarge, Pose::z);
+        Run automatic = reconstruct_guarded(cloud_of(s), axis_options(s));
+        REQUIRE(automatic.status == Status::ok);
+        CHECK(automatic.report.folds <= anatomical.run.report.folds);
+        CHECK(automatic.report.layer_count < anatomical.run.report.layer_count);
+    }
+}
+
+TEST_CASE("automatic layers: a bent tube is cut where its centre line drifts, and folds vanish") {
+    for (double amplitude : {1.0, 2.0}) {
+        CAPTURE(amplitude);
+        const BentTube tube = bent_tube(8000, amplitude);
+        const Cloud cloud = {tube.xyz.data(), tube.xyz.size() / 3, 0, Scalar::float64};
+        Options automatic = {};
+        automatic.axis = Axis::z;
+        Options single = automatic;
+        single.layer_count = 1;
+        Run split = reconstruct_guarded(cloud, automatic);
+        Run whole = reconstruct_guarded(cloud, single);
+        REQUIRE(split.status == Status::ok);
+        REQUIRE(whole.status == Status::ok);
+        mesh_check::Result s = check_bent_mesh(tube, split), w = check_bent_mesh(tube, whole);
+        MESSAGE("bent tube, amplitude " << amplitude << ": automatic " << split.report.layer_count << " layers, "
+                                        << split.report.folds << " folds, " << s.intersecting_pairs
+                                        << " intersecting pairs; one layer " << whole.report.folds << " folds, "
+                                        << w.intersecting_pairs << " intersecting pairs");
+        CHECK(split.report.layer_count >= 2);
+        CHECK(s.manifold());
+        CHECK(s.boundary_loops == 2);
+        CHECK(split.report.unused == 0);
+        CHECK(split.report.folds < whole.report.folds);
+        CHECK(s.intersecting_pairs < w.intersecting_pairs);
+        CHECK(s.max_deviation() < w.max_deviation());
+        // The layers tile the height range: each one starts where the one below ends.
+        for (size_t k = 1; k < split.layers.size(); ++k) CHECK(split.layers[k].bottom == split.layers[k - 1].top);
+    }
+}
+
+TEST_CASE("automatic layers: a tall thin tube is cut into layers at most 24 radii tall") {
+    const double radius = 0.05;  // 120 radii tall
+    Shape s = shapes::thin_tube(kLarge, Pose::z, radius);
+    Run run = reconstruct_guarded(cloud_of(s), axis_options(s));
+    check_annulus_through_every_point(s, run);
+    CHECK(run.report.layer_count >= 5);
+    for (const LayerInfo& layer : run.layers) {
+        CHECK(layer.top - layer.bottom <= 24 * layer.radius * 1.05);
+        CHECK(layer.radius == doctest::Approx(radius).epsilon(0.05));
+    }
+}

@@ -253,6 +253,34 @@ void generate_tube(size_t n, uint64_t seed, std::vector<double>& xyz) {
     }
 }
 
+const double kVaseCuts[2] = {-kPi / 3, kPi / 3};
+const double kBentTubeCuts[4] = {-3.6, -1.2, 1.2, 3.6};
+
+void generate_vase(size_t n, uint64_t seed, std::vector<double>& xyz) {
+    Random random(seed);
+    xyz.resize(3 * n);
+    for (size_t i = 0; i < n; ++i) {
+        double theta = kTwoPi * random.uniform();
+        double z = -3 + 6 * random.uniform();
+        double r = 1 + 0.5 * std::sin(1.5 * z);
+        xyz[3 * i] = r * std::cos(theta);
+        xyz[3 * i + 1] = r * std::sin(theta);
+        xyz[3 * i + 2] = z;
+    }
+}
+
+void generate_bent_tube(size_t n, uint64_t seed, std::vector<double>& xyz) {
+    Random random(seed);
+    xyz.resize(3 * n);
+    for (size_t i = 0; i < n; ++i) {
+        double theta = kTwoPi * random.uniform();
+        double z = -6 + 12 * random.uniform();
+        xyz[3 * i] = 2 * std::sin(kPi * z / 12) + std::cos(theta);
+        xyz[3 * i + 1] = std::sin(theta);
+        xyz[3 * i + 2] = z;
+    }
+}
+
 void generate_paper_head(size_t n, uint64_t seed, std::vector<double>& xyz) {
     sample_surface(Surface{head_point, head_density}, n, seed, xyz);
 }

@@ -17,6 +17,16 @@ namespace bench {
 // z in [0, 8]: n points with (theta, z) uniform in [0, 2 pi) x [0, 8].
 void generate_tube(size_t n, uint64_t seed, std::vector<double>& xyz);
 
+// Layering comparisons (issue 8): a vase r = 1 + 0.5 sin(1.5 z), z in [-3, 3], whose
+// calmest sections (radius extremes) are at z = -pi/3 and pi/3 (kVaseCuts); and a
+// unit tube over z in [-6, 6] whose centre line bends to x = 2 sin(pi z / 12), so no
+// straight line runs inside all of it (kBentTubeCuts: five equal layers, the fewest equal
+// layers found by hand to give no fold).
+extern const double kVaseCuts[2];
+extern const double kBentTubeCuts[4];
+void generate_vase(size_t n, uint64_t seed, std::vector<double>& xyz);
+void generate_bent_tube(size_t n, uint64_t seed, std::vector<double>& xyz);
+
 // The shapes of the three experiments of the 2014 paper (Xiao, Deng, Li; section 2), made
 // up from the paper's point counts, height ranges and cut heights only (the paper's
 // clouds are not public). n is the point count; the paper's are below.

@@ -131,4 +131,39 @@ Boundary find_boundary(const uint32_t* triangles, size_t triangle_count,
     return result;
 }
 
+AngleStats smallest_angles(const uint32_t* triangles, size_t triangle_count,
+                           const stratmesh::Cloud& cloud) {
+    AngleStats stats;
+    if (triangle_count == 0) return stats;
+    std::vector<double> smallest(triangle_count);
+    size_t below = 0;
+    for (size_t t = 0; t < triangle_count; ++t) {
+        double p[3][3];
+        for (size_t k = 0; k < 3; ++k) cloud_point(cloud, triangles[3 * t + k], p[k]);
+        double least = 180;
+        for (int k = 0; k < 3; ++k) {
+            const double* a = p[k];
+            const double* b = p[(k + 1) % 3];
+            const double* c = p[(k + 2) % 3];
+            double u[3], v[3];
+            for (int d = 0; d < 3; ++d) {
+                u[d] = b[d] - a[d];
+                v[d] = c[d] - a[d];
+            }
+            double cross[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                               u[0] * v[1] - u[1] * v[0]};
+            double sine = std::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
+            double cosine = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+            least = std::min(least, std::atan2(sine, cosine) * 180 / 3.14159265358979323846);
+        }
+        smallest[t] = least;
+        below += least < 10;
+    }
+    std::sort(smallest.begin(), smallest.end());
+    stats.p05 = smallest[triangle_count / 20];
+    stats.median = smallest[triangle_count / 2];
+    stats.below_10 = static_cast<double>(below) / static_cast<double>(triangle_count);
+    return stats;
+}
+
 }  // namespace bench

@@ -35,6 +35,16 @@ Boundary find_boundary(const uint32_t* triangles, size_t triangle_count,
                        const stratmesh::Cloud& cloud, const double axis[3],
                        const double origin[3]);
 
+// The distribution of the triangles' smallest angles, in degrees (a measure of shape:
+// 60 for an equilateral triangle, 0 for a sliver).
+struct AngleStats {
+    double p05 = 0, median = 0;   // 5th percentile and median of the smallest angles
+    double below_10 = 0;          // fraction of triangles whose smallest angle is under 10
+};
+
+AngleStats smallest_angles(const uint32_t* triangles, size_t triangle_count,
+                           const stratmesh::Cloud& cloud);
+
 }  // namespace bench
 
 #endif  // STRATMESH_BENCH_MESH_H

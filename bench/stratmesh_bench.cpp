@@ -135,9 +135,10 @@ struct Layering {
 
 constexpr Layering kNoLayering = {stratmesh::Axis::automatic, 0, nullptr, 0};
 
-// Eight equal layers along z, and one.
+// Eight equal layers along z; one layer; automatic layers.
 constexpr Layering kTubeLayers = {stratmesh::Axis::z, 8, nullptr, 0};
-constexpr Layering kTubeOneLayer = {stratmesh::Axis::z, 1, nullptr, 0};
+constexpr Layering kOneLayerAlongZ = {stratmesh::Axis::z, 1, nullptr, 0};
+constexpr Layering kAutomaticAlongZ = {stratmesh::Axis::z, 0, nullptr, 0};
 
 // The paper's cuts along z (section 2).
 template <size_t N> constexpr Layering cuts_along_z(const double (&cuts)[N]) {
@@ -174,7 +175,26 @@ const CaseSpec kCases[] = {
      kTubeLayers},
     // The cloud of tube-1e6 (same seed) in a single layer.
     {"tube-1e6-1layer", "tube", Kind::reconstruct, 1000000, 0x5EED0102u, 5,
-     bench::generate_tube, kTubeOneLayer},
+     bench::generate_tube, kOneLayerAlongZ},
+    // Automatic layers against one layer and against cuts chosen by hand (issue 8).
+    {"layering-head-auto", "layering", Kind::reconstruct, bench::kHeadPoints, 0x5EED0201u, 5,
+     bench::generate_paper_head, kAutomaticAlongZ},
+    {"layering-head-1layer", "layering", Kind::reconstruct, bench::kHeadPoints, 0x5EED0201u, 5,
+     bench::generate_paper_head, kOneLayerAlongZ},
+    {"layering-head-cuts", "layering", Kind::reconstruct, bench::kHeadPoints, 0x5EED0201u, 5,
+     bench::generate_paper_head, cuts_along_z(bench::kHeadCuts)},
+    {"layering-vase-auto", "layering", Kind::reconstruct, 20000, 0x5EED0301u, 5,
+     bench::generate_vase, kAutomaticAlongZ},
+    {"layering-vase-1layer", "layering", Kind::reconstruct, 20000, 0x5EED0301u, 5,
+     bench::generate_vase, kOneLayerAlongZ},
+    {"layering-vase-cuts", "layering", Kind::reconstruct, 20000, 0x5EED0301u, 5,
+     bench::generate_vase, cuts_along_z(bench::kVaseCuts)},
+    {"layering-bent-auto", "layering", Kind::reconstruct, 20000, 0x5EED0302u, 5,
+     bench::generate_bent_tube, kAutomaticAlongZ},
+    {"layering-bent-1layer", "layering", Kind::reconstruct, 20000, 0x5EED0302u, 5,
+     bench::generate_bent_tube, kOneLayerAlongZ},
+    {"layering-bent-cuts", "layering", Kind::reconstruct, 20000, 0x5EED0302u, 5,
+     bench::generate_bent_tube, cuts_along_z(bench::kBentTubeCuts)},
     {"paper-head", "paper", Kind::layered, bench::kHeadPoints, 0x5EED0201u, 11,
      bench::generate_paper_head, cuts_along_z(bench::kHeadCuts)},
     {"paper-ventricle", "paper", Kind::layered, bench::kVentriclePoints, 0x5EED0202u, 11,
@@ -715,6 +735,10 @@ Result measure_reconstruct(const ReconstructCase& job) {
         line.add("top_loop_height_min", boundary.top_loop_height_min);
         line.add("top_loop_height_max", boundary.top_loop_height_max);
         line.add("top_loop_radius", boundary.top_loop_radius);
+        bench::AngleStats angles = bench::smallest_angles(triangles.get(), triangle_count, cloud);
+        line.add("min_angle_p05", angles.p05);
+        line.add("min_angle_median", angles.median);
+        line.add("frac_min_angle_lt10", angles.below_10);
     }
     line.append(job.extra);
     line.print();

@@ -1873,7 +1873,7 @@ inline void plan_layers(const Options& options, double lo, double hi, size_t poi
 // the points plus O(bins^2) on the profile, deterministic.
 
 const uint32_t kProfileSectors = 8;
-const double kCentreDrift = 0.5;
+const double kCentreDrift = 0.75;
 const size_t kPointsPerProfileBin = 256;
 const double kDensityWeight = 0.5;
 
@@ -1972,8 +1972,9 @@ inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_
     radius /= static_cast<double>(points);
     if (bin_height * (range.end - range.first) > kMaxTurns * radius) return false;
     for (uint32_t b = range.first; b < range.end; ++b) {
-        // Too few points, or too few directions, to say: such a bin's centroid is noise.
-        if (profile[b].count < kPointsPerProfileBin / 4 || profile[b].sectors_seen < kProfileSectors / 2)
+        // Too few points to say, or an arc rather than a ring (the slanted end of a scan):
+        // such a bin's centroid says nothing about where the centre line must run.
+        if (profile[b].count < kPointsPerProfileBin / 4 || profile[b].sectors_seen < kProfileSectors)
             continue;
         double dx = profile[b].cx - cx, dy = profile[b].cy - cy;
         double standard_error = std::sqrt(profile[b].square_sum / (2.0 * profile[b].count * profile[b].count));

@@ -68,7 +68,8 @@
 // delaunay_2d needs 72 bytes per point plus about 10 KiB; its output is at most
 // 2n - 5 triangles (24 bytes per point). reconstruct needs about 112 bytes per point
 // (the triangulation of its largest possible layer with the layer's coordinates, plus the
-// layer grouping and boundary loops); its output is at most 2n triangles.
+// layer grouping and boundary loops), about 118 with the close_ends flag; its output is at
+// most 2n triangles.
 //
 // Stack: no recursion anywhere. The exact incircle's expansions (about 8 KiB) live in the
 // workspace when called from the triangulation, and on the stack only when you call
@@ -254,11 +255,24 @@ enum Flags : uint32_t {
     // NaN/Inf points are skipped and counted (Report::rejected) instead of refused with
     // Status::invalid_point.
     skip_invalid_points = 1u << 0,
+    // Closes the surface's boundary loops with caps, so a tube becomes a closed, edge- and
+    // vertex-manifold, consistently oriented surface (Euler characteristic 2, normals
+    // outward: the bottom cap faces -axis, the top one +axis). A cap is a triangulation of
+    // its loop over the loop's own vertices (no new vertex): the constrained Delaunay
+    // triangulation of the loop's projection across the axis (Report::axis), avoiding any
+    // diagonal that is already an edge of the surface. A loop whose projection is not a
+    // simple polygon stays open: the call still returns ok, Report::caps_left_open counts
+    // it and Report::detail says so. Caps do not cross one another; like the rest of the
+    // surface, they are not checked against the tube. The workspace bound grows by about 6
+    // bytes per point with this flag; reconstruct_max_triangles() still suffices (a closed
+    // surface through V vertices has 2V - 4 triangles).
+    close_ends = 1u << 1,
 };
 
 // Phases reported to Options::progress, in the order they run. Each layer is stitched to
 // the one below as soon as it is triangulated, so stitching time falls within
-// `triangulate`; `stitch` is announced once, when the last band is done.
+// `triangulate`; `stitch` is announced once, when the last band is done. The caps of
+// close_ends are made within `manifold`.
 enum class Phase : uint32_t { validate = 0, layers, triangulate, stitch, manifold, done };
 
 // All zero means defaults: `Options options = {};` is always valid.
@@ -320,6 +334,12 @@ struct Report {
     // input, one byte less does not. Compare with reconstruct_workspace_size().
     size_t workspace_used;
     size_t diagonal_swaps;   // band diagonals swapped when stitching layers (paper's step 4)
+    // With close_ends: boundary loops closed by a cap, loops left open (their projection
+    // across the axis is not a simple polygon), and the cap triangles, which are the last
+    // cap_triangles of the output (included in triangle_count). All 0 without the flag.
+    size_t caps_closed;
+    size_t caps_left_open;
+    size_t cap_triangles;
 };
 
 // A size in bytes that is always enough workspace for reconstruct() of point_count
@@ -335,7 +355,8 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 
 // Reconstructs a triangle mesh through the points of a columnar cloud: one surface,
 // edge- and vertex-manifold, consistently oriented, an open tube (two boundary loops) on
-// columnar input, with every valid distinct point a vertex unless the report says why not.
+// columnar input, closed by two caps with the close_ends flag, with every valid distinct
+// point a vertex unless the report says why not.
 //
 // cloud           the points (see Cloud), at most 2^32 - 3. They are only read.
 // options         see Options; `Options options = {};` gives the defaults.
@@ -344,11 +365,13 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // triangles       receives 3 * (*triangle_count) indices into the cloud, each triangle
 //                 counter-clockwise seen from outside (normals point away from the axis).
 //                 Triangles come layer by layer, bottom to top, each layer's band to the
-//                 layer below just before it. The order is deterministic.
+//                 layer below just before it, then the caps (close_ends), one loop after
+//                 another. The order is deterministic.
 // triangle_capacity  triangles that fit in `triangles`; reconstruct_max_triangles() always
 //                 suffices. When too small: Status::triangle_capacity and *triangle_count
-//                 says how many are needed (the array's contents are then unspecified;
-//                 nothing is written past the capacity).
+//                 says how many are needed (with close_ends, counting every loop as closed;
+//                 the array's contents are then unspecified; nothing is written past the
+//                 capacity).
 // triangle_count  required; receives the number of triangles (0 on failure).
 // report          optional; see Report. Filled on every status, counts adding up (except
 //                 when buffers overlap: see invalid_argument below).
@@ -2820,6 +2843,501 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
     return removed;
 }
 
+// >>caps ====================================================================================
+//
+// With the close_ends flag, each boundary loop of the final surface is closed by a cap made
+// of triangles over the loop's own vertices. The loop is triangulated in its projection
+// across the axis: first checked to be a simple polygon (a sweep over its edges sorted by x,
+// exact orient2d), then ear clipping, then Lawson flips of the cap's diagonals until it is
+// the constrained Delaunay triangulation of the polygon (ear clipping alone leaves slivers).
+// A triangulation of a simple polygon lifts to a surface that is a graph over it, so the
+// cap's triangles cannot cross one another. Each cap triangle runs the loop's edges against
+// the surface's direction, so the closed surface stays consistently oriented (the bottom cap
+// faces -axis, the top one +axis). A diagonal that is already an edge of the surface would
+// join three triangles: ears and flips that would make one are skipped. A loop whose
+// projection is not simple, or whose remaining ears all make such a diagonal, stays open.
+//
+// The loops of a star-shaped layer run monotonically in angle around its centre (see the
+// unroll section), so their projections are simple but for rounding or the safety net's
+// removals.
+
+// The surface's directed edges between boundary vertices, grouped by first vertex, each
+// group sorted; and per vertex the far end of its boundary edge. The output is
+// vertex-manifold, so a vertex has at most one boundary edge leaving it.
+struct CapGraph {
+    size_t* offsets;          // point_count + 1: each vertex's range in `targets`
+    uint32_t* targets;        // at most 3 per triangle
+    uint32_t* boundary_next;  // per vertex, or kNoIndex
+
+    bool leads_to(uint32_t a, uint32_t b) const {
+        size_t lo = offsets[a], hi = offsets[a + 1];
+        while (lo < hi) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (targets[mid] < b) lo = mid + 1; else hi = mid;
+        }
+        return lo < offsets[a + 1] && targets[lo] == b;
+    }
+    // For boundary vertices a and b only.
+    bool has_edge(uint32_t a, uint32_t b) const { return leads_to(a, b) || leads_to(b, a); }
+};
+
+// A loop edge keyed by its smaller x, for the simplicity sweep.
+struct SweepEdge {
+    double x;
+    uint32_t edge;
+    bool operator>(const SweepEdge& other) const {
+        return x > other.x || (x == other.x && edge > other.edge);
+    }
+};
+
+// The arrays of one loop, sized for all boundary vertices together (every loop fits).
+// Positions are the loop's vertices in cap order, 0 .. length - 1.
+struct CapLoop {
+    uint32_t* ids;            // all loops one after another, each in cap order
+    unsigned char* starts;    // per entry of `ids`: kLoopStart, kLoopBroken or 0
+    double* xy;               // per position: the projection, mirrored to turn counter-clockwise
+    unsigned char* flags;     // per position while clipping, per cap triangle while flipping
+    double* scratch;          // for incircle
+    SweepEdge* sweep;         // per edge; shares its memory with the arrays below
+    uint32_t* prev;           // per position: the neighbours in the polygon left to clip
+    uint32_t* next;
+    uint32_t* reflex;         // positions that were not strictly convex when last checked
+    uint32_t* owner;          // per position p: the cap triangle edge (3 t + k) beyond the
+                              // polygon edge p -> next[p], or kNoIndex on the loop itself
+    uint32_t* corners;        // per cap triangle: 3 positions, counter-clockwise
+    uint32_t* across;         // per cap triangle edge k (corner k to k + 1): the edge beyond
+    uint32_t* stack;          // cap triangles whose edges are to be checked
+};
+
+const unsigned char kLoopStart = 1, kLoopBroken = 2;
+const unsigned char kRemoved = 1, kReflex = 2, kQueued = 4;
+
+// The allocation sequences of the cap phase: the call runs them with its real sizes,
+// reconstruct_workspace_size with the largest possible ones, so the two cannot disagree.
+inline bool allocate_cap_graph(CapGraph& g, size_t point_count, size_t triangle_count,
+                               Arena& arena) {
+    g.offsets = arena.alloc<size_t>(point_count + 1);
+    g.targets = arena.alloc<uint32_t>(3 * triangle_count);
+    g.boundary_next = arena.alloc<uint32_t>(point_count);
+    return !arena.failed;
+}
+
+inline bool allocate_cap_loop(CapLoop& c, size_t length, Arena& arena) {
+    c.ids = arena.alloc<uint32_t>(length);
+    c.starts = arena.alloc<unsigned char>(length);
+    c.xy = arena.alloc<double>(2 * length);
+    c.flags = arena.alloc<unsigned char>(length);
+    c.scratch = arena.alloc<double>(kIncircleScratch);
+    // The sweep is over before clipping starts: the clipping arrays reuse its memory.
+    size_t mark = arena.mark();
+    c.sweep = arena.alloc<SweepEdge>(length);
+    arena.rewind(mark);
+    c.prev = arena.alloc<uint32_t>(length);
+    c.next = arena.alloc<uint32_t>(length);
+    c.reflex = arena.alloc<uint32_t>(length);
+    c.owner = arena.alloc<uint32_t>(length);
+    c.corners = arena.alloc<uint32_t>(3 * length);
+    c.across = arena.alloc<uint32_t>(3 * length);
+    c.stack = arena.alloc<uint32_t>(length);
+    return !arena.failed;
+}
+
+// Fills the graph from the triangles; returns the number of boundary vertices. Only edges
+// between boundary vertices are kept (the diagonals of a cap join boundary vertices), so
+// on a tube the graph is small and built in three streaming passes.
+inline size_t build_cap_graph(const uint32_t* tri, size_t count, size_t point_count,
+                              CapGraph& g) {
+    // Around an inner vertex the triangles leave towards the same vertices they arrive
+    // from; around a boundary vertex (one fan, a chain) the two sets differ by the far
+    // ends of its two boundary edges. So the xor of all of them is 0 exactly at inner
+    // vertices: the ends differ, since a loop has at least 3 vertices.
+    uint32_t* side = g.boundary_next;
+    std::memset(side, 0, sizeof(uint32_t) * point_count);
+    for (size_t t = 0; t < count; ++t) {
+        const uint32_t* c = tri + 3 * t;
+        side[c[0]] ^= c[1] ^ c[2];
+        side[c[1]] ^= c[2] ^ c[0];
+        side[c[2]] ^= c[0] ^ c[1];
+    }
+    auto kept = [&](uint32_t a, uint32_t b) { return side[a] != 0 && side[b] != 0; };
+    std::memset(g.offsets, 0, sizeof(size_t) * (point_count + 1));
+    for (size_t k = 0; k < 3 * count; ++k) {
+        uint32_t to = tri[k - k % 3 + (k + 1) % 3];
+        if (kept(tri[k], to)) ++g.offsets[tri[k] + 1];
+    }
+    for (size_t v = 0; v < point_count; ++v) g.offsets[v + 1] += g.offsets[v];
+    size_t total = g.offsets[point_count];
+    // Filled from the end of each range, so offsets[v + 1] ends as the start of v's.
+    for (size_t k = 3 * count; k-- > 0;) {
+        uint32_t to = tri[k - k % 3 + (k + 1) % 3];
+        if (kept(tri[k], to)) g.targets[--g.offsets[tri[k] + 1]] = to;
+    }
+    for (size_t v = 0; v < point_count; ++v) g.offsets[v] = g.offsets[v + 1];
+    g.offsets[point_count] = total;
+    size_t boundary = 0;
+    for (size_t v = 0; v < point_count; ++v) {
+        uint32_t* group = g.targets + g.offsets[v];
+        size_t size = g.offsets[v + 1] - g.offsets[v];
+        if (size <= 16) {
+            for (size_t i = 1; i < size; ++i)
+                for (size_t j = i; j > 0 && group[j - 1] > group[j]; --j) {
+                    uint32_t s = group[j];
+                    group[j] = group[j - 1];
+                    group[j - 1] = s;
+                }
+        } else {
+            heap_sort(group, size);
+        }
+    }
+    // Every group is sorted: now the boundary edge leaving each boundary vertex, the one
+    // no triangle runs backwards. `side` is read for v just before it is overwritten.
+    for (size_t v = 0; v < point_count; ++v) {
+        uint32_t a = static_cast<uint32_t>(v);
+        uint32_t next = kNoIndex;
+        if (side[v] != 0)
+            for (size_t k = g.offsets[v]; k < g.offsets[v + 1]; ++k)
+                if (!g.leads_to(g.targets[k], a)) next = g.targets[k];
+        g.boundary_next[v] = next;
+        boundary += next != kNoIndex;
+    }
+    return boundary;
+}
+
+// Chains the boundary edges into loops, stored one after another in cap order (the
+// boundary reversed); a chain that does not come back to its start is marked broken.
+// Returns the cap triangles all the unbroken loops would need.
+inline size_t trace_boundary_loops(CapGraph& g, size_t point_count, CapLoop& c,
+                                   size_t* loop_entries) {
+    size_t filled = 0, triangles = 0;
+    for (size_t v = 0; v < point_count; ++v) {
+        if (g.boundary_next[v] == kNoIndex) continue;
+        size_t start = filled;
+        uint32_t at = static_cast<uint32_t>(v);
+        while (g.boundary_next[at] != kNoIndex) {  // each boundary vertex is taken once
+            c.ids[filled] = at;
+            c.starts[filled++] = 0;
+            uint32_t to = g.boundary_next[at];
+            g.boundary_next[at] = kNoIndex;
+            at = to;
+        }
+        size_t length = filled - start;
+        bool closed = at == v && length >= 3;
+        c.starts[start] = closed ? kLoopStart : kLoopBroken;
+        for (size_t i = start, j = filled - 1; i < j; ++i, --j) {
+            uint32_t t = c.ids[i];
+            c.ids[i] = c.ids[j];
+            c.ids[j] = t;
+        }
+        if (closed) triangles += length - 2;
+    }
+    *loop_entries = filled;
+    return triangles;
+}
+
+inline bool same_point(const double* a, const double* b) { return a[0] == b[0] && a[1] == b[1]; }
+
+// For p collinear with a and b: whether it lies on the closed segment ab.
+inline bool on_segment(const double* a, const double* b, const double* p) {
+    for (int k = 0; k < 2; ++k) {
+        double low = a[k] < b[k] ? a[k] : b[k], high = a[k] < b[k] ? b[k] : a[k];
+        if (p[k] < low || p[k] > high) return false;
+    }
+    return true;
+}
+
+// -1, 0 or 1 as x is below, at or above y: the sign of x - y, without rounding.
+inline int compare(double x, double y) { return (x > y) - (x < y); }
+
+// Whether the closed segments pq and rs share a point.
+inline bool segments_meet(const double* p, const double* q, const double* r, const double* s) {
+    double d1 = orient2d_robust(r, s, p), d2 = orient2d_robust(r, s, q);
+    double d3 = orient2d_robust(p, q, r), d4 = orient2d_robust(p, q, s);
+    if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0)))
+        return true;
+    return (d1 == 0 && on_segment(r, s, p)) || (d2 == 0 && on_segment(r, s, q)) ||
+           (d3 == 0 && on_segment(p, q, r)) || (d4 == 0 && on_segment(p, q, s));
+}
+
+// Whether the closed polygon xy[0 .. length) is simple: no repeated point, no edge folding
+// back onto the next, no two other edges meeting. Edges are swept in order of their
+// smaller x; each is tested against those whose x range reaches into its own.
+inline bool polygon_is_simple(const double* xy, uint32_t length, SweepEdge* sweep) {
+    if (length < 3) return false;
+    auto at = [&](uint32_t i) { return xy + 2 * static_cast<size_t>(i); };
+    for (uint32_t i = 0; i < length; ++i) {
+        const double* a = at(i == 0 ? length - 1 : i - 1);
+        const double* b = at(i);
+        const double* c = at(i + 1 == length ? 0 : i + 1);
+        if (same_point(b, c)) return false;
+        // Collinear neighbours on the same side of b: the two edges overlap.
+        if (orient2d_robust(a, b, c) == 0 && compare(a[0], b[0]) == compare(c[0], b[0]) &&
+            compare(a[1], b[1]) == compare(c[1], b[1]))
+            return false;
+    }
+    for (uint32_t e = 0; e < length; ++e) {
+        const double* a = at(e);
+        const double* b = at(e + 1 == length ? 0 : e + 1);
+        sweep[e] = {a[0] < b[0] ? a[0] : b[0], e};
+    }
+    heap_sort(sweep, length);
+    for (uint32_t i = 0; i < length; ++i) {
+        uint32_t e = sweep[i].edge, e_end = e + 1 == length ? 0 : e + 1;
+        const double* a = at(e);
+        const double* b = at(e_end);
+        double right = a[0] < b[0] ? b[0] : a[0];
+        double low = a[1] < b[1] ? a[1] : b[1], high = a[1] < b[1] ? b[1] : a[1];
+        for (uint32_t j = i + 1; j < length && sweep[j].x <= right; ++j) {
+            uint32_t f = sweep[j].edge, f_end = f + 1 == length ? 0 : f + 1;
+            if (f == e_end || f_end == e) continue;  // neighbours: checked above
+            const double* c = at(f);
+            const double* d = at(f_end);
+            if ((c[1] < low && d[1] < low) || (c[1] > high && d[1] > high)) continue;
+            if (segments_meet(a, b, c, d)) return false;
+        }
+    }
+    return true;
+}
+
+// Whether p lies in the closed triangle abc (counter-clockwise).
+inline bool in_closed_triangle(const double* a, const double* b, const double* c, const double* p) {
+    return orient2d_robust(a, b, p) >= 0 && orient2d_robust(b, c, p) >= 0 &&
+           orient2d_robust(c, a, p) >= 0;
+}
+
+// Triangulates one loop, already checked simple and counter-clockwise. ids: the loop's
+// vertices, whose diagonals must not be edges of the surface. Returns false if no ear is
+// left (every one would repeat an edge of the surface).
+class CapTriangulation {
+public:
+    CapTriangulation(CapLoop& c, const uint32_t* ids, uint32_t length, const CapGraph& g)
+        : c_(c), ids_(ids), length_(length), g_(g) {}
+
+    bool clip_ears() {
+        uint32_t reflex_count = 0;
+        for (uint32_t i = 0; i < length_; ++i) {
+            c_.prev[i] = i == 0 ? length_ - 1 : i - 1;
+            c_.next[i] = i + 1 == length_ ? 0 : i + 1;
+            c_.owner[i] = kNoIndex;
+            c_.flags[i] = 0;
+        }
+        for (uint32_t i = 0; i < length_; ++i) {
+            if (convex(i)) continue;
+            c_.flags[i] = kReflex;
+            c_.reflex[reflex_count++] = i;
+        }
+        uint32_t remaining = length_, v = 0, misses = 0;
+        triangles_ = 0;
+        while (remaining > 3) {
+            if (!is_ear(v, reflex_count)) {
+                v = c_.next[v];
+                if (++misses > remaining) return false;
+                continue;
+            }
+            uint32_t p = c_.prev[v], n = c_.next[v];
+            uint32_t t = add_triangle(p, v, n);
+            c_.owner[p] = 3 * t + 2;  // the new polygon edge p -> n has t beyond it
+            c_.next[p] = n;
+            c_.prev[n] = p;
+            c_.flags[v] = kRemoved;
+            // Clipping only narrows the corners at p and n: a reflex one may turn convex.
+            settle_corner(p);
+            settle_corner(n);
+            --remaining;
+            misses = 0;
+            v = p;
+        }
+        if (!convex(v)) return false;
+        uint32_t p = c_.prev[v], n = c_.next[v];
+        uint32_t t = add_triangle(p, v, n);
+        link(3 * t + 2, c_.owner[n]);
+        return true;
+    }
+
+    // Lawson flips until every diagonal is locally Delaunay in the polygon (or would repeat
+    // an edge of the surface).
+    void make_delaunay() {
+        uint32_t depth = 0;
+        for (uint32_t t = 0; t < triangles_; ++t) c_.flags[t] = 0;
+        for (uint32_t t = 0; t < triangles_; ++t) queue(t, depth);
+        while (depth > 0) {
+            uint32_t t = c_.stack[--depth];
+            c_.flags[t] = 0;
+            for (uint32_t k = 0; k < 3; ++k) {
+                uint32_t u = flip_if_illegal(t, k);
+                if (u == kNoIndex) continue;
+                queue(t, depth);
+                queue(u, depth);
+                break;
+            }
+        }
+    }
+
+    uint32_t triangles() const { return triangles_; }
+
+private:
+    const double* point(uint32_t i) const { return c_.xy + 2 * static_cast<size_t>(i); }
+
+    bool convex(uint32_t i) const {
+        return orient2d_robust(point(c_.prev[i]), point(i), point(c_.next[i])) > 0;
+    }
+
+    void settle_corner(uint32_t i) {
+        if ((c_.flags[i] & kReflex) && convex(i)) c_.flags[i] = 0;
+    }
+
+    void queue(uint32_t t, uint32_t& depth) {
+        if (c_.flags[t] & kQueued) return;
+        c_.flags[t] = kQueued;
+        c_.stack[depth++] = t;
+    }
+
+    // Strictly convex, a diagonal that is no edge of the surface, and no other corner in
+    // the closed triangle. Only non-convex corners need testing (in a simple polygon, a
+    // triangle holding a corner holds a reflex one); those turned convex leave the list.
+    bool is_ear(uint32_t v, uint32_t& reflex_count) {
+        if (c_.flags[v] & kReflex) return false;
+        uint32_t p = c_.prev[v], n = c_.next[v];
+        if (g_.has_edge(ids_[p], ids_[n])) return false;
+        bool empty = true;
+        uint32_t kept = 0;
+        for (uint32_t k = 0; k < reflex_count; ++k) {
+            uint32_t r = c_.reflex[k];
+            if (c_.flags[r] != kReflex) continue;
+            c_.reflex[kept++] = r;
+            if (empty && r != p && r != n && in_closed_triangle(point(p), point(v), point(n), point(r)))
+                empty = false;
+        }
+        reflex_count = kept;
+        return empty;
+    }
+
+    // Adds triangle (p, v, n) and links its edges p -> v and v -> n to the triangles beyond.
+    uint32_t add_triangle(uint32_t p, uint32_t v, uint32_t n) {
+        uint32_t t = triangles_++;
+        uint32_t* corner = c_.corners + 3 * static_cast<size_t>(t);
+        corner[0] = p;
+        corner[1] = v;
+        corner[2] = n;
+        link(3 * t, c_.owner[p]);
+        link(3 * t + 1, c_.owner[v]);
+        c_.across[3 * static_cast<size_t>(t) + 2] = kNoIndex;
+        return t;
+    }
+
+    void link(uint32_t edge, uint32_t other) {
+        c_.across[edge] = other;
+        if (other != kNoIndex) c_.across[other] = edge;
+    }
+
+    // Flips the diagonal on edge k of t if the vertex beyond lies in t's circumcircle, the
+    // quadrilateral is strictly convex and the new diagonal is no edge of the surface;
+    // returns the other triangle, or kNoIndex if nothing was flipped.
+    uint32_t flip_if_illegal(uint32_t t, uint32_t k) {
+        uint32_t beyond = c_.across[3 * t + k];
+        if (beyond == kNoIndex) return kNoIndex;
+        uint32_t u = beyond / 3, j = beyond % 3;
+        uint32_t* ct = c_.corners + 3 * static_cast<size_t>(t);
+        uint32_t* cu = c_.corners + 3 * static_cast<size_t>(u);
+        uint32_t a = ct[k], b = ct[(k + 1) % 3], w = ct[(k + 2) % 3], d = cu[(j + 2) % 3];
+        if (incircle_perturbed(point(a), point(b), point(w), point(d), c_.scratch) <= 0)
+            return kNoIndex;
+        if (orient2d_robust(point(a), point(d), point(w)) <= 0 ||
+            orient2d_robust(point(d), point(b), point(w)) <= 0 || g_.has_edge(ids_[w], ids_[d]))
+            return kNoIndex;
+        uint32_t beyond_bw = c_.across[3 * t + (k + 1) % 3], beyond_wa = c_.across[3 * t + (k + 2) % 3];
+        uint32_t beyond_ad = c_.across[3 * u + (j + 1) % 3], beyond_db = c_.across[3 * u + (j + 2) % 3];
+        // t becomes a -> d -> w (d -> w the new diagonal), u becomes d -> b -> w.
+        ct[0] = a;
+        ct[1] = d;
+        ct[2] = w;
+        cu[0] = d;
+        cu[1] = b;
+        cu[2] = w;
+        link(3 * t, beyond_ad);
+        link(3 * t + 2, beyond_wa);
+        link(3 * u, beyond_db);
+        link(3 * u + 1, beyond_bw);
+        link(3 * t + 1, 3 * u + 2);
+        return u;
+    }
+
+    CapLoop& c_;
+    const uint32_t* ids_;
+    uint32_t length_;
+    const CapGraph& g_;
+    uint32_t triangles_ = 0;
+};
+
+struct CapCounts {
+    size_t closed, left_open, triangles;
+};
+
+// Caps every boundary loop of the surface tri[0 .. 3 count), appending the cap triangles
+// (count grows). project(id, xy) gives a vertex's coordinates across the axis. Returns ok;
+// out_of_memory; or triangle_capacity with *needed the triangles every cap closing would take.
+template <class Project>
+Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity, size_t point_count,
+                          const Project& project, Arena& arena, CapCounts& caps, size_t* needed) {
+    caps = {0, 0, 0};
+    size_t mark = arena.mark();
+    CapGraph g;
+    if (!allocate_cap_graph(g, point_count, count, arena)) return Status::out_of_memory;
+    size_t boundary = build_cap_graph(tri, count, point_count, g);
+    if (boundary == 0) {
+        arena.rewind(mark);
+        return Status::ok;
+    }
+    CapLoop c;
+    if (!allocate_cap_loop(c, boundary, arena)) return Status::out_of_memory;
+    size_t entries = 0;
+    size_t cap_triangles = trace_boundary_loops(g, point_count, c, &entries);
+    if (cap_triangles > capacity - count) {
+        *needed = count + cap_triangles;
+        return Status::triangle_capacity;
+    }
+    for (size_t start = 0; start < entries;) {
+        size_t end = start + 1;
+        while (end < entries && c.starts[end] == 0) ++end;
+        const uint32_t* ids = c.ids + start;
+        // Cap triangle edges are numbered 3 t + k in 32 bits.
+        bool usable = c.starts[start] == kLoopStart && end - start <= (kNoIndex - 1) / 3;
+        uint32_t length = static_cast<uint32_t>(end - start);
+        start = end;
+        if (!usable) {
+            ++caps.left_open;
+            continue;
+        }
+        for (uint32_t i = 0; i < length; ++i) project(ids[i], c.xy + 2 * static_cast<size_t>(i));
+        if (!polygon_is_simple(c.xy, length, c.sweep)) {
+            ++caps.left_open;
+            continue;
+        }
+        // The lexicographically lowest corner is convex: it gives the turning direction.
+        uint32_t lowest = 0;
+        for (uint32_t i = 1; i < length; ++i)
+            if (lex_less(c.xy + 2 * static_cast<size_t>(i), c.xy + 2 * static_cast<size_t>(lowest)))
+                lowest = i;
+        double turn = orient2d_robust(c.xy + 2 * static_cast<size_t>(lowest == 0 ? length - 1 : lowest - 1),
+                                      c.xy + 2 * static_cast<size_t>(lowest),
+                                      c.xy + 2 * static_cast<size_t>(lowest + 1 == length ? 0 : lowest + 1));
+        if (turn < 0)
+            for (uint32_t i = 0; i < length; ++i) c.xy[2 * static_cast<size_t>(i)] = -c.xy[2 * static_cast<size_t>(i)];
+        CapTriangulation cap(c, ids, length, g);
+        if (turn == 0 || !cap.clip_ears()) {
+            ++caps.left_open;
+            continue;
+        }
+        cap.make_delaunay();
+        for (size_t k = 0; k < 3 * static_cast<size_t>(cap.triangles()); ++k)
+            tri[3 * count + k] = ids[c.corners[k]];
+        count += cap.triangles();
+        caps.triangles += cap.triangles();
+        ++caps.closed;
+    }
+    arena.rewind(mark);
+    return Status::ok;
+}
+
 // >>reconstruct =============================================================================
 //
 // Validate, choose the frame and the layers, group the points by layer, then for each
@@ -2847,7 +3365,7 @@ inline bool plan_reconstruct(ReconstructMemory& m, size_t count, size_t layer_li
 
 // The largest scratch any phase takes on top of the plan, for `count` points; 0 if that
 // is beyond what size_t can count.
-inline size_t reconstruct_scratch_size(size_t count) {
+inline size_t reconstruct_scratch_size(size_t count, bool close) {
     size_t total = count + 1;
     Arena layer = Arena::measuring();
     layer.alloc<Local>(count);
@@ -2883,11 +3401,22 @@ inline size_t reconstruct_scratch_size(size_t count) {
     double* cuts = nullptr;
     allocate_profile(profile, profile_bin_count(count), &bins, &ranges, &cuts);
 
-    if (layer.failed || band.failed || manifold.failed || profile.failed) return 0;  // beyond size_t
+    // The caps: every point on a boundary loop, as many triangles as the output can hold.
+    Arena caps = Arena::measuring();
+    if (close) {
+        CapGraph graph;
+        CapLoop loop;
+        allocate_cap_graph(graph, count, triangles, caps);
+        allocate_cap_loop(loop, count, caps);
+    }
+
+    if (layer.failed || band.failed || manifold.failed || profile.failed || caps.failed)
+        return 0;  // beyond size_t
     size_t most = layer.high_water;
     if (profile.high_water > most) most = profile.high_water;
     if (band.high_water > most) most = band.high_water;
     if (manifold.high_water > most) most = manifold.high_water;
+    if (caps.high_water > most) most = caps.high_water;
     return most;
 }
 
@@ -2981,7 +3510,8 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
     detail::ReconstructMemory m;
     detail::plan_reconstruct(m, point_count,
                              detail::planned_layer_limit(point_count, options), arena);
-    size_t scratch = detail::reconstruct_scratch_size(point_count);
+    size_t scratch = detail::reconstruct_scratch_size(point_count,
+                                                      (options.flags & close_ends) != 0);
     if (arena.failed || scratch == 0 || scratch > SIZE_MAX - arena.required_bytes()) return 0;
     return arena.required_bytes() + scratch;
 }
@@ -3147,6 +3677,27 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     size_t count = sink.count, used = 0;
     size_t removed = enforce_manifold(triangles, count, cloud.count, arena, &used);
     if (removed == SIZE_MAX) return finish(Status::out_of_memory);
+    CapCounts caps = {0, 0, 0};
+    if (options.flags & close_ends) {
+        auto project = [&](uint32_t id, double* xy) {
+            Local p = frame.local(reader.point(id));
+            xy[0] = p.x;
+            xy[1] = p.y;
+        };
+        size_t needed = 0;
+        status = cap_boundary_loops(triangles, count, triangle_capacity, cloud.count, project,
+                                    arena, caps, &needed);
+        if (status == Status::triangle_capacity) {
+            *triangle_count = needed;
+            rep.triangle_count = needed;
+            rep.detail = "the triangle array is too small for the caps; triangle_count says how "
+                         "many are needed";
+        }
+        if (status != Status::ok) return finish(status);
+    }
+    rep.caps_closed = caps.closed;
+    rep.caps_left_open = caps.left_open;
+    rep.cap_triangles = caps.triangles;
     *triangle_count = count;
     rep.triangle_count = count;
     rep.illegal_removed = removed;
@@ -3160,6 +3711,9 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
                      "(the layer is not star-shaped around its centre there): not vertices";
     else if (valid - rep.duplicates > used)
         rep.detail = "the manifold safety net removed the triangles of some points";
+    else if (caps.left_open > 0)
+        rep.detail = "a boundary loop's projection across the axis is not a simple polygon (or "
+                     "each of its ears would repeat an edge of the surface): it is left open";
     rep.diagonal_swaps = swaps;
     notify(options, Phase::done, 1);
     return finish(Status::ok);

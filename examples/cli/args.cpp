@@ -47,6 +47,9 @@ const char kUsage[] =
     "  --ascii               text PLY or STL\n"
     "  --skip-invalid        skip points with NaN or infinite coordinates (they stay in\n"
     "                        the output, unused) instead of refusing the input\n"
+    "  --cap                 close the tube's ends with caps over its boundary loops: a\n"
+    "                        closed, watertight surface (a loop that cannot be capped\n"
+    "                        stays open; the summary and the report count it)\n"
     "  -q, --quiet           no progress and no summary on stderr (errors still are)\n"
     "  --version             print the version and exit\n"
     "  -h, --help            print this help and exit\n"
@@ -139,13 +142,15 @@ bool apply_valued(std::string_view name, std::string_view value, CommandLine& li
 bool apply_flag(std::string_view name, CommandLine& line) {
     if (name == "--ascii") line.ascii = true;
     if (name == "--skip-invalid") line.skip_invalid = true;
+    if (name == "--cap") line.cap = true;
     if (name == "--quiet") line.quiet = true;
     return true;
 }
 
 const char* const kValuedOptions[] = {"--output", "--report", "--axis",
                                       "--cuts",   "--layers", "--layer-height"};
-const char* const kFlags[] = {"--ascii", "--skip-invalid", "--quiet", "--help", "--version"};
+const char* const kFlags[] = {"--ascii", "--skip-invalid", "--cap", "--quiet", "--help",
+                              "--version"};
 
 std::string_view canonical_name(std::string_view name) {
     if (name == "-o") return "--output";

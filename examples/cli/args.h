@@ -21,6 +21,7 @@ struct CommandLine {
     double layer_height = 0;         // --layer-height, 0 if not given
     bool ascii = false;
     bool skip_invalid = false;
+    bool cap = false;              // --cap: close the ends (stratmesh::close_ends)
     bool quiet = false;
 };
 

@@ -72,6 +72,7 @@ void record_command_line(const CommandLine& line, RunRecord& record) {
     record.layer_count = line.layer_count;
     record.layer_height = line.layer_height;
     record.skip_invalid = line.skip_invalid;
+    record.cap = line.cap;
 }
 
 stratmesh::Options make_options(const CommandLine& line, ProgressMonitor& monitor) {
@@ -82,7 +83,8 @@ stratmesh::Options make_options(const CommandLine& line, ProgressMonitor& monito
     options.cut_count = line.cuts.size();
     options.layer_count = line.layer_count;
     options.layer_height = line.layer_height;
-    options.flags = line.skip_invalid ? stratmesh::skip_invalid_points : 0u;
+    options.flags = (line.skip_invalid ? stratmesh::skip_invalid_points : 0u) |
+                    (line.cap ? stratmesh::close_ends : 0u);
     options.progress = &ProgressMonitor::callback;
     options.progress_user = &monitor;
     return options;

@@ -196,6 +196,7 @@ void write_options(JsonWriter& j, const RunRecord& r) {
     j.key("layer_height");
     j.number(r.layer_height > 0 ? r.layer_height : std::numeric_limits<double>::quiet_NaN());
     j.flag_field("skip_invalid", r.skip_invalid);
+    j.flag_field("cap", r.cap);
     j.end_object();
 }
 
@@ -229,6 +230,12 @@ void write_counts(JsonWriter& j, const stratmesh::Report& rep, stratmesh::Status
     j.count_field("triangles", rep.triangle_count);
     j.count_field("illegal_removed", rep.illegal_removed);
     j.count_field("folds", rep.folds);
+    j.key("caps");
+    j.begin_object();
+    j.count_field("closed", rep.caps_closed);
+    j.count_field("left_open", rep.caps_left_open);
+    j.count_field("triangles", rep.cap_triangles);
+    j.end_object();
     j.key("axis");
     j.begin_object();
     j.numbers_field("direction", rep.axis, 3);

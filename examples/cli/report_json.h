@@ -31,6 +31,7 @@ struct RunRecord {
     uint32_t layer_count = 0; // --layers, 0 if not given
     double layer_height = 0;  // --layer-height, 0 if not given
     bool skip_invalid = false;
+    bool cap = false;
     // The outcome. report.layers is not used: the filled entries are copied to `layers`.
     bool reconstructed = false; // reconstruct() ran (the input could be read)
     stratmesh::Status status = stratmesh::Status::ok;

@@ -48,6 +48,9 @@ void print_counts(std::FILE* out, const stratmesh::Report& rep) {
     std::fprintf(out, "  layers     %zu\n", rep.layer_count);
     std::fprintf(out, "  triangles  %zu (%zu illegal removed, %zu folds)\n", rep.triangle_count,
                  rep.illegal_removed, rep.folds);
+    if (rep.caps_closed + rep.caps_left_open > 0)
+        std::fprintf(out, "  caps       %zu closed (%zu triangles), %zu left open\n",
+                     rep.caps_closed, rep.cap_triangles, rep.caps_left_open);
 }
 
 void print_costs(std::FILE* out, const RunRecord& r) {

@@ -777,6 +777,172 @@ inline double incircle_exact(const double* a, const double* b, const double* c,
     return expansion_top(acc_len, acc);
 }
 
+// The integer stage of incircle. Exact zeros are the common case on grids (every
+// rectangle of grid points is cocircular), and proving them with expansion products
+// costs several times more than this. Every double is an integer times a power of two,
+// so when the six differences span at most 62 bits from the highest set bit of any to the
+// lowest set bit of any, scaling them by one power of two makes them integers below 2^62,
+// and the determinant an integer below 2^252: fixed-width integer arithmetic gets it
+// exactly, whatever the magnitudes, without underflow.
+
+// floor(log2(|v|)) for a finite non-zero double.
+inline int top_bit_exponent(double v) {
+    uint64_t bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    int biased = static_cast<int>((bits >> 52) & 0x7FF);
+    if (biased != 0) return biased - 1023;
+    // Subnormal: the conversion of the mantissa (below 2^52) to double is exact, and its
+    // exponent field tells where the top bit is.
+    double mantissa = static_cast<double>(bits & ((uint64_t(1) << 52) - 1));
+    std::memcpy(&bits, &mantissa, sizeof bits);
+    return static_cast<int>((bits >> 52) & 0x7FF) - 1023 - 1074;
+}
+
+// 2^e for -1022 <= e <= 1023.
+inline double power_of_two(int e) {
+    uint64_t bits = static_cast<uint64_t>(e + 1023) << 52;
+    double v;
+    std::memcpy(&v, &bits, sizeof v);
+    return v;
+}
+
+// Unsigned integers as little-endian arrays of 64-bit words.
+struct Uint128 {
+    uint64_t word[2];
+};
+
+struct Uint256 {
+    uint64_t word[4];
+};
+
+// a * b exactly. Where the compiler has a 128-bit type this is one instruction on 64-bit
+// targets; elsewhere it is built from 32-bit halves. Both are exact, so results agree.
+inline Uint128 multiply_wide(uint64_t a, uint64_t b) {
+    Uint128 r;
+#if defined(__SIZEOF_INT128__)
+    __extension__ typedef unsigned __int128 uint128_type;
+    uint128_type p = static_cast<uint128_type>(a) * b;
+    r.word[0] = static_cast<uint64_t>(p);
+    r.word[1] = static_cast<uint64_t>(p >> 64);
+#else
+    const uint64_t mask = 0xFFFFFFFFu;
+    uint64_t a0 = a & mask, a1 = a >> 32, b0 = b & mask, b1 = b >> 32;
+    uint64_t p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0, p11 = a1 * b1;
+    uint64_t middle = (p00 >> 32) + (p01 & mask) + (p10 & mask);
+    r.word[0] = (middle << 32) | (p00 & mask);
+    r.word[1] = p11 + (p01 >> 32) + (p10 >> 32) + (middle >> 32);
+#endif
+    return r;
+}
+
+// a + b + carry; carry becomes the carry out (the carry in is 0 or 1).
+inline uint64_t add_with_carry(uint64_t a, uint64_t b, uint64_t& carry) {
+    uint64_t s = a + b;
+    uint64_t out = s < a;
+    uint64_t t = s + carry;
+    carry = out | (t < s);
+    return t;
+}
+
+// sum += term or sum -= term, two's complement modulo 2^(64 N); term is zero-extended.
+template <size_t N, size_t M>
+inline void words_accumulate(uint64_t (&sum)[N], const uint64_t (&term)[M], bool subtract) {
+    uint64_t flip = subtract ? ~uint64_t(0) : 0;
+    uint64_t carry = subtract ? 1 : 0;
+    for (size_t k = 0; k < N; ++k)
+        sum[k] = add_with_carry(sum[k], (k < M ? term[k] : 0) ^ flip, carry);
+}
+
+// Makes a two's complement number its magnitude; returns whether it was negative.
+template <size_t N>
+inline bool words_to_magnitude(uint64_t (&value)[N]) {
+    if ((value[N - 1] >> 63) == 0) return false;
+    uint64_t carry = 1;
+    for (size_t k = 0; k < N; ++k) {
+        value[k] = ~value[k] + carry;
+        carry = carry & (value[k] == 0);
+    }
+    return true;
+}
+
+// a * b for a, b < 2^127 (the top word cannot overflow).
+inline Uint256 multiply_wide(const Uint128& a, const Uint128& b) {
+    Uint128 p00 = multiply_wide(a.word[0], b.word[0]);
+    Uint128 p01 = multiply_wide(a.word[0], b.word[1]);
+    Uint128 p10 = multiply_wide(a.word[1], b.word[0]);
+    Uint128 p11 = multiply_wide(a.word[1], b.word[1]);
+    Uint256 r;
+    uint64_t carry = 0, carry2 = 0;
+    r.word[0] = p00.word[0];
+    r.word[1] = add_with_carry(p00.word[1], p01.word[0], carry);
+    r.word[1] = add_with_carry(r.word[1], p10.word[0], carry2);
+    carry += carry2;
+    carry2 = 0;
+    r.word[2] = add_with_carry(p01.word[1], p10.word[1], carry);
+    r.word[2] = add_with_carry(r.word[2], p11.word[0], carry2);
+    r.word[3] = p11.word[1] + carry + carry2;
+    return r;
+}
+
+// Sets *det to the determinant of incircle_from_differences (the rows are exact, hence
+// finite, differences), or returns false when they span more than 62 bits: then the
+// expansions must do.
+inline bool incircle_from_integer_differences(const double rows[3][2], double* det) {
+    double largest = 0;
+    for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 2; ++k)
+            if (abs_value(rows[i][k]) > largest) largest = abs_value(rows[i][k]);
+    if (largest == 0) {
+        *det = 0;
+        return true;
+    }
+    // Scale the largest difference into [2^61, 2^62). Below 2^-962 that takes a factor
+    // beyond the double range: rare enough to leave to the expansions.
+    int shift = 61 - top_bit_exponent(largest);
+    if (shift > 1023) return false;
+    double scale = power_of_two(shift);
+    uint64_t magnitude[3][2];
+    bool negative[3][2];
+    for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 2; ++k) {
+            // Exact unless it underflows (only when scaling down), which the test below
+            // catches: what underflowed is not a non-zero integer.
+            double scaled = rows[i][k] * scale;
+            int64_t n = static_cast<int64_t>(scaled);
+            if (static_cast<double>(n) != scaled || (n == 0 && rows[i][k] != 0)) return false;
+            negative[i][k] = n < 0;
+            magnitude[i][k] = n < 0 ? 0 - static_cast<uint64_t>(n) : static_cast<uint64_t>(n);
+        }
+    uint64_t sum[4] = {0, 0, 0, 0};
+    for (int i = 0; i < 3; ++i) {
+        // The lift of row i times the minor of the other two rows u, v: u x v.
+        Uint128 lift = multiply_wide(magnitude[i][0], magnitude[i][0]);
+        Uint128 square = multiply_wide(magnitude[i][1], magnitude[i][1]);
+        words_accumulate(lift.word, square.word, false);
+        int u = (i + 1) % 3, v = (i + 2) % 3;
+        Uint128 minor = {{0, 0}};
+        Uint128 left = multiply_wide(magnitude[u][0], magnitude[v][1]);
+        Uint128 right = multiply_wide(magnitude[u][1], magnitude[v][0]);
+        words_accumulate(minor.word, left.word, negative[u][0] != negative[v][1]);
+        words_accumulate(minor.word, right.word, negative[u][1] == negative[v][0]);
+        bool minor_negative = words_to_magnitude(minor.word);
+        words_accumulate(sum, multiply_wide(lift, minor).word, minor_negative);
+    }
+    bool sum_negative = words_to_magnitude(sum);
+    double value = 0;
+    for (int k = 3; k >= 0; --k) value = value * 0x1p64 + static_cast<double>(sum[k]);
+    if (value == 0) {
+        *det = 0;
+        return true;
+    }
+    // The magnitude only approximates; the sign must survive the scaling back.
+    value = std::ldexp(value, -4 * shift);
+    if (value == 0) value = DBL_TRUE_MIN;
+    if (!is_finite(value)) value = DBL_MAX;
+    *det = sum_negative ? -value : value;
+    return true;
+}
+
 // An expansion rounded to a double-double hi + lo, |lo| <= eps |hi|: the components are
 // summed smallest first with error-free sums, so the result is off by a few eps^2 of the
 // value. (Taking the expansion's two largest components instead is not enough: a
@@ -793,15 +959,15 @@ inline void to_double_double(const double* e, int len, double* hi, double* lo) {
     two_sum(h, l, *hi, *lo);
 }
 
-// incircle when the six coordinate differences are exact doubles: the 3x3 determinant of
-// rows (dx, dy, L = dx^2 + dy^2), expanded along L. Each lift L and minor M = u x v is
-// formed exactly (cheap). First the three products L M are summed in double-double
-// arithmetic from the lifts and minors rounded to double-doubles (each off by a few
-// eps^2): each product is then off by about 12 eps^2 |L M| and the sum adds about 6 eps^2
-// per term, so a result beyond 64 eps^2 sum |L M| has the right sign. That settles
-// near-cocircular points whose determinant is not zero (rings, rounded grids); exact
-// zeros (integer grids, axis-aligned rectangles) take the exact products. Needs 264
-// doubles of scratch.
+// incircle when the six coordinate differences are exact doubles but span too many bits
+// for the integer stage: the 3x3 determinant of rows (dx, dy, L = dx^2 + dy^2), expanded
+// along L. Each lift L and minor M = u x v is formed exactly (cheap). First the three
+// products L M are summed in double-double arithmetic from the lifts and minors rounded
+// to double-doubles (each off by a few eps^2): each product is then off by about
+// 12 eps^2 |L M| and the sum adds about 6 eps^2 per term, so a result beyond
+// 64 eps^2 sum |L M| has the right sign. That settles near-cocircular points whose
+// determinant is not zero; exact zeros take the exact products. Needs 264 doubles of
+// scratch.
 inline double incircle_from_differences(const double rows[3][2], double* scratch) {
     double lift[3][4], minor[3][4];
     int lift_len[3], minor_len[3];
@@ -848,6 +1014,44 @@ inline double incircle_from_differences(const double rows[3][2], double* scratch
     return expansion_top(det_len, det);
 }
 
+// The differences of a, b, c to d, as rows; whether all six are exact.
+inline bool differences_to(const double* a, const double* b, const double* c, const double* d,
+                           double rows[3][2]) {
+    const double* p[3] = {a, b, c};
+    bool exact = true;
+    for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 2; ++k) {
+            double tail;
+            two_diff(p[i][k], d[k], rows[i][k], tail);
+            exact = exact && tail == 0;
+        }
+    return exact;
+}
+
+// incircle once the filter has failed. The integer stage goes first: the differences of
+// nearby points are nearly always exact and narrow enough, and it needs no rescaling
+// (there is no underflow to avoid). Kept apart from the filter so that the common, filtered
+// call stays small.
+inline double incircle_beyond_filter(const double* a, const double* b, const double* c,
+                                     const double* d, double* scratch) {
+    double rows[3][2], det = 0;
+    if (differences_to(a, b, c, d, rows) && incircle_from_integer_differences(rows, &det))
+        return det;
+    const double magnitudes[14] = {rows[0][0], rows[1][0], rows[2][0], rows[0][1],
+                                   rows[1][1], rows[2][1], a[0], a[1], b[0], b[1],
+                                   c[0], c[1], d[0], d[1]};
+    double factor = rescaling_factor(magnitudes, 14, 160);
+    const double* points[4] = {a, b, c, d};
+    double scaled[4][2];
+    rescale_points(factor, points, scaled, 4);
+    a = points[0];
+    b = points[1];
+    c = points[2];
+    d = points[3];
+    if (differences_to(a, b, c, d, rows)) return incircle_from_differences(rows, scratch);
+    return incircle_exact(a, b, c, d, scratch);
+}
+
 // Sign-exact incircle using `scratch` (kIncircleScratch doubles) when the filter fails.
 inline double incircle_robust(const double* a, const double* b, const double* c,
                               const double* d, double* scratch) {
@@ -866,28 +1070,7 @@ inline double incircle_robust(const double* a, const double* b, const double* c,
                        (abs_value(adxbdy) + abs_value(bdxady)) * clift;
     double bound = kIncircleBoundA * permanent + kUnderflowGuard;
     if (det > bound || -det > bound) return det;
-    const double magnitudes[14] = {adx, bdx, cdx, ady, bdy, cdy, a[0], a[1],
-                                   b[0], b[1], c[0], c[1], d[0], d[1]};
-    double factor = rescaling_factor(magnitudes, 14, 160);
-    const double* points[4] = {a, b, c, d};
-    double scaled[4][2];
-    rescale_points(factor, points, scaled, 4);
-    a = points[0];
-    b = points[1];
-    c = points[2];
-    d = points[3];
-    double t[6];
-    two_diff(a[0], d[0], adx, t[0]);
-    two_diff(b[0], d[0], bdx, t[1]);
-    two_diff(c[0], d[0], cdx, t[2]);
-    two_diff(a[1], d[1], ady, t[3]);
-    two_diff(b[1], d[1], bdy, t[4]);
-    two_diff(c[1], d[1], cdy, t[5]);
-    if (t[0] == 0 && t[1] == 0 && t[2] == 0 && t[3] == 0 && t[4] == 0 && t[5] == 0) {
-        const double rows[3][2] = {{adx, ady}, {bdx, bdy}, {cdx, cdy}};
-        return incircle_from_differences(rows, scratch);
-    }
-    return incircle_exact(a, b, c, d, scratch);
+    return incircle_beyond_filter(a, b, c, d, scratch);
 }
 
 // Lexicographic order on (x, y): the rank that sets each point's perturbation.

@@ -701,89 +701,14 @@ inline void rescale_points(double factor, const double** points, double (*storag
     }
 }
 
-// Sign-exact orient2d: the filter decides unless |det| is within the rounding error, then
-// the differences are tried for exactness, then the raw coordinates are used.
-inline double orient2d_robust(const double* a, const double* b, const double* c) {
-    double acx = a[0] - c[0], bcx = b[0] - c[0];
-    double acy = a[1] - c[1], bcy = b[1] - c[1];
-    double left = acx * bcy;
-    double right = acy * bcx;
-    double det = left - right;
-    double bound = kOrientBoundA * (abs_value(left) + abs_value(right)) + kUnderflowGuard;
-    if (det > bound || -det > bound) return det;
-    const double magnitudes[10] = {acx, bcx, acy, bcy, a[0], a[1], b[0], b[1], c[0], c[1]};
-    double factor = rescaling_factor(magnitudes, 10, 400);
-    const double* points[3] = {a, b, c};
-    double scaled[3][2];
-    rescale_points(factor, points, scaled, 3);
-    a = points[0];
-    b = points[1];
-    c = points[2];
-    double t0, t1, t2, t3;
-    two_diff(a[0], c[0], acx, t0);
-    two_diff(b[0], c[0], bcx, t1);
-    two_diff(a[1], c[1], acy, t2);
-    two_diff(b[1], c[1], bcy, t3);
-    if (t0 == 0 && t1 == 0 && t2 == 0 && t3 == 0) {
-        double d[4];
-        cross_exact(acx, acy, bcx, bcy, d);
-        return expansion_top(4, d);
-    }
-    return orient2d_exact(a, b, c);
-}
-
-// Scratch, in doubles, for the exact incircle below.
-const int kIncircleScratch = 1024;
-
-// incircle from the raw coordinates: the 4x4 determinant with rows (x, y, x^2 + y^2, 1),
-// expanded along the lift column. Needs kIncircleScratch doubles of scratch.
-inline double incircle_exact(const double* a, const double* b, const double* c,
-                             const double* d, double* scratch) {
-    const double* p[4] = {a, b, c, d};
-    double* acc = scratch;         // 384
-    double* acc2 = scratch + 384;  // 384
-    double* term = scratch + 768;  // 96
-    double* tmp = scratch + 864;   // 96
-    double* scaled = scratch + 960; // 24
-    double* orient = scratch + 984; // 12
-    double* cross = scratch + 996;  // 8
-    double lift[4], lp[2], lq[2];
-    int acc_len = 0;
-    for (int skip = 0; skip < 4; ++skip) {
-        // orient2d of the other three points, in their order.
-        const double* q[3];
-        for (int k = 0, m = 0; k < 4; ++k)
-            if (k != skip) q[m++] = p[k];
-        double ab[4], bc[4], ca[4];
-        cross_exact(q[0][0], q[0][1], q[1][0], q[1][1], ab);
-        cross_exact(q[1][0], q[1][1], q[2][0], q[2][1], bc);
-        cross_exact(q[2][0], q[2][1], q[0][0], q[0][1], ca);
-        int clen = expansion_sum(4, ab, 4, bc, cross);
-        int olen = expansion_sum(clen, cross, 4, ca, orient);
-        two_product(p[skip][0], p[skip][0], lp[1], lp[0]);
-        two_product(p[skip][1], p[skip][1], lq[1], lq[0]);
-        int llen = expansion_sum(2, lp, 2, lq, lift);
-        int tlen = expansion_product(olen, orient, llen, lift, term, tmp, scaled);
-        // Cofactor signs of the lift column: +, -, +, -.
-        if (skip % 2 == 1) expansion_negate(tlen, term);
-        if (acc_len == 0) {
-            std::memcpy(acc, term, sizeof(double) * static_cast<size_t>(tlen));
-            acc_len = tlen;
-        } else {
-            acc_len = expansion_sum(acc_len, acc, tlen, term, acc2);
-            std::memcpy(acc, acc2, sizeof(double) * static_cast<size_t>(acc_len));
-        }
-    }
-    return expansion_top(acc_len, acc);
-}
-
-// The integer stage of incircle. Exact zeros are the common case on grids (every
-// rectangle of grid points is cocircular), and proving them with expansion products
-// costs several times more than this. Every double is an integer times a power of two,
-// so when the six differences span at most 62 bits from the highest set bit of any to the
-// lowest set bit of any, scaling them by one power of two makes them integers below 2^62,
-// and the determinant an integer below 2^252: fixed-width integer arithmetic gets it
-// exactly, whatever the magnitudes, without underflow.
+// Integer stages. Exact zeros are the common case on grids: every rectangle of grid points
+// is cocircular and grid lines make collinear triples, and proving those zeros with
+// expansion products costs several times more than this. Every double is an integer times
+// a power of two, so when the differences a predicate uses span at most 62 bits, from the
+// highest set bit of any to the lowest set bit of any, scaling them all by one power of
+// two makes them integers below 2^62, and the determinant (of degree 2 or 4 in them) an
+// integer below 2^125 or 2^252. Fixed-width integer arithmetic gets it exactly, whatever
+// the magnitudes and without underflow, so these stages need no rescaling.
 
 // floor(log2(|v|)) for a finite non-zero double.
 inline int top_bit_exponent(double v) {
@@ -884,63 +809,183 @@ inline Uint256 multiply_wide(const Uint128& a, const Uint128& b) {
     return r;
 }
 
-// Sets *det to the determinant of incircle_from_differences (the rows are exact, hence
-// finite, differences), or returns false when they span more than 62 bits: then the
-// expansions must do.
-inline bool incircle_from_integer_differences(const double rows[3][2], double* det) {
+// Up to six differences as integers below 2^62: value[i] * 2^shift is
+// (-1)^negative[i] * magnitude[i].
+struct ScaledIntegers {
+    uint64_t magnitude[6];
+    bool negative[6];
+    int shift;
+};
+
+// Scales `count` (at most 6) exact, hence finite, differences into integers; false when
+// they span more than 62 bits, or all lie below 2^-962 (the factor would leave the double
+// range; rare enough to leave to the expansions).
+inline bool to_integers(const double* values, int count, ScaledIntegers& out) {
     double largest = 0;
-    for (int i = 0; i < 3; ++i)
-        for (int k = 0; k < 2; ++k)
-            if (abs_value(rows[i][k]) > largest) largest = abs_value(rows[i][k]);
-    if (largest == 0) {
-        *det = 0;
-        return true;
+    for (int i = 0; i < count; ++i)
+        if (abs_value(values[i]) > largest) largest = abs_value(values[i]);
+    out.shift = largest == 0 ? 0 : 61 - top_bit_exponent(largest);
+    if (out.shift > 1023) return false;
+    double scale = power_of_two(out.shift);
+    for (int i = 0; i < count; ++i) {
+        // Exact unless it underflows (only when scaling down), which the test below
+        // catches: what underflowed is not a non-zero integer.
+        double scaled = values[i] * scale;
+        int64_t n = static_cast<int64_t>(scaled);
+        if (static_cast<double>(n) != scaled || (n == 0 && values[i] != 0)) return false;
+        out.negative[i] = n < 0;
+        out.magnitude[i] = n < 0 ? 0 - static_cast<uint64_t>(n) : static_cast<uint64_t>(n);
     }
-    // Scale the largest difference into [2^61, 2^62). Below 2^-962 that takes a factor
-    // beyond the double range: rare enough to leave to the expansions.
-    int shift = 61 - top_bit_exponent(largest);
-    if (shift > 1023) return false;
-    double scale = power_of_two(shift);
-    uint64_t magnitude[3][2];
-    bool negative[3][2];
-    for (int i = 0; i < 3; ++i)
-        for (int k = 0; k < 2; ++k) {
-            // Exact unless it underflows (only when scaling down), which the test below
-            // catches: what underflowed is not a non-zero integer.
-            double scaled = rows[i][k] * scale;
-            int64_t n = static_cast<int64_t>(scaled);
-            if (static_cast<double>(n) != scaled || (n == 0 && rows[i][k] != 0)) return false;
-            negative[i][k] = n < 0;
-            magnitude[i][k] = n < 0 ? 0 - static_cast<uint64_t>(n) : static_cast<uint64_t>(n);
-        }
+    return true;
+}
+
+// u0 v1 - u1 v0 for four of the integers, given by index: its magnitude (below 2^125)
+// and whether it is negative.
+inline Uint128 integer_cross(const ScaledIntegers& z, int u0, int u1, int v0, int v1,
+                             bool* negative) {
+    Uint128 cross = {{0, 0}};
+    Uint128 left = multiply_wide(z.magnitude[u0], z.magnitude[v1]);
+    Uint128 right = multiply_wide(z.magnitude[u1], z.magnitude[v0]);
+    words_accumulate(cross.word, left.word, z.negative[u0] != z.negative[v1]);
+    words_accumulate(cross.word, right.word, z.negative[u1] == z.negative[v0]);
+    *negative = words_to_magnitude(cross.word);
+    return cross;
+}
+
+// (-1)^negative * magnitude * 2^exponent as a double. Only the sign is exact: a non-zero
+// value is kept from rounding to zero or infinity.
+template <size_t N>
+inline double to_signed_double(const uint64_t (&magnitude)[N], bool negative, int exponent) {
+    double value = 0;
+    for (size_t k = N; k-- > 0;) value = value * 0x1p64 + static_cast<double>(magnitude[k]);
+    if (value == 0) return 0;
+    value = std::ldexp(value, exponent);
+    if (value == 0) value = DBL_TRUE_MIN;
+    if (!is_finite(value)) value = DBL_MAX;
+    return negative ? -value : value;
+}
+
+// orient2d from exact differences u = a - c, v = b - c: u x v, or false when the integer
+// stage does not apply.
+inline bool orient2d_from_integer_differences(const double differences[4], double* det) {
+    ScaledIntegers z;
+    if (!to_integers(differences, 4, z)) return false;
+    bool negative = false;
+    Uint128 cross = integer_cross(z, 0, 1, 2, 3, &negative);
+    *det = to_signed_double(cross.word, negative, -2 * z.shift);
+    return true;
+}
+
+// incircle from exact differences to d, rows (dx, dy): the 3x3 determinant of rows
+// (dx, dy, dx^2 + dy^2) expanded along the lifts, or false when the integer stage does
+// not apply.
+inline bool incircle_from_integer_differences(const double rows[3][2], double* det) {
+    ScaledIntegers z;
+    if (!to_integers(&rows[0][0], 6, z)) return false;
     uint64_t sum[4] = {0, 0, 0, 0};
     for (int i = 0; i < 3; ++i) {
         // The lift of row i times the minor of the other two rows u, v: u x v.
-        Uint128 lift = multiply_wide(magnitude[i][0], magnitude[i][0]);
-        Uint128 square = multiply_wide(magnitude[i][1], magnitude[i][1]);
+        Uint128 lift = multiply_wide(z.magnitude[2 * i], z.magnitude[2 * i]);
+        Uint128 square = multiply_wide(z.magnitude[2 * i + 1], z.magnitude[2 * i + 1]);
         words_accumulate(lift.word, square.word, false);
-        int u = (i + 1) % 3, v = (i + 2) % 3;
-        Uint128 minor = {{0, 0}};
-        Uint128 left = multiply_wide(magnitude[u][0], magnitude[v][1]);
-        Uint128 right = multiply_wide(magnitude[u][1], magnitude[v][0]);
-        words_accumulate(minor.word, left.word, negative[u][0] != negative[v][1]);
-        words_accumulate(minor.word, right.word, negative[u][1] == negative[v][0]);
-        bool minor_negative = words_to_magnitude(minor.word);
+        int u = 2 * ((i + 1) % 3), v = 2 * ((i + 2) % 3);
+        bool minor_negative = false;
+        Uint128 minor = integer_cross(z, u, u + 1, v, v + 1, &minor_negative);
         words_accumulate(sum, multiply_wide(lift, minor).word, minor_negative);
     }
-    bool sum_negative = words_to_magnitude(sum);
-    double value = 0;
-    for (int k = 3; k >= 0; --k) value = value * 0x1p64 + static_cast<double>(sum[k]);
-    if (value == 0) {
-        *det = 0;
-        return true;
-    }
-    // The magnitude only approximates; the sign must survive the scaling back.
-    value = std::ldexp(value, -4 * shift);
-    if (value == 0) value = DBL_TRUE_MIN;
-    if (!is_finite(value)) value = DBL_MAX;
-    *det = sum_negative ? -value : value;
+    bool negative = words_to_magnitude(sum);
+    *det = to_signed_double(sum, negative, -4 * z.shift);
     return true;
+}
+
+// orient2d once the filter has failed: the differences are tried for exactness (in the
+// integer stage, then with rescaling in expansions), then the raw coordinates are used.
+// Kept apart from the filter so that the common, filtered call stays small.
+inline double orient2d_beyond_filter(const double* a, const double* b, const double* c) {
+    double differences[4], tails[4], det = 0;
+    two_diff(a[0], c[0], differences[0], tails[0]);
+    two_diff(a[1], c[1], differences[1], tails[1]);
+    two_diff(b[0], c[0], differences[2], tails[2]);
+    two_diff(b[1], c[1], differences[3], tails[3]);
+    bool exact = tails[0] == 0 && tails[1] == 0 && tails[2] == 0 && tails[3] == 0;
+    if (exact && orient2d_from_integer_differences(differences, &det)) return det;
+    const double magnitudes[10] = {differences[0], differences[2], differences[1],
+                                   differences[3], a[0], a[1], b[0], b[1], c[0], c[1]};
+    double factor = rescaling_factor(magnitudes, 10, 400);
+    const double* points[3] = {a, b, c};
+    double scaled[3][2];
+    rescale_points(factor, points, scaled, 3);
+    a = points[0];
+    b = points[1];
+    c = points[2];
+    double acx, acy, bcx, bcy, t0, t1, t2, t3;
+    two_diff(a[0], c[0], acx, t0);
+    two_diff(b[0], c[0], bcx, t1);
+    two_diff(a[1], c[1], acy, t2);
+    two_diff(b[1], c[1], bcy, t3);
+    if (t0 == 0 && t1 == 0 && t2 == 0 && t3 == 0) {
+        double d[4];
+        cross_exact(acx, acy, bcx, bcy, d);
+        return expansion_top(4, d);
+    }
+    return orient2d_exact(a, b, c);
+}
+
+// Sign-exact orient2d: the filter decides unless |det| is within the rounding error.
+inline double orient2d_robust(const double* a, const double* b, const double* c) {
+    double acx = a[0] - c[0], bcx = b[0] - c[0];
+    double acy = a[1] - c[1], bcy = b[1] - c[1];
+    double left = acx * bcy;
+    double right = acy * bcx;
+    double det = left - right;
+    double bound = kOrientBoundA * (abs_value(left) + abs_value(right)) + kUnderflowGuard;
+    if (det > bound || -det > bound) return det;
+    return orient2d_beyond_filter(a, b, c);
+}
+
+// Scratch, in doubles, for the exact incircle below.
+const int kIncircleScratch = 1024;
+
+// incircle from the raw coordinates: the 4x4 determinant with rows (x, y, x^2 + y^2, 1),
+// expanded along the lift column. Needs kIncircleScratch doubles of scratch.
+inline double incircle_exact(const double* a, const double* b, const double* c,
+                             const double* d, double* scratch) {
+    const double* p[4] = {a, b, c, d};
+    double* acc = scratch;         // 384
+    double* acc2 = scratch + 384;  // 384
+    double* term = scratch + 768;  // 96
+    double* tmp = scratch + 864;   // 96
+    double* scaled = scratch + 960; // 24
+    double* orient = scratch + 984; // 12
+    double* cross = scratch + 996;  // 8
+    double lift[4], lp[2], lq[2];
+    int acc_len = 0;
+    for (int skip = 0; skip < 4; ++skip) {
+        // orient2d of the other three points, in their order.
+        const double* q[3];
+        for (int k = 0, m = 0; k < 4; ++k)
+            if (k != skip) q[m++] = p[k];
+        double ab[4], bc[4], ca[4];
+        cross_exact(q[0][0], q[0][1], q[1][0], q[1][1], ab);
+        cross_exact(q[1][0], q[1][1], q[2][0], q[2][1], bc);
+        cross_exact(q[2][0], q[2][1], q[0][0], q[0][1], ca);
+        int clen = expansion_sum(4, ab, 4, bc, cross);
+        int olen = expansion_sum(clen, cross, 4, ca, orient);
+        two_product(p[skip][0], p[skip][0], lp[1], lp[0]);
+        two_product(p[skip][1], p[skip][1], lq[1], lq[0]);
+        int llen = expansion_sum(2, lp, 2, lq, lift);
+        int tlen = expansion_product(olen, orient, llen, lift, term, tmp, scaled);
+        // Cofactor signs of the lift column: +, -, +, -.
+        if (skip % 2 == 1) expansion_negate(tlen, term);
+        if (acc_len == 0) {
+            std::memcpy(acc, term, sizeof(double) * static_cast<size_t>(tlen));
+            acc_len = tlen;
+        } else {
+            acc_len = expansion_sum(acc_len, acc, tlen, term, acc2);
+            std::memcpy(acc, acc2, sizeof(double) * static_cast<size_t>(acc_len));
+        }
+    }
+    return expansion_top(acc_len, acc);
 }
 
 // An expansion rounded to a double-double hi + lo, |lo| <= eps |hi|: the components are

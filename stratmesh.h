@@ -96,10 +96,12 @@
 //   within one call for incircle (2^800 for orient2d): say 1e-45 next to 1e+50. Beyond
 //   that, products of differences cannot all be represented and the sign may be wrong
 //   (subnormal and tiny inputs are fine: they are rescaled). A fast floating-point filter with a proven error bound decides almost
-//   every call; expansion arithmetic decides the rest, after an exact power-of-two
-//   rescaling when the points are very close together or very far apart. The
-//   implementation pins floating-point contraction off (no fused multiply-add),
-//   whatever the compiler's flags.
+//   every call; fixed-width integer arithmetic decides most of the rest (exact coordinate
+//   differences spanning at most 62 bits, as between neighbours on a grid), and
+//   expansion arithmetic the remainder, after an exact power-of-two rescaling when the
+//   points are very close together or very far apart. The implementation pins
+//   floating-point contraction off (no fused multiply-add), whatever the compiler's
+//   flags.
 // - delaunay_2d produces the Delaunay triangulation of the distinct input points. Where
 //   four or more points are cocircular, the triangulation is made unique by a symbolic
 //   perturbation (each point is lifted off the paraboloid by an infinitesimal amount that

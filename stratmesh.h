@@ -97,10 +97,12 @@
 //   within one call for incircle (2^800 for orient2d): say 1e-45 next to 1e+50. Beyond
 //   that, products of differences cannot all be represented and the sign may be wrong
 //   (subnormal and tiny inputs are fine: they are rescaled). A fast floating-point filter with a proven error bound decides almost
-//   every call; expansion arithmetic decides the rest, after an exact power-of-two
-//   rescaling when the points are very close together or very far apart. The
-//   implementation pins floating-point contraction off (no fused multiply-add),
-//   whatever the compiler's flags.
+//   every call; fixed-width integer arithmetic decides most of the rest (exact coordinate
+//   differences spanning at most 62 bits, as between neighbours on a grid), and
+//   expansion arithmetic the remainder, after an exact power-of-two rescaling when the
+//   points are very close together or very far apart. The implementation pins
+//   floating-point contraction off (no fused multiply-add), whatever the compiler's
+//   flags.
 // - delaunay_2d produces the Delaunay triangulation of the distinct input points. Where
 //   four or more points are cocircular, the triangulation is made unique by a symbolic
 //   perturbation (each point is lifted off the paraboloid by an infinitesimal amount that
@@ -798,17 +800,216 @@ inline void rescale_points(double factor, const double** points, double (*storag
     }
 }
 
-// Sign-exact orient2d: the filter decides unless |det| is within the rounding error, then
-// the differences are tried for exactness, then the raw coordinates are used.
-inline double orient2d_robust(const double* a, const double* b, const double* c) {
-    double acx = a[0] - c[0], bcx = b[0] - c[0];
-    double acy = a[1] - c[1], bcy = b[1] - c[1];
-    double left = acx * bcy;
-    double right = acy * bcx;
-    double det = left - right;
-    double bound = kOrientBoundA * (abs_value(left) + abs_value(right)) + kUnderflowGuard;
-    if (det > bound || -det > bound) return det;
-    const double magnitudes[10] = {acx, bcx, acy, bcy, a[0], a[1], b[0], b[1], c[0], c[1]};
+// Integer stages. Exact zeros are the common case on grids: every rectangle of grid points
+// is cocircular and grid lines make collinear triples, and proving those zeros with
+// expansion products costs several times more than this. Every double is an integer times
+// a power of two, so when the differences a predicate uses span at most 62 bits, from the
+// highest set bit of any to the lowest set bit of any, scaling them all by one power of
+// two makes them integers below 2^62, and the determinant (of degree 2 or 4 in them) an
+// integer below 2^125 or 2^252. Fixed-width integer arithmetic gets it exactly, whatever
+// the magnitudes and without underflow, so these stages need no rescaling.
+
+// floor(log2(|v|)) for a finite non-zero double.
+inline int top_bit_exponent(double v) {
+    uint64_t bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    int biased = static_cast<int>((bits >> 52) & 0x7FF);
+    if (biased != 0) return biased - 1023;
+    // Subnormal: the conversion of the mantissa (below 2^52) to double is exact, and its
+    // exponent field tells where the top bit is.
+    double mantissa = static_cast<double>(bits & ((uint64_t(1) << 52) - 1));
+    std::memcpy(&bits, &mantissa, sizeof bits);
+    return static_cast<int>((bits >> 52) & 0x7FF) - 1023 - 1074;
+}
+
+// 2^e for -1022 <= e <= 1023.
+inline double power_of_two(int e) {
+    uint64_t bits = static_cast<uint64_t>(e + 1023) << 52;
+    double v;
+    std::memcpy(&v, &bits, sizeof v);
+    return v;
+}
+
+// Unsigned integers as little-endian arrays of 64-bit words.
+struct Uint128 {
+    uint64_t word[2];
+};
+
+struct Uint256 {
+    uint64_t word[4];
+};
+
+// a * b exactly. Where the compiler has a 128-bit type this is one instruction on 64-bit
+// targets; elsewhere it is built from 32-bit halves. Both are exact, so results agree.
+inline Uint128 multiply_wide(uint64_t a, uint64_t b) {
+    Uint128 r;
+#if defined(__SIZEOF_INT128__)
+    __extension__ typedef unsigned __int128 uint128_type;
+    uint128_type p = static_cast<uint128_type>(a) * b;
+    r.word[0] = static_cast<uint64_t>(p);
+    r.word[1] = static_cast<uint64_t>(p >> 64);
+#else
+    const uint64_t mask = 0xFFFFFFFFu;
+    uint64_t a0 = a & mask, a1 = a >> 32, b0 = b & mask, b1 = b >> 32;
+    uint64_t p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0, p11 = a1 * b1;
+    uint64_t middle = (p00 >> 32) + (p01 & mask) + (p10 & mask);
+    r.word[0] = (middle << 32) | (p00 & mask);
+    r.word[1] = p11 + (p01 >> 32) + (p10 >> 32) + (middle >> 32);
+#endif
+    return r;
+}
+
+// a + b + carry; carry becomes the carry out (the carry in is 0 or 1).
+inline uint64_t add_with_carry(uint64_t a, uint64_t b, uint64_t& carry) {
+    uint64_t s = a + b;
+    uint64_t out = s < a;
+    uint64_t t = s + carry;
+    carry = out | (t < s);
+    return t;
+}
+
+// sum += term or sum -= term, two's complement modulo 2^(64 N); term is zero-extended.
+template <size_t N, size_t M>
+inline void words_accumulate(uint64_t (&sum)[N], const uint64_t (&term)[M], bool subtract) {
+    uint64_t flip = subtract ? ~uint64_t(0) : 0;
+    uint64_t carry = subtract ? 1 : 0;
+    for (size_t k = 0; k < N; ++k)
+        sum[k] = add_with_carry(sum[k], (k < M ? term[k] : 0) ^ flip, carry);
+}
+
+// Makes a two's complement number its magnitude; returns whether it was negative.
+template <size_t N>
+inline bool words_to_magnitude(uint64_t (&value)[N]) {
+    if ((value[N - 1] >> 63) == 0) return false;
+    uint64_t carry = 1;
+    for (size_t k = 0; k < N; ++k) {
+        value[k] = ~value[k] + carry;
+        carry = carry & (value[k] == 0);
+    }
+    return true;
+}
+
+// a * b for a, b < 2^127 (the top word cannot overflow).
+inline Uint256 multiply_wide(const Uint128& a, const Uint128& b) {
+    Uint128 p00 = multiply_wide(a.word[0], b.word[0]);
+    Uint128 p01 = multiply_wide(a.word[0], b.word[1]);
+    Uint128 p10 = multiply_wide(a.word[1], b.word[0]);
+    Uint128 p11 = multiply_wide(a.word[1], b.word[1]);
+    Uint256 r;
+    uint64_t carry = 0, carry2 = 0;
+    r.word[0] = p00.word[0];
+    r.word[1] = add_with_carry(p00.word[1], p01.word[0], carry);
+    r.word[1] = add_with_carry(r.word[1], p10.word[0], carry2);
+    carry += carry2;
+    carry2 = 0;
+    r.word[2] = add_with_carry(p01.word[1], p10.word[1], carry);
+    r.word[2] = add_with_carry(r.word[2], p11.word[0], carry2);
+    r.word[3] = p11.word[1] + carry + carry2;
+    return r;
+}
+
+// Up to six differences as integers below 2^62: value[i] * 2^shift is
+// (-1)^negative[i] * magnitude[i].
+struct ScaledIntegers {
+    uint64_t magnitude[6];
+    bool negative[6];
+    int shift;
+};
+
+// Scales `count` (at most 6) exact, hence finite, differences into integers; false when
+// they span more than 62 bits, or all lie below 2^-962 (the factor would leave the double
+// range; rare enough to leave to the expansions).
+inline bool to_integers(const double* values, int count, ScaledIntegers& out) {
+    double largest = 0;
+    for (int i = 0; i < count; ++i)
+        if (abs_value(values[i]) > largest) largest = abs_value(values[i]);
+    out.shift = largest == 0 ? 0 : 61 - top_bit_exponent(largest);
+    if (out.shift > 1023) return false;
+    double scale = power_of_two(out.shift);
+    for (int i = 0; i < count; ++i) {
+        // Exact unless it underflows (only when scaling down), which the test below
+        // catches: what underflowed is not a non-zero integer.
+        double scaled = values[i] * scale;
+        int64_t n = static_cast<int64_t>(scaled);
+        if (static_cast<double>(n) != scaled || (n == 0 && values[i] != 0)) return false;
+        out.negative[i] = n < 0;
+        out.magnitude[i] = n < 0 ? 0 - static_cast<uint64_t>(n) : static_cast<uint64_t>(n);
+    }
+    return true;
+}
+
+// u0 v1 - u1 v0 for four of the integers, given by index: its magnitude (below 2^125)
+// and whether it is negative.
+inline Uint128 integer_cross(const ScaledIntegers& z, int u0, int u1, int v0, int v1,
+                             bool* negative) {
+    Uint128 cross = {{0, 0}};
+    Uint128 left = multiply_wide(z.magnitude[u0], z.magnitude[v1]);
+    Uint128 right = multiply_wide(z.magnitude[u1], z.magnitude[v0]);
+    words_accumulate(cross.word, left.word, z.negative[u0] != z.negative[v1]);
+    words_accumulate(cross.word, right.word, z.negative[u1] == z.negative[v0]);
+    *negative = words_to_magnitude(cross.word);
+    return cross;
+}
+
+// (-1)^negative * magnitude * 2^exponent as a double. Only the sign is exact: a non-zero
+// value is kept from rounding to zero or infinity.
+template <size_t N>
+inline double to_signed_double(const uint64_t (&magnitude)[N], bool negative, int exponent) {
+    double value = 0;
+    for (size_t k = N; k-- > 0;) value = value * 0x1p64 + static_cast<double>(magnitude[k]);
+    if (value == 0) return 0;
+    value = std::ldexp(value, exponent);
+    if (value == 0) value = DBL_TRUE_MIN;
+    if (!is_finite(value)) value = DBL_MAX;
+    return negative ? -value : value;
+}
+
+// orient2d from exact differences u = a - c, v = b - c: u x v, or false when the integer
+// stage does not apply.
+inline bool orient2d_from_integer_differences(const double differences[4], double* det) {
+    ScaledIntegers z;
+    if (!to_integers(differences, 4, z)) return false;
+    bool negative = false;
+    Uint128 cross = integer_cross(z, 0, 1, 2, 3, &negative);
+    *det = to_signed_double(cross.word, negative, -2 * z.shift);
+    return true;
+}
+
+// incircle from exact differences to d, rows (dx, dy): the 3x3 determinant of rows
+// (dx, dy, dx^2 + dy^2) expanded along the lifts, or false when the integer stage does
+// not apply.
+inline bool incircle_from_integer_differences(const double rows[3][2], double* det) {
+    ScaledIntegers z;
+    if (!to_integers(&rows[0][0], 6, z)) return false;
+    uint64_t sum[4] = {0, 0, 0, 0};
+    for (int i = 0; i < 3; ++i) {
+        // The lift of row i times the minor of the other two rows u, v: u x v.
+        Uint128 lift = multiply_wide(z.magnitude[2 * i], z.magnitude[2 * i]);
+        Uint128 square = multiply_wide(z.magnitude[2 * i + 1], z.magnitude[2 * i + 1]);
+        words_accumulate(lift.word, square.word, false);
+        int u = 2 * ((i + 1) % 3), v = 2 * ((i + 2) % 3);
+        bool minor_negative = false;
+        Uint128 minor = integer_cross(z, u, u + 1, v, v + 1, &minor_negative);
+        words_accumulate(sum, multiply_wide(lift, minor).word, minor_negative);
+    }
+    bool negative = words_to_magnitude(sum);
+    *det = to_signed_double(sum, negative, -4 * z.shift);
+    return true;
+}
+
+// orient2d once the filter has failed: the differences are tried for exactness (in the
+// integer stage, then with rescaling in expansions), then the raw coordinates are used.
+// Kept apart from the filter so that the common, filtered call stays small.
+inline double orient2d_beyond_filter(const double* a, const double* b, const double* c) {
+    double differences[4], tails[4], det = 0;
+    two_diff(a[0], c[0], differences[0], tails[0]);
+    two_diff(a[1], c[1], differences[1], tails[1]);
+    two_diff(b[0], c[0], differences[2], tails[2]);
+    two_diff(b[1], c[1], differences[3], tails[3]);
+    bool exact = tails[0] == 0 && tails[1] == 0 && tails[2] == 0 && tails[3] == 0;
+    if (exact && orient2d_from_integer_differences(differences, &det)) return det;
+    const double magnitudes[10] = {differences[0], differences[2], differences[1],
+                                   differences[3], a[0], a[1], b[0], b[1], c[0], c[1]};
     double factor = rescaling_factor(magnitudes, 10, 400);
     const double* points[3] = {a, b, c};
     double scaled[3][2];
@@ -816,7 +1017,7 @@ inline double orient2d_robust(const double* a, const double* b, const double* c)
     a = points[0];
     b = points[1];
     c = points[2];
-    double t0, t1, t2, t3;
+    double acx, acy, bcx, bcy, t0, t1, t2, t3;
     two_diff(a[0], c[0], acx, t0);
     two_diff(b[0], c[0], bcx, t1);
     two_diff(a[1], c[1], acy, t2);
@@ -827,6 +1028,18 @@ inline double orient2d_robust(const double* a, const double* b, const double* c)
         return expansion_top(4, d);
     }
     return orient2d_exact(a, b, c);
+}
+
+// Sign-exact orient2d: the filter decides unless |det| is within the rounding error.
+inline double orient2d_robust(const double* a, const double* b, const double* c) {
+    double acx = a[0] - c[0], bcx = b[0] - c[0];
+    double acy = a[1] - c[1], bcy = b[1] - c[1];
+    double left = acx * bcy;
+    double right = acy * bcx;
+    double det = left - right;
+    double bound = kOrientBoundA * (abs_value(left) + abs_value(right)) + kUnderflowGuard;
+    if (det > bound || -det > bound) return det;
+    return orient2d_beyond_filter(a, b, c);
 }
 
 // Scratch, in doubles, for the exact incircle below.
@@ -890,15 +1103,15 @@ inline void to_double_double(const double* e, int len, double* hi, double* lo) {
     two_sum(h, l, *hi, *lo);
 }
 
-// incircle when the six coordinate differences are exact doubles: the 3x3 determinant of
-// rows (dx, dy, L = dx^2 + dy^2), expanded along L. Each lift L and minor M = u x v is
-// formed exactly (cheap). First the three products L M are summed in double-double
-// arithmetic from the lifts and minors rounded to double-doubles (each off by a few
-// eps^2): each product is then off by about 12 eps^2 |L M| and the sum adds about 6 eps^2
-// per term, so a result beyond 64 eps^2 sum |L M| has the right sign. That settles
-// near-cocircular points whose determinant is not zero (rings, rounded grids); exact
-// zeros (integer grids, axis-aligned rectangles) take the exact products. Needs 264
-// doubles of scratch.
+// incircle when the six coordinate differences are exact doubles but span too many bits
+// for the integer stage: the 3x3 determinant of rows (dx, dy, L = dx^2 + dy^2), expanded
+// along L. Each lift L and minor M = u x v is formed exactly (cheap). First the three
+// products L M are summed in double-double arithmetic from the lifts and minors rounded
+// to double-doubles (each off by a few eps^2): each product is then off by about
+// 12 eps^2 |L M| and the sum adds about 6 eps^2 per term, so a result beyond
+// 64 eps^2 sum |L M| has the right sign. That settles near-cocircular points whose
+// determinant is not zero; exact zeros take the exact products. Needs 264 doubles of
+// scratch.
 inline double incircle_from_differences(const double rows[3][2], double* scratch) {
     double lift[3][4], minor[3][4];
     int lift_len[3], minor_len[3];
@@ -945,6 +1158,44 @@ inline double incircle_from_differences(const double rows[3][2], double* scratch
     return expansion_top(det_len, det);
 }
 
+// The differences of a, b, c to d, as rows; whether all six are exact.
+inline bool differences_to(const double* a, const double* b, const double* c, const double* d,
+                           double rows[3][2]) {
+    const double* p[3] = {a, b, c};
+    bool exact = true;
+    for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 2; ++k) {
+            double tail;
+            two_diff(p[i][k], d[k], rows[i][k], tail);
+            exact = exact && tail == 0;
+        }
+    return exact;
+}
+
+// incircle once the filter has failed. The integer stage goes first: the differences of
+// nearby points are nearly always exact and narrow enough, and it needs no rescaling
+// (there is no underflow to avoid). Kept apart from the filter so that the common, filtered
+// call stays small.
+inline double incircle_beyond_filter(const double* a, const double* b, const double* c,
+                                     const double* d, double* scratch) {
+    double rows[3][2], det = 0;
+    if (differences_to(a, b, c, d, rows) && incircle_from_integer_differences(rows, &det))
+        return det;
+    const double magnitudes[14] = {rows[0][0], rows[1][0], rows[2][0], rows[0][1],
+                                   rows[1][1], rows[2][1], a[0], a[1], b[0], b[1],
+                                   c[0], c[1], d[0], d[1]};
+    double factor = rescaling_factor(magnitudes, 14, 160);
+    const double* points[4] = {a, b, c, d};
+    double scaled[4][2];
+    rescale_points(factor, points, scaled, 4);
+    a = points[0];
+    b = points[1];
+    c = points[2];
+    d = points[3];
+    if (differences_to(a, b, c, d, rows)) return incircle_from_differences(rows, scratch);
+    return incircle_exact(a, b, c, d, scratch);
+}
+
 // Sign-exact incircle using `scratch` (kIncircleScratch doubles) when the filter fails.
 inline double incircle_robust(const double* a, const double* b, const double* c,
                               const double* d, double* scratch) {
@@ -963,28 +1214,7 @@ inline double incircle_robust(const double* a, const double* b, const double* c,
                        (abs_value(adxbdy) + abs_value(bdxady)) * clift;
     double bound = kIncircleBoundA * permanent + kUnderflowGuard;
     if (det > bound || -det > bound) return det;
-    const double magnitudes[14] = {adx, bdx, cdx, ady, bdy, cdy, a[0], a[1],
-                                   b[0], b[1], c[0], c[1], d[0], d[1]};
-    double factor = rescaling_factor(magnitudes, 14, 160);
-    const double* points[4] = {a, b, c, d};
-    double scaled[4][2];
-    rescale_points(factor, points, scaled, 4);
-    a = points[0];
-    b = points[1];
-    c = points[2];
-    d = points[3];
-    double t[6];
-    two_diff(a[0], d[0], adx, t[0]);
-    two_diff(b[0], d[0], bdx, t[1]);
-    two_diff(c[0], d[0], cdx, t[2]);
-    two_diff(a[1], d[1], ady, t[3]);
-    two_diff(b[1], d[1], bdy, t[4]);
-    two_diff(c[1], d[1], cdy, t[5]);
-    if (t[0] == 0 && t[1] == 0 && t[2] == 0 && t[3] == 0 && t[4] == 0 && t[5] == 0) {
-        const double rows[3][2] = {{adx, ady}, {bdx, bdy}, {cdx, cdy}};
-        return incircle_from_differences(rows, scratch);
-    }
-    return incircle_exact(a, b, c, d, scratch);
+    return incircle_beyond_filter(a, b, c, d, scratch);
 }
 
 // Lexicographic order on (x, y): the rank that sets each point's perturbation.

@@ -436,6 +436,65 @@ TEST_CASE("orient2d and incircle are exact with mixed magnitudes") {
     }
 }
 
+// The integer stages take orient2d and incircle when the differences are exact and span at
+// most 62 bits; wider spans take the expansions. Points are d plus integers of a chosen
+// width times a power of two, so the span is set directly, on both sides of the limit and
+// at magnitudes that scale the integers up (tiny points) or down (huge ones).
+TEST_CASE("orient2d and incircle are exact when the differences are integers spanning up to 62 bits and beyond") {
+    Random rng(15);
+    int collinear = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        int width = rng.integer(1, 66);
+        int power = rng.integer(-1000, 900);
+        CAPTURE(width);
+        CAPTURE(power);
+        auto offset = [&](int bits) {
+            // A random integer below 2^bits, at most 53 significant bits, random sign.
+            if (bits == 0) return 0.0;
+            int significant = std::min(bits, 53);
+            double v = std::ldexp(static_cast<double>(rng.bits() >> (64 - significant)), bits - significant);
+            return (rng.bits() & 1u) ? -v : v;
+        };
+        Point d{std::ldexp(static_cast<double>(rng.integer(-3, 3)), power + width), std::ldexp(0.5, power)};
+        Point q[3];
+        for (Point& p : q) {
+            p = Point{d[0] + std::ldexp(offset(width), power), d[1] + std::ldexp(offset(rng.integer(0, width)), power)};
+            if (rng.integer(0, 7) == 0) p[static_cast<size_t>(rng.integer(0, 1))] = d[static_cast<size_t>(rng.integer(0, 1))];
+        }
+        CHECK(lib_incircle(q[0], q[1], q[2], d) == ref_incircle(q[0], q[1], q[2], d));
+        CHECK(lib_orient(q[0], q[1], d) == ref_orient(q[0], q[1], d));
+        // Collinear when the arithmetic below is exact (the reference tells); then nudged
+        // by an ulp.
+        Point u{q[0][0] - d[0], q[0][1] - d[1]};
+        Point e{d[0] - 2 * u[0], d[1] - 2 * u[1]};
+        if (ref_orient(q[0], e, d) == 0) {
+            ++collinear;
+            CHECK(lib_orient(q[0], e, d) == 0);
+            // Not a zero coordinate: its neighbour, 2^-1074, is outside the contract.
+            size_t axis = e[0] != 0 && (trial % 2 || e[1] == 0) ? 0 : 1;
+            e[axis] = std::nextafter(e[axis], trial % 3 ? HUGE_VAL : -HUGE_VAL);
+            CHECK(lib_orient(q[0], e, d) == ref_orient(q[0], e, d));
+        }
+        // Exactly cocircular: the reflections of (x, y) in the axes through d, and a
+        // rectangle; then one point moved by an ulp.
+        double x = std::ldexp(offset(width), power), y = std::ldexp(offset(rng.integer(1, width)), power);
+        Point centre{std::ldexp(1.0, power + width), std::ldexp(3.0, power + width)};
+        Point r[4] = {{centre[0] + x, centre[1] + y}, {centre[0] - x, centre[1] + y},
+                      {centre[0] - x, centre[1] - y}, {centre[0] + x, centre[1] - y}};
+        if (x != 0 && y != 0 && r[0][0] - centre[0] == x && r[0][1] - centre[1] == y &&
+            r[2][0] - centre[0] == -x && r[2][1] - centre[1] == -y) {
+            CHECK(ref_incircle(r[0], r[1], r[2], r[3]) == 0);
+            CHECK(lib_incircle(r[0], r[1], r[2], r[3]) == 0);
+            Point s{centre[0] + y, centre[1] + x};
+            CHECK(lib_incircle(r[0], r[1], r[2], s) == ref_incircle(r[0], r[1], r[2], s));
+            size_t axis = static_cast<size_t>(trial % 2);
+            r[3][axis] = std::nextafter(r[3][axis], trial % 3 ? HUGE_VAL : -HUGE_VAL);
+            CHECK(lib_incircle(r[0], r[1], r[2], r[3]) == ref_incircle(r[0], r[1], r[2], r[3]));
+        }
+    }
+    CHECK(collinear > 5000);
+}
+
 TEST_CASE("orient2d is exactly zero on collinear points and incircle on cocircular points") {
     Random rng(13);
     // Integer grid lines: a + k d for small integer directions.

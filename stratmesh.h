@@ -96,8 +96,8 @@
 //   whose non-zero coordinates and coordinate differences span at most 2^320 in magnitude
 //   within one call for incircle (2^800 for orient2d): say 1e-45 next to 1e+50. Beyond
 //   that, products of differences cannot all be represented and the sign may be wrong
-//   (subnormal and tiny inputs are fine: they are rescaled). A fast floating-point filter with a proven error bound decides almost
-//   every call; fixed-width integer arithmetic decides most of the rest (exact coordinate
+//   (subnormal and tiny inputs are fine: they are rescaled). A fast floating-point
+//   filter with a proven error bound decides almost every call; fixed-width integer arithmetic decides most of the rest (exact coordinate
 //   differences spanning at most 62 bits, as between neighbours on a grid), and
 //   expansion arithmetic the remainder, after an exact power-of-two rescaling when the
 //   points are very close together or very far apart. The implementation pins
@@ -221,10 +221,10 @@ size_t delaunay_2d_max_triangles(size_t point_count);
 //
 // Returns ok; invalid_argument (a null pointer with a non-zero count, a stride too small,
 // or any two of the span of xy's points, the workspace, the triangle array, duplicate_of
-// and *info sharing a byte: then nothing at all is written); too_many_points; invalid_point; too_few_points (fewer than 3 distinct points);
-// collinear (no triangle exists); out_of_memory;
-// triangle_capacity. On every status but ok, triangle_count is 0 (except
-// triangle_capacity) and no triangle is written.
+// and *info sharing a byte: then nothing at all is written); too_many_points;
+// invalid_point; too_few_points (fewer than 3 distinct points); collinear (no triangle
+// exists); out_of_memory; triangle_capacity. On every status but ok, triangle_count is 0
+// (except triangle_capacity) and no triangle is written.
 Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
                    void* workspace, size_t workspace_bytes,
                    uint32_t* triangles, size_t triangle_capacity,

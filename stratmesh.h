@@ -2020,11 +2020,18 @@ inline bool has_three_distinct_points(const CloudReader& cloud, size_t count) {
 }
 
 // Layer boundaries: bounds[0] = lowest height, bounds[count] = highest, layer i holds the
-// heights in [bounds[i], bounds[i+1]) (the last layer includes its top).
+// heights in [bounds[i] - tolerance, bounds[i+1] - tolerance) (the last layer includes its
+// top). The tolerance (2^-40 of the height range) puts a point that lies on a cut up to
+// rounding into the layer above, as one exactly on it: with a tilted axis the heights of
+// a planar contour (a CT slice, a scan row) differ in their last bits, and a cut on that
+// plane would otherwise split the contour between two layers.
 struct LayerPlan {
     double* bounds;
     uint32_t count;
+    double tolerance;
 };
+
+const double kCutTolerance = 0x1p-40;
 
 const size_t kMaxAutomaticLayers = 256;
 // Heights are divided by at least layer height / kMaxTurns when unrolled, so exp() stays
@@ -2292,7 +2299,7 @@ inline uint32_t layer_of(const LayerPlan& plan, double h) {
     uint32_t lo = 0, hi = plan.count;  // answer in [lo, hi)
     while (hi - lo > 1) {
         uint32_t mid = lo + (hi - lo) / 2;
-        if (h >= plan.bounds[mid])
+        if (h >= plan.bounds[mid] - plan.tolerance)
             lo = mid;
         else
             hi = mid;
@@ -3815,7 +3822,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     size_t layer_limit = planned_layer_limit(cloud.count, options);
     if (!plan_reconstruct(m, cloud.count, layer_limit, arena)) return finish(Status::out_of_memory);
     notify(options, Phase::layers, 0);
-    LayerPlan plan = {m.bounds, 0};
+    LayerPlan plan = {m.bounds, 0, (hi - lo) * kCutTolerance};
     if (automatic_layers(options)) {
         size_t mark = arena.mark();
         uint32_t bins = profile_bin_count(valid);

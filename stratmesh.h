@@ -282,7 +282,8 @@ struct Options {
     Axis axis;
     double direction[3];     // for Axis::direction; any non-zero length
     // Layers, first match wins: explicit cut positions along the axis, as the coordinate
-    // dot(point, axis) (with Axis::z, a cut at 68 is the plane z = 68); any order,
+    // dot(point, axis) (with Axis::z, a cut at 68 is the plane z = 68; a point on a cut,
+    // up to 2^-40 of the cloud's height, belongs to the layer above); any order,
     // repeats and cuts outside the cloud are ignored; else layer_count equal-height
     // layers; else layers of about layer_height; else automatic: the fewest layers (at
     // most 256) such that one centre line serves each layer and none is taller than 24

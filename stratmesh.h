@@ -289,8 +289,10 @@ struct Options {
     // most 256) such that one centre line serves each layer and none is taller than 24
     // of its radii, cut where the cross-section changes least and not through dense
     // detail (the paper's rule; see "automatic layers" in >>layers). A layer with fewer
-    // than 16 points, or whose points do not surround its centre, is merged with the next
-    // one; the report lists the layers actually used (Report::layers: bottom and top).
+    // than 16 points, thinner than about two rows of points, or whose points do not
+    // surround its centre, is merged with the next one (a remainder that small or thin,
+    // with the last); the report lists the layers actually used (Report::layers: bottom
+    // and top).
     const double* cuts;
     size_t cut_count;
     uint32_t layer_count;
@@ -2041,6 +2043,15 @@ const size_t kMaxAutomaticLayers = 256;
 const double kMaxTurns = 24.0;
 // A layer with fewer points is merged with the next one (the last layer only needs 3).
 const size_t kMinLayerPoints = 16;
+// A layer also needs about two rows of points: thinner ones make bands of a few points
+// that fold and cross. With n points over height h around radius r, the spacing is about
+// sqrt(2 pi r h / n), so the rows number sqrt(h n / (2 pi r)).
+const double kMinLayerRows = 2;
+
+inline bool thick_enough(size_t points, double height, double radius) {
+    const double two_pi = 6.28318530717958647693;
+    return static_cast<double>(points) * height >= kMinLayerRows * kMinLayerRows * two_pi * radius;
+}
 
 // The number of layers the options can ask for, before empty layers are dropped.
 inline size_t planned_layer_limit(size_t point_count, const Options& options) {
@@ -3801,13 +3812,16 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
         return Status::too_few_points;
     }
 
-    double lo = DBL_MAX, hi = -DBL_MAX;
+    double lo = DBL_MAX, hi = -DBL_MAX, radius_sum = 0;
     for (size_t i = 0; i < cloud.count; ++i) {
         if (!reader.valid(i)) continue;
         Local p = frame.local(reader.point(i));
         if (p.h < lo) lo = p.h;
         if (p.h > hi) hi = p.h;
+        radius_sum += std::sqrt(p.x * p.x + p.y * p.y);
     }
+    // Around the cloud's centroid line: only the thin-layer test uses it.
+    const double typical_radius = radius_sum / static_cast<double>(valid);
     if (!(hi > lo)) {
         rep.detail = "every point has the same height along the axis";
         return Status::flat_cloud;
@@ -3854,11 +3868,20 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
         Cylinder cyl = {0, 0, 0, 0, 0};
         size_t before = sink.count, folds_before = sink.folds;
         for (;;) {
+            // A remainder too small or thin to stand as a last layer joins this one.
+            size_t rest = m.layer_start[plan.count] - m.layer_start[last + 1];
+            double rest_height = plan.bounds[plan.count] - plan.bounds[last + 1];
+            if (last + 1 < plan.count &&
+                !(rest >= kMinLayerPoints && thick_enough(rest, rest_height, typical_radius)))
+                last = plan.count - 1;
             const uint32_t* ids = m.order + m.layer_start[first];
             size_t n = m.layer_start[last + 1] - m.layer_start[first];
             status = Status::not_columnar;
-            // Tiny layers make coarse, folding bands: they join the next layer if any.
-            if (n >= 3 && (n >= kMinLayerPoints || last + 1 == plan.count)) {
+            // Tiny or thin layers make coarse, folding bands: they join the next layer if
+            // any.
+            bool last_layer = last + 1 == plan.count;
+            double height = plan.bounds[last + 1] - plan.bounds[first];
+            if (n >= 3 && (last_layer || (n >= kMinLayerPoints && thick_enough(n, height, typical_radius)))) {
                 status = triangulate_layer(reader, frame, ids, n, plan.bounds[first],
                                            plan.bounds[last + 1], arena, sink, loops, counts,
                                            &cyl);

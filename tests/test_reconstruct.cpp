@@ -1597,10 +1597,13 @@ TEST_CASE("malformed clouds: the documented status, counts that add up, nothing 
         CHECK(run.report.duplicates + run.report.unused == 5);
     }
     SUBCASE("all points on one line beside the axis, or across it: no surface") {
+        // Small integers times powers of two: exactly on their lines whatever the compiler
+        // contracts (a fused multiply-add would move 0.01 * i - 1 off the line).
         std::vector<double> beside, across;
         for (int i = 0; i < 200; ++i) {
-            beside.insert(beside.end(), {1.0, 0.5, 0.01 * i});
-            across.insert(across.end(), {0.01 * i - 1, 0.02 * i - 2, 0.005 * i});
+            const double k = i, centred = i - 100;
+            beside.insert(beside.end(), {1.0, 0.5, k * 0x1p-6});
+            across.insert(across.end(), {centred * 0x1p-7, centred * 0x1p-6, k * 0x1p-8});
         }
         for (const std::vector<double>* line : {&beside, &across}) {
             Run run = reconstruct_guarded(Cloud{line->data(), 200, 0, Scalar::float64}, along_z);

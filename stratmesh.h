@@ -113,8 +113,9 @@
 // - NaN or infinite coordinates are refused (Status::invalid_point, with the index), or
 //   skipped and counted with the skip_invalid_points flag of reconstruct.
 // - reconstruct keeps its own predicate calls inside that exact range, whatever the cloud:
-//   the frame is rescaled by a power of two and the unrolled coordinates are bounded (see
-//   >>unroll), so a far outlier or a cloud at 1e-300 cannot break a sign.
+//   the frame is rescaled by a power of two (even for a cloud spanning more than the
+//   largest double) and the unrolled coordinates are bounded (see >>unroll), so a far
+//   outlier or a cloud at 1e-300 cannot break a sign.
 // - reconstruct's output is edge- and vertex-manifold and consistently oriented for every
 //   input it accepts: the layers and the bands between them form one annulus by
 //   construction, and a final safety net removes (and counts) any triangle that would
@@ -1900,8 +1901,17 @@ struct Frame {
     // neither overflow (a cloud at 1e200) nor underflow (at 1e-200); being a power of two,
     // it changes no rounding and the triangles do not depend on it.
     double scale;
+    // Set when the cloud spans more than the largest double (coordinates of both signs
+    // near 1e308): p - origin would overflow, so halves are subtracted instead.
+    bool halved;
+    Vec3 half_origin;
+    // (p - origin) * scale, without overflow.
+    Vec3 offset(Vec3 p) const {
+        if (halved) return scaled(scaled(p, 0.5) - half_origin, 2 * scale);
+        return scaled(p - origin, scale);
+    }
     Local local(Vec3 p) const {
-        Vec3 d = scaled(p - origin, scale);
+        Vec3 d = offset(p);
         return {dot(d, e1), dot(d, e2), dot(d, axis)};
     }
     // A frame height back as the user's coordinate along the axis, dot(point, axis).
@@ -1961,14 +1971,26 @@ inline Status choose_frame(const CloudReader& cloud, size_t count, const Options
         high = {p.x > high.x ? p.x : high.x, p.y > high.y ? p.y : high.y, p.z > high.z ? p.z : high.z};
         ++valid;
     }
-    frame.origin = valid ? scaled(sum, 1.0 / static_cast<double>(valid)) : Vec3{0, 0, 0};
-    double extent = 0;
-    if (valid) {
-        Vec3 size = high - low;
-        extent = size.x > size.y ? size.x : size.y;
-        if (size.z > extent) extent = size.z;
+    if (!(is_finite(sum.x) && is_finite(sum.y) && is_finite(sum.z))) {
+        // Coordinates near the top of the double range: sum them scaled down by 2^-40,
+        // which leaves room for 2^32 points.
+        sum = {0, 0, 0};
+        for (size_t i = 0; i < count; ++i) {
+            if (!cloud.valid(i)) continue;
+            Vec3 p = scaled(cloud.point(i), 0x1p-40);
+            sum = {sum.x + p.x, sum.y + p.y, sum.z + p.z};
+        }
+        frame.origin = scaled(scaled(sum, 1.0 / static_cast<double>(valid)), 0x1p40);
+    } else {
+        frame.origin = valid ? scaled(sum, 1.0 / static_cast<double>(valid)) : Vec3{0, 0, 0};
     }
-    frame.scale = scale_for_extent(extent);
+    Vec3 size = valid ? high - low : Vec3{0, 0, 0};
+    frame.halved = !(is_finite(size.x) && is_finite(size.y) && is_finite(size.z));
+    if (frame.halved) size = scaled(high, 0.5) - scaled(low, 0.5);
+    frame.half_origin = scaled(frame.origin, 0.5);
+    double extent = size.x > size.y ? size.x : size.y;
+    if (size.z > extent) extent = size.z;
+    frame.scale = scale_for_extent(extent) * (frame.halved ? 0.5 : 1.0);
     Vec3 axis = {0, 0, 1};
     switch (options.axis) {
     case Axis::x: axis = {1, 0, 0}; break;
@@ -1983,7 +2005,7 @@ inline Status choose_frame(const CloudReader& cloud, size_t count, const Options
         double m[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
         for (size_t i = 0; i < count; ++i) {
             if (!cloud.valid(i)) continue;
-            Vec3 d = scaled(cloud.point(i) - frame.origin, frame.scale);
+            Vec3 d = frame.offset(cloud.point(i));
             double c[3] = {d.x, d.y, d.z};
             for (int r = 0; r < 3; ++r)
                 for (int s = 0; s < 3; ++s) m[r][s] += c[r] * c[s];

@@ -11,7 +11,9 @@
 // subnormal), D (wrong incircle signs for points a few ulps apart near 2^-218), E (repeats
 // of unused points missing from Report::duplicates: no longer reproduces), G (reconstruct
 // made a repeated point a vertex instead of its lowest twin for a cloud with one far
-// outlier: the annulus coordinates spread beyond the predicates' exact range).
+// outlier: the annulus coordinates spread beyond the predicates' exact range), H (undefined
+// behaviour, a NaN cast to an integer, for a cloud whose coordinates span more than the
+// largest double: the frame's extent and the centroid's sum overflowed).
 // B: incircle has the wrong sign when the coordinates and their differences spread over
 //    more than 2^320 in magnitude: outside the documented contract (products of four terms
 //    cannot all be represented); the filter skips spreads above 300.

@@ -1469,11 +1469,11 @@ bool counts_add_up(const Report& r) {
     return r.points_in == r.points_used + r.duplicates + r.rejected + r.unused;
 }
 
-// The cylinder of reference_cylinder() scaled by `scale` about the origin and moved by
-// `offset`, with its analytic surface moved along (the radius is 1 everywhere, so the
-// scaled radius is `scale`).
-Shape moved_cylinder(double scale, const double offset[3]) {
-    Shape s = reference_cylinder();
+// A unit-radius cylinder (reference_cylinder() unless given) scaled by `scale` about the
+// origin and moved by `offset`, with its analytic surface moved along (the radius is 1
+// everywhere, so the scaled radius is `scale`).
+Shape moved_cylinder(double scale, const double offset[3], const Shape& base = reference_cylinder()) {
+    Shape s = base;
     for (size_t i = 0; i < s.xyz.size(); ++i) s.xyz[i] = s.xyz[i] * scale + offset[i % 3];
     for (int k = 0; k < 3; ++k) s.transform.t[k] = s.transform.t[k] * scale + offset[k];
     s.radius = [scale](double, double) { return scale; };
@@ -1683,6 +1683,18 @@ TEST_CASE("extreme magnitudes: scaling by a power of two gives the same triangle
         Run run = reconstruct_guarded(cloud_of(scaled), o);
         check_annulus_through_every_point(scaled, run);
         CHECK(run.triangles == reference.triangles);
+    }
+    SUBCASE("a cloud spanning more than the largest double: the same triangles as at unit size") {
+        // Centred on the origin and scaled by 2^1022, heights run from -3 2^1022 to
+        // 3 2^1022: their range, and the sum of the points, overflow a double.
+        const double centring[3] = {-0.25, 0.5, -2};
+        const Shape centred = moved_cylinder(1, centring), vast = moved_cylinder(0x1p1022, origin, centred);
+        Run small = reconstruct_guarded(cloud_of(centred), o);
+        Run run = reconstruct_guarded(cloud_of(vast), o);
+        check_annulus_through_every_point(centred, small);
+        REQUIRE(run.status == Status::ok);
+        CHECK(run.triangles == small.triangles);
+        CHECK(run.report.unused == 0);
     }
     for (double scale : {1e-30, 1e30}) {
         CAPTURE(scale);

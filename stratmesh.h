@@ -1288,20 +1288,45 @@ namespace detail {
 
 const uint32_t kHilbertBits = 13;  // per axis; 5 bits of the 32-bit key are left for rounds
 
+// The curve as a state machine. At each level the remaining sub-square is the unit
+// square under one of four transforms (complemented or not, x and y swapped or not; the
+// two commute): the quadrant's bits, seen through the transform, give the curve digit
+// (3 rx) ^ ry, and a quadrant with ry = 0 swaps the transform (and complements it if
+// rx = 1). The table runs two levels a step: entry (state << 4 | x bits << 2 | y bits)
+// holds the two digits in its low 4 bits and the next state above them. Built at compile
+// time from that rule, so it is a constant, not state.
+struct HilbertTable {
+    unsigned char entry[64];
+    constexpr HilbertTable() : entry() {
+        for (uint32_t i = 0; i < 64; ++i) {
+            uint32_t complement = (i >> 4) & 1u, swapped = i >> 5, digits = 0;
+            for (uint32_t level = 2; level-- > 0;) {
+                uint32_t bx = (i >> (2 + level)) & 1u, by = (i >> level) & 1u;
+                uint32_t rx = (swapped ? by : bx) ^ complement;
+                uint32_t ry = (swapped ? bx : by) ^ complement;
+                digits = (digits << 2) | ((3u * rx) ^ ry);
+                complement ^= rx & (ry ^ 1u);
+                swapped ^= ry ^ 1u;
+            }
+            entry[i] = static_cast<unsigned char>(digits | (complement << 4) | (swapped << 5));
+        }
+    }
+};
+
+constexpr HilbertTable kHilbertTable{};
+
 inline uint32_t hilbert_index(uint32_t x, uint32_t y) {
-    const uint32_t full = (1u << kHilbertBits) - 1;
-    uint32_t d = 0;
-    for (uint32_t s = 1u << (kHilbertBits - 1); s > 0; s >>= 1) {
-        uint32_t rx = (x & s) ? 1u : 0u;
-        uint32_t ry = (y & s) ? 1u : 0u;
-        d += s * s * ((3u * rx) ^ ry);
-        // Rotate the quadrant, without branches (their outcome is random).
-        uint32_t reflect = full & (0u - (rx & (ry ^ 1u)));
-        x ^= reflect;
-        y ^= reflect;
-        uint32_t swap = (x ^ y) & (0u - (ry ^ 1u));
-        x ^= swap;
-        y ^= swap;
+    // kHilbertBits is odd: a zero level is put on top, entered with x and y swapped so
+    // that it leaves the identity transform (its digit is 0), and the 14 levels run in
+    // seven steps.
+    static_assert(kHilbertBits % 2 == 1, "the levels are paired under one zero level");
+    uint32_t state = 2, d = 0;
+    for (uint32_t shift = kHilbertBits + 1; shift >= 2;) {
+        shift -= 2;
+        uint32_t bx = (x >> shift) & 3u, by = (y >> shift) & 3u;
+        uint32_t e = kHilbertTable.entry[(state << 4) | (bx << 2) | by];
+        d = (d << 4) | (e & 15u);
+        state = e >> 4;
     }
     return d;
 }

@@ -7,7 +7,7 @@
 // and the triangle array ends where its allocation ends, so any overrun trips
 // AddressSanitizer. Options: every axis (direction with zero/NaN components too), cuts
 // with NaN, unsorted and repeated values, layer_count, layer_height, skip_invalid_points,
-// a layer array to fill.
+// close_ends (caps), a layer array to fill.
 //
 // Checked after each run: the status is a documented one; the report's counts add up on
 // every status; on ok, every index < n, no repeated index in a triangle, at most
@@ -152,6 +152,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     }
     if (ocfg & 0x20) options.flags |= stratmesh::skip_invalid_points;
+    if (ocfg & 0x80) options.flags |= stratmesh::close_ends;
     const size_t max_tris = stratmesh::reconstruct_max_triangles(n, options);
     const bool small_capacity = (ocfg & 0x40) != 0;
     const size_t capacity = small_capacity ? std::min<size_t>(max_tris, in.below(64)) : max_tris;

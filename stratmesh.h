@@ -291,9 +291,9 @@ struct Options {
     // most 256) such that one centre line serves each layer and none is taller than 24
     // of its radii, cut where the cross-section changes least and not through dense
     // detail (the paper's rule; see "automatic layers" in >>layers). A layer with fewer
-    // than 16 points, thinner than about two rows of points, or whose points do not
-    // surround its centre, is merged with the next one (a remainder that small or thin,
-    // with the last); the report lists the layers actually used (Report::layers: bottom
+    // than 16 points, thinner than about one and a half rows of points around its own
+    // radius, or whose points do not surround its centre, is merged with the next one (a
+    // remainder that small or thin, with the last); the report lists the layers actually used (Report::layers: bottom
     // and top).
     const double* cuts;
     size_t cut_count;
@@ -371,9 +371,9 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 //                 alignment.
 // triangles       receives 3 * (*triangle_count) indices into the cloud, each triangle
 //                 counter-clockwise seen from outside (normals point away from the axis).
-//                 Triangles come layer by layer, bottom to top, each layer's band to the
-//                 layer below just before it, then the caps (close_ends), one loop after
-//                 another. The order is deterministic.
+//                 Triangles come layer by layer, bottom to top: each layer's own triangles,
+//                 then the band joining it to the layer below; then the caps (close_ends),
+//                 one loop after another. The order is deterministic.
 // triangle_capacity  triangles that fit in `triangles`; reconstruct_max_triangles() always
 //                 suffices. When too small: Status::triangle_capacity and *triangle_count
 //                 says how many are needed (with close_ends, counting every loop as closed;
@@ -2091,10 +2091,12 @@ const size_t kMaxAutomaticLayers = 256;
 const double kMaxTurns = 24.0;
 // A layer with fewer points is merged with the next one (the last layer only needs 3).
 const size_t kMinLayerPoints = 16;
-// A layer also needs about two rows of points: thinner ones make bands of a few points
-// that fold and cross. With n points over height h around radius r, the spacing is about
-// sqrt(2 pi r h / n), so the rows number sqrt(h n / (2 pi r)).
-const double kMinLayerRows = 2;
+// A layer also needs about one and a half rows of points: thinner ones make bands of a few
+// points that fold and cross. With n points over height h around radius r (the layer's
+// own), the spacing is about sqrt(2 pi r h / n), so the rows number sqrt(h n / (2 pi r)).
+// A stack of planar contours one per layer, as far apart as a few point spacings along the
+// contour, passes.
+const double kMinLayerRows = 1.5;
 
 inline bool thick_enough(size_t points, double height, double radius) {
     const double two_pi = 6.28318530717958647693;
@@ -2558,7 +2560,7 @@ struct TriangleSink {
 // >>layer triangulation =====================================================================
 
 struct LayerLoops {
-    uint32_t* bottom;  // original indices, counter-clockwise on the annulus
+    uint32_t* bottom;  // layer-local indices, counter-clockwise on the annulus
     uint32_t bottom_count;
     uint32_t* top;
     uint32_t top_count;
@@ -2587,14 +2589,10 @@ struct LayerDuplicates {
     }
 };
 
-inline uint32_t original_id(const uint32_t* ids, const uint32_t* order, uint32_t v) {
-    return ids[order[v] - 1];
-}
-
-// Collects the link of vertex `centre` counter-clockwise into loop (original indices).
+// Collects the link of vertex `centre` counter-clockwise into loop (layer-local indices).
 // False if the centre touches the hull: the layer does not surround its axis.
-inline bool centre_link(const Triangulation& tr, uint32_t centre, const uint32_t* ids,
-                        const uint32_t* order, uint32_t* loop, uint32_t* count) {
+inline bool centre_link(const Triangulation& tr, uint32_t centre, const uint32_t* order,
+                        uint32_t* loop, uint32_t* count) {
     uint32_t start = kNoIndex;
     for (uint32_t e = 0; e < 3 * tr.triangle_count; ++e)
         if (tr.vertex[e] == centre) {
@@ -2607,48 +2605,64 @@ inline bool centre_link(const Triangulation& tr, uint32_t centre, const uint32_t
         uint32_t u = tr.vertex[next_edge(e)];
         if (u == kGhost || tr.vertex[prev_edge(e)] == kGhost || n > tr.triangle_count)
             return false;
-        loop[n++] = original_id(ids, order, u);
+        loop[n++] = order[u] - 1;
         e = tr.twin[prev_edge(e)];  // the next triangle counter-clockwise around the centre
     } while (e != start);
     *count = n;
     return true;
 }
 
-// Collects the convex hull counter-clockwise into loop (original indices). A ghost
+// Collects the convex hull counter-clockwise into loop (layer-local indices). A ghost
 // (a, b, G) holds G -> a; the twin of G -> a is a -> G in the ghost (z, a, G), whose next
 // half-edge is G -> z: the hull vertex after a.
-inline void hull_loop(const Triangulation& tr, const uint32_t* ids, const uint32_t* order,
-                      uint32_t* loop, uint32_t* count) {
+inline void hull_loop(const Triangulation& tr, const uint32_t* order, uint32_t* loop,
+                      uint32_t* count) {
     uint32_t start = 0;
     while (tr.vertex[start] != kGhost) ++start;
     uint32_t n = 0, e = start;
     do {
-        loop[n++] = original_id(ids, order, tr.vertex[next_edge(e)]);
+        loop[n++] = order[tr.vertex[next_edge(e)]] - 1;
         e = next_edge(tr.twin[e]);
     } while (e != start && n <= tr.triangle_count);
     *count = n;
 }
 
-// Triangulates one layer: its points ids[0..count) (heights [h0, h1]) rolled onto the
-// annulus of the cylinder fitted to them (*cyl) plus the centre. Emits the surface
-// triangles, fills the loops. Returns ok, not_columnar (the layer does not surround its
-// axis, or is degenerate: the caller merges it with the next one), out_of_memory or
-// internal_error.
-inline Status triangulate_layer(const CloudReader& cloud, const Frame& frame,
-                                const uint32_t* ids, size_t count, double h0, double h1,
+// A layer's points in frame coordinates, read from the cloud once (every later pass, the
+// stitch and the fold test read this compact array instead of the cloud at random), and
+// the cylinder fitted to them. Triangles and loops name the points by their position in
+// `ids` (layer-local indices).
+struct LoadedLayer {
+    const uint32_t* ids;  // layer-local index -> reader index
+    size_t count;
+    Local* points;
+    Cylinder cyl;
+};
+
+inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint32_t* ids,
+                       size_t count, double h0, double h1, Arena& arena, LoadedLayer& layer) {
+    layer.ids = ids;
+    layer.count = count;
+    layer.points = arena.alloc<Local>(count);
+    if (arena.failed) return false;
+    for (size_t i = 0; i < count; ++i) layer.points[i] = frame.local(cloud.point(ids[i]));
+    layer.cyl = fit_cylinder(layer.points, count, h0, h1);
+    return true;
+}
+
+// Triangulates a loaded layer rolled onto the annulus of its cylinder plus the centre.
+// Emits the surface triangles and fills the loops, in layer-local indices. Returns ok,
+// not_columnar (the layer does not surround its axis, or is degenerate: the caller merges
+// it with the next one), out_of_memory or internal_error. Its scratch is released.
+inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& layer,
                                 Arena& arena, TriangleSink& sink, LayerLoops& loops,
-                                LayerCounts& counts, Cylinder* cylinder) {
-    const size_t total = count + 1;  // local id 0 is the centre
+                                LayerCounts& counts) {
+    const size_t total = layer.count + 1;  // triangulation vertex 0 is the centre
+    const Local* points = layer.points;
+    const Cylinder& cyl = layer.cyl;
     size_t mark = arena.mark();
-    // The layer's frame coordinates, read from the cloud once: every later pass, and the
-    // triangles' fold test, reads this compact array instead of the cloud at random.
-    Local* points = arena.alloc<Local>(count);
     uint32_t* order = arena.alloc<uint32_t>(total);
     double* xy = arena.alloc<double>(2 * total);
     if (arena.failed) return Status::out_of_memory;
-    for (size_t i = 0; i < count; ++i) points[i] = frame.local(cloud.point(ids[i]));
-    const Cylinder cyl = fit_cylinder(points, count, h0, h1);
-    *cylinder = cyl;
     // The insertion order is taken on the unrolled strip (angle, height), where the points
     // are spread evenly: on the annulus their density falls off with the radius squared
     // and a curve over its bounding box would lump the inner rings together.
@@ -2676,23 +2690,22 @@ inline Status triangulate_layer(const CloudReader& cloud, const Frame& frame,
     tr.xy = xy;
     if (!allocate_triangulation(tr, total, arena)) return Status::out_of_memory;
     counts = LayerCounts{0, 0};
-    LayerDuplicates classify = {&cloud, ids, order, &counts};
+    LayerDuplicates classify = {&cloud, layer.ids, order, &counts};
     DuplicateSink duplicates = {LayerDuplicates::report, &classify};
     uint32_t inserted = 0;
     Status status = triangulate_points(tr, static_cast<uint32_t>(total), duplicates, &inserted);
     if (status == Status::internal_error) return status;
     if (status != Status::ok ||
-        !centre_link(tr, centre, ids, order, loops.bottom, &loops.bottom_count)) {
+        !centre_link(tr, centre, order, loops.bottom, &loops.bottom_count)) {
         arena.rewind(mark);
         return Status::not_columnar;
     }
-    hull_loop(tr, ids, order, loops.top, &loops.top_count);
+    hull_loop(tr, order, loops.top, &loops.top_count);
     for (uint32_t t = 0; t < tr.triangle_count; ++t) {
         const uint32_t* v = tr.vertex + 3 * t;
         if (tr.is_ghost(t) || v[0] == centre || v[1] == centre || v[2] == centre) continue;
-        sink.emit(original_id(ids, order, v[0]), original_id(ids, order, v[1]),
-                  original_id(ids, order, v[2]), points[order[v[0]] - 1],
-                  points[order[v[1]] - 1], points[order[v[2]] - 1], cyl);
+        uint32_t a = order[v[0]] - 1, b = order[v[1]] - 1, c = order[v[2]] - 1;
+        sink.emit(a, b, c, points[a], points[b], points[c], cyl);
     }
     arena.rewind(mark);
     return Status::ok;
@@ -2747,7 +2760,7 @@ inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
 }
 
 struct Band {
-    const uint32_t* a;  // loop A, original indices
+    const uint32_t* a;  // loop A, band indices (see stitch_layers)
     const double* xa;   // its strip coordinates, angles increasing from the smallest
     uint32_t p;
     const uint32_t* b;
@@ -2867,17 +2880,31 @@ inline size_t swap_diagonals(Band& band) {
     return swaps;
 }
 
-// Stitches loop a (top of the lower layer, cylinder ca) to loop b (bottom of the upper
-// layer, cylinder cb, whose h0 is the cut).
+// Stitches loop A (the lower layer's top loop: reader indices a_ids, cylinder ca) to the
+// loaded upper layer's bottom loop b (layer-local indices; the layer's cylinder has the
+// cut as h0). The band's triangles name the upper layer's points by layer-local index and
+// the i-th point of A by layer.count + i.
 inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cylinder& ca,
-                          uint32_t* a, uint32_t p, const Cylinder& cb, uint32_t* b, uint32_t q,
-                          Arena& arena, TriangleSink& sink, size_t* swaps) {
+                          const uint32_t* a_ids, uint32_t p, const LoadedLayer& layer,
+                          uint32_t* b, uint32_t q, Arena& arena, TriangleSink& sink,
+                          size_t* swaps) {
+    const Cylinder& cb = layer.cyl;
+    const uint32_t below = static_cast<uint32_t>(layer.count);
     size_t mark = arena.mark();
+    uint32_t* a = arena.alloc<uint32_t>(p);
+    Local* a_points = arena.alloc<Local>(p);
     double* xa = arena.alloc<double>(2 * static_cast<size_t>(p));
     double* xb = arena.alloc<double>(2 * static_cast<size_t>(q));
     unsigned char* steps = arena.alloc<unsigned char>(static_cast<size_t>(p) + q);
     double* scratch = arena.alloc<double>(kIncircleScratch);
     if (arena.failed) return false;
+    for (uint32_t i = 0; i < p; ++i) {
+        a[i] = below + i;
+        a_points[i] = frame.local(cloud.point(a_ids[i]));
+    }
+    auto point = [&](uint32_t id) -> const Local& {
+        return id < below ? layer.points[id] : a_points[id - below];
+    };
     Cylinder shared;
     shared.cx = (ca.cx + cb.cx) / 2;
     shared.cy = (ca.cy + cb.cy) / 2;
@@ -2886,7 +2913,7 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
     shared.scale = (ca.scale + cb.scale) / 2;
     const double unrolled_radius = 1 / shared.scale;
     auto unroll = [&](uint32_t id, double* uv) {
-        Local l = frame.local(cloud.point(id));
+        const Local& l = point(id);
         uv[0] = unrolled_radius * polar_angle(l.x - shared.cx, l.y - shared.cy);
         uv[1] = l.h - shared.h0;
     };
@@ -2929,8 +2956,7 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
             x = b[j % q], y = b[(j + 1) % q], z = a[i % p];
             ++j;
         }
-        sink.emit(x, y, z, frame.local(cloud.point(x)), frame.local(cloud.point(y)),
-                  frame.local(cloud.point(z)), shared);
+        sink.emit(x, y, z, point(x), point(y), point(z), shared);
     }
     arena.rewind(mark);
     return true;
@@ -2946,6 +2972,12 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
 // arriving where the next leaves. Triangles on a repeated directed edge go (the later
 // one), then every fan but the largest; repeated until nothing changes, since a removal
 // can split a neighbour's fan.
+//
+// It runs on each chunk of the surface (a layer's triangles and the band joining it to the
+// layer below) as soon as the chunk is built, so that chunks are final when they leave
+// (the stream hands them out at once) and the net's memory follows the largest layer, not
+// the cloud. Chunks meet only along the layers' top loops, where each side gives a loop
+// vertex one chain of triangles ending on the loop's edges by construction.
 
 // In-place sort of packed (key, value) pairs: insertion sort for the small fans of almost
 // every vertex, heap sort (O(n log n), no recursion) for large ones.
@@ -3056,17 +3088,16 @@ inline size_t repair_fan(const uint32_t* tri, const uint32_t* incident, size_t b
     return removed;
 }
 
-// Removes triangles until the mesh is edge- and vertex-manifold and consistently oriented.
-// Compacts the survivors in place (keeping their order); returns the number removed, or
-// SIZE_MAX if the arena is too small. *used receives the number of vertices left.
+// Removes triangles until the mesh tri[0 .. 3 count), whose indices are below point_count,
+// is edge- and vertex-manifold and consistently oriented. Compacts the survivors in place
+// (keeping their order); returns the number removed, or SIZE_MAX if the arena is too small.
 //
 // The work runs on relabelled triangles: vertices numbered in the order the triangles
 // first name them (input indices are restored at the end). The triangles come out of the
 // layers in spatial order, so relabelled fans and their triangles sit close together in
 // memory whatever order the input points had; only the relabelling itself reads the input
 // indices at random.
-inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count, Arena& arena,
-                               size_t* used) {
+inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count, Arena& arena) {
     size_t mark = arena.mark();
     uint32_t* original = arena.alloc<uint32_t>(point_count);  // label -> input index
     unsigned char* dead = arena.alloc<unsigned char>(count);
@@ -3121,13 +3152,6 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
             removed += repair_fan(local, incident, offsets[v], offsets[v + 1], v, dead, fan);
         if (removed == before) break;
     }
-    size_t vertices = 0;
-    for (uint32_t v = 0; v < labels; ++v) {
-        bool touched = false;
-        for (size_t k = offsets[v]; k < offsets[v + 1] && !touched; ++k)
-            touched = !dead[incident[k]];
-        vertices += touched;
-    }
     size_t alive = 0;
     for (size_t t = 0; t < count; ++t) {
         if (dead[t]) continue;
@@ -3135,7 +3159,6 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
         ++alive;
     }
     count = alive;
-    *used = vertices;
     arena.rewind(mark);
     return removed;
 }
@@ -3643,12 +3666,179 @@ Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity, size_t 
 // angular coverage) is merged with the next one; trailing points that never form such a
 // layer stay unused and are reported. Last, the manifold safety net.
 
+// ---- the surface, chunk by chunk -----------------------------------------------------------
+//
+// Both reconstruct() and the stream grow the surface the same way, from a queue of planned
+// layers (height ranges with their points, bottom to top). A run of planned layers becomes
+// one triangulated layer (a "group"); its chunk is its own triangles and the band to the
+// group below, run through the manifold safety net on its own. The grouping rule: a group
+// is the next planned layer, extended by the following ones while it has fewer than
+// kMinLayerPoints points, is thinner than kMinLayerRows rows of points around its own radius,
+// or does not surround its axis; when the points after it are too few or thin to stand on
+// their own (compared with the group's radius), everything left joins it. Every decision
+// reads only the group and the layers after it, and a larger rest only ever passes the rest
+// test more easily, so a stream that waits until the rest passes, or ends, decides exactly
+// as reconstruct() does over the whole cloud.
+
+struct LayerQueue {
+    const uint32_t* ids;    // reader indices of the planned layers' points, layer after layer
+    const uint32_t* start;  // start[k]: first position in ids of planned layer k, k <= planned
+    const double* bounds;   // planned layer k spans heights bounds[k] .. bounds[k + 1];
+                            // bounds[planned] is the highest point so far
+    uint32_t planned;       // planned layers known
+    bool complete;          // no planned layer will be added
+};
+
+struct SurfaceChain {
+    Frame frame;
+    CloudReader reader;
+    const uint32_t* output_id;  // reader index -> output index; null: the same
+    // The last group's top loop (reader indices) with, per point, whether that group's own
+    // chunk left it without a triangle; two sets of buffers, swapped per group.
+    uint32_t* top;
+    unsigned char* top_unused;
+    uint32_t top_count;
+    Cylinder top_cylinder;
+    uint32_t* next_top;
+    unsigned char* next_unused;
+    uint32_t* bottom;
+    size_t groups, duplicates, collisions, swaps, removed, used, trailing;
+};
+
+inline bool allocate_chain(SurfaceChain& c, size_t points, Arena& arena) {
+    c.top = arena.alloc<uint32_t>(points);
+    c.next_top = arena.alloc<uint32_t>(points);
+    c.bottom = arena.alloc<uint32_t>(points);
+    c.top_unused = arena.alloc<unsigned char>(points);
+    c.next_unused = arena.alloc<unsigned char>(points);
+    c.top_count = 0;
+    c.groups = c.duplicates = c.collisions = c.swaps = c.removed = c.used = c.trailing = 0;
+    return !arena.failed;
+}
+
+// The safety net over the chunk sink[chunk_start ..), then its indices from layer-local and
+// band indices to output indices; counts the points that became vertices.
+inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
+                           size_t chunk_start, Arena& arena, TriangleSink& sink) {
+    uint32_t* tri = sink.triangles + 3 * chunk_start;
+    size_t count = sink.count - chunk_start;
+    const size_t below = layer.count, vertices = layer.count + c.top_count;
+    size_t removed = enforce_manifold(tri, count, vertices, arena);
+    if (removed == SIZE_MAX) return Status::out_of_memory;
+    sink.count = chunk_start + count;
+    c.removed += removed;
+    size_t mark = arena.mark();
+    unsigned char* seen = arena.alloc<unsigned char>(vertices);
+    if (arena.failed) return Status::out_of_memory;
+    std::memset(seen, 0, vertices);
+    for (size_t k = 0; k < 3 * count; ++k) seen[tri[k]] = 1;
+    for (size_t l = 0; l < below; ++l) c.used += seen[l];
+    for (uint32_t i = 0; i < c.top_count; ++i) c.used += seen[below + i] & c.top_unused[i];
+    for (uint32_t i = 0; i < loops.top_count; ++i) c.next_unused[i] = !seen[loops.top[i]];
+    for (size_t k = 0; k < 3 * count; ++k) {
+        uint32_t l = tri[k];
+        uint32_t id = l < below ? layer.ids[l] : c.top[l - below];
+        tri[k] = c.output_id ? c.output_id[id] : id;
+    }
+    arena.rewind(mark);
+    return Status::ok;
+}
+
+// What one step of the queue did.
+struct GroupResult {
+    uint32_t last;           // the group is planned layers [first, last]
+    bool waiting;            // the queue must grow (or complete) before this group is known
+    size_t points;           // its points, duplicates included
+    LayerCounts counts;
+    size_t triangles, folds; // its chunk, before the safety net
+    Cylinder cylinder;
+};
+
+// Forms the group starting at planned layer `first`, triangulates it, stitches it to the
+// chain's top loop and finishes the chunk. Returns ok (also when waiting), not_columnar when
+// the rest of the queue cannot form a layer (counted in c.trailing), or an error.
+inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Arena& arena,
+                        TriangleSink& sink, GroupResult& result) {
+    result.waiting = false;
+    uint32_t last = first;
+    for (;;) {
+        const bool final = q.complete && last + 1 == q.planned;
+        if (!final && last + 1 >= q.planned) {
+            result.waiting = true;
+            return Status::ok;
+        }
+        const uint32_t* ids = q.ids + q.start[first];
+        const size_t n = q.start[last + 1] - q.start[first];
+        const double h0 = q.bounds[first], h1 = q.bounds[last + 1];
+        size_t mark = arena.mark();
+        LoadedLayer layer;
+        if (!load_layer(c.reader, c.frame, ids, n, h0, h1, arena, layer))
+            return Status::out_of_memory;
+        if (!final) {
+            size_t rest = q.start[q.planned] - q.start[last + 1];
+            double rest_height = q.bounds[q.planned] - q.bounds[last + 1];
+            if (!(rest >= kMinLayerPoints && thick_enough(rest, rest_height, layer.cyl.radius))) {
+                arena.rewind(mark);
+                if (!q.complete) {
+                    result.waiting = true;
+                    return Status::ok;
+                }
+                last = q.planned - 1;  // a remainder too small or thin to stand joins this group
+                continue;
+            }
+        }
+        Status status = Status::not_columnar;
+        // Tiny or thin layers make coarse, folding bands: they join the next layer if any.
+        if (n >= 3 && (final || (n >= kMinLayerPoints && thick_enough(n, h1 - h0, layer.cyl.radius)))) {
+            const size_t chunk_start = sink.count, folds = sink.folds;
+            LayerLoops loops = {c.bottom, 0, c.next_top, 0};
+            status = triangulate_layer(c.reader, layer, arena, sink, loops, result.counts);
+            if (status == Status::ok && c.top_count > 0 &&
+                !stitch_layers(c.reader, c.frame, c.top_cylinder, c.top, c.top_count, layer,
+                               loops.bottom, loops.bottom_count, arena, sink, &c.swaps))
+                status = Status::out_of_memory;
+            result.triangles = sink.count - chunk_start;
+            result.folds = sink.folds - folds;
+            // Past the caller's capacity only the count goes on (triangle_capacity follows).
+            if (status == Status::ok && sink.count <= sink.capacity)
+                status = finish_chunk(c, layer, loops, chunk_start, arena, sink);
+            if (status == Status::ok) {
+                for (uint32_t i = 0; i < loops.top_count; ++i) loops.top[i] = ids[loops.top[i]];
+                uint32_t* top = c.top;
+                unsigned char* unused = c.top_unused;
+                c.top = loops.top;
+                c.top_unused = c.next_unused;
+                c.top_count = loops.top_count;
+                c.next_top = top;
+                c.next_unused = unused;
+                c.top_cylinder = layer.cyl;
+                c.duplicates += result.counts.duplicates;
+                c.collisions += result.counts.collisions;
+                ++c.groups;
+                result.last = last;
+                result.points = n;
+                result.cylinder = layer.cyl;
+            }
+        }
+        arena.rewind(mark);
+        if (status != Status::not_columnar) return status;
+        if (final) {
+            c.trailing += n;
+            result.last = last;
+            return Status::not_columnar;
+        }
+        ++last;
+    }
+}
+
+// ---- reconstruct -----------------------------------------------------------------------------
+
 // Workspace that lives through the whole call, then the largest scratch of any phase.
 struct ReconstructMemory {
     double* bounds;        // layer bounds
     uint32_t* layer_start; // first position in `order` of each layer
     uint32_t* order;       // valid points grouped by layer
-    uint32_t* loops[3];    // previous top, bottom, top
+    SurfaceChain chain;
 };
 
 inline bool plan_reconstruct(ReconstructMemory& m, size_t count, size_t layer_limit,
@@ -3656,41 +3846,44 @@ inline bool plan_reconstruct(ReconstructMemory& m, size_t count, size_t layer_li
     m.bounds = arena.alloc<double>(layer_limit + 1);
     m.layer_start = arena.alloc<uint32_t>(layer_limit + 2);
     m.order = arena.alloc<uint32_t>(count);
-    for (uint32_t*& loop : m.loops) loop = arena.alloc<uint32_t>(count);
-    return !arena.failed;
+    return allocate_chain(m.chain, count, arena);
 }
 
-// The largest scratch any phase takes on top of the plan, for `count` points; 0 if that
-// is beyond what size_t can count.
+// The largest scratch any phase takes on top of the plan, for groups of up to `count`
+// points; 0 if that is beyond what size_t can count.
 inline size_t reconstruct_scratch_size(size_t count, bool close) {
     size_t total = count + 1;
-    Arena layer = Arena::measuring();
-    layer.alloc<Local>(count);
-    layer.alloc<uint32_t>(total);
-    layer.alloc<double>(2 * total);
-    size_t mark = layer.mark();
-    for (int k = 0; k < 3; ++k) layer.alloc<uint32_t>(total);  // the spatial sort
-    layer.rewind(mark);
+    // A group: its points, then the triangulation or the band, then the safety net.
+    Arena group = Arena::measuring();
+    group.alloc<Local>(count);
+    size_t loaded = group.mark();
+    group.alloc<uint32_t>(total);
+    group.alloc<double>(2 * total);
+    size_t mark = group.mark();
+    for (int k = 0; k < 3; ++k) group.alloc<uint32_t>(total);  // the spatial sort
+    group.rewind(mark);
     Triangulation tr;
-    allocate_triangulation(tr, total, layer);
-
-    Arena band = Arena::measuring();
-    band.alloc<double>(2 * count);
-    band.alloc<double>(2);  // the second loop's alignment
-    band.alloc<unsigned char>(count);
-    band.alloc<double>(kIncircleScratch);
-
+    allocate_triangulation(tr, total, group);
+    group.rewind(loaded);
+    group.alloc<uint32_t>(count);  // the band: loop A's band indices and points
+    group.alloc<Local>(count);
+    group.alloc<double>(2 * count);
+    group.alloc<double>(2);  // the second loop's alignment
+    group.alloc<unsigned char>(count);
+    group.alloc<double>(kIncircleScratch);
+    group.rewind(loaded);
+    // The chunk's safety net: its vertices are the group's and the loop below's, at most
+    // `count` (the stream's window holds both), with at most 2 triangles each.
     size_t triangles = 2 * count;
-    Arena manifold = Arena::measuring();
-    manifold.alloc<uint32_t>(count);
-    manifold.alloc<unsigned char>(triangles);
-    mark = manifold.mark();
-    manifold.alloc<uint32_t>(count);
-    manifold.rewind(mark);
-    manifold.alloc<uint32_t>(count + 1);
-    manifold.alloc<uint32_t>(3 * triangles);
-    manifold.alloc<uint64_t>(triangles);
-    for (int k = 0; k < 4; ++k) manifold.alloc<uint32_t>(triangles);
+    group.alloc<uint32_t>(count);
+    group.alloc<unsigned char>(triangles);
+    mark = group.mark();
+    group.alloc<uint32_t>(count);
+    group.rewind(mark);
+    group.alloc<uint32_t>(count + 1);
+    group.alloc<uint32_t>(3 * triangles);
+    group.alloc<uint64_t>(triangles);
+    for (int k = 0; k < 4; ++k) group.alloc<uint32_t>(triangles);
 
     Arena profile = Arena::measuring();
     ProfileBin* bins = nullptr;
@@ -3707,12 +3900,9 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
         allocate_cap_loop(loop, count, caps);
     }
 
-    if (layer.failed || band.failed || manifold.failed || profile.failed || caps.failed)
-        return 0;  // beyond size_t
-    size_t most = layer.high_water;
+    if (group.failed || profile.failed || caps.failed) return 0;  // beyond size_t
+    size_t most = group.high_water;
     if (profile.high_water > most) most = profile.high_water;
-    if (band.high_water > most) most = band.high_water;
-    if (manifold.high_water > most) most = manifold.high_water;
     if (caps.high_water > most) most = caps.high_water;
     return most;
 }
@@ -3860,16 +4050,13 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
         return Status::too_few_points;
     }
 
-    double lo = DBL_MAX, hi = -DBL_MAX, radius_sum = 0;
+    double lo = DBL_MAX, hi = -DBL_MAX;
     for (size_t i = 0; i < cloud.count; ++i) {
         if (!reader.valid(i)) continue;
         Local p = frame.local(reader.point(i));
         if (p.h < lo) lo = p.h;
         if (p.h > hi) hi = p.h;
-        radius_sum += std::sqrt(p.x * p.x + p.y * p.y);
     }
-    // Around the cloud's centroid line: only the thin-layer test uses it.
-    const double typical_radius = radius_sum / static_cast<double>(valid);
     if (!(hi > lo)) {
         rep.detail = "every point has the same height along the axis";
         return Status::flat_cloud;
@@ -3904,66 +4091,25 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
 
     notify(options, Phase::triangulate, 0);
     TriangleSink sink = {triangles, triangle_capacity, 0, 0};
-    uint32_t* previous_top = m.loops[0];
-    uint32_t previous_top_count = 0;
-    Cylinder previous = {0, 0, 0, 0, 0};
-    size_t collisions = 0, swaps = 0, trailing = 0;
-    uint32_t first = 0;
-    while (first < plan.count) {
-        uint32_t last = first;
-        LayerLoops loops = {m.loops[1], 0, m.loops[2], 0};
-        LayerCounts counts = {0, 0};
-        Cylinder cyl = {0, 0, 0, 0, 0};
-        size_t before = sink.count, folds_before = sink.folds;
-        for (;;) {
-            // A remainder too small or thin to stand as a last layer joins this one.
-            size_t rest = m.layer_start[plan.count] - m.layer_start[last + 1];
-            double rest_height = plan.bounds[plan.count] - plan.bounds[last + 1];
-            if (last + 1 < plan.count &&
-                !(rest >= kMinLayerPoints && thick_enough(rest, rest_height, typical_radius)))
-                last = plan.count - 1;
-            const uint32_t* ids = m.order + m.layer_start[first];
-            size_t n = m.layer_start[last + 1] - m.layer_start[first];
-            status = Status::not_columnar;
-            // Tiny or thin layers make coarse, folding bands: they join the next layer if
-            // any.
-            bool last_layer = last + 1 == plan.count;
-            double height = plan.bounds[last + 1] - plan.bounds[first];
-            if (n >= 3 && (last_layer || (n >= kMinLayerPoints && thick_enough(n, height, typical_radius)))) {
-                status = triangulate_layer(reader, frame, ids, n, plan.bounds[first],
-                                           plan.bounds[last + 1], arena, sink, loops, counts,
-                                           &cyl);
-            }
-            if (status == Status::ok) break;
-            if (status != Status::not_columnar) return finish(status);
-            if (last + 1 == plan.count) {
-                trailing = n;
-                break;
-            }
-            ++last;
-        }
-        if (status != Status::ok) break;
-        if (previous_top_count > 0 &&
-            !stitch_layers(reader, frame, previous, previous_top, previous_top_count, cyl,
-                           loops.bottom, loops.bottom_count, arena, sink, &swaps))
-            return finish(Status::out_of_memory);
-        size_t points = m.layer_start[last + 1] - m.layer_start[first];
-        rep.duplicates += counts.duplicates;
-        collisions += counts.collisions;
+    SurfaceChain& chain = m.chain;
+    chain.frame = frame;
+    chain.reader = reader;
+    chain.output_id = nullptr;
+    const LayerQueue queue = {m.order, m.layer_start, plan.bounds, plan.count, true};
+    for (uint32_t first = 0; first < plan.count;) {
+        GroupResult group;
+        status = add_group(chain, queue, first, arena, sink, group);
+        if (status == Status::not_columnar) break;
+        if (status != Status::ok) return finish(status);
         if (rep.layer_count < layer_capacity)
-            describe_layer(frame, cyl, plan.bounds[first], plan.bounds[last + 1],
-                           points - counts.duplicates, sink.count - before,
-                           sink.folds - folds_before, layer_infos[rep.layer_count]);
+            describe_layer(frame, group.cylinder, plan.bounds[first], plan.bounds[group.last + 1],
+                           group.points - group.counts.duplicates, group.triangles, group.folds,
+                           layer_infos[rep.layer_count]);
         ++rep.layer_count;
-        // This layer's top loop is the next one's "previous": rotate the buffers.
-        uint32_t* spare = previous_top;
-        previous_top = loops.top;
-        previous_top_count = loops.top_count;
-        m.loops[2] = spare;
-        previous = cyl;
-        first = last + 1;
+        first = group.last + 1;
         notify(options, Phase::triangulate, static_cast<double>(first) / plan.count);
     }
+    rep.duplicates = chain.duplicates;
     if (rep.layer_count == 0) {
         rep.detail = "no layer's points surround the axis: the cloud is not columnar around "
                      "it (try another axis)";
@@ -3983,9 +4129,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     }
 
     notify(options, Phase::manifold, 0);
-    size_t count = sink.count, used = 0;
-    size_t removed = enforce_manifold(triangles, count, cloud.count, arena, &used);
-    if (removed == SIZE_MAX) return finish(Status::out_of_memory);
+    size_t count = sink.count;
     CapCounts caps = {0, 0, 0};
     if (options.flags & close_ends) {
         auto project = [&](uint32_t id, double* xy) {
@@ -4009,21 +4153,21 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     rep.cap_triangles = caps.triangles;
     *triangle_count = count;
     rep.triangle_count = count;
-    rep.illegal_removed = removed;
+    rep.illegal_removed = chain.removed;
     rep.folds = sink.folds;
-    rep.points_used = used;
-    if (trailing > 0)
+    rep.points_used = chain.used;
+    if (chain.trailing > 0)
         rep.detail = "the points of the last layers do not surround the axis: they are not "
                      "vertices";
-    else if (collisions > 0)
+    else if (chain.collisions > 0)
         rep.detail = "some points share their place on the unrolled layer with another point "
                      "(the layer is not star-shaped around its centre there): not vertices";
-    else if (valid - rep.duplicates > used)
+    else if (valid - rep.duplicates > chain.used)
         rep.detail = "the manifold safety net removed the triangles of some points";
     else if (caps.left_open > 0)
         rep.detail = "a boundary loop's projection across the axis is not a simple polygon (or "
                      "each of its ears would repeat an edge of the surface): it is left open";
-    rep.diagonal_swaps = swaps;
+    rep.diagonal_swaps = chain.swaps;
     notify(options, Phase::done, 1);
     return finish(Status::ok);
 }

@@ -1451,8 +1451,10 @@ TEST_CASE("workspace: the bound suffices, the reported peak is exact, one byte s
         CHECK(run(peak - 1, short_by_one) == Status::out_of_memory);
         CHECK(short_by_one.points_in == short_by_one.points_used + short_by_one.duplicates +
                                            short_by_one.rejected + short_by_one.unused);
+        // The bound is the peak of the worst layout, every point in one layer; with more
+        // layers the peak follows the largest layer.
         const double ratio = static_cast<double>(bound) / static_cast<double>(peak);
-        CHECK(ratio < 3.0);
+        if (setup.options.layer_count == 1) CHECK(ratio < 1.2);
         MESSAGE(std::string(setup.name) << ": bound " << bound << " B, peak " << peak << " B, bound / peak "
                            << ratio);
     }

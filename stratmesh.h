@@ -154,6 +154,7 @@ namespace stratmesh {
     X(invalid_layers, "a cut, the layer count or the layer height is NaN, infinite or negative") \
     X(flat_cloud, "the cloud has no extent along the axis")                               \
     X(not_columnar, "the points do not surround the axis in any layer")                   \
+    X(out_of_order, "a streamed layer is out of axis order: its top is below the previous one, or a point lies outside its heights") \
     /* memory */                                                                          \
     X(out_of_memory, "the workspace is smaller than its *_workspace_size() bound")         \
     X(triangle_capacity, "the triangle array is too small for the result")               \
@@ -271,6 +272,11 @@ enum Flags : uint32_t {
     // bytes per point with this flag; reconstruct_max_triangles() still suffices (a closed
     // surface through V vertices has 2V - 4 triangles).
     close_ends = 1u << 1,
+    // The frame's reference point is Options::origin instead of the centroid of the cloud
+    // (reconstruct) or of the first layer (the stream). The reference point changes only
+    // rounding, but a stream and a reconstruct() that are to give the same triangles need
+    // the same one.
+    origin_given = 1u << 2,
 };
 
 // Phases reported to Options::progress, in the order they run. Each layer is stitched to
@@ -300,6 +306,7 @@ struct Options {
     uint32_t layer_count;
     double layer_height;
     uint32_t flags;          // Flags bits
+    double origin[3];        // with the origin_given flag
     // Optional progress callback: called with each phase as it starts, and with the
     // fraction of that phase done from time to time. Must not call back into stratmesh.
     void (*progress)(void* user, Phase phase, double fraction);
@@ -347,6 +354,9 @@ struct Report {
     size_t caps_closed;
     size_t caps_left_open;
     size_t cap_triangles;
+    // The stream only: the most points it held at once (compare with the max_points_held
+    // given to stream_workspace_size()).
+    size_t points_held;
 };
 
 // A size in bytes that is always enough workspace for reconstruct() of point_count
@@ -399,6 +409,84 @@ Status reconstruct(const Cloud& cloud, const Options& options,
                    void* workspace, size_t workspace_bytes,
                    uint32_t* triangles, size_t triangle_capacity, size_t* triangle_count,
                    Report* report);
+
+// ==== Streaming reconstruction =============================================================
+//
+// For clouds that arrive layer by layer (a CT slice, a turntable turn, a lidar ring) or do
+// not fit in memory at once (a pipe, a tunnel, a tree stem): push the points of one layer
+// at a time, bottom to top along the axis; triangles come out through a callback as soon
+// as they are final. The stream holds only the layers it still needs: the top loop of the
+// last finished layer, the layer being formed and the pushes after it, so its memory
+// follows the largest layers, not the cloud.
+//
+//     stratmesh::Options options = {};
+//     options.axis = stratmesh::Axis::z;                   // required: not automatic
+//     std::vector<unsigned char> work(stratmesh::stream_workspace_size(3 * max_layer, options));
+//     stratmesh::Stream* stream = nullptr;
+//     stratmesh::stream_open(options, work.data(), work.size(), on_triangles, &mesh, &report,
+//                            &stream);
+//     for (each layer) stratmesh::stream_push(stream, layer_cloud, layer_top);
+//     stratmesh::stream_close(stream);
+//
+// Same triangles as reconstruct(): a push is one planned layer, as between two cuts, and
+// the stream forms layers from pushes by the rules reconstruct() applies to its planned
+// layers (a push too small, too thin or not surrounding its axis joins the next; a last
+// rest too small or thin joins the layer below it), waiting for later pushes where a rule
+// needs them. So reconstruct() of the concatenated pushes, with Options::cuts at the tops
+// of all pushes but the last, the same axis, the same origin (flag origin_given) and the
+// points of each push in the same order, gives the same triangles in the same order, with
+// the same global indices (checked on every test shape), provided no point lies within
+// 2^-40 of the height range below a cut (reconstruct() counts such a point in the layer
+// above) and no cut lies outside the points' height range. The stream makes no caps (the
+// close_ends flag is refused): cap the two boundary loops yourself, or run reconstruct().
+//
+// Memory: stream_workspace_size(max_points_held) bytes, about 190 per point held. The
+// stream holds the last layer's top loop, the layer being formed (pushes that join it
+// included) and the pushes after it until they can form a layer: when every push is at
+// least 16 points and 1.5 rows of points thick, three times the largest push suffices.
+// A push that would hold more returns out_of_memory and changes nothing; Report::points_held
+// says what a run needed.
+
+struct Stream;  // lives in the caller's workspace
+
+// Receives final triangles: 3 * count global indices (the position of the point among all
+// points pushed so far, invalid ones included), counter-clockwise seen from outside. The
+// array is only valid during the call.
+typedef void (*TriangleCallback)(void* user, const uint32_t* triangles, size_t count);
+
+// Bytes for a stream that holds at most max_points_held points at once; 0 if that is
+// beyond what this platform can address.
+size_t stream_workspace_size(size_t max_points_held, const Options& options);
+
+// Opens a stream in the workspace. options: axis (x, y, z or direction; automatic needs
+// the whole cloud and is refused with invalid_axis), flags skip_invalid_points and
+// origin_given; the layer options and the progress callback are not used (the pushes are
+// the layers). emit receives the triangles; report (optional) is updated after every push
+// and at close, and must stay valid until then (its layer array too). On success *stream
+// is the handle, valid until stream_close or until the workspace is reused.
+// Returns ok, invalid_argument (a null emit or stream, close_ends, a null workspace),
+// invalid_axis, out_of_memory (workspace smaller than stream_workspace_size(3 + ...)).
+Status stream_open(const Options& options, void* workspace, size_t workspace_bytes,
+                   TriangleCallback emit, void* emit_user, Report* report, Stream** stream);
+
+// Pushes the next layer: its points (any stride and scalar, as for reconstruct) and its top,
+// the height (dot(point, axis)) where the next layer begins. Every point must lie between
+// the previous push's top and this one's (up to 2^-40 of their size; the first push has no
+// lower limit), and top must not be below the previous top; the top of the last push only
+// bounds its points (the last layer ends at its highest point). May call emit.
+// Returns ok; invalid_argument (null stream, points in the workspace, a null pointer with a
+// non-zero count, a bad stride or scalar); invalid_point (NaN/Inf without
+// skip_invalid_points, or a point more than 2^60 times the first layer's size away);
+// invalid_layers (a NaN or infinite top); out_of_order; too_many_points (2^32 - 3 points in
+// all); out_of_memory (more than the workspace can hold: the push is refused and the stream
+// unchanged); and, from triangulating, the errors of reconstruct(), after which the stream
+// only returns that status. A refused push changes nothing.
+Status stream_push(Stream* stream, const Cloud& points, double top);
+
+// Forms and emits the last layers and completes the report. Returns ok or the status of
+// reconstruct() for the same cloud (too_few_points, flat_cloud, not_columnar, ...). The
+// stream cannot be pushed to afterwards.
+Status stream_close(Stream* stream);
 
 } // namespace stratmesh
 
@@ -2011,8 +2099,21 @@ inline Status choose_frame(const CloudReader& cloud, size_t count, const Options
         frame.origin = valid ? scaled(sum, 1.0 / static_cast<double>(valid)) : Vec3{0, 0, 0};
     }
     Vec3 size = valid ? high - low : Vec3{0, 0, 0};
+    Vec3 half_size = valid ? scaled(high, 0.5) - scaled(low, 0.5) : Vec3{0, 0, 0};
+    if (options.flags & origin_given) {
+        Vec3 given = {options.origin[0], options.origin[1], options.origin[2]};
+        if (!(is_finite(given.x) && is_finite(given.y) && is_finite(given.z)))
+            return Status::invalid_argument;
+        // The extent covers the way from the given origin to the cloud, so the frame's
+        // coordinates stay near 1 however far the origin is.
+        Vec3 way = scaled(frame.origin, 0.5) - scaled(given, 0.5);
+        way = {abs_value(way.x), abs_value(way.y), abs_value(way.z)};
+        half_size = {half_size.x + way.x, half_size.y + way.y, half_size.z + way.z};
+        size = {size.x + 2 * way.x, size.y + 2 * way.y, size.z + 2 * way.z};
+        frame.origin = given;
+    }
     frame.halved = !(is_finite(size.x) && is_finite(size.y) && is_finite(size.z));
-    if (frame.halved) size = scaled(high, 0.5) - scaled(low, 0.5);
+    if (frame.halved) size = half_size;
     frame.half_origin = scaled(frame.origin, 0.5);
     double extent = size.x > size.y ? size.x : size.y;
     if (size.z > extent) extent = size.z;
@@ -4005,6 +4106,22 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
 
 namespace detail {
 
+// The chain's counts into the report, with the reason when a valid point is not a vertex.
+inline void report_chain(const SurfaceChain& chain, size_t valid, Report& rep) {
+    rep.duplicates = chain.duplicates;
+    rep.illegal_removed = chain.removed;
+    rep.points_used = chain.used;
+    rep.diagonal_swaps = chain.swaps;
+    if (chain.trailing > 0)
+        rep.detail = "the points of the last layers do not surround the axis: they are not "
+                     "vertices";
+    else if (chain.collisions > 0)
+        rep.detail = "some points share their place on the unrolled layer with another point "
+                     "(the layer is not star-shaped around its centre there): not vertices";
+    else if (valid - rep.duplicates > chain.used)
+        rep.detail = "the manifold safety net removed the triangles of some points";
+}
+
 // The whole reconstruction; `rep` arrives zeroed but for its layer array. Report::unused
 // is left to the caller, who derives it so the counts add up on every path.
 inline Status run_reconstruction(const Cloud& cloud, const Options& options, void* workspace,
@@ -4153,21 +4270,11 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     rep.cap_triangles = caps.triangles;
     *triangle_count = count;
     rep.triangle_count = count;
-    rep.illegal_removed = chain.removed;
     rep.folds = sink.folds;
-    rep.points_used = chain.used;
-    if (chain.trailing > 0)
-        rep.detail = "the points of the last layers do not surround the axis: they are not "
-                     "vertices";
-    else if (chain.collisions > 0)
-        rep.detail = "some points share their place on the unrolled layer with another point "
-                     "(the layer is not star-shaped around its centre there): not vertices";
-    else if (valid - rep.duplicates > chain.used)
-        rep.detail = "the manifold safety net removed the triangles of some points";
-    else if (caps.left_open > 0)
+    report_chain(chain, valid, rep);
+    if (!rep.detail && caps.left_open > 0)
         rep.detail = "a boundary loop's projection across the axis is not a simple polygon (or "
                      "each of its ears would repeat an edge of the surface): it is left open";
-    rep.diagonal_swaps = chain.swaps;
     notify(options, Phase::done, 1);
     return finish(Status::ok);
 }
@@ -4193,6 +4300,344 @@ Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
                                                triangles, triangle_capacity, triangle_count,
                                                rep);
     rep.unused = rep.points_in - rep.points_used - rep.duplicates - rep.rejected;
+    return status;
+}
+
+// >>stream ==================================================================================
+//
+// The stream is reconstruct()'s loop over planned layers, driven by pushes: each push is
+// appended to a window of held points as one planned layer, and add_group runs for as long
+// as it can decide. A finished group's chunk goes to the callback; then the window keeps
+// only that group's top loop (moved to the front) and the pushes after it.
+
+struct Stream {
+    detail::Arena arena;          // the scratch, after everything below
+    detail::ByteRange workspace;  // for the overlap check of pushed points
+    Options options;
+    TriangleCallback emit;
+    void* emit_user;
+    Report* user_report;
+    Report rep;
+    size_t capacity;              // points the window holds
+    uint32_t slot_capacity;       // pushes it holds
+    detail::Vec3* points;         // the window: the last top loop, then the held pushes
+    uint32_t* global;             // window position -> global index
+    uint32_t* positions;          // 0, 1, 2, ...: window positions as reader indices
+    uint32_t* start;              // held push k starts at window position start[k]
+    double* bounds;               // its heights: bounds[k] .. bounds[k + 1]
+    uint32_t planned;             // pushes held
+    size_t fill;                  // window positions in use
+    detail::TriangleSink sink;    // one chunk at a time
+    detail::SurfaceChain chain;
+    bool has_frame;
+    double last_top;              // the previous push's top, as a frame height
+    double lowest, highest;       // the points' frame heights so far
+    size_t distinct;              // distinct points seen, up to 3
+    detail::Vec3 seen[2];
+    Status failure;               // sticky: a triangulation error
+    bool closed;
+};
+
+namespace detail {
+
+// Points more than this many times the first layer's size away from it are refused: the
+// frame is scaled to the first layer, and the predicates' exact range must hold.
+const double kStreamRange = 0x1p60;
+
+// Everything a stream holds for a window of `capacity` points.
+inline bool layout_stream(Stream& s, size_t capacity, Arena& arena) {
+    s.capacity = capacity;
+    s.slot_capacity = static_cast<uint32_t>(capacity + 1);
+    s.points = arena.alloc<Vec3>(capacity);
+    s.global = arena.alloc<uint32_t>(capacity);
+    s.positions = arena.alloc<uint32_t>(capacity);
+    s.start = arena.alloc<uint32_t>(static_cast<size_t>(s.slot_capacity) + 1);
+    s.bounds = arena.alloc<double>(static_cast<size_t>(s.slot_capacity) + 1);
+    // A chunk's triangles: at most two per point of the group and the loop below it.
+    s.sink = {arena.alloc<uint32_t>(3 * 2 * capacity), 2 * capacity, 0, 0};
+    return allocate_chain(s.chain, capacity, arena) && !arena.failed;
+}
+
+inline size_t stream_bytes(size_t capacity) {
+    if (capacity > kMaxPoints - 1) return 0;
+    Arena arena = Arena::measuring();
+    arena.alloc<Stream>(1);
+    Stream probe;
+    layout_stream(probe, capacity, arena);
+    size_t scratch = reconstruct_scratch_size(capacity, false);
+    if (arena.failed || scratch == 0 || scratch > SIZE_MAX - arena.required_bytes()) return 0;
+    return arena.required_bytes() + scratch;
+}
+
+inline void publish(Stream& s) {
+    s.rep.unused = s.rep.points_in - s.rep.points_used - s.rep.duplicates - s.rep.rejected;
+    s.rep.workspace_used = s.arena.peak_from_buffer();
+    if (s.user_report) *s.user_report = s.rep;
+}
+
+// Keeps the last group's top loop (moved to the front of the window) and the pushes after
+// planned layer `last`.
+inline void drop_group(Stream& s, uint32_t last) {
+    const uint32_t loop = s.chain.top_count;
+    const size_t rest_from = s.start[last + 1], rest = s.fill - rest_from;
+    size_t mark = s.arena.mark();
+    Vec3* loop_points = s.arena.alloc<Vec3>(loop);
+    uint32_t* loop_global = s.arena.alloc<uint32_t>(loop);
+    // The scratch bound covers a group as large as the window, far more than this.
+    for (uint32_t i = 0; i < loop; ++i) {
+        loop_points[i] = s.points[s.chain.top[i]];
+        loop_global[i] = s.global[s.chain.top[i]];
+    }
+    std::memmove(s.points + loop, s.points + rest_from, rest * sizeof(Vec3));
+    std::memmove(s.global + loop, s.global + rest_from, rest * sizeof(uint32_t));
+    std::memcpy(s.points, loop_points, loop * sizeof(Vec3));
+    std::memcpy(s.global, loop_global, loop * sizeof(uint32_t));
+    for (uint32_t i = 0; i < loop; ++i) s.chain.top[i] = i;
+    s.arena.rewind(mark);
+    const uint32_t kept = s.planned - (last + 1);
+    for (uint32_t k = 0; k <= kept; ++k) {
+        s.start[k] = static_cast<uint32_t>(s.start[k + last + 1] - rest_from + loop);
+        s.bounds[k] = s.bounds[k + last + 1];
+    }
+    s.planned = kept;
+    s.fill = loop + rest;
+}
+
+// Forms, emits and drops every group the held pushes decide.
+inline Status advance(Stream& s, bool complete) {
+    while (s.planned > 0) {
+        const LayerQueue queue = {s.positions, s.start, s.bounds, s.planned, complete};
+        GroupResult group;
+        s.sink.count = 0;
+        Status status = add_group(s.chain, queue, 0, s.arena, s.sink, group);
+        if (status == Status::not_columnar) return Status::ok;  // the rest is trailing
+        if (status == Status::ok && s.sink.count > s.sink.capacity) status = Status::internal_error;
+        if (status != Status::ok) return status;
+        if (group.waiting) return Status::ok;
+        if (s.sink.count > 0) s.emit(s.emit_user, s.sink.triangles, s.sink.count);
+        s.rep.triangle_count += s.sink.count;
+        if (s.rep.layer_count < s.rep.layer_capacity)
+            describe_layer(s.chain.frame, group.cylinder, s.bounds[0], s.bounds[group.last + 1],
+                           group.points - group.counts.duplicates, group.triangles, group.folds,
+                           s.rep.layers[s.rep.layer_count]);
+        ++s.rep.layer_count;
+        drop_group(s, group.last);
+    }
+    return Status::ok;
+}
+
+inline bool tracks_new_distinct_point(Stream& s, Vec3 p) {
+    for (size_t k = 0; k < s.distinct && k < 2; ++k)
+        if (p.x == s.seen[k].x && p.y == s.seen[k].y && p.z == s.seen[k].z) return false;
+    if (s.distinct < 2) s.seen[s.distinct] = p;
+    return true;
+}
+
+}  // namespace detail
+
+size_t stream_workspace_size(size_t max_points_held, const Options& options) {
+    (void)options;
+    return detail::stream_bytes(max_points_held);
+}
+
+Status stream_open(const Options& options, void* workspace, size_t workspace_bytes,
+                   TriangleCallback emit, void* emit_user, Report* report, Stream** stream) {
+    if (!stream || !emit || !workspace || (options.flags & close_ends)) return Status::invalid_argument;
+    *stream = nullptr;
+    const detail::ByteRange work = detail::byte_range(workspace, workspace_bytes);
+    if (report) {
+        const detail::ByteRange ranges[] = {
+            work, detail::byte_range(report, sizeof(Report)),
+            detail::byte_range(report->layers,
+                               detail::saturating_product(report->layer_capacity, sizeof(LayerInfo)))};
+        if (detail::any_overlap(ranges, 3)) return Status::invalid_argument;
+    }
+    if (options.axis == Axis::automatic) return Status::invalid_axis;
+    // The largest window this workspace holds.
+    size_t low = 0, high = workspace_bytes / sizeof(detail::Vec3);
+    if (high > detail::kMaxPoints - 1) high = detail::kMaxPoints - 1;
+    while (low < high) {
+        size_t mid = low + (high - low + 1) / 2;
+        size_t bytes = detail::stream_bytes(mid);
+        if (bytes != 0 && bytes <= workspace_bytes) low = mid; else high = mid - 1;
+    }
+    if (low < detail::kMinLayerPoints) return Status::out_of_memory;
+    detail::Arena arena = detail::Arena::over(workspace, workspace_bytes);
+    Stream* s = arena.alloc<Stream>(1);
+    if (!s) return Status::out_of_memory;
+    std::memset(static_cast<void*>(s), 0, sizeof *s);
+    if (!detail::layout_stream(*s, low, arena)) return Status::out_of_memory;
+    s->arena = arena;
+    s->workspace = work;
+    s->options = options;
+    s->options.cuts = nullptr;
+    s->options.cut_count = 0;
+    s->emit = emit;
+    s->emit_user = emit_user;
+    s->user_report = report;
+    s->rep.layers = report ? report->layers : nullptr;
+    s->rep.layer_capacity = s->rep.layers ? report->layer_capacity : 0;
+    s->failure = Status::ok;
+    for (size_t i = 0; i < low; ++i) s->positions[i] = static_cast<uint32_t>(i);
+    // The frame's axis is checked now, on no points.
+    detail::Frame frame;
+    detail::CloudReader none = {nullptr, 0, false};
+    Status status = detail::choose_frame(none, 0, options, frame);
+    if (status != Status::ok) return status;
+    detail::publish(*s);
+    *stream = s;
+    return Status::ok;
+}
+
+Status stream_push(Stream* stream, const Cloud& points, double top) {
+    if (!stream || stream->closed) return Status::invalid_argument;
+    Stream& s = *stream;
+    if (s.failure != Status::ok) return s.failure;
+    size_t scalar = points.scalar == Scalar::float32 ? sizeof(float)
+                  : points.scalar == Scalar::float64 ? sizeof(double) : 0;
+    size_t stride = points.stride_bytes ? points.stride_bytes : 3 * scalar;
+    if (scalar == 0 || stride < 3 * scalar || (points.count > 0 && !points.xyz))
+        return Status::invalid_argument;
+    if (detail::ranges_overlap(detail::strided_range(points.xyz, points.count, stride, 3 * scalar),
+                               s.workspace))
+        return Status::invalid_argument;
+    if (!detail::is_finite(top)) return Status::invalid_layers;
+    if (points.count > detail::kMaxPoints - 1 - s.rep.points_in) return Status::too_many_points;
+    const detail::CloudReader reader = {static_cast<const unsigned char*>(points.xyz), stride,
+                                        points.scalar == Scalar::float32};
+    // Check everything before anything changes.
+    size_t valid = 0;
+    for (size_t i = 0; i < points.count; ++i) {
+        if (reader.valid(i)) {
+            ++valid;
+        } else if (!(s.options.flags & skip_invalid_points)) {
+            s.rep.first_invalid_point = s.rep.points_in + i;
+            s.rep.detail = "a point has a NaN or infinite coordinate (see first_invalid_point; "
+                           "the skip_invalid_points flag skips such points instead)";
+            detail::publish(s);
+            return Status::invalid_point;
+        }
+    }
+    if (!s.has_frame && valid == 0) {  // nothing to place yet: pushes before the first point
+        s.rep.points_in += points.count;
+        s.rep.rejected += points.count;
+        detail::publish(s);
+        return Status::ok;
+    }
+    detail::Frame frame = s.chain.frame;
+    if (!s.has_frame) {
+        Status status = detail::choose_frame(reader, points.count, s.options, frame);
+        if (status != Status::ok) return status;
+    }
+    const double top_height = (top - detail::dot(frame.origin, frame.axis)) * frame.scale;
+    auto slack = [](double h) { return 0x1p-40 * (1 + detail::abs_value(h)); };
+    if (s.has_frame && top_height < s.last_top) {
+        s.rep.detail = "a pushed layer's top is below the previous layer's top";
+        detail::publish(s);
+        return Status::out_of_order;
+    }
+    double low = DBL_MAX, high = -DBL_MAX;
+    for (size_t i = 0; i < points.count; ++i) {
+        if (!reader.valid(i)) continue;
+        detail::Local p = frame.local(reader.point(i));
+        if (!(detail::abs_value(p.x) <= detail::kStreamRange &&
+              detail::abs_value(p.y) <= detail::kStreamRange &&
+              detail::abs_value(p.h) <= detail::kStreamRange)) {
+            s.rep.first_invalid_point = s.rep.points_in + i;
+            s.rep.detail = "a pushed point lies more than 2^60 times the first layer's size away "
+                           "from it";
+            detail::publish(s);
+            return Status::invalid_point;
+        }
+        if (p.h > top_height + slack(top_height) ||
+            (s.has_frame && p.h < s.last_top - slack(s.last_top))) {
+            s.rep.detail = "a pushed point lies outside its layer: below the previous layer's "
+                           "top or above its own";
+            detail::publish(s);
+            return Status::out_of_order;
+        }
+        if (p.h < low) low = p.h;
+        if (p.h > high) high = p.h;
+    }
+    if (s.fill + valid > s.capacity || s.planned + 1 > s.slot_capacity) {
+        s.rep.detail = "the stream would hold more points or layers than its workspace: push "
+                       "thicker layers, or give more workspace (see Report::points_held)";
+        detail::publish(s);
+        return Status::out_of_memory;
+    }
+    // Commit.
+    if (!s.has_frame) {
+        s.has_frame = true;
+        s.chain.frame = frame;
+        s.chain.reader = {reinterpret_cast<const unsigned char*>(s.points), sizeof(detail::Vec3), false};
+        s.chain.output_id = s.global;
+        s.rep.axis[0] = frame.axis.x;
+        s.rep.axis[1] = frame.axis.y;
+        s.rep.axis[2] = frame.axis.z;
+        s.rep.axis_origin[0] = frame.origin.x;
+        s.rep.axis_origin[1] = frame.origin.y;
+        s.rep.axis_origin[2] = frame.origin.z;
+        s.lowest = low;
+        s.highest = high;
+        s.bounds[0] = low;
+        s.start[0] = 0;
+    } else {
+        s.bounds[s.planned] = s.last_top;  // was the highest point so far
+    }
+    for (size_t i = 0; i < points.count; ++i) {
+        if (!reader.valid(i)) {
+            ++s.rep.rejected;
+            continue;
+        }
+        detail::Vec3 p = reader.point(i);
+        if (s.distinct < 3 && detail::tracks_new_distinct_point(s, p)) ++s.distinct;
+        s.points[s.fill] = p;
+        s.global[s.fill] = static_cast<uint32_t>(s.rep.points_in + i);
+        ++s.fill;
+    }
+    s.rep.points_in += points.count;
+    if (valid > 0 && high > s.highest) s.highest = high;
+    ++s.planned;
+    s.start[s.planned] = static_cast<uint32_t>(s.fill);
+    s.bounds[s.planned] = s.highest;
+    s.last_top = top_height;
+    if (s.fill > s.rep.points_held) s.rep.points_held = s.fill;
+    Status status = detail::advance(s, false);
+    if (status != Status::ok) s.failure = status;
+    detail::report_chain(s.chain, s.rep.points_in - s.rep.rejected, s.rep);
+    s.rep.folds = s.sink.folds;
+    detail::publish(s);
+    return status;
+}
+
+Status stream_close(Stream* stream) {
+    if (!stream || stream->closed) return Status::invalid_argument;
+    Stream& s = *stream;
+    s.closed = true;
+    Status status = s.failure;
+    const size_t valid = s.rep.points_in - s.rep.rejected;
+    if (status == Status::ok && (valid < 3 || s.distinct < 3)) {
+        s.rep.detail = "fewer than 3 distinct valid points";
+        status = Status::too_few_points;
+    } else if (status == Status::ok && !(s.highest > s.lowest)) {
+        s.rep.detail = "every point has the same height along the axis";
+        status = Status::flat_cloud;
+    }
+    if (status == Status::ok) status = detail::advance(s, true);
+    if (status == Status::ok) {
+        detail::report_chain(s.chain, valid, s.rep);
+        s.rep.folds = s.sink.folds;
+        if (s.rep.layer_count == 0) {
+            s.rep.detail = "no layer's points surround the axis: the cloud is not columnar "
+                           "around it (try another axis)";
+            status = Status::not_columnar;
+        } else if (s.rep.triangle_count == 0) {
+            s.rep.detail = "every point lies on the boundary of its layer: too few points to "
+                           "span a surface";
+            status = Status::too_few_points;
+        }
+    }
+    detail::publish(s);
     return status;
 }
 

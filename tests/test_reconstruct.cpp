@@ -21,6 +21,7 @@
 //     annulus skip points slightly inside them) and 1.3 off the boundary; up to 3.22
 //     through the bands with several layers (noisy tube, 2000 points).
 #include "stratmesh.h"
+#include "support/library_options.h"
 #include "support/mesh_check.h"
 #include "support/shapes.h"
 
@@ -98,21 +99,8 @@ Run reconstruct_guarded(const Cloud& cloud, const Options& options, size_t misal
     return run;
 }
 
-Cloud cloud_of(const Shape& s) { return Cloud{s.xyz.data(), s.size(), 0, Scalar::float64}; }
-
-// The stacking axis of a shape as the library is told it.
-Options axis_options(const Shape& s) {
-    Options o = {};
-    switch (s.pose) {
-    case Pose::z: o.axis = Axis::z; break;
-    case Pose::x: o.axis = Axis::x; break;
-    case Pose::tilted:
-        o.axis = Axis::direction;
-        s.axis_direction(o.direction);
-        break;
-    }
-    return o;
-}
+using library_options::axis_options;
+using library_options::cloud_of;
 
 mesh_check::Result check_mesh(const Shape& s, const uint32_t* triangles, size_t count,
                               bool self_intersections,

@@ -1,0 +1,274 @@
+// The streaming reconstruction: pushed layer by layer, it gives reconstruct()'s triangles
+// on the same layers, in bounded memory, and refuses malformed pushes without changing.
+#include "stratmesh.h"
+#include "support/library_options.h"
+#include "support/mesh_check.h"
+#include "support/shapes.h"
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace {
+
+using library_options::axis_options;
+using stratmesh::Cloud;
+using stratmesh::LayerInfo;
+using stratmesh::Options;
+using stratmesh::Report;
+using stratmesh::Scalar;
+using stratmesh::Status;
+using shapes::Pose;
+using shapes::Shape;
+
+// A cloud cut into layers: the points reordered layer after layer (input order within a
+// layer) and the cuts between them, each half-way across a gap between the points'
+// heights, so that which side a point lies on does not depend on rounding.
+struct Layered {
+    std::vector<double> xyz;
+    std::vector<double> cuts;   // one fewer than the layers
+    std::vector<size_t> start;  // first point of each layer, then the end
+    double top = 0;             // above every point: the last push's top
+    size_t size() const { return xyz.size() / 3; }
+};
+
+double height_of(const double* p, const double axis[3]) {
+    return p[0] * axis[0] + p[1] * axis[1] + p[2] * axis[2];
+}
+
+// Layers at the given fractions of the height range (each moved to the middle of the
+// nearest gap between point heights).
+Layered layer_cloud(const std::vector<double>& xyz, const double axis[3],
+                    const std::vector<double>& fractions) {
+    const size_t n = xyz.size() / 3;
+    std::vector<double> heights(n);
+    for (size_t i = 0; i < n; ++i) heights[i] = height_of(&xyz[3 * i], axis);
+    std::vector<double> sorted = heights;
+    std::sort(sorted.begin(), sorted.end());
+    Layered out;
+    for (double f : fractions) {
+        size_t k = static_cast<size_t>(f * static_cast<double>(n - 1));
+        while (k + 1 < n && sorted[k + 1] - sorted[k] < 1e-9 * (1 + std::fabs(sorted[k]))) ++k;
+        if (k + 1 >= n) continue;
+        double cut = (sorted[k] + sorted[k + 1]) / 2;
+        if (out.cuts.empty() || cut > out.cuts.back()) out.cuts.push_back(cut);
+    }
+    out.top = sorted.back() + 1;
+    out.start.push_back(0);
+    for (size_t layer = 0; layer <= out.cuts.size(); ++layer) {
+        double lo = layer == 0 ? -std::numeric_limits<double>::infinity() : out.cuts[layer - 1];
+        double hi = layer == out.cuts.size() ? std::numeric_limits<double>::infinity() : out.cuts[layer];
+        for (size_t i = 0; i < n; ++i)
+            if (heights[i] >= lo && heights[i] < hi) out.xyz.insert(out.xyz.end(), &xyz[3 * i], &xyz[3 * i] + 3);
+        out.start.push_back(out.xyz.size() / 3);
+    }
+    return out;
+}
+
+std::vector<double> equal_fractions(size_t layers) {
+    std::vector<double> f;
+    for (size_t k = 1; k < layers; ++k) f.push_back(static_cast<double>(k) / static_cast<double>(layers));
+    return f;
+}
+
+struct Output {
+    Status status = Status::internal_error;
+    std::vector<uint32_t> triangles;
+    Report report{};
+    std::vector<LayerInfo> layers;
+};
+
+void collect(void* user, const uint32_t* triangles, size_t count) {
+    std::vector<uint32_t>* out = static_cast<std::vector<uint32_t>*>(user);
+    out->insert(out->end(), triangles, triangles + 3 * count);
+}
+
+Output run_batch(const Layered& l, Options o) {
+    Output out;
+    o.cuts = l.cuts.data();
+    o.cut_count = l.cuts.size();
+    const Cloud cloud = {l.xyz.data(), l.size(), 0, Scalar::float64};
+    std::vector<unsigned char> work(stratmesh::reconstruct_workspace_size(cloud.count, o));
+    out.triangles.resize(3 * stratmesh::reconstruct_max_triangles(cloud.count, o));
+    out.layers.resize(512);
+    out.report.layers = out.layers.data();
+    out.report.layer_capacity = out.layers.size();
+    size_t count = 0;
+    out.status = stratmesh::reconstruct(cloud, o, work.data(), work.size(), out.triangles.data(),
+                                        out.triangles.size() / 3, &count, &out.report);
+    out.triangles.resize(3 * count);
+    return out;
+}
+
+// Pushes the layers one at a time into a stream that may hold `held` points.
+Output run_stream(const Layered& l, const Options& o, size_t held) {
+    Output out;
+    std::vector<unsigned char> work(stratmesh::stream_workspace_size(held, o));
+    out.layers.resize(512);
+    out.report.layers = out.layers.data();
+    out.report.layer_capacity = out.layers.size();
+    stratmesh::Stream* stream = nullptr;
+    out.status = stratmesh::stream_open(o, work.data(), work.size(), collect, &out.triangles,
+                                        &out.report, &stream);
+    if (out.status != Status::ok) return out;
+    for (size_t k = 0; k + 1 < l.start.size(); ++k) {
+        const Cloud layer = {l.xyz.data() + 3 * l.start[k], l.start[k + 1] - l.start[k], 0,
+                             Scalar::float64};
+        out.status = stratmesh::stream_push(stream, layer, k < l.cuts.size() ? l.cuts[k] : l.top);
+        if (out.status != Status::ok) return out;
+    }
+    out.status = stratmesh::stream_close(stream);
+    return out;
+}
+
+// The origin both runs use: the first point (any point will do, as long as it is shared).
+Options shared_origin(const Shape& s) {
+    Options o = axis_options(s);
+    o.flags = stratmesh::origin_given;
+    for (int k = 0; k < 3; ++k) o.origin[k] = s.xyz[static_cast<size_t>(k)];
+    return o;
+}
+
+void check_same(const Output& batch, const Output& stream) {
+    REQUIRE(batch.status == Status::ok);
+    CHECK(stream.status == batch.status);
+    CHECK(stream.triangles.size() == batch.triangles.size());
+    CHECK(stream.triangles == batch.triangles);
+    CHECK(stream.report.points_in == batch.report.points_in);
+    CHECK(stream.report.points_used == batch.report.points_used);
+    CHECK(stream.report.duplicates == batch.report.duplicates);
+    CHECK(stream.report.unused == batch.report.unused);
+    CHECK(stream.report.triangle_count == batch.report.triangle_count);
+    CHECK(stream.report.illegal_removed == batch.report.illegal_removed);
+    CHECK(stream.report.folds == batch.report.folds);
+    CHECK(stream.report.diagonal_swaps == batch.report.diagonal_swaps);
+    REQUIRE(stream.report.layer_count == batch.report.layer_count);
+    for (size_t k = 0; k < batch.report.layer_count && k < batch.layers.size(); ++k) {
+        CHECK(stream.layers[k].point_count == batch.layers[k].point_count);
+        CHECK(stream.layers[k].triangle_count == batch.layers[k].triangle_count);
+        CHECK(stream.layers[k].bottom == doctest::Approx(batch.layers[k].bottom));
+        CHECK(stream.layers[k].top == doctest::Approx(batch.layers[k].top));
+        CHECK(stream.layers[k].radius == doctest::Approx(batch.layers[k].radius));
+    }
+}
+
+struct StreamShape {
+    const char* name;
+    Shape (*make)(size_t, Pose);
+};
+
+const StreamShape kShapes[] = {
+    {"cylinder", [](size_t n, Pose p) { return shapes::cylinder(n, p); }},
+    {"elliptic tube", [](size_t n, Pose p) { return shapes::elliptic_tube(n, p); }},
+    {"bumpy tube", [](size_t n, Pose p) { return shapes::bumpy_tube(n, p); }},
+    {"cone", [](size_t n, Pose p) { return shapes::cone(n, p); }},
+    {"vase", [](size_t n, Pose p) { return shapes::vase(n, p); }},
+    {"scan grid", [](size_t n, Pose p) { return shapes::scan_grid(n, p); }},
+    {"CT slices", [](size_t n, Pose p) { return shapes::ct_slices(n, p); }},
+    {"noisy tube", [](size_t n, Pose p) { return shapes::noisy_tube(n, p); }},
+    {"head", [](size_t n, Pose p) { return shapes::head(n, p); }},
+};
+
+}  // namespace
+
+TEST_CASE("stream: the same triangles as reconstruct() on the same layers, every test shape") {
+    // Equal layers; many thin pushes that must merge; uneven pushes with a thin last one.
+    const std::vector<std::vector<double>> plans = {
+        equal_fractions(6), equal_fractions(40), {0.03, 0.06, 0.85, 0.97}, {}};
+    for (const StreamShape& kind : kShapes) {
+        for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
+            for (size_t n : {size_t(400), size_t(3000)}) {
+                const Shape s = kind.make(n, pose);
+                double axis[3];
+                s.axis_direction(axis);
+                for (size_t plan = 0; plan < plans.size(); ++plan) {
+                    INFO(kind.name << " (" << shapes::pose_name(pose) << "), " << n
+                                   << " points, plan " << plan);
+                    const Layered l = layer_cloud(s.xyz, axis, plans[plan]);
+                    const Options o = shared_origin(s);
+                    const Output batch = run_batch(l, o);
+                    // Room for the whole cloud: the stream's grouping is tested, not its memory.
+                    const Output stream = run_stream(l, o, l.size());
+                    check_same(batch, stream);
+                }
+            }
+        }
+    }
+}
+
+TEST_CASE("stream: pushes of one contour each (CT slices) merge into layers as reconstruct() does") {
+    for (Pose pose : {Pose::z, Pose::x}) {
+        const Shape s = shapes::ct_slices(2000, pose);
+        double axis[3];
+        s.axis_direction(axis);
+        std::vector<double> fractions;  // a cut between every two planes
+        for (size_t k = 1; k < s.planes.size(); ++k) fractions.push_back(static_cast<double>(k) / static_cast<double>(s.planes.size()));
+        const Layered l = layer_cloud(s.xyz, axis, fractions);
+        REQUIRE(l.cuts.size() == s.planes.size() - 1);
+        const Options o = shared_origin(s);
+        const Output batch = run_batch(l, o);
+        const Output stream = run_stream(l, o, l.size());
+        check_same(batch, stream);
+    }
+}
+
+TEST_CASE("stream: 200,000 points in 100 layers run in a workspace sized for 2.5 layers") {
+    const Shape s = shapes::bumpy_tube(200000, Pose::z);
+    double axis[3];
+    s.axis_direction(axis);
+    const Layered l = layer_cloud(s.xyz, axis, equal_fractions(100));
+    size_t largest = 0;
+    for (size_t k = 0; k + 1 < l.start.size(); ++k) largest = std::max(largest, l.start[k + 1] - l.start[k]);
+    const Options o = shared_origin(s);
+    const size_t held = largest * 5 / 2;
+    const Output stream = run_stream(l, o, held);
+    const Output batch = run_batch(l, o);
+    check_same(batch, stream);
+    CHECK(stream.report.points_held <= held);
+    CHECK(stream.report.points_held > largest);
+    const size_t stream_bytes = stratmesh::stream_workspace_size(held, o);
+    const size_t batch_bytes = stratmesh::reconstruct_workspace_size(l.size(), o);
+    CHECK(stream.report.workspace_used <= stream_bytes);
+    CHECK(stream_bytes * 20 < batch_bytes);
+    MESSAGE("largest layer " << largest << " points, held at most " << stream.report.points_held
+                             << "; stream workspace " << stream_bytes << " B, batch " << batch_bytes << " B");
+}
+
+TEST_CASE("stream: the output is a manifold tube through every point") {
+    const Shape s = shapes::vase(5000, Pose::tilted);
+    double axis[3];
+    s.axis_direction(axis);
+    const Layered l = layer_cloud(s.xyz, axis, equal_fractions(10));
+    Options o = axis_options(s);  // no origin given: the first layer's centroid
+    const Output out = run_stream(l, o, l.size());
+    REQUIRE(out.status == Status::ok);
+    Shape reordered = s;
+    reordered.xyz = l.xyz;
+    mesh_check::Input in;
+    in.points = reordered.xyz.data();
+    in.point_count = reordered.size();
+    in.triangles = out.triangles.data();
+    in.triangle_count = out.triangles.size() / 3;
+    reordered.axis_point(in.axis_point);
+    reordered.axis_direction(in.axis_direction);
+    in.surface = [&reordered](const double* p) { return reordered.deviation(p); };
+    in.self_intersections = true;
+    const mesh_check::Result r = mesh_check::check(in);
+    CHECK(r.bad_indices == 0);
+    CHECK(r.nonmanifold_edges == 0);
+    CHECK(r.nonmanifold_vertices == 0);
+    CHECK(r.inconsistent_edges == 0);
+    CHECK(r.components == 1);
+    CHECK(r.boundary_loops == 2);
+    CHECK(r.euler == 0);
+    CHECK(r.vertices_used == s.size());
+    CHECK(r.inward == 0);
+    CHECK(r.intersecting_pairs == 0);
+    CHECK(out.report.points_used == s.size());
+    CHECK(out.report.layer_count == 10);
+}

@@ -66,7 +66,7 @@
 // the input.
 //
 // delaunay_2d needs 72 bytes per point plus about 10 KiB; its output is at most
-// 2n - 5 triangles (24 bytes per point). reconstruct needs about 112 bytes per point
+// 2n - 5 triangles (24 bytes per point). reconstruct needs about 114 bytes per point
 // (the triangulation of its largest possible layer with the layer's coordinates, plus the
 // layer grouping and boundary loops), about 118 with the close_ends flag; its output is at
 // most 2n triangles.
@@ -285,6 +285,14 @@ enum Flags : uint32_t {
 // close_ends are made within `manifold`.
 enum class Phase : uint32_t { validate = 0, layers, triangulate, stitch, manifold, done };
 
+// One job of a batch run by Options::run_jobs: job(context, index).
+typedef void (*JobFunction)(void* context, uint32_t index);
+
+// Runs job(context, i) once for every i in [0, count), in any order, on any threads (the
+// caller's pool, RTOS tasks, std::thread, or a plain loop), and returns when all have
+// finished. Jobs are independent: each writes only its own part of the workspace.
+typedef void (*JobRunner)(void* user, uint32_t count, JobFunction job, void* context);
+
 // All zero means defaults: `Options options = {};` is always valid.
 struct Options {
     Axis axis;
@@ -311,7 +319,20 @@ struct Options {
     // fraction of that phase done from time to time. Must not call back into stratmesh.
     void (*progress)(void* user, Phase phase, double fraction);
     void* progress_user;
+    // Optional, reconstruct() only: with a runner, the layers are triangulated as
+    // independent jobs (at most kMaxJobs of them, each over a run of consecutive layers with
+    // its own scratch in the workspace), and so are the safety net's passes over the
+    // chunks; the stitching between layers stays in order. The triangles and the report
+    // are the same bytes whatever the runner does, as long as it runs every job once.
+    // reconstruct_workspace_size() grows with a runner (see there); a workspace too small
+    // for the jobs' scratch runs them in order instead (Report::parallel_layers says how
+    // many layers were triangulated by jobs). Jobs call no user code, not even progress.
+    JobRunner run_jobs;
+    void* jobs_user;
 };
+
+// The most jobs reconstruct() hands to Options::run_jobs at once.
+const uint32_t kMaxJobs = 64;
 
 struct LayerInfo {
     double bottom, top;      // extent along the axis, as dot(point, axis)
@@ -357,6 +378,9 @@ struct Report {
     // The stream only: the most points it held at once (compare with the max_points_held
     // given to stream_workspace_size()).
     size_t points_held;
+    // With Options::run_jobs: the layers triangulated by jobs (0 if the workspace was too
+    // small for them, or without a runner).
+    size_t parallel_layers;
 };
 
 // A size in bytes that is always enough workspace for reconstruct() of point_count
@@ -3900,7 +3924,9 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
                 status = Status::out_of_memory;
             result.triangles = sink.count - chunk_start;
             result.folds = sink.folds - folds;
+            // The layer's points are no longer needed: the safety net takes their room.
             // Past the caller's capacity only the count goes on (triangle_capacity follows).
+            arena.rewind(mark);
             if (status == Status::ok && sink.count <= sink.capacity)
                 status = finish_chunk(c, layer, loops, chunk_start, arena, sink);
             if (status == Status::ok) {
@@ -3972,9 +3998,10 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
     group.alloc<double>(2);  // the second loop's alignment
     group.alloc<unsigned char>(count);
     group.alloc<double>(kIncircleScratch);
-    group.rewind(loaded);
-    // The chunk's safety net: its vertices are the group's and the loop below's, at most
-    // `count` (the stream's window holds both), with at most 2 triangles each.
+    group.rewind(0);
+    // The chunk's safety net, once the group's points are released: its vertices are the
+    // group's and the loop below's, at most `count` (the stream's window holds both), with
+    // at most 2 triangles each.
     size_t triangles = 2 * count;
     group.alloc<uint32_t>(count);
     group.alloc<unsigned char>(triangles);

@@ -3213,6 +3213,48 @@ inline size_t repair_fan(const uint32_t* tri, const uint32_t* incident, size_t b
     return removed;
 }
 
+// The common case, decided without sorting and without reading the triangles: a vertex's
+// corners as packed (leaving << 32 | arriving) neighbours, at most kSmallFan of them, none
+// repeating a leaving edge, forming one chain or one cycle. False sends the vertex to
+// repair_fan, which then decides as if this had not run. The corners sit together in
+// memory, where the triangles they come from are scattered: this is what keeps the safety
+// net from waiting on memory.
+const size_t kSmallFan = 16;
+
+inline bool fan_is_one_piece(const uint64_t* corners, size_t size) {
+    if (size > kSmallFan) return false;
+    uint32_t leave[kSmallFan], next[kSmallFan];
+    for (size_t j = 0; j < size; ++j) leave[j] = static_cast<uint32_t>(corners[j] >> 32);
+    // Branch-free scans: which corner leaves where corner i arrives, and whether another
+    // corner leaves where i does (a repeated directed edge).
+    uint32_t has_previous = 0, repeats = 0;
+    for (size_t i = 0; i < size; ++i) {
+        const uint32_t arrive = static_cast<uint32_t>(corners[i]);
+        uint32_t found = kNoIndex, same = 0;
+        for (size_t j = 0; j < size; ++j) {
+            const bool match = leave[j] == arrive;
+            found = match ? static_cast<uint32_t>(j) : found;
+            has_previous |= static_cast<uint32_t>(match) << j;
+            same += leave[j] == leave[i];
+        }
+        next[i] = found;
+        repeats |= same - 1;
+    }
+    if (repeats != 0) return false;
+    const uint32_t all = (1u << size) - 1;
+    const uint32_t starts = all & ~has_previous;
+    if (starts & (starts - 1)) return false;  // two chains or more
+    size_t start = 0;
+    while (starts && !(starts >> start & 1u)) ++start;
+    size_t walked = 0;
+    for (size_t at = start; at != kNoIndex && walked <= size;) {
+        ++walked;
+        at = next[at];
+        if (at == start) break;
+    }
+    return walked == size;
+}
+
 // Removes triangles until the mesh tri[0 .. 3 count), whose indices are below point_count,
 // is edge- and vertex-manifold and consistently oriented. Compacts the survivors in place
 // (keeping their order); returns the number removed, or SIZE_MAX if the arena is too small.
@@ -3248,6 +3290,7 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
     };
     uint32_t* offsets = arena.alloc<uint32_t>(static_cast<size_t>(labels) + 1);
     uint32_t* incident = arena.alloc<uint32_t>(3 * count);
+    uint64_t* corners = arena.alloc<uint64_t>(3 * count);  // per incidence: (leaving, arriving)
     if (arena.failed) return give_up();
     std::memset(offsets, 0, sizeof(uint32_t) * (static_cast<size_t>(labels) + 1));
     for (size_t k = 0; k < 3 * count; ++k) ++offsets[local[k] + 1];
@@ -3258,8 +3301,12 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
     }
     // Incidences in triangle order: a forward pass that bumps each vertex's write cursor,
     // kept in `incident`'s own slots by filling from the end of each range.
-    for (size_t k = 3 * count; k-- > 0;)
-        incident[--offsets[local[k] + 1]] = static_cast<uint32_t>(k / 3);
+    for (size_t k = 3 * count; k-- > 0;) {
+        const uint32_t* c = local + (k - k % 3);
+        const size_t at = --offsets[local[k] + 1];
+        incident[at] = static_cast<uint32_t>(k / 3);
+        corners[at] = (static_cast<uint64_t>(c[(k + 1) % 3]) << 32) | c[(k + 2) % 3];
+    }
     // Now offsets[v + 1] is the start of v's range; shift back to the usual layout.
     for (uint32_t v = 0; v < labels; ++v) offsets[v] = offsets[v + 1];
     offsets[labels] = static_cast<uint32_t>(3 * count);
@@ -3274,7 +3321,8 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
     for (size_t pass = 0; pass <= count; ++pass) {
         size_t before = removed;
         for (uint32_t v = 0; v < labels; ++v)
-            removed += repair_fan(local, incident, offsets[v], offsets[v + 1], v, dead, fan);
+            if (removed > 0 || !fan_is_one_piece(corners + offsets[v], offsets[v + 1] - offsets[v]))
+                removed += repair_fan(local, incident, offsets[v], offsets[v + 1], v, dead, fan);
         if (removed == before) break;
     }
     size_t alive = 0;

@@ -3027,8 +3027,10 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
         a[i] = below + i;
         a_points[i] = frame.local(cloud.point(a_ids[i]));
     }
-    auto point = [&](uint32_t id) -> const Local& {
-        return id < below ? layer.points[id] : a_points[id - below];
+    // The layer's points were loaded, unless a job triangulated it ahead (then read again).
+    auto point = [&](uint32_t id) -> Local {
+        if (id >= below) return a_points[id - below];
+        return layer.points ? layer.points[id] : frame.local(cloud.point(layer.ids[id]));
     };
     Cylinder shared;
     shared.cx = (ca.cx + cb.cx) / 2;
@@ -3038,7 +3040,7 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
     shared.scale = (ca.scale + cb.scale) / 2;
     const double unrolled_radius = 1 / shared.scale;
     auto unroll = [&](uint32_t id, double* uv) {
-        const Local& l = point(id);
+        const Local l = point(id);
         uv[0] = unrolled_radius * polar_angle(l.x - shared.cx, l.y - shared.cy);
         uv[1] = l.h - shared.h0;
     };
@@ -3917,6 +3919,26 @@ inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const Laye
     return Status::ok;
 }
 
+// Whether a group of n points over `height` around `radius` is triangulated on its own
+// (else it joins the next planned layer; the final group only needs 3 points).
+inline bool group_stands(size_t n, double height, double radius, bool final) {
+    return n >= 3 && (final || (n >= kMinLayerPoints && thick_enough(n, height, radius)));
+}
+
+// A planned layer triangulated ahead by a job (see "parallel layers" below): what
+// triangulate_layer gave, kept until the group is formed in order.
+struct LayerAhead {
+    bool done;               // triangulate_layer ran: status, and on ok all below
+    Status status;
+    Cylinder cylinder;
+    LayerCounts counts;
+    size_t triangle_count, folds;
+    uint32_t* triangles;     // as the sink writes them, in layer-local indices
+    uint32_t* bottom;
+    uint32_t* top;
+    uint32_t bottom_count, top_count;
+};
+
 // What one step of the queue did.
 struct GroupResult {
     uint32_t last;           // the group is planned layers [first, last]
@@ -3927,11 +3949,32 @@ struct GroupResult {
     Cylinder cylinder;
 };
 
+// What triangulate_layer would do now, from a job's result.
+inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops& loops,
+                         LayerCounts& counts) {
+    if (ahead.status != Status::ok) return ahead.status;
+    if (sink.count < sink.capacity) {
+        size_t room = sink.capacity - sink.count;
+        size_t copied = ahead.triangle_count < room ? ahead.triangle_count : room;
+        std::memcpy(sink.triangles + 3 * sink.count, ahead.triangles, 3 * copied * sizeof(uint32_t));
+    }
+    sink.count += ahead.triangle_count;
+    sink.folds += ahead.folds;
+    std::memcpy(loops.bottom, ahead.bottom, ahead.bottom_count * sizeof(uint32_t));
+    std::memcpy(loops.top, ahead.top, ahead.top_count * sizeof(uint32_t));
+    loops.bottom_count = ahead.bottom_count;
+    loops.top_count = ahead.top_count;
+    counts = ahead.counts;
+    return Status::ok;
+}
+
 // Forms the group starting at planned layer `first`, triangulates it, stitches it to the
-// chain's top loop and finishes the chunk. Returns ok (also when waiting), not_columnar when
-// the rest of the queue cannot form a layer (counted in c.trailing), or an error.
+// chain's top loop and finishes the chunk. `ahead` (optional) is planned layer `first`
+// triangulated ahead: used when the group is that layer alone. Returns ok (also when
+// waiting), not_columnar when the rest of the queue cannot form a layer (counted in
+// c.trailing), or an error.
 inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Arena& arena,
-                        TriangleSink& sink, GroupResult& result) {
+                        TriangleSink& sink, GroupResult& result, const LayerAhead* ahead) {
     result.waiting = false;
     uint32_t last = first;
     for (;;) {
@@ -3944,8 +3987,9 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
         const size_t n = q.start[last + 1] - q.start[first];
         const double h0 = q.bounds[first], h1 = q.bounds[last + 1];
         size_t mark = arena.mark();
-        LoadedLayer layer;
-        if (!load_layer(c.reader, c.frame, ids, n, h0, h1, arena, layer))
+        const bool triangulated = ahead && ahead->done && last == first;
+        LoadedLayer layer = {ids, n, nullptr, triangulated ? ahead->cylinder : Cylinder{}};
+        if (!triangulated && !load_layer(c.reader, c.frame, ids, n, h0, h1, arena, layer))
             return Status::out_of_memory;
         if (!final) {
             size_t rest = q.start[q.planned] - q.start[last + 1];
@@ -3962,10 +4006,13 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
         }
         Status status = Status::not_columnar;
         // Tiny or thin layers make coarse, folding bands: they join the next layer if any.
-        if (n >= 3 && (final || (n >= kMinLayerPoints && thick_enough(n, h1 - h0, layer.cyl.radius)))) {
+        if (group_stands(n, h1 - h0, layer.cyl.radius, final)) {
             const size_t chunk_start = sink.count, folds = sink.folds;
             LayerLoops loops = {c.bottom, 0, c.next_top, 0};
-            status = triangulate_layer(c.reader, layer, arena, sink, loops, result.counts);
+            if (triangulated)
+                status = take_ahead(*ahead, sink, loops, result.counts);
+            else
+                status = triangulate_layer(c.reader, layer, arena, sink, loops, result.counts);
             if (status == Status::ok && c.top_count > 0 &&
                 !stitch_layers(c.reader, c.frame, c.top_cylinder, c.top, c.top_count, layer,
                                loops.bottom, loops.bottom_count, arena, sink, &c.swaps))
@@ -4083,6 +4130,163 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
     return most;
 }
 
+// ---- parallel layers -----------------------------------------------------------------------
+//
+// With Options::run_jobs, every planned layer that could stand as a group on its own (at
+// least kMinLayerPoints points, or the last one) is loaded and, if group_stands, triangulated
+// ahead by a job, into its own part of the workspace. Then the groups are formed in order
+// as always; a group that is one planned layer takes the job's result instead of
+// triangulating (add_group), any other group (merged layers) is triangulated then. So the
+// result is the sequential one whatever the jobs' order and threads. Jobs are contiguous runs
+// of such layers with about equal point counts, each with the scratch of its largest layer.
+
+struct ParallelLayers {
+    bool ready;                  // the jobs ran
+    const CloudReader* reader;
+    const Frame* frame;
+    const LayerQueue* queue;
+    uint32_t slots;              // layers done ahead
+    LayerAhead* ahead;           // per slot
+    uint32_t* layer_of_slot;
+    uint32_t* slot_of_layer;     // kNoIndex: not done ahead
+    uint32_t job_count;
+    uint32_t first_slot[kMaxJobs + 1];
+    unsigned char* scratch[kMaxJobs];
+    size_t scratch_bytes[kMaxJobs];
+
+    const LayerAhead* ahead_of(uint32_t layer) const {
+        uint32_t slot = slot_of_layer[layer];
+        return slot == kNoIndex ? nullptr : ahead + slot;
+    }
+};
+
+// Room for the results of `slots` layers holding `points` points in all, out of `layers`
+// planned layers.
+inline bool allocate_ahead(ParallelLayers& p, uint32_t slots, size_t points, size_t layers,
+                           Arena& arena, uint32_t** triangles, uint32_t** loops) {
+    p.ahead = arena.alloc<LayerAhead>(slots);
+    p.layer_of_slot = arena.alloc<uint32_t>(slots);
+    p.slot_of_layer = arena.alloc<uint32_t>(layers);
+    *triangles = arena.alloc<uint32_t>(3 * 2 * points);
+    *loops = arena.alloc<uint32_t>(2 * points);
+    return !arena.failed;
+}
+
+inline bool may_stand_alone(const LayerQueue& q, uint32_t k) {
+    size_t n = q.start[k + 1] - q.start[k];
+    return n >= kMinLayerPoints || (k + 1 == q.planned && n >= 3);
+}
+
+// The job scratch bound: a run of layers needs the scratch of its largest, and scratch grows
+// linearly with rounding, so jobs over n points in all need at most this.
+inline size_t job_scratch_bound(size_t points) {
+    size_t whole = reconstruct_scratch_size(points, false), one = reconstruct_scratch_size(0, false);
+    const size_t slack = 1024;  // the rounding of every allocation, with room to spare
+    if (whole == 0 || one > (SIZE_MAX - whole) / kMaxJobs - slack) return 0;
+    return whole + kMaxJobs * (one + slack);
+}
+
+inline void run_layer_job(void* context, uint32_t index) {
+    const ParallelLayers& p = *static_cast<const ParallelLayers*>(context);
+    const LayerQueue& q = *p.queue;
+    Arena arena = Arena::over(p.scratch[index], p.scratch_bytes[index]);
+    for (uint32_t slot = p.first_slot[index]; slot < p.first_slot[index + 1]; ++slot) {
+        LayerAhead& a = p.ahead[slot];
+        const uint32_t k = p.layer_of_slot[slot];
+        const size_t n = q.start[k + 1] - q.start[k];
+        arena.rewind(0);
+        LoadedLayer layer;
+        if (!load_layer(*p.reader, *p.frame, q.ids + q.start[k], n, q.bounds[k], q.bounds[k + 1],
+                        arena, layer) ||
+            !group_stands(n, q.bounds[k + 1] - q.bounds[k], layer.cyl.radius, k + 1 == q.planned))
+            continue;
+        TriangleSink sink = {a.triangles, 2 * n, 0, 0};
+        LayerLoops loops = {a.bottom, 0, a.top, 0};
+        a.status = triangulate_layer(*p.reader, layer, arena, sink, loops, a.counts);
+        // An annulus through n points has at most 2n triangles; anything else is redone in order.
+        if ((a.status != Status::ok && a.status != Status::not_columnar) || sink.count > sink.capacity)
+            continue;
+        a.cylinder = layer.cyl;
+        a.triangle_count = sink.count;
+        a.folds = sink.folds;
+        a.bottom_count = loops.bottom_count;
+        a.top_count = loops.top_count;
+        a.done = true;
+    }
+}
+
+// Plans the jobs over the queue, carves their results and scratch from the arena and runs
+// them. Returns with p.ready false (and the arena as it was) when there is nothing to gain or
+// no room: the groups are then triangulated in order. The results stay in the arena; the
+// jobs' scratch is released.
+inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& arena) {
+    p.ready = false;
+    const LayerQueue& q = *p.queue;
+    uint32_t slots = 0;
+    size_t points = 0;
+    for (uint32_t k = 0; k < q.planned; ++k)
+        if (may_stand_alone(q, k)) {
+            ++slots;
+            points += q.start[k + 1] - q.start[k];
+        }
+    if (slots < 2) return;
+    const size_t mark = arena.mark();
+    auto give_up = [&]() {
+        arena.failed = false;
+        arena.rewind(mark);
+    };
+    uint32_t* triangles = nullptr;
+    uint32_t* loops = nullptr;
+    if (!allocate_ahead(p, slots, points, q.planned, arena, &triangles, &loops)) return give_up();
+    p.slots = slots;
+    uint32_t slot = 0;
+    size_t at = 0;
+    for (uint32_t k = 0; k < q.planned; ++k) {
+        p.slot_of_layer[k] = kNoIndex;
+        if (!may_stand_alone(q, k)) continue;
+        const size_t n = q.start[k + 1] - q.start[k];
+        LayerAhead& a = p.ahead[slot];
+        a.done = false;
+        a.triangles = triangles + 6 * at;
+        a.bottom = loops + 2 * at;
+        a.top = loops + 2 * at + n;
+        at += n;
+        p.layer_of_slot[slot] = k;
+        p.slot_of_layer[k] = slot++;
+    }
+    const size_t results = arena.mark();
+    // Jobs: runs of slots with about equal point counts.
+    uint32_t most = slots < kMaxJobs ? slots : kMaxJobs;
+    const size_t share = (points + most - 1) / most;
+    uint32_t job = 0;
+    size_t in_job = 0;
+    p.first_slot[0] = 0;
+    for (uint32_t s = 0; s < slots; ++s) {
+        uint32_t k = p.layer_of_slot[s];
+        in_job += q.start[k + 1] - q.start[k];
+        if (in_job >= share && job + 1 < most && s + 1 < slots) {
+            p.first_slot[++job] = s + 1;
+            in_job = 0;
+        }
+    }
+    p.job_count = job + 1;
+    p.first_slot[p.job_count] = slots;
+    for (uint32_t j = 0; j < p.job_count; ++j) {
+        size_t largest = 0;
+        for (uint32_t s = p.first_slot[j]; s < p.first_slot[j + 1]; ++s) {
+            uint32_t k = p.layer_of_slot[s];
+            size_t n = q.start[k + 1] - q.start[k];
+            if (n > largest) largest = n;
+        }
+        p.scratch_bytes[j] = reconstruct_scratch_size(largest, false) + Arena::kAlign;
+        p.scratch[j] = arena.alloc<unsigned char>(p.scratch_bytes[j]);
+    }
+    if (arena.failed) return give_up();
+    options.run_jobs(options.jobs_user, p.job_count, run_layer_job, &p);
+    arena.rewind(results);
+    p.ready = true;
+}
+
 inline void notify(const Options& options, Phase phase, double fraction) {
     if (options.progress) options.progress(options.progress_user, phase, fraction);
 }
@@ -4171,10 +4375,23 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
     if (point_count > detail::kMaxPoints - 1) return 0;
     detail::Arena arena = detail::Arena::measuring();
     detail::ReconstructMemory m;
-    detail::plan_reconstruct(m, point_count,
-                             detail::planned_layer_limit(point_count, options), arena);
+    const size_t layer_limit = detail::planned_layer_limit(point_count, options);
+    detail::plan_reconstruct(m, point_count, layer_limit, arena);
     size_t scratch = detail::reconstruct_scratch_size(point_count,
                                                       (options.flags & close_ends) != 0);
+    if (options.run_jobs) {
+        // The layers done ahead (at most one per kMinLayerPoints points, plus the last) stay
+        // while the groups are formed; the jobs' scratch comes and goes before.
+        detail::ParallelLayers p;
+        uint32_t* triangles = nullptr;
+        uint32_t* loops = nullptr;
+        size_t slots = point_count / detail::kMinLayerPoints + 1;
+        detail::allocate_ahead(p, static_cast<uint32_t>(slots), point_count, layer_limit, arena,
+                               &triangles, &loops);
+        size_t jobs = detail::job_scratch_bound(point_count);
+        if (jobs == 0) return 0;
+        if (jobs > scratch) scratch = jobs;
+    }
     if (arena.failed || scratch == 0 || scratch > SIZE_MAX - arena.required_bytes()) return 0;
     return arena.required_bytes() + scratch;
 }
@@ -4288,9 +4505,20 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     chain.reader = reader;
     chain.output_id = nullptr;
     const LayerQueue queue = {m.order, m.layer_start, plan.bounds, plan.count, true};
+    ParallelLayers parallel;
+    parallel.ready = false;
+    if (options.run_jobs) {
+        parallel.reader = &reader;
+        parallel.frame = &frame;
+        parallel.queue = &queue;
+        triangulate_ahead(options, parallel, arena);
+        for (uint32_t slot = 0; parallel.ready && slot < parallel.slots; ++slot)
+            rep.parallel_layers += parallel.ahead[slot].done;
+    }
     for (uint32_t first = 0; first < plan.count;) {
         GroupResult group;
-        status = add_group(chain, queue, first, arena, sink, group);
+        status = add_group(chain, queue, first, arena, sink, group,
+                           parallel.ready ? parallel.ahead_of(first) : nullptr);
         if (status == Status::not_columnar) break;
         if (status != Status::ok) return finish(status);
         if (rep.layer_count < layer_capacity)
@@ -4484,7 +4712,7 @@ inline Status advance(Stream& s, bool complete) {
         const LayerQueue queue = {s.positions, s.start, s.bounds, s.planned, complete};
         GroupResult group;
         s.sink.count = 0;
-        Status status = add_group(s.chain, queue, 0, s.arena, s.sink, group);
+        Status status = add_group(s.chain, queue, 0, s.arena, s.sink, group, nullptr);
         if (status == Status::not_columnar) return Status::ok;  // the rest is trailing
         if (status == Status::ok && s.sink.count > s.sink.capacity) status = Status::internal_error;
         if (status != Status::ok) return status;

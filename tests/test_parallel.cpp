@@ -1,0 +1,160 @@
+// Parallel layers: with Options::run_jobs, reconstruct() gives the same bytes (triangles and
+// report) as without, whatever order and threads the runner uses, in the workspace its
+// bound promises.
+#include "stratmesh.h"
+#include "support/library_options.h"
+#include "support/shapes.h"
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <cstring>
+#include <thread>
+#include <vector>
+
+namespace {
+
+using library_options::axis_options;
+using library_options::cloud_of;
+using stratmesh::JobFunction;
+using stratmesh::LayerInfo;
+using stratmesh::Options;
+using stratmesh::Report;
+using stratmesh::Status;
+using shapes::Pose;
+using shapes::Shape;
+
+// Runners: in order, in reverse order, and on threads taking indices from a counter.
+void run_in_order(void*, uint32_t count, JobFunction job, void* context) {
+    for (uint32_t i = 0; i < count; ++i) job(context, i);
+}
+
+void run_in_reverse(void*, uint32_t count, JobFunction job, void* context) {
+    for (uint32_t i = count; i-- > 0;) job(context, i);
+}
+
+void run_on_threads(void* user, uint32_t count, JobFunction job, void* context) {
+    const unsigned threads = *static_cast<const unsigned*>(user);
+    std::atomic<uint32_t> next{0};
+    auto work = [&]() {
+        for (uint32_t i = next++; i < count; i = next++) job(context, i);
+    };
+    std::vector<std::thread> pool;
+    for (unsigned t = 1; t < threads && t < count; ++t) pool.emplace_back(work);
+    work();
+    for (std::thread& t : pool) t.join();
+}
+
+struct Result {
+    Status status = Status::internal_error;
+    std::vector<uint32_t> triangles;
+    Report report{};
+    std::vector<LayerInfo> layers;
+    size_t bound = 0;
+};
+
+Result run(const Shape& s, const Options& o) {
+    Result r;
+    const stratmesh::Cloud cloud = cloud_of(s);
+    r.bound = stratmesh::reconstruct_workspace_size(cloud.count, o);
+    std::vector<unsigned char> work(r.bound);
+    r.triangles.resize(3 * stratmesh::reconstruct_max_triangles(cloud.count, o));
+    r.layers.resize(300);
+    r.report.layers = r.layers.data();
+    r.report.layer_capacity = r.layers.size();
+    size_t count = 0;
+    r.status = stratmesh::reconstruct(cloud, o, work.data(), work.size(), r.triangles.data(),
+                                      r.triangles.size() / 3, &count, &r.report);
+    r.triangles.resize(3 * count);
+    r.layers.resize(std::min<size_t>(r.report.layer_count, r.layers.size()));
+    return r;
+}
+
+void check_same(const Result& sequential, const Result& parallel) {
+    REQUIRE(parallel.status == sequential.status);
+    CHECK(parallel.triangles == sequential.triangles);
+    CHECK(parallel.report.points_used == sequential.report.points_used);
+    CHECK(parallel.report.duplicates == sequential.report.duplicates);
+    CHECK(parallel.report.folds == sequential.report.folds);
+    CHECK(parallel.report.diagonal_swaps == sequential.report.diagonal_swaps);
+    CHECK(parallel.report.illegal_removed == sequential.report.illegal_removed);
+    REQUIRE(parallel.layers.size() == sequential.layers.size());
+    for (size_t k = 0; k < parallel.layers.size(); ++k)
+        CHECK(std::memcmp(&parallel.layers[k], &sequential.layers[k], sizeof(LayerInfo)) == 0);
+    CHECK(parallel.report.workspace_used <= parallel.bound);
+}
+
+struct Layout {
+    const char* name;
+    void (*apply)(Options&, std::vector<double>&, const Shape&);
+};
+
+const Layout kLayouts[] = {
+    {"6 equal layers", [](Options& o, std::vector<double>&, const Shape&) { o.layer_count = 6; }},
+    {"40 equal layers (thin ones merge)", [](Options& o, std::vector<double>&, const Shape&) { o.layer_count = 40; }},
+    {"automatic", [](Options&, std::vector<double>&, const Shape&) {}},
+    {"uneven cuts", [](Options& o, std::vector<double>& cuts, const Shape& s) {
+         for (double f : {0.03, 0.06, 0.85}) cuts.push_back(s.along_axis(s.z_min + f * (s.z_max - s.z_min)));
+         o.cuts = cuts.data();
+         o.cut_count = cuts.size();
+     }},
+};
+
+}  // namespace
+
+TEST_CASE("parallel layers: the same bytes as in order, whatever the runner, on every test shape") {
+    const std::vector<Shape> shapes_list = {
+        shapes::cylinder(3000, Pose::z),    shapes::bumpy_tube(3000, Pose::tilted),
+        shapes::cone(3000, Pose::x),        shapes::vase(3000, Pose::z),
+        shapes::scan_grid(3000, Pose::z),   shapes::ct_slices(3000, Pose::tilted),
+        shapes::noisy_tube(3000, Pose::z),  shapes::head(3000, Pose::tilted),
+        shapes::elliptic_tube(3000, Pose::x)};
+    unsigned two = 2, eight = 8;
+    for (const Shape& s : shapes_list) {
+        for (const Layout& layout : kLayouts) {
+            INFO(s.name << " (" << shapes::pose_name(s.pose) << "), " << layout.name);
+            std::vector<double> cuts;
+            Options o = axis_options(s);
+            layout.apply(o, cuts, s);
+            const Result sequential = run(s, o);
+            REQUIRE(sequential.status == Status::ok);
+            CHECK(sequential.report.parallel_layers == 0);
+            struct Runner {
+                stratmesh::JobRunner run;
+                void* user;
+            };
+            for (Runner runner : {Runner{run_in_order, nullptr}, Runner{run_in_reverse, nullptr},
+                                  Runner{run_on_threads, &two}, Runner{run_on_threads, &eight}}) {
+                Options p = o;
+                p.run_jobs = runner.run;
+                p.jobs_user = runner.user;
+                const Result parallel = run(s, p);
+                check_same(sequential, parallel);
+                if (sequential.report.layer_count > 1) CHECK(parallel.report.parallel_layers > 0);
+            }
+        }
+    }
+}
+
+TEST_CASE("parallel layers: a workspace too small for the jobs falls back to working in order") {
+    const Shape s = shapes::bumpy_tube(4000, Pose::z);
+    Options o = axis_options(s);
+    o.layer_count = 8;
+    const Result sequential = run(s, o);
+    Options p = o;
+    p.run_jobs = run_in_order;
+    const stratmesh::Cloud cloud = cloud_of(s);
+    // The sequential bound: enough for the groups, not for the layers done ahead.
+    std::vector<unsigned char> work(stratmesh::reconstruct_workspace_size(cloud.count, o));
+    REQUIRE(work.size() < stratmesh::reconstruct_workspace_size(cloud.count, p));
+    std::vector<uint32_t> tris(3 * stratmesh::reconstruct_max_triangles(cloud.count, p));
+    Report report = {};
+    size_t count = 0;
+    REQUIRE(stratmesh::reconstruct(cloud, p, work.data(), work.size(), tris.data(), tris.size() / 3,
+                                   &count, &report) == Status::ok);
+    tris.resize(3 * count);
+    CHECK(tris == sequential.triangles);
+    CHECK(report.parallel_layers == 0);
+}

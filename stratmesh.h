@@ -3224,6 +3224,7 @@ inline size_t repair_fan(const uint32_t* tri, const uint32_t* incident, size_t b
 const size_t kSmallFan = 16;
 
 inline bool fan_is_one_piece(const uint64_t* corners, size_t size) {
+    if (size == 0) return true;
     if (size > kSmallFan) return false;
     uint32_t leave[kSmallFan], next[kSmallFan];
     for (size_t j = 0; j < size; ++j) leave[j] = static_cast<uint32_t>(corners[j] >> 32);
@@ -3255,6 +3256,33 @@ inline bool fan_is_one_piece(const uint64_t* corners, size_t size) {
         if (at == start) break;
     }
     return walked == size;
+}
+
+// Whether every vertex v with checked[v] != 0 passes fan_is_one_piece in tri[0 .. 3 count)
+// (indices below point_count): then the safety net would remove nothing at those vertices.
+// Lets the net's work be split (see ParallelLayers); the arena's failure answers false.
+inline bool fans_are_one_piece(const uint32_t* tri, size_t count, size_t point_count,
+                               const unsigned char* checked, Arena& arena) {
+    size_t mark = arena.mark();
+    uint32_t* offsets = arena.alloc<uint32_t>(point_count + 1);
+    if (arena.failed) return false;
+    std::memset(offsets, 0, sizeof(uint32_t) * (point_count + 1));
+    for (size_t k = 0; k < 3 * count; ++k)
+        if (checked[tri[k]]) ++offsets[tri[k] + 1];
+    for (size_t v = 0; v < point_count; ++v) offsets[v + 1] += offsets[v];
+    uint64_t* corners = arena.alloc<uint64_t>(offsets[point_count]);
+    if (arena.failed) return false;
+    for (size_t k = 0; k < 3 * count; ++k) {
+        if (!checked[tri[k]]) continue;
+        const uint32_t* c = tri + (k - k % 3);
+        corners[offsets[tri[k]]++] = (static_cast<uint64_t>(c[(k + 1) % 3]) << 32) | c[(k + 2) % 3];
+    }
+    // Each cursor now sits at the next vertex's start.
+    bool one_piece = true;
+    for (size_t v = 0, begin = 0; v < point_count && one_piece; begin = offsets[v++])
+        one_piece = fan_is_one_piece(corners + begin, offsets[v] - begin);
+    arena.rewind(mark);
+    return one_piece;
 }
 
 // Removes triangles until the mesh tri[0 .. 3 count), whose indices are below point_count,
@@ -3891,14 +3919,34 @@ inline bool allocate_chain(SurfaceChain& c, size_t points, Arena& arena) {
     return !arena.failed;
 }
 
+// Whether the safety net would remove nothing from the chunk, given that the fans of the
+// layer's vertices off its bottom loop were found whole by the job that triangulated it:
+// only the vertices the band touches are left to check.
+inline bool band_fans_are_one_piece(const uint32_t* tri, size_t count, size_t below,
+                                    size_t vertices, const LayerLoops& loops, Arena& arena) {
+    size_t mark = arena.mark();
+    unsigned char* checked = arena.alloc<unsigned char>(vertices);
+    if (arena.failed) return false;
+    std::memset(checked, 0, below);
+    std::memset(checked + below, 1, vertices - below);
+    for (uint32_t i = 0; i < loops.bottom_count; ++i) checked[loops.bottom[i]] = 1;
+    bool whole = fans_are_one_piece(tri, count, vertices, checked, arena);
+    arena.rewind(mark);
+    return whole;
+}
+
 // The safety net over the chunk sink[chunk_start ..), then its indices from layer-local and
-// band indices to output indices; counts the points that became vertices.
+// band indices to output indices; counts the points that became vertices. `interior_whole`:
+// a job found the fans of the layer's vertices off its bottom loop whole.
 inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                           size_t chunk_start, Arena& arena, TriangleSink& sink) {
+                           bool interior_whole, size_t chunk_start, Arena& arena,
+                           TriangleSink& sink) {
     uint32_t* tri = sink.triangles + 3 * chunk_start;
     size_t count = sink.count - chunk_start;
     const size_t below = layer.count, vertices = layer.count + c.top_count;
-    size_t removed = enforce_manifold(tri, count, vertices, arena);
+    size_t removed = 0;
+    if (!interior_whole || !band_fans_are_one_piece(tri, count, below, vertices, loops, arena))
+        removed = enforce_manifold(tri, count, vertices, arena);
     if (removed == SIZE_MAX) return Status::out_of_memory;
     sink.count = chunk_start + count;
     c.removed += removed;
@@ -3937,6 +3985,7 @@ struct LayerAhead {
     uint32_t* bottom;
     uint32_t* top;
     uint32_t bottom_count, top_count;
+    bool interior_whole;     // the fans of the vertices off the bottom loop are whole
 };
 
 // What one step of the queue did.
@@ -4023,7 +4072,8 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
             // Past the caller's capacity only the count goes on (triangle_capacity follows).
             arena.rewind(mark);
             if (status == Status::ok && sink.count <= sink.capacity)
-                status = finish_chunk(c, layer, loops, chunk_start, arena, sink);
+                status = finish_chunk(c, layer, loops, triangulated && ahead->interior_whole,
+                                      chunk_start, arena, sink);
             if (status == Status::ok) {
                 for (uint32_t i = 0; i < loops.top_count; ++i) loops.top[i] = ids[loops.top[i]];
                 uint32_t* top = c.top;
@@ -4211,6 +4261,14 @@ inline void run_layer_job(void* context, uint32_t index) {
         a.folds = sink.folds;
         a.bottom_count = loops.bottom_count;
         a.top_count = loops.top_count;
+        a.interior_whole = false;
+        // The safety net's check of the vertices no band touches, done here in parallel.
+        unsigned char* checked = a.status == Status::ok ? arena.alloc<unsigned char>(n) : nullptr;
+        if (checked) {
+            std::memset(checked, 1, n);
+            for (uint32_t i = 0; i < loops.bottom_count; ++i) checked[loops.bottom[i]] = 0;
+            a.interior_whole = fans_are_one_piece(a.triangles, sink.count, n, checked, arena);
+        }
         a.done = true;
     }
 }
@@ -4907,7 +4965,9 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     if (s.fill > s.rep.points_held) s.rep.points_held = s.fill;
     Status status = detail::advance(s, false);
     if (status != Status::ok) s.failure = status;
+    // The counts so far; why a point is not a vertex is only known at the close.
     detail::report_chain(s.chain, s.rep.points_in - s.rep.rejected, s.rep);
+    s.rep.detail = nullptr;
     s.rep.folds = s.sink.folds;
     detail::publish(s);
     return status;

@@ -143,6 +143,8 @@ void check_same(const Output& batch, const Output& stream) {
     CHECK(stream.report.points_used == batch.report.points_used);
     CHECK(stream.report.duplicates == batch.report.duplicates);
     CHECK(stream.report.unused == batch.report.unused);
+    CHECK(std::string(stream.report.detail ? stream.report.detail : "") ==
+          std::string(batch.report.detail ? batch.report.detail : ""));
     CHECK(stream.report.triangle_count == batch.report.triangle_count);
     CHECK(stream.report.illegal_removed == batch.report.illegal_removed);
     CHECK(stream.report.folds == batch.report.folds);

@@ -827,6 +827,17 @@ TEST_CASE("command line: every option") {
     CHECK(other.layer_count == 12);
     CHECK(other.axis == stratmesh::Axis::z);
     CHECK(other.input == "-odd name.ply");
+    CHECK(other.threads >= 1); // the machine's, by default
+    CHECK_FALSE(other.stream);
+    CommandLine streamed;
+    REQUIRE(parse({"in.ply", "-o", "m.ply", "--stream", "--axis", "y", "--layer-height", "2",
+                   "--stream-points", "5000", "--threads", "3", "--origin", "1,2,3"},
+                  streamed, error) == CommandAction::run);
+    CHECK(streamed.stream);
+    CHECK(streamed.stream_points == 5000);
+    CHECK(streamed.threads == 3);
+    CHECK(streamed.origin_given);
+    CHECK(streamed.origin[2] == 3);
 }
 
 TEST_CASE("command line: help and version win over errors") {
@@ -863,4 +874,20 @@ TEST_CASE("command line: usage errors") {
     CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--ascii=yes"}), "takes no value"));
     CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--layers", "3", "--cuts", "1"}),
                    "at most one of"));
+    for (const char* bad : {"0", "-1", "abc", "2.5", "1025"})
+        CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--threads", bad}), "--threads"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--origin", "1,2"}), "--origin"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--stream-points", "15"}),
+                   "--stream-points"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--stream", "--cuts", "1"}),
+                   "--stream needs --axis"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--stream", "--axis", "z"}),
+                   "--stream needs --cuts or --layer-height"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--stream", "--axis", "z", "--layers", "3"}),
+                   "--stream needs --cuts or --layer-height"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.stl", "--stream", "--axis", "z", "--cuts", "1"}),
+                   "--stream cannot write STL"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--stream", "--axis", "z", "--cuts", "1",
+                                "--cap"}),
+                   "--stream cannot --cap"));
 }

@@ -565,7 +565,8 @@ TEST_CASE("point by point reading: what it cannot read, and errors that name the
         std::string bytes;
         const char* message;
     } cases[] = {
-        {"truncated.ply", whole.substr(0, whole.size() - 40), "the file ends inside element 'vertex' record 7 of 10"},
+        {"truncated.ply", whole.substr(0, whole.size() - 40),
+         "the file ends inside element 'vertex' record 7 of 10"},
         {"listed.ply", double_binary_ply(xyz, false), "the vertex element has list properties"},
         {"face_first.ply", busy_binary_ply(xyz, false), "element 'face' comes before the vertices"},
         {"mesh.off", "OFF\n3 1 0\n1 2 3\n4 5 6\n7 8 9\n3 0 1 2\n", "OFF files cannot be read"},
@@ -883,8 +884,9 @@ TEST_CASE("command line: usage errors") {
                    "--stream needs --axis"));
     CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--stream", "--axis", "z"}),
                    "--stream needs --cuts or --layer-height"));
-    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--stream", "--axis", "z", "--layers", "3"}),
-                   "--stream needs --cuts or --layer-height"));
+    CHECK(contains(
+        usage_error({"a.ply", "-o", "m.ply", "--stream", "--axis", "z", "--layers", "3"}),
+        "--stream needs --cuts or --layer-height"));
     CHECK(contains(usage_error({"a.ply", "-o", "m.stl", "--stream", "--axis", "z", "--cuts", "1"}),
                    "--stream cannot write STL"));
     CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--stream", "--axis", "z", "--cuts", "1",

@@ -54,13 +54,13 @@ const char kUsage[] =
     "  --threads N           triangulate the layers on N threads (default: the machine's\n"
     "                        hardware threads); the output is the same bytes for any N\n"
     "  --origin X,Y,Z        the reference point of the unrolling frame (default: the\n"
-    "                        cloud's centroid; with --stream, the first point read)\n"
+    "                        cloud's centroid; with --stream, the first valid point)\n"
     "  --stream              read and reconstruct layer by layer in bounded memory; needs\n"
     "                        --axis x|y|z|X,Y,Z and --cuts or --layer-height, points\n"
     "                        sorted along the axis, input PLY, XYZ or OBJ, output PLY, OBJ\n"
     "                        or OFF (not STL). The same triangles as the run without\n"
     "                        --stream given --cuts at the layer tops reached (the report's\n"
-    "                        stream.batch_cuts) and --origin at the first point\n"
+    "                        stream.batch_cuts) and --origin at that first point\n"
     "  --stream-points N     the most points the stream may hold at once (default\n"
     "                        3000000, about 190 bytes each); about three layers' worth\n"
     "  -q, --quiet           no progress and no summary on stderr (errors still are)\n"
@@ -137,7 +137,8 @@ bool parse_layer_height(std::string_view text, CommandLine& line, std::string& e
 bool parse_threads(std::string_view text, CommandLine& line, std::string& error) {
     uint64_t count = 0;
     if (parse_count(text, count) != CountParse::ok || count < 1 || count > 1024) {
-        error = "--threads: expected a whole number from 1 to 1024, not '" + std::string(text) + "'";
+        error = "--threads: expected a whole number from 1 to 1024, not '" + std::string(text) +
+                "'";
         return false;
     }
     line.threads = static_cast<uint32_t>(count);
@@ -313,7 +314,8 @@ private:
         if (mesh_format_from_extension(line_.output) == MeshFormat::unknown)
             return fail("cannot tell the mesh format of '" + line_.output +
                         "' from its extension (use .ply, .obj, .off or .stl)");
-        if (layer_choices > 1) return fail("give at most one of --cuts, --layers and --layer-height");
+        if (layer_choices > 1)
+            return fail("give at most one of --cuts, --layers and --layer-height");
         if (line_.stream) fail(stream_conflict(line_));
     }
 

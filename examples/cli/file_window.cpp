@@ -46,7 +46,8 @@ bool FileWindow::next_lines(std::string_view& lines) {
         last = lines.rfind('\n');
         if (last != std::string_view::npos || !fill()) break;
     }
-    if (last == std::string_view::npos) lines = std::string_view(buffer_.data() + pos_, end_ - pos_);
+    if (last == std::string_view::npos)
+        lines = std::string_view(buffer_.data() + pos_, end_ - pos_);
     if (lines.empty()) return false;
     if (last != std::string_view::npos) lines = lines.substr(0, last + 1);
     pos_ += lines.size();

@@ -568,7 +568,8 @@ public:
         if (record_ == vertex.count) return false;
         xyz[0] = xyz[1] = xyz[2] = 0;
         bool ok = header_.encoding == PlyEncoding::ascii
-                      ? read_ascii_record(tokens_, vertex, layout_.coordinate_of, xyz, record_, error)
+                      ? read_ascii_record(tokens_, vertex, layout_.coordinate_of, xyz, record_,
+                                          error)
                       : next_binary(vertex, xyz, error);
         std::string failure = file_->failure();
         if (!failure.empty()) error = failure;
@@ -616,7 +617,8 @@ std::unique_ptr<PointReader> open_ply_points(std::unique_ptr<FileWindow> file, s
     encoding = encoding_name(header.encoding);
     file->skip(header.data_offset);
     file->set_first_line(header.data_line);
-    auto points = std::make_unique<PlyPoints>(std::move(file), std::move(header), std::move(layout));
+    auto points =
+        std::make_unique<PlyPoints>(std::move(file), std::move(header), std::move(layout));
     if (!points->skip_to_vertices(error)) return nullptr;
     return points;
 }

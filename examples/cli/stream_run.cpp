@@ -99,7 +99,8 @@ private:
     StreamOutcome read_and_push(PointReader& reader, std::string& error) {
         double point[3];
         while (reader.next(point, error)) {
-            bool valid = std::isfinite(point[0]) && std::isfinite(point[1]) && std::isfinite(point[2]);
+            bool valid =
+                std::isfinite(point[0]) && std::isfinite(point[1]) && std::isfinite(point[2]);
             if (valid && !stream_ && !open_stream(point)) return StreamOutcome::refused;
             double height = point[0] * axis_[0] + point[1] * axis_[1] + point[2] * axis_[2];
             // Invalid points have no place in the order: they stay in the layer being read.
@@ -161,7 +162,8 @@ private:
         if (points_read_ > 0 && !push(last_top)) return StreamOutcome::refused;
         if (!record_.batch_cuts.empty()) record_.batch_cuts.pop_back();
         Clock::time_point start = Clock::now();
-        record_.status = stream_ ? stratmesh::stream_close(stream_) : stratmesh::Status::too_few_points;
+        record_.status =
+            stream_ ? stratmesh::stream_close(stream_) : stratmesh::Status::too_few_points;
         stream_seconds_ += seconds_since(start);
         record_.reconstruct_seconds = stream_seconds_;
         if (record_.status != stratmesh::Status::ok) return StreamOutcome::refused;

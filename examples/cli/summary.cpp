@@ -55,7 +55,8 @@ void print_counts(std::FILE* out, const stratmesh::Report& rep) {
 }
 
 void print_costs(std::FILE* out, const RunRecord& r) {
-    std::fprintf(out, "  threads    %u\n", static_cast<unsigned>(r.threads));
+    if (!r.stream) // the stream triangulates in order, whatever --threads says
+        std::fprintf(out, "  threads    %u\n", static_cast<unsigned>(r.threads));
     std::fprintf(out, "  time       read %s, reconstruct %s%s, write %s\n",
                  seconds_text(r.read_seconds).c_str(), seconds_text(r.reconstruct_seconds).c_str(),
                  phase_times_text(r).c_str(), seconds_text(r.write_seconds).c_str());

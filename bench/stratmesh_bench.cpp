@@ -18,6 +18,7 @@
 #include "bench_mesh.h"
 #include "bench_ply.h"
 #include "bench_random.h"
+#include "thread_jobs.h"  // the tool's std::thread job runner (examples/cli)
 
 #include <algorithm>
 #include <chrono>
@@ -123,6 +124,8 @@ enum class Kind {
     reconstruct,  // stratmesh::reconstruct on a 3D cloud, beside delaunay_2d on as many
                   // uniform 2D points (its reference cost)
     layered,      // the same, plus one line per layer of the result (the paper's cases)
+    threads,      // reconstruct without a job runner against a 2-thread runner
+    stream,       // the stream, pushed layer by layer, against reconstruct on the same layers
 };
 
 // How a 3D case is cut into layers (see stratmesh::Options); unused by 2D cases.
@@ -139,6 +142,8 @@ constexpr Layering kNoLayering = {stratmesh::Axis::automatic, 0, nullptr, 0};
 constexpr Layering kTubeLayers = {stratmesh::Axis::z, 8, nullptr, 0};
 constexpr Layering kOneLayerAlongZ = {stratmesh::Axis::z, 1, nullptr, 0};
 constexpr Layering kAutomaticAlongZ = {stratmesh::Axis::z, 0, nullptr, 0};
+// A hundred equal layers along z (the stream case cuts them itself, between the extremes).
+constexpr Layering kHundredLayers = {stratmesh::Axis::z, 100, nullptr, 0};
 
 // The paper's cuts along z (section 2).
 template <size_t N> constexpr Layering cuts_along_z(const double (&cuts)[N]) {
@@ -176,6 +181,14 @@ const CaseSpec kCases[] = {
     // The cloud of tube-1e6 (same seed) in a single layer.
     {"tube-1e6-1layer", "tube", Kind::reconstruct, 1000000, 0x5EED0102u, 5,
      bench::generate_tube, kOneLayerAlongZ},
+    // The clouds of tube-1e6 and tube-4e6 (same seeds): no runner against two threads.
+    {"threads-tube-1e6", "threads", Kind::threads, 1000000, 0x5EED0102u, 3,
+     bench::generate_tube, kTubeLayers},
+    {"threads-tube-4e6", "threads", Kind::threads, 4000000, 0x5EED0103u, 3,
+     bench::generate_tube, kTubeLayers},
+    // The cloud of tube-4e6 streamed in 100 layers, against reconstruct on the same layers.
+    {"stream-tube-4e6", "stream", Kind::stream, 4000000, 0x5EED0103u, 3, bench::generate_tube,
+     kHundredLayers},
     // Automatic layers against one layer and against cuts chosen by hand (issue 8).
     {"layering-head-auto", "layering", Kind::reconstruct, bench::kHeadPoints, 0x5EED0201u, 5,
      bench::generate_paper_head, kAutomaticAlongZ},
@@ -745,6 +758,218 @@ Result measure_reconstruct(const ReconstructCase& job) {
     return result;
 }
 
+// ==== Threads and stream ===================================================================
+
+// The triangles of one reconstruct() call, and what it reported.
+struct Reconstructed {
+    stratmesh::Status status = stratmesh::Status::ok;
+    stratmesh::Report report = stratmesh::Report();
+    std::vector<uint32_t> triangles;  // 3 per triangle
+    double seconds = 0;
+};
+
+// Runs reconstruct() once into `out` with a workspace of at least the options' bound.
+void run_reconstruct(const stratmesh::Cloud& cloud, const stratmesh::Options& options,
+                     unsigned char* workspace, size_t workspace_bytes, Reconstructed& out) {
+    size_t max_triangles = stratmesh::reconstruct_max_triangles(cloud.count, options);
+    out.triangles.resize(3 * max_triangles);
+    out.report = stratmesh::Report();
+    size_t count = 0;
+    Clock::time_point start = Clock::now();
+    out.status = stratmesh::reconstruct(cloud, options, workspace, workspace_bytes,
+                                        out.triangles.data(), max_triangles, &count, &out.report);
+    out.seconds = seconds_between(start, Clock::now());
+    out.triangles.resize(3 * count);
+}
+
+// Runs `first` and `second` one after the other, `runs` times each, so both see the same
+// load; each returns its time.
+template <class First, class Second>
+void alternate(int runs, First first, Second second, std::vector<double>& first_times,
+               std::vector<double>& second_times) {
+    for (int run = 0; run < runs; ++run) {
+        first_times.push_back(first());
+        second_times.push_back(second());
+    }
+}
+
+// The fields every case line starts with.
+JsonLine case_line(const std::string& name, size_t n, int runs) {
+    JsonLine line;
+    line.add("name", name);
+    line.add("n", n);
+    line.add("runs", runs);
+    return line;
+}
+
+// Times reconstruct() with no job runner and with a 2-thread runner, alternately, on one
+// workspace (sized for the runner, the larger bound), and compares their triangles.
+Result measure_threads(const std::string& name, const stratmesh::Cloud& cloud,
+                       const Layering& layering, int runs) {
+    stratmesh::Options serial = reconstruct_options(layering, nullptr);
+    serial.progress = nullptr;
+    stratmesh::Options threaded = serial;
+    stratmesh_cli::ThreadJobs jobs;
+    jobs.threads = 2;
+    jobs.attach(threaded);
+    size_t workspace_bytes = stratmesh::reconstruct_workspace_size(cloud.count, threaded);
+    std::unique_ptr<unsigned char[]> workspace = allocate_touched(workspace_bytes);
+    Reconstructed one, two;
+    std::vector<double> one_times, two_times;
+    alternate(
+        runs,
+        [&] {
+            run_reconstruct(cloud, serial, workspace.get(), workspace_bytes, one);
+            return one.seconds;
+        },
+        [&] {
+            run_reconstruct(cloud, threaded, workspace.get(), workspace_bytes, two);
+            return two.seconds;
+        },
+        one_times, two_times);
+    bool ok = one.status == stratmesh::Status::ok && two.status == stratmesh::Status::ok;
+    Result result = {ok ? Outcome::ok : Outcome::failed, cloud.count, median(two_times),
+                     std::nan("")};
+    JsonLine line = case_line(name, cloud.count, runs);
+    line.add("layers", one.report.layer_count);
+    line.add("seconds_no_runner", median(one_times));
+    line.add("seconds_2_threads", median(two_times));
+    line.add("speedup", median(one_times) / median(two_times));
+    line.add("parallel_layers", two.report.parallel_layers);
+    line.add("identical", one.triangles == two.triangles);
+    line.add("triangles", one.triangles.size() / 3);
+    line.add("workspace_bytes_no_runner",
+             stratmesh::reconstruct_workspace_size(cloud.count, serial));
+    line.add("workspace_bytes_2_threads", workspace_bytes);
+    line.add("status", status_name(one.status));
+    line.add("status_2_threads", status_name(two.status));
+    line.print();
+    return result;
+}
+
+// A cloud regrouped into equal layers along z: the points of each layer in input order,
+// layer after layer, and the cuts between the layers.
+struct LayeredCloud {
+    std::vector<double> xyz;
+    std::vector<double> cuts;
+    std::vector<size_t> start;  // the first point of each layer, then the end
+    double top = 0;             // the highest point's height: the last push's top
+};
+
+LayeredCloud layer_along_z(const std::vector<double>& coords, uint32_t layers) {
+    LayeredCloud out;
+    const size_t n = coords.size() / 3;
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (size_t i = 0; i < n; ++i) {
+        lo = std::min(lo, coords[3 * i + 2]);
+        hi = std::max(hi, coords[3 * i + 2]);
+    }
+    for (uint32_t k = 1; k < layers; ++k)
+        out.cuts.push_back(lo + (hi - lo) * static_cast<double>(k) / static_cast<double>(layers));
+    out.top = hi;
+    std::vector<std::vector<size_t>> members(layers);
+    for (size_t i = 0; i < n; ++i) {
+        auto above = std::upper_bound(out.cuts.begin(), out.cuts.end(), coords[3 * i + 2]);
+        members[static_cast<size_t>(above - out.cuts.begin())].push_back(i);
+    }
+    out.xyz.reserve(coords.size());
+    for (const std::vector<size_t>& layer : members) {
+        out.start.push_back(out.xyz.size() / 3);
+        for (size_t i : layer) out.xyz.insert(out.xyz.end(), &coords[3 * i], &coords[3 * i] + 3);
+    }
+    out.start.push_back(n);
+    return out;
+}
+
+void collect_triangles(void* user, const uint32_t* triangles, size_t count) {
+    auto& all = *static_cast<std::vector<uint32_t>*>(user);
+    all.insert(all.end(), triangles, triangles + 3 * count);
+}
+
+// Pushes every layer through a stream in `workspace`; the triangles land in out.triangles.
+void run_stream(const LayeredCloud& cloud, const stratmesh::Options& options,
+                unsigned char* workspace, size_t workspace_bytes, Reconstructed& out) {
+    out.triangles.clear();
+    out.report = stratmesh::Report();
+    Clock::time_point start = Clock::now();
+    stratmesh::Stream* stream = nullptr;
+    out.status = stratmesh::stream_open(options, workspace, workspace_bytes, collect_triangles,
+                                        &out.triangles, &out.report, &stream);
+    for (size_t k = 0; k + 1 < cloud.start.size() && out.status == stratmesh::Status::ok; ++k) {
+        stratmesh::Cloud layer = {&cloud.xyz[3 * cloud.start[k]],
+                                  cloud.start[k + 1] - cloud.start[k], 0,
+                                  stratmesh::Scalar::float64};
+        double top = k < cloud.cuts.size() ? cloud.cuts[k] : cloud.top;
+        out.status = stratmesh::stream_push(stream, layer, top);
+    }
+    if (out.status == stratmesh::Status::ok) out.status = stratmesh::stream_close(stream);
+    out.seconds = seconds_between(start, Clock::now());
+}
+
+// Times the stream (workspace for 2.5 times the largest layer) and reconstruct() with the
+// same cuts and origin on the regrouped cloud, alternately, and compares their triangles.
+Result measure_stream(const std::string& name, const std::vector<double>& coords,
+                      const Layering& layering, int runs) {
+    LayeredCloud layered = layer_along_z(coords, layering.layer_count);
+    size_t largest = 0;
+    for (size_t k = 0; k + 1 < layered.start.size(); ++k)
+        largest = std::max(largest, layered.start[k + 1] - layered.start[k]);
+    stratmesh::Options options = {};
+    options.axis = stratmesh::Axis::z;
+    options.flags = stratmesh::origin_given;
+    for (size_t k = 0; k < 3; ++k) options.origin[k] = layered.xyz[k];
+    size_t stream_bytes = stratmesh::stream_workspace_size(largest * 5 / 2, options);
+    stratmesh::Options batch = options;
+    batch.cuts = layered.cuts.data();
+    batch.cut_count = layered.cuts.size();
+    stratmesh::Cloud cloud = {layered.xyz.data(), layered.xyz.size() / 3, 0,
+                              stratmesh::Scalar::float64};
+    size_t batch_bytes = stratmesh::reconstruct_workspace_size(cloud.count, batch);
+    std::unique_ptr<unsigned char[]> stream_workspace = allocate_touched(stream_bytes);
+    std::unique_ptr<unsigned char[]> batch_workspace = allocate_touched(batch_bytes);
+    Reconstructed streamed, whole;
+    streamed.triangles.reserve(3 * stratmesh::reconstruct_max_triangles(cloud.count, batch));
+    std::vector<double> stream_times, batch_times;
+    alternate(
+        runs,
+        [&] {
+            run_stream(layered, options, stream_workspace.get(), stream_bytes, streamed);
+            return streamed.seconds;
+        },
+        [&] {
+            run_reconstruct(cloud, batch, batch_workspace.get(), batch_bytes, whole);
+            return whole.seconds;
+        },
+        stream_times, batch_times);
+    bool ok = streamed.status == stratmesh::Status::ok && whole.status == stratmesh::Status::ok;
+    Result result = {ok ? Outcome::ok : Outcome::failed, cloud.count, median(stream_times),
+                     std::nan("")};
+    JsonLine line = case_line(name, cloud.count, runs);
+    line.add("pushes", layered.start.size() - 1);
+    line.add("largest_push", largest);
+    line.add("stream_seconds", median(stream_times));
+    line.add("reconstruct_seconds", median(batch_times));
+    line.add("stream_workspace_bytes", stream_bytes);
+    line.add("reconstruct_workspace_bytes", batch_bytes);
+    line.add("workspace_ratio",
+             static_cast<double>(batch_bytes) / static_cast<double>(stream_bytes));
+    line.add("stream_workspace_used", streamed.report.workspace_used);
+    line.add("reconstruct_workspace_used", whole.report.workspace_used);
+    line.add("workspace_used_ratio", static_cast<double>(whole.report.workspace_used) /
+                                         static_cast<double>(streamed.report.workspace_used));
+    line.add("points_held", streamed.report.points_held);
+    line.add("layers", whole.report.layer_count);
+    line.add("stream_layers", streamed.report.layer_count);
+    line.add("identical", streamed.triangles == whole.triangles);
+    line.add("triangles", whole.triangles.size() / 3);
+    line.add("stream_triangles", streamed.triangles.size() / 3);
+    line.add("status", status_name(whole.status));
+    line.add("stream_status", status_name(streamed.status));
+    if (streamed.report.detail) line.add("stream_detail", streamed.report.detail);
+    line.print();
+    return result;
+}
+
 // ==== Inputs ===============================================================================
 
 // The size of a raw x, y float64 file, checked: true and `bytes` set if it is a non-empty
@@ -841,6 +1066,12 @@ Result run_job(const Job& job, const Options& options) {
                              ? Outcome::ok
                              : Outcome::failed;
         return result;
+    case Kind::threads: {
+        stratmesh::Cloud cloud = {coords.data(), coords.size() / 3, 0,
+                                  stratmesh::Scalar::float64};
+        return measure_threads(job.name, cloud, job.layering, job.runs);
+    }
+    case Kind::stream: return measure_stream(job.name, coords, job.layering, job.runs);
     case Kind::reconstruct:
     case Kind::layered: {
         stratmesh::Cloud cloud = {coords.data(), coords.size() / 3, 0,
@@ -925,6 +1156,22 @@ void print_help(std::FILE* out) {
         "per layer first: name, layer, bottom, top, point_count, triangle_count,\n"
         "fold_count, radius. After tube-1e6 and tube-4e6, a growth line compares\n"
         "their seconds_ratio with nlogn_prediction = 4 log(4e6) / log(1e6).\n"
+        "\n"
+        "threads (cases threads-tube-1e6, threads-tube-4e6: 8 layers):\n"
+        "  seconds_no_runner, seconds_2_threads   medians of reconstruct without a job\n"
+        "                            runner and with a 2-thread std::thread runner\n"
+        "  speedup                   seconds_no_runner / seconds_2_threads\n"
+        "  parallel_layers           Report::parallel_layers of the threaded run\n"
+        "  identical                 both triangle arrays are the same bytes\n"
+        "  workspace_bytes_no_runner, workspace_bytes_2_threads   the two bounds\n"
+        "stream (case stream-tube-4e6: 100 equal layers along z):\n"
+        "  stream_seconds, reconstruct_seconds   medians of the stream pushed layer by\n"
+        "                            layer and of reconstruct with the same cuts and origin\n"
+        "  stream_workspace_bytes    stream_workspace_size(2.5 x largest_push)\n"
+        "  reconstruct_workspace_bytes, workspace_ratio (reconstruct / stream)\n"
+        "  stream_workspace_used, reconstruct_workspace_used, workspace_used_ratio\n"
+        "                            Report::workspace_used of each\n"
+        "  points_held, identical    the stream's Report::points_held; same triangles\n"
         "\n"
         "  --case NAME   run only this case or family (repeatable, or a comma list);\n"
         "                see --list. Without --case, --xy or --cloud, every case runs.\n"

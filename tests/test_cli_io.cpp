@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -482,6 +483,109 @@ TEST_CASE("extensions") {
 
 // ==== mesh writers ========================================================================
 
+// ==== point-by-point reading (--stream) ===================================================
+
+namespace {
+
+// Every point of a file through open_point_reader; false with the error if it fails.
+bool read_streamed(const std::string& path, std::vector<double>& xyz, std::string& error,
+                   CloudInfo& info) {
+    std::unique_ptr<PointReader> reader = open_point_reader(path, info, error);
+    if (!reader) return false;
+    xyz.clear();
+    double point[3];
+    while (reader->next(point, error)) xyz.insert(xyz.end(), point, point + 3);
+    return error.empty();
+}
+
+// Binary PLY of float records with no list: a fixed-size element before the vertices and
+// a face list after them.
+std::string fixed_binary_ply(const std::vector<double>& xyz, bool big_endian) {
+    size_t n = xyz.size() / 3;
+    std::string header = std::string("ply\nformat ") +
+                         (big_endian ? "binary_big_endian" : "binary_little_endian") +
+                         " 1.0\nelement camera 2\nproperty double view\nproperty uchar id\n"
+                         "element vertex " + std::to_string(n) + "\n" + kXyz +
+                         "property uchar red\nelement face 1\n"
+                         "property list uchar int vertex_indices\nend_header\n";
+    Bytes b{big_endian, header};
+    b.put<double>(1.5).put<uint8_t>(1).put<double>(-2.5).put<uint8_t>(2);
+    for (size_t i = 0; i < n; ++i) {
+        for (size_t k = 0; k < 3; ++k) b.put(static_cast<float>(xyz[3 * i + k]));
+        b.put<uint8_t>(9);
+    }
+    b.put<uint8_t>(3).put<int32_t>(0).put<int32_t>(1).put<int32_t>(2);
+    return b.data;
+}
+
+std::string xyz_text(const std::vector<double>& xyz, const char* separator) {
+    std::string text = "x y z\n# a comment\n\n";
+    for (size_t i = 0; i < xyz.size(); i += 3)
+        text += exact_text(xyz[i]) + separator + exact_text(xyz[i + 1]) + separator +
+                exact_text(xyz[i + 2]) + "\n";
+    return text;
+}
+
+} // namespace
+
+TEST_CASE("point by point reading gives the points of the whole-file readers") {
+    TempDir dir;
+    // 60000 points make every file longer than the reader's 1 MiB window.
+    std::vector<double> xyz = test_points(60000);
+    std::string obj = "o cloud\n";
+    for (size_t i = 0; i < xyz.size(); i += 3)
+        obj += "v " + exact_text(xyz[i]) + " " + exact_text(xyz[i + 1]) + " " +
+               exact_text(xyz[i + 2]) + "\nvn 0 0 1\n";
+    const std::pair<const char*, std::string> files[] = {
+        {"little.ply", fixed_binary_ply(xyz, false)}, {"big.ply", fixed_binary_ply(xyz, true)},
+        {"lf.ply", ascii_ply(xyz, "\n")},             {"crlf.ply", ascii_ply(xyz, "\r\n")},
+        {"spaces.xyz", xyz_text(xyz, " ")},           {"commas.csv", xyz_text(xyz, ",")},
+        {"cloud.obj", obj}};
+    for (const auto& file : files) {
+        CAPTURE(file.first);
+        save(dir.file(file.first), file.second);
+        std::vector<double> whole, streamed;
+        std::string error;
+        CloudInfo whole_info, streamed_info;
+        REQUIRE_MESSAGE(read_cloud_file(dir.file(file.first), whole, error, &whole_info), error);
+        REQUIRE_MESSAGE(read_streamed(dir.file(file.first), streamed, error, streamed_info), error);
+        CHECK(streamed == whole);
+        CHECK(streamed.size() == xyz.size());
+        CHECK(streamed_info.format == whole_info.format);
+        CHECK(streamed_info.encoding == whole_info.encoding);
+    }
+}
+
+TEST_CASE("point by point reading: what it cannot read, and errors that name the place") {
+    TempDir dir;
+    std::vector<double> xyz = test_points(10);
+    std::string whole = fixed_binary_ply(xyz, false), ascii = ascii_ply(xyz, "\n");
+    const struct {
+        const char* name;
+        std::string bytes;
+        const char* message;
+    } cases[] = {
+        {"truncated.ply", whole.substr(0, whole.size() - 40),
+         "the file ends inside element 'vertex' record 7 of 10"},
+        {"listed.ply", double_binary_ply(xyz, false), "the vertex element has list properties"},
+        {"face_first.ply", busy_binary_ply(xyz, false), "element 'face' comes before the vertices"},
+        {"mesh.off", "OFF\n3 1 0\n1 2 3\n4 5 6\n7 8 9\n3 0 1 2\n", "OFF files cannot be read"},
+        {"bad.xyz", "1 2 3\n4 5 6\n7 eight 9\n", "line 3: 'eight' is not a number"},
+        {"ascii_short.ply", ascii.substr(0, ascii.size() - 30),
+         "the file ends inside element 'vertex' record 9 of 10"},
+        {"empty.xyz", "", "the file is empty"}};
+    for (const auto& c : cases) {
+        std::string name = c.name;
+        CAPTURE(name);
+        save(dir.file(c.name), c.bytes);
+        std::vector<double> got;
+        std::string error;
+        CloudInfo info;
+        CHECK_FALSE(read_streamed(dir.file(c.name), got, error, info));
+        CHECK_MESSAGE(contains(error, c.message), error);
+    }
+}
+
 namespace {
 
 struct WrittenMesh {
@@ -524,6 +628,53 @@ TEST_CASE("PLY, OBJ and OFF output: every vertex in input order, exact, triangle
             CHECK(back.tris == m.tris);
         }
     }
+}
+
+TEST_CASE("the stream writer, fed piece by piece, writes what write_mesh_file writes") {
+    TempDir dir;
+    for (bool float_exact : {false, true}) {
+        WrittenMesh m = small_mesh(float_exact);
+        const std::pair<const char*, bool> outputs[] = {
+            {"m.ply", false}, {"m.ply", true}, {"m.off", false}, {"m.obj", false}};
+        for (const auto& out : outputs) {
+            std::string name = out.first;
+            CAPTURE(name);
+            CAPTURE(out.second);
+            mini_mesh::Mesh whole = write_and_read(m, dir.file("whole_" + name), out.second);
+            std::string path = dir.file("pieces_" + name), error;
+            MeshStreamWriter writer;
+            REQUIRE_MESSAGE(writer.open(path, mesh_format_from_extension(path), out.second, error),
+                            error);
+            // Vertices 0-2, the triangle over them, the other vertices, the rest.
+            writer.add_vertices(m.xyz.data(), 3);
+            writer.add_triangles(m.tris.data(), 1);
+            writer.add_vertices(m.xyz.data() + 9, m.xyz.size() / 3 - 3);
+            writer.add_triangles(m.tris.data() + 3, m.tris.size() / 3 - 1);
+            REQUIRE_MESSAGE(writer.finish(true, error), error);
+            mini_mesh::Mesh pieces;
+            REQUIRE(mini_mesh::read(path, pieces));
+            CHECK(pieces.xyz == whole.xyz);
+            CHECK(pieces.tris == whole.tris);
+            std::string whole_bytes, piece_bytes;
+            REQUIRE(mini_mesh::load(dir.file("whole_" + name), whole_bytes));
+            REQUIRE(mini_mesh::load(path, piece_bytes));
+            if (name != "m.obj") CHECK(piece_bytes == whole_bytes); // OBJ interleaves v and f
+        }
+    }
+}
+
+TEST_CASE("the stream writer removes its output when abandoned or unwritable") {
+    TempDir dir;
+    std::string error;
+    {
+        MeshStreamWriter writer;
+        REQUIRE(writer.open(dir.file("m.ply"), MeshFormat::ply, false, error));
+        CHECK(std::filesystem::exists(dir.file("m.ply")));
+    }
+    CHECK_FALSE(std::filesystem::exists(dir.file("m.ply")));
+    MeshStreamWriter writer;
+    CHECK_FALSE(writer.open(dir.file("no/such/dir/m.ply"), MeshFormat::ply, false, error));
+    CHECK(contains(error, "no/such/dir/m.ply: cannot create"));
 }
 
 TEST_CASE("binary PLY uses float when every coordinate is a float, double otherwise") {
@@ -677,6 +828,17 @@ TEST_CASE("command line: every option") {
     CHECK(other.layer_count == 12);
     CHECK(other.axis == stratmesh::Axis::z);
     CHECK(other.input == "-odd name.ply");
+    CHECK(other.threads >= 1); // the machine's, by default
+    CHECK_FALSE(other.stream);
+    CommandLine streamed;
+    REQUIRE(parse({"in.ply", "-o", "m.ply", "--stream", "--axis", "y", "--layer-height", "2",
+                   "--stream-points", "5000", "--threads", "3", "--origin", "1,2,3"},
+                  streamed, error) == CommandAction::run);
+    CHECK(streamed.stream);
+    CHECK(streamed.stream_points == 5000);
+    CHECK(streamed.threads == 3);
+    CHECK(streamed.origin_given);
+    CHECK(streamed.origin[2] == 3);
 }
 
 TEST_CASE("command line: help and version win over errors") {
@@ -713,4 +875,21 @@ TEST_CASE("command line: usage errors") {
     CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--ascii=yes"}), "takes no value"));
     CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--layers", "3", "--cuts", "1"}),
                    "at most one of"));
+    for (const char* bad : {"0", "-1", "abc", "2.5", "1025"})
+        CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--threads", bad}), "--threads"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--origin", "1,2"}), "--origin"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--stream-points", "15"}),
+                   "--stream-points"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--stream", "--cuts", "1"}),
+                   "--stream needs --axis"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--stream", "--axis", "z"}),
+                   "--stream needs --cuts or --layer-height"));
+    CHECK(contains(
+        usage_error({"a.ply", "-o", "m.ply", "--stream", "--axis", "z", "--layers", "3"}),
+        "--stream needs --cuts or --layer-height"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.stl", "--stream", "--axis", "z", "--cuts", "1"}),
+                   "--stream cannot write STL"));
+    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--stream", "--axis", "z", "--cuts", "1",
+                                "--cap"}),
+                   "--stream cannot --cap"));
 }

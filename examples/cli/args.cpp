@@ -6,6 +6,7 @@
 #include <cmath>
 #include <iterator>
 #include <string_view>
+#include <thread>
 
 namespace stratmesh_cli {
 
@@ -50,12 +51,25 @@ const char kUsage[] =
     "  --cap                 close the tube's ends with caps over its boundary loops: a\n"
     "                        closed, watertight surface (a loop that cannot be capped\n"
     "                        stays open; the summary and the report count it)\n"
+    "  --threads N           triangulate the layers on N threads (default: the machine's\n"
+    "                        hardware threads); the output is the same bytes for any N\n"
+    "  --origin X,Y,Z        the reference point of the unrolling frame (default: the\n"
+    "                        cloud's centroid; with --stream, the first valid point)\n"
+    "  --stream              read and reconstruct layer by layer in bounded memory; needs\n"
+    "                        --axis x|y|z|X,Y,Z and --cuts or --layer-height, points\n"
+    "                        sorted along the axis, input PLY, XYZ or OBJ, output PLY, OBJ\n"
+    "                        or OFF (not STL). The same triangles as the run without\n"
+    "                        --stream given --cuts at the layer tops reached (the report's\n"
+    "                        stream.batch_cuts) and --origin at that first point\n"
+    "  --stream-points N     the most points the stream may hold at once (default\n"
+    "                        3000000, about 190 bytes each); about three layers' worth\n"
     "  -q, --quiet           no progress and no summary on stderr (errors still are)\n"
     "  --version             print the version and exit\n"
     "  -h, --help            print this help and exit\n"
     "\n"
     "Exit status: 0 success; 1 the reconstruction refused the input; 2 usage error;\n"
-    "3 file error (cannot open, read, parse or write).\n";
+    "3 file error (cannot open, read, parse or write); 4 with --stream, a point lies below\n"
+    "the one before it along the axis (sort the input along the axis first).\n";
 
 bool parse_finite(std::string_view text, double& value) {
     return parse_number(text, value) && std::isfinite(value);
@@ -120,6 +134,36 @@ bool parse_layer_height(std::string_view text, CommandLine& line, std::string& e
     return false;
 }
 
+bool parse_threads(std::string_view text, CommandLine& line, std::string& error) {
+    uint64_t count = 0;
+    if (parse_count(text, count) != CountParse::ok || count < 1 || count > 1024) {
+        error = "--threads: expected a whole number from 1 to 1024, not '" + std::string(text) +
+                "'";
+        return false;
+    }
+    line.threads = static_cast<uint32_t>(count);
+    return true;
+}
+
+bool parse_stream_points(std::string_view text, CommandLine& line, std::string& error) {
+    if (parse_count(text, line.stream_points) == CountParse::ok && line.stream_points >= 16)
+        return true;
+    error = "--stream-points: expected a whole number of at least 16, not '" + std::string(text) +
+            "'";
+    return false;
+}
+
+bool parse_origin(std::string_view text, CommandLine& line, std::string& error) {
+    std::vector<double> v;
+    if (!parse_number_list(text, v) || v.size() != 3) {
+        error = "--origin: expected a point X,Y,Z, not '" + std::string(text) + "'";
+        return false;
+    }
+    line.origin_given = true;
+    for (size_t k = 0; k < 3; ++k) line.origin[k] = v[k];
+    return true;
+}
+
 bool parse_cuts(std::string_view text, CommandLine& line, std::string& error) {
     if (parse_number_list(text, line.cuts)) return true;
     error = "--cuts: expected numbers separated by commas, not '" + std::string(text) + "'";
@@ -135,6 +179,9 @@ bool apply_valued(std::string_view name, std::string_view value, CommandLine& li
     if (name == "--cuts") return parse_cuts(value, line, error);
     if (name == "--layers") return parse_layers(value, line, error);
     if (name == "--layer-height") return parse_layer_height(value, line, error);
+    if (name == "--threads") return parse_threads(value, line, error);
+    if (name == "--stream-points") return parse_stream_points(value, line, error);
+    if (name == "--origin") return parse_origin(value, line, error);
     if (value.empty()) error = std::string(name) + ": the file name is empty";
     return error.empty();
 }
@@ -144,13 +191,36 @@ bool apply_flag(std::string_view name, CommandLine& line) {
     if (name == "--skip-invalid") line.skip_invalid = true;
     if (name == "--cap") line.cap = true;
     if (name == "--quiet") line.quiet = true;
+    if (name == "--stream") line.stream = true;
     return true;
 }
 
-const char* const kValuedOptions[] = {"--output", "--report", "--axis",
-                                      "--cuts",   "--layers", "--layer-height"};
-const char* const kFlags[] = {"--ascii", "--skip-invalid", "--cap", "--quiet", "--help",
-                              "--version"};
+const char* const kValuedOptions[] = {"--output",  "--report",        "--axis",
+                                      "--cuts",    "--layers",        "--layer-height",
+                                      "--threads", "--stream-points", "--origin"};
+const char* const kFlags[] = {"--ascii", "--skip-invalid", "--cap",    "--quiet",
+                              "--help",  "--version",      "--stream"};
+
+// What --stream cannot do, or an empty string.
+std::string stream_conflict(const CommandLine& line) {
+    if (line.axis == stratmesh::Axis::automatic)
+        return "--stream needs --axis x, y, z or X,Y,Z: the automatic axis is the principal "
+               "direction of the whole cloud, unknown until every point is read";
+    if (line.cuts.empty() && line.layer_height <= 0)
+        return "--stream needs --cuts or --layer-height: the layers are formed as the points "
+               "arrive (--layers and automatic layers need the whole cloud's height)";
+    if (line.cap) return "--stream cannot --cap: the stream makes no caps";
+    if (mesh_format_from_extension(line.output) == MeshFormat::stl)
+        return "--stream cannot write STL (its triangles repeat their corners' coordinates, "
+               "which the stream no longer holds): write PLY, OBJ or OFF";
+    return "";
+}
+
+// The machine's hardware threads, at least 1.
+uint32_t default_threads() {
+    unsigned count = std::thread::hardware_concurrency();
+    return count > 0 ? count : 1;
+}
 
 std::string_view canonical_name(std::string_view name) {
     if (name == "-o") return "--output";
@@ -172,6 +242,7 @@ public:
         : argc_(argc), argv_(argv), line_(line) {}
 
     CommandAction run(std::string& error) {
+        line_.threads = default_threads();
         for (index_ = 1; index_ < argc_; ++index_) take(argv_[index_]);
         if (help_) return CommandAction::help;
         if (version_) return CommandAction::version;
@@ -243,7 +314,9 @@ private:
         if (mesh_format_from_extension(line_.output) == MeshFormat::unknown)
             return fail("cannot tell the mesh format of '" + line_.output +
                         "' from its extension (use .ply, .obj, .off or .stl)");
-        if (layer_choices > 1) fail("give at most one of --cuts, --layers and --layer-height");
+        if (layer_choices > 1)
+            return fail("give at most one of --cuts, --layers and --layer-height");
+        if (line_.stream) fail(stream_conflict(line_));
     }
 
     int argc_;

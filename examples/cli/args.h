@@ -23,6 +23,11 @@ struct CommandLine {
     bool skip_invalid = false;
     bool cap = false;              // --cap: close the ends (stratmesh::close_ends)
     bool quiet = false;
+    uint32_t threads = 1;           // --threads (default: the hardware's threads, at least 1)
+    bool stream = false;            // --stream: read and reconstruct layer by layer
+    uint64_t stream_points = 3000000; // --stream-points: the most points the stream holds
+    bool origin_given = false;      // --origin
+    double origin[3] = {0, 0, 0};
 };
 
 enum class CommandAction { run, help, version, usage_error };

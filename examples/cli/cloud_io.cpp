@@ -139,4 +139,31 @@ bool read_cloud_file(const std::string& path, std::vector<double>& xyz, std::str
     return ok;
 }
 
+std::unique_ptr<PointReader> open_point_reader(const std::string& path, CloudInfo& info,
+                                               std::string& error) {
+    // Enough to detect any format (detect_cloud_format looks at 200 lines at most).
+    const size_t kDetectBytes = 1 << 16;
+    std::FILE* opened = std::fopen(path.c_str(), "rb");
+    if (!opened) {
+        error = path + ": cannot open: " + std::strerror(errno);
+        return nullptr;
+    }
+    auto file = std::make_unique<FileWindow>(opened);
+    std::string_view start = file->peek(kDetectBytes);
+    info.format = detect_cloud_format(start.data(), start.size());
+    info.encoding = "text";
+    std::unique_ptr<PointReader> reader;
+    if (start.empty())
+        error = file->failure().empty() ? "the file is empty" : file->failure();
+    else if (info.format == CloudFormat::off)
+        error = "OFF files cannot be read point by point (--stream): convert the file to PLY "
+                "or XYZ";
+    else if (info.format == CloudFormat::ply)
+        reader = open_ply_points(std::move(file), error, info.encoding);
+    else
+        reader = open_text_points(std::move(file), info.format == CloudFormat::obj);
+    if (!reader) error = path + ": " + error;
+    return reader;
+}
+
 } // namespace stratmesh_cli

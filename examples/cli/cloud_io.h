@@ -12,6 +12,7 @@
 #define STRATMESH_CLI_CLOUD_IO_H
 
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,23 @@ bool read_file_bytes(const std::string& path, std::vector<char>& bytes, std::str
 // content wins over a misleading extension). Errors start with the path.
 bool read_cloud_file(const std::string& path, std::vector<double>& xyz, std::string& error,
                      CloudInfo* info = nullptr);
+
+// Reads a cloud file point by point with a window of about a megabyte (--stream), so the
+// memory does not grow with the file. PLY (ascii, or binary whose vertex records have no
+// list property, with no list element before the vertices), XYZ-style columns and OBJ;
+// OFF is refused.
+class PointReader {
+public:
+    virtual ~PointReader() = default;
+    // The next point; false at the end of the points (`error` left empty) or on an error
+    // (`error` says what and where, like the whole-file readers).
+    virtual bool next(double xyz[3], std::string& error) = 0;
+};
+
+// Opens `path` for reading point by point, with the format detected from its first
+// block; null with `error` (starting with the path) if it cannot.
+std::unique_ptr<PointReader> open_point_reader(const std::string& path, CloudInfo& info,
+                                               std::string& error);
 
 } // namespace stratmesh_cli
 

@@ -2,6 +2,10 @@
 #ifndef STRATMESH_CLI_CLOUD_READERS_H
 #define STRATMESH_CLI_CLOUD_READERS_H
 
+#include "cloud_io.h"
+#include "file_window.h"
+
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -14,6 +18,11 @@ bool read_ply(std::string_view data, std::vector<double>& xyz, std::string& erro
 bool read_xyz(std::string_view data, std::vector<double>& xyz, std::string& error);
 bool read_off(std::string_view data, std::vector<double>& xyz, std::string& error);
 bool read_obj(std::string_view data, std::vector<double>& xyz, std::string& error);
+
+// Point-by-point readers over a file window positioned at the start of the file.
+std::unique_ptr<PointReader> open_ply_points(std::unique_ptr<FileWindow> file, std::string& error,
+                                             std::string& encoding);
+std::unique_ptr<PointReader> open_text_points(std::unique_ptr<FileWindow> file, bool obj);
 
 // True for OFF header keywords: OFF with the optional prefixes ST, C, N, 4, n.
 bool is_off_keyword(std::string_view token);

@@ -7,10 +7,13 @@
 #include "args.h"
 #include "cloud_io.h"
 #include "mesh_io.h"
+#include "peak_memory.h"
 #include "progress.h"
 #include "report_json.h"
 #include "stratmesh.h"
+#include "stream_run.h"
 #include "summary.h"
+#include "thread_jobs.h"
 
 #include <chrono>
 #include <cstdint>
@@ -37,6 +40,7 @@ const int kExitOk = 0;
 const int kExitRefused = 1;
 const int kExitUsage = 2;
 const int kExitFile = 3;
+const int kExitUnsorted = 4;
 
 // Progress is drawn for inputs this large, when stderr is a terminal.
 const size_t kProgressPoints = 200000;
@@ -73,9 +77,13 @@ void record_command_line(const CommandLine& line, RunRecord& record) {
     record.layer_height = line.layer_height;
     record.skip_invalid = line.skip_invalid;
     record.cap = line.cap;
+    record.threads = line.threads;
+    record.origin_given = line.origin_given || line.stream;
+    for (size_t k = 0; k < 3; ++k) record.origin[k] = line.origin[k];
 }
 
-stratmesh::Options make_options(const CommandLine& line, ProgressMonitor& monitor) {
+stratmesh::Options make_options(const CommandLine& line, ProgressMonitor& monitor,
+                                ThreadJobs& jobs) {
     stratmesh::Options options = {};
     options.axis = line.axis;
     for (size_t k = 0; k < 3; ++k) options.direction[k] = line.direction[k];
@@ -87,6 +95,12 @@ stratmesh::Options make_options(const CommandLine& line, ProgressMonitor& monito
                     (line.cap ? stratmesh::close_ends : 0u);
     options.progress = &ProgressMonitor::callback;
     options.progress_user = &monitor;
+    if (line.origin_given) {
+        options.flags |= stratmesh::origin_given;
+        for (size_t k = 0; k < 3; ++k) options.origin[k] = line.origin[k];
+    }
+    jobs.threads = line.threads;
+    jobs.attach(options);
     return options;
 }
 
@@ -142,11 +156,7 @@ void record_outcome(stratmesh::Report report, std::vector<stratmesh::LayerInfo>&
     record.reconstructed = true;
     record.reconstruct_seconds = monitor.total_seconds();
     for (size_t p = 0; p < kTimedPhases; ++p) record.phase_seconds[p] = monitor.phase_seconds(p);
-    if (report.layer_count < layers.size()) layers.resize(report.layer_count);
-    record.layers = std::move(layers);
-    report.layers = nullptr; // it pointed into `layers`
-    report.layer_capacity = 0;
-    record.report = report;
+    record.take_report(report, layers);
 }
 
 // Runs reconstruct() and records its outcome; false if the buffers cannot be allocated.
@@ -155,7 +165,8 @@ bool reconstruct_points(const std::vector<double>& xyz, const CommandLine& line,
     size_t count = xyz.size() / 3;
     bool show = !line.quiet && count >= kProgressPoints && STRATMESH_CLI_STDERR_IS_TERMINAL();
     ProgressMonitor monitor(show, stderr);
-    stratmesh::Options options = make_options(line, monitor);
+    ThreadJobs jobs;
+    stratmesh::Options options = make_options(line, monitor, jobs);
     record.workspace_bytes = stratmesh::reconstruct_workspace_size(count, options);
     size_t max_triangles = stratmesh::reconstruct_max_triangles(count, options);
     record.triangle_buffer_bytes = max_triangles <= SIZE_MAX / 12 ? 12 * max_triangles : SIZE_MAX;
@@ -185,6 +196,11 @@ void explain_refusal(const CommandLine& line, const RunRecord& record) {
                      "--skip-invalid skips such points\n",
                      record.report.first_invalid_point);
     if (record.report.detail) std::fprintf(stderr, "stratmesh: %s\n", record.report.detail);
+    if (record.stream && record.status == stratmesh::Status::out_of_memory)
+        std::fprintf(stderr,
+                     "stratmesh: --stream-points %llu is too few for these layers: raise it or "
+                     "cut thinner layers\n",
+                     static_cast<unsigned long long>(record.stream_points));
 }
 
 bool write_report(const CommandLine& line, const RunRecord& record) {
@@ -210,21 +226,48 @@ bool write_output(const CommandLine& line, const std::vector<double>& xyz,
     return true;
 }
 
+// Prints the summary and writes the report of a run whose mesh is written.
+int finish_run(const CommandLine& line, RunRecord& record) {
+    record.peak_rss_bytes = peak_resident_bytes();
+    if (!line.quiet) print_summary(stderr, record);
+    return write_report(line, record) ? kExitOk : kExitFile;
+}
+
+int refuse(const CommandLine& line, RunRecord& record) {
+    explain_refusal(line, record);
+    record.peak_rss_bytes = peak_resident_bytes();
+    write_report(line, record);
+    return kExitRefused;
+}
+
+int run_streamed(const CommandLine& line, RunRecord& record) {
+    ProgressMonitor silent(false, stderr);
+    ThreadJobs jobs;
+    std::string error;
+    StreamOutcome outcome = run_stream(line, make_options(line, silent, jobs), record, error);
+    switch (outcome) {
+    case StreamOutcome::done: return finish_run(line, record);
+    case StreamOutcome::refused: return refuse(line, record);
+    case StreamOutcome::file_error: break;
+    case StreamOutcome::unsorted:
+        std::fprintf(stderr, "stratmesh: %s: %s\n", line.input.c_str(), error.c_str());
+        return kExitUnsorted;
+    }
+    std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
+    return kExitFile;
+}
+
 int run(const CommandLine& line) {
     RunRecord record;
     record_command_line(line, record);
+    if (line.stream) return run_streamed(line, record);
     std::vector<double> xyz;
     Reconstruction result;
     if (!read_input(line, xyz, record)) return kExitFile;
     if (!reconstruct_points(xyz, line, result, record)) return kExitRefused;
-    if (record.status != stratmesh::Status::ok) {
-        explain_refusal(line, record);
-        write_report(line, record);
-        return kExitRefused;
-    }
+    if (record.status != stratmesh::Status::ok) return refuse(line, record);
     if (!write_output(line, xyz, result, record)) return kExitFile;
-    if (!line.quiet) print_summary(stderr, record);
-    return write_report(line, record) ? kExitOk : kExitFile;
+    return finish_run(line, record);
 }
 
 } // namespace

@@ -9,10 +9,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <vector>
 
 namespace stratmesh_cli {
-
-namespace {
 
 // Collects output in memory and hands it to the file in large blocks.
 class BlockWriter {
@@ -20,6 +19,8 @@ public:
     explicit BlockWriter(std::FILE* file) : file_(file) {}
 
     std::string& buffer() { return buffer_; }
+    std::FILE* file() const { return file_; }
+    bool failed() const { return failure_ != 0; }
 
     void flush_if_large() {
         if (buffer_.size() >= kBlockBytes) flush();
@@ -50,6 +51,9 @@ private:
     std::string buffer_;
     int failure_ = 0;
 };
+
+namespace {
+
 
 // ---- encoding ----------------------------------------------------------------------------
 
@@ -122,36 +126,64 @@ void write_ply_header(std::string& out, const MeshView& mesh, bool ascii, bool s
     out += "property list uchar uint vertex_indices\nend_header\n";
 }
 
-void write_ply_binary_body(BlockWriter& w, const MeshView& mesh, bool single) {
-    std::string& out = w.buffer();
-    for (size_t i = 0; i < 3 * mesh.vertex_count; ++i) {
+void append_binary_vertex(std::string& out, const double* p, bool single) {
+    for (size_t k = 0; k < 3; ++k) {
         if (single)
-            append_le_float(out, to_float(mesh.xyz[i]));
+            append_le_float(out, to_float(p[k]));
         else
-            append_le_double(out, mesh.xyz[i]);
+            append_le_double(out, p[k]);
+    }
+}
+
+void append_binary_face(std::string& out, const uint32_t* triangle) {
+    out += static_cast<char>(3);
+    for (size_t k = 0; k < 3; ++k) append_le_u32(out, triangle[k]);
+}
+
+void write_ply_binary_body(BlockWriter& w, const MeshView& mesh, bool single) {
+    for (size_t i = 0; i < mesh.vertex_count; ++i) {
+        append_binary_vertex(w.buffer(), mesh.xyz + 3 * i, single);
         w.flush_if_large();
     }
     for (size_t t = 0; t < mesh.triangle_count; ++t) {
-        out += static_cast<char>(3);
-        for (size_t k = 0; k < 3; ++k) append_le_u32(out, mesh.triangles[3 * t + k]);
+        append_binary_face(w.buffer(), mesh.triangles + 3 * t);
         w.flush_if_large();
     }
 }
 
-void write_ply_ascii_body(BlockWriter& w, const MeshView& mesh) {
-    std::string& out = w.buffer();
+// Text PLY, OBJ and OFF share their shape: a vertex line per point, a face line per
+// triangle.
+struct TextStyle {
+    const char* vertex_prefix; // "v " or ""
+    const char* face_prefix;   // "f" or "3"
+    uint32_t index_base;       // 1 or 0
+};
+
+const TextStyle kObjStyle = {"v ", "f", 1};
+const TextStyle kOffStyle = {"", "3", 0}; // text PLY's too
+
+void append_vertex_line(std::string& out, const double* p, const TextStyle& style) {
+    out += style.vertex_prefix;
+    append_point(out, p);
+    out += '\n';
+}
+
+void append_face_line(std::string& out, const uint32_t* triangle, const TextStyle& style) {
+    out += style.face_prefix;
+    for (size_t k = 0; k < 3; ++k) {
+        out += ' ';
+        append_index(out, uint64_t{triangle[k]} + style.index_base);
+    }
+    out += '\n';
+}
+
+void write_text_body(BlockWriter& w, const MeshView& mesh, const TextStyle& style) {
     for (size_t i = 0; i < mesh.vertex_count; ++i) {
-        append_point(out, mesh.xyz + 3 * i);
-        out += '\n';
+        append_vertex_line(w.buffer(), mesh.xyz + 3 * i, style);
         w.flush_if_large();
     }
     for (size_t t = 0; t < mesh.triangle_count; ++t) {
-        out += '3';
-        for (size_t k = 0; k < 3; ++k) {
-            out += ' ';
-            append_index(out, mesh.triangles[3 * t + k]);
-        }
-        out += '\n';
+        append_face_line(w.buffer(), mesh.triangles + 3 * t, style);
         w.flush_if_large();
     }
 }
@@ -160,47 +192,26 @@ void write_ply(BlockWriter& w, const MeshView& mesh, bool ascii) {
     bool single = !ascii && all_coordinates_are_floats(mesh.xyz, mesh.vertex_count);
     write_ply_header(w.buffer(), mesh, ascii, single);
     if (ascii)
-        write_ply_ascii_body(w, mesh);
+        write_text_body(w, mesh, kOffStyle);
     else
         write_ply_binary_body(w, mesh, single);
 }
 
-// OBJ and OFF share their shape: a vertex line per point, a face line per triangle.
-struct TextStyle {
-    const char* vertex_prefix; // "v " or ""
-    const char* face_prefix;   // "f" or "3"
-    uint32_t index_base;       // 1 or 0
-};
+std::string obj_header() { return std::string("# ") + generator_comment() + "\n"; }
 
-void write_text_body(BlockWriter& w, const MeshView& mesh, const TextStyle& style) {
-    std::string& out = w.buffer();
-    for (size_t i = 0; i < mesh.vertex_count; ++i) {
-        out += style.vertex_prefix;
-        append_point(out, mesh.xyz + 3 * i);
-        out += '\n';
-        w.flush_if_large();
-    }
-    for (size_t t = 0; t < mesh.triangle_count; ++t) {
-        out += style.face_prefix;
-        for (size_t k = 0; k < 3; ++k) {
-            out += ' ';
-            append_index(out, uint64_t{mesh.triangles[3 * t + k]} + style.index_base);
-        }
-        out += '\n';
-        w.flush_if_large();
-    }
+std::string off_header(size_t vertex_count, size_t triangle_count) {
+    return std::string("OFF\n# ") + generator_comment() + "\n" + std::to_string(vertex_count) +
+           " " + std::to_string(triangle_count) + " 0\n";
 }
 
 void write_obj(BlockWriter& w, const MeshView& mesh) {
-    w.buffer() += std::string("# ") + generator_comment() + "\n";
-    write_text_body(w, mesh, TextStyle{"v ", "f", 1});
+    w.buffer() += obj_header();
+    write_text_body(w, mesh, kObjStyle);
 }
 
 void write_off(BlockWriter& w, const MeshView& mesh) {
-    w.buffer() += std::string("OFF\n# ") + generator_comment() + "\n" +
-                  std::to_string(mesh.vertex_count) + " " + std::to_string(mesh.triangle_count) +
-                  " 0\n";
-    write_text_body(w, mesh, TextStyle{"", "3", 0});
+    w.buffer() += off_header(mesh.vertex_count, mesh.triangle_count);
+    write_text_body(w, mesh, kOffStyle);
 }
 
 // The unit normal of triangle t (zero if degenerate), from the right-hand rule.
@@ -340,6 +351,106 @@ bool write_mesh_file(const std::string& path, MeshFormat format, const MeshView&
     if (writer.close(error)) return true;
     error = path + ": cannot write: " + error;
     std::remove(path.c_str());
+    return false;
+}
+
+MeshStreamWriter::MeshStreamWriter() = default;
+
+// A writer still open here is abandoned: its file is closed and the output removed.
+MeshStreamWriter::~MeshStreamWriter() {
+    std::string ignored;
+    if (out_) finish(false, ignored);
+}
+
+bool MeshStreamWriter::open(const std::string& path, MeshFormat format, bool ascii,
+                            std::string& error) {
+    path_ = path;
+    format_ = format;
+    ascii_ = ascii && format == MeshFormat::ply;
+    std::FILE* file = std::fopen(path.c_str(), "wb");
+    std::FILE* vertices = format == MeshFormat::obj ? nullptr : std::tmpfile();
+    std::FILE* faces = format == MeshFormat::obj ? nullptr : std::tmpfile();
+    if (file) out_ = std::make_unique<BlockWriter>(file);
+    if (vertices) vertices_ = std::make_unique<BlockWriter>(vertices);
+    if (faces) faces_ = std::make_unique<BlockWriter>(faces);
+    bool temporaries = format == MeshFormat::obj || (vertices && faces);
+    if (file && temporaries) {
+        if (format == MeshFormat::obj) out_->buffer() += obj_header();
+        return true;
+    }
+    error = path + (file ? ": cannot create a temporary file: " : ": cannot create: ") +
+            std::strerror(errno);
+    finish(false, error);
+    return false;
+}
+
+void MeshStreamWriter::add_vertices(const double* xyz, size_t count) {
+    BlockWriter& w = format_ == MeshFormat::obj ? *out_ : *vertices_;
+    bool binary = format_ == MeshFormat::ply && !ascii_;
+    all_floats_ = all_floats_ && all_coordinates_are_floats(xyz, count);
+    for (size_t i = 0; i < count; ++i) {
+        if (binary)
+            append_binary_vertex(w.buffer(), xyz + 3 * i, false);
+        else
+            append_vertex_line(w.buffer(), xyz + 3 * i,
+                               format_ == MeshFormat::obj ? kObjStyle : kOffStyle);
+        w.flush_if_large();
+    }
+    vertex_count_ += count;
+}
+
+void MeshStreamWriter::add_triangles(const uint32_t* triangles, size_t count) {
+    BlockWriter& w = format_ == MeshFormat::obj ? *out_ : *faces_;
+    bool binary = format_ == MeshFormat::ply && !ascii_;
+    for (size_t t = 0; t < count; ++t) {
+        if (binary)
+            append_binary_face(w.buffer(), triangles + 3 * t);
+        else
+            append_face_line(w.buffer(), triangles + 3 * t,
+                             format_ == MeshFormat::obj ? kObjStyle : kOffStyle);
+        w.flush_if_large();
+    }
+    triangle_count_ += count;
+}
+
+// Appends a temporary body to the output; binary PLY vertices were kept as doubles and
+// become floats when every coordinate is one (as write_mesh_file decides).
+bool MeshStreamWriter::copy_body(BlockWriter& from, bool doubles_to_floats) {
+    from.flush();
+    std::rewind(from.file());
+    std::vector<char> chunk(1 << 20); // a whole number of doubles
+    while (size_t got = std::fread(chunk.data(), 1, chunk.size(), from.file())) {
+        if (!doubles_to_floats) out_->buffer().append(chunk.data(), got);
+        for (size_t at = 0; doubles_to_floats && at + 8 <= got; at += 8) {
+            double value = 0;
+            std::memcpy(&value, chunk.data() + at, 8);
+            append_le_float(out_->buffer(), to_float(value));
+        }
+        out_->flush_if_large();
+    }
+    return !from.failed() && !std::ferror(from.file());
+}
+
+bool MeshStreamWriter::finish(bool keep, std::string& error) {
+    bool single = format_ == MeshFormat::ply && !ascii_ && all_floats_;
+    if (keep && format_ != MeshFormat::obj) {
+        MeshView counts = {nullptr, vertex_count_, nullptr, triangle_count_};
+        if (format_ == MeshFormat::ply)
+            write_ply_header(out_->buffer(), counts, ascii_, single);
+        else
+            out_->buffer() += off_header(vertex_count_, triangle_count_);
+    }
+    std::string failure;
+    bool ok = keep && (format_ == MeshFormat::obj ||
+                       (copy_body(*vertices_, single) && copy_body(*faces_, false)));
+    if (keep && !ok) failure = "a temporary file cannot be read back";
+    for (std::unique_ptr<BlockWriter>* w : {&vertices_, &faces_, &out_}) {
+        if (*w && !(*w)->close(failure)) ok = false;
+        w->reset();
+    }
+    if (ok) return true;
+    if (keep) error = path_ + ": cannot write: " + failure;
+    std::remove(path_.c_str());
     return false;
 }
 

@@ -15,6 +15,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <memory>
 #include <string>
 
 namespace stratmesh_cli {
@@ -41,6 +43,38 @@ bool all_coordinates_are_floats(const double* xyz, size_t count);
 // On failure the partial file is removed and `error` names the file and the cause.
 bool write_mesh_file(const std::string& path, MeshFormat format, const MeshView& mesh, bool ascii,
                      std::string& error);
+
+class BlockWriter;
+
+// Writes a mesh whose vertices and triangles arrive piece by piece (--stream), in bounded
+// memory, with the same vertex rule and the same bytes as write_mesh_file() given the
+// whole mesh (OBJ excepted: its vertex and face lines interleave as they arrive). OBJ goes
+// straight to the file; PLY and OFF, whose headers count what follows, collect the vertex
+// and face bodies in two temporary files and copy them after the header at finish().
+// STL, which repeats the corners' coordinates in every triangle, is not supported.
+class MeshStreamWriter {
+public:
+    MeshStreamWriter();
+    ~MeshStreamWriter();
+
+    // Creates the output; false with a message naming the file.
+    bool open(const std::string& path, MeshFormat format, bool ascii, std::string& error);
+    void add_vertices(const double* xyz, size_t count);
+    // Triangles must only use vertices already added.
+    void add_triangles(const uint32_t* triangles, size_t count);
+    // Completes the file; on failure removes it and says why. `keep` false just removes it.
+    bool finish(bool keep, std::string& error);
+
+private:
+    bool copy_body(BlockWriter& from, bool doubles_to_floats);
+
+    std::string path_;
+    MeshFormat format_ = MeshFormat::unknown;
+    bool ascii_ = false;
+    std::unique_ptr<BlockWriter> out_, vertices_, faces_;
+    size_t vertex_count_ = 0, triangle_count_ = 0;
+    bool all_floats_ = true;
+};
 
 } // namespace stratmesh_cli
 

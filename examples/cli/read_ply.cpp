@@ -2,6 +2,7 @@
 // x, y and z are kept; every other property and element is stepped over, so normals,
 // colours, intensities and faces (before or after the vertices) do no harm.
 #include "cloud_readers.h"
+#include "file_window.h"
 #include "text_scan.h"
 
 #include <cstdint>
@@ -431,8 +432,11 @@ bool read_binary_body(std::string_view data, const PlyHeader& header, const Vert
 }
 
 // ---- ascii body --------------------------------------------------------------------------
+// The record readers take any token source: a TokenCursor over the whole file, or
+// FileTokens over a window of it (--stream).
 
-bool next_ascii_value(TokenCursor& in, const PlyElement& element, uint64_t record, double& value,
+template <class Tokens>
+bool next_ascii_value(Tokens& in, const PlyElement& element, uint64_t record, double& value,
                       std::string& error) {
     std::string_view token;
     if (!in.next(token)) {
@@ -445,7 +449,8 @@ bool next_ascii_value(TokenCursor& in, const PlyElement& element, uint64_t recor
     return false;
 }
 
-bool next_ascii_list_length(TokenCursor& in, const PlyElement& element, uint64_t record,
+template <class Tokens>
+bool next_ascii_list_length(Tokens& in, const PlyElement& element, uint64_t record,
                             uint64_t& count, std::string& error) {
     std::string_view token;
     if (!in.next(token)) {
@@ -459,7 +464,8 @@ bool next_ascii_list_length(TokenCursor& in, const PlyElement& element, uint64_t
     return false;
 }
 
-bool read_ascii_record(TokenCursor& in, const PlyElement& element,
+template <class Tokens>
+bool read_ascii_record(Tokens& in, const PlyElement& element,
                        const std::vector<int>& coordinate_of, double* xyz, uint64_t record,
                        std::string& error) {
     for (size_t p = 0; p < element.properties.size(); ++p) {
@@ -477,7 +483,8 @@ bool read_ascii_record(TokenCursor& in, const PlyElement& element,
     return true;
 }
 
-bool read_ascii_element(TokenCursor& in, const PlyElement& element,
+template <class Tokens>
+bool read_ascii_element(Tokens& in, const PlyElement& element,
                         const std::vector<int>& coordinate_of, std::vector<double>* xyz,
                         std::string& error) {
     if (element.properties.empty()) return true;
@@ -501,7 +508,120 @@ bool read_ascii_body(std::string_view data, const PlyHeader& header, const Verte
                               error);
 }
 
+// ---- streaming (--stream) ----------------------------------------------------------------
+
+// Tokens of a file read through a FileWindow: a TokenCursor over each run of whole lines.
+class FileTokens {
+public:
+    explicit FileTokens(FileWindow& file) : file_(file), cursor_(std::string_view(), 1) {}
+
+    bool next(std::string_view& token) {
+        std::string_view lines;
+        while (!cursor_.next(token)) {
+            if (!file_.next_lines(lines)) return false;
+            cursor_ = TokenCursor(lines, file_.lines_first_line());
+        }
+        return true;
+    }
+    size_t line_number() const { return cursor_.line_number(); }
+
+private:
+    FileWindow& file_;
+    TokenCursor cursor_;
+};
+
+// The vertex element's points, one record at a time.
+class PlyPoints : public PointReader {
+public:
+    PlyPoints(std::unique_ptr<FileWindow> file, PlyHeader header, VertexLayout layout)
+        : file_(std::move(file)), header_(std::move(header)), layout_(std::move(layout)),
+          tokens_(*file_) {}
+
+    // Steps over the elements before the vertices.
+    bool skip_to_vertices(std::string& error) {
+        for (size_t e = 0; e < layout_.element; ++e) {
+            const PlyElement& element = header_.elements[e];
+            if (header_.encoding == PlyEncoding::ascii) {
+                std::vector<int> none(element.properties.size(), -1);
+                if (!read_ascii_element(tokens_, element, none, nullptr, error)) return false;
+                continue;
+            }
+            uint64_t size = fixed_record_size(element);
+            if (size == 0 && !element.properties.empty()) {
+                error = "element " + quote(element.name) +
+                        " comes before the vertices and has list properties: it cannot be "
+                        "stepped over without reading it whole";
+                return false;
+            }
+            if (element.count > UINT64_MAX / (size ? size : 1) ||
+                !file_->discard(element.count * size)) {
+                error = at_byte(file_->offset()) + "the file ends inside element " +
+                        quote(element.name);
+                return false;
+            }
+        }
+        return true;
+    }
+
+    bool next(double xyz[3], std::string& error) override {
+        const PlyElement& vertex = header_.elements[layout_.element];
+        if (record_ == vertex.count) return false;
+        xyz[0] = xyz[1] = xyz[2] = 0;
+        bool ok = header_.encoding == PlyEncoding::ascii
+                      ? read_ascii_record(tokens_, vertex, layout_.coordinate_of, xyz, record_,
+                                          error)
+                      : next_binary(vertex, xyz, error);
+        std::string failure = file_->failure();
+        if (!failure.empty()) error = failure;
+        ++record_;
+        return ok && failure.empty();
+    }
+
+private:
+    bool next_binary(const PlyElement& vertex, double xyz[3], std::string& error) {
+        size_t size = static_cast<size_t>(fixed_record_size(vertex));
+        std::string_view bytes = file_->peek(size);
+        if (bytes.size() < size) {
+            error = at_byte(file_->offset() + bytes.size()) + "the file ends inside " +
+                    record_place(vertex, record_);
+            return false;
+        }
+        ByteReader in(bytes, 0, header_.encoding == PlyEncoding::big_endian);
+        file_->skip(size);
+        return read_binary_record(in, vertex, layout_.coordinate_of, xyz, record_, error);
+    }
+
+    std::unique_ptr<FileWindow> file_;
+    PlyHeader header_;
+    VertexLayout layout_;
+    FileTokens tokens_;
+    uint64_t record_ = 0;
+};
+
 } // namespace
+
+std::unique_ptr<PointReader> open_ply_points(std::unique_ptr<FileWindow> file, std::string& error,
+                                             std::string& encoding) {
+    // The header must lie within the first block: headers are a few hundred bytes.
+    const size_t kMaxHeader = 1 << 20;
+    PlyHeader header;
+    VertexLayout layout;
+    if (!parse_header(file->peek(kMaxHeader), header, error)) return nullptr;
+    if (!find_vertex_layout(header, layout, error)) return nullptr;
+    const PlyElement& vertex = header.elements[layout.element];
+    if (header.encoding != PlyEncoding::ascii && fixed_record_size(vertex) == 0) {
+        error = "the vertex element has list properties: a binary PLY file with them cannot "
+                "be read point by point";
+        return nullptr;
+    }
+    encoding = encoding_name(header.encoding);
+    file->skip(header.data_offset);
+    file->set_first_line(header.data_line);
+    auto points =
+        std::make_unique<PlyPoints>(std::move(file), std::move(header), std::move(layout));
+    if (!points->skip_to_vertices(error)) return nullptr;
+    return points;
+}
 
 bool read_ply(std::string_view data, std::vector<double>& xyz, std::string& error,
               std::string& encoding) {

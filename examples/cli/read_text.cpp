@@ -1,6 +1,7 @@
 // Text readers: numeric columns (XYZ, PTS, TXT, CSV), OFF and OBJ. All are line based,
 // keep the first three numbers of each point line and name the line of any error.
 #include "cloud_readers.h"
+#include "file_window.h"
 #include "text_scan.h"
 
 #include <cstdint>
@@ -114,6 +115,73 @@ bool read_off_header(LineCursor& lines, uint64_t& vertex_count, std::string& err
     return false;
 }
 
+// The lines of a column file (XYZ, PTS, TXT, CSV): a point per line, except blank and
+// comment lines, a first line of column names and a PTS count line.
+class ColumnRows {
+public:
+    // Appends the line's point, if it has one; false with a message on a bad line.
+    bool take(std::string_view line, size_t line_number, std::vector<double>& xyz,
+              std::string& error) {
+        std::string_view content = strip_comment(line, true);
+        NumberRow row = scan_numbers(content, true);
+        if (row.fields == 0) return true;
+        bool column_names = first_content_ && row.all_start_with_letters;
+        first_content_ = false;
+        if (column_names || is_count_line(content)) return true;
+        return take_point(row, line_number, xyz, error);
+    }
+
+private:
+    bool first_content_ = true;
+};
+
+// Appends the point of an OBJ "v" line; other lines are ignored.
+bool take_obj_line(std::string_view line, size_t line_number, std::vector<double>& xyz,
+                   std::string& error) {
+    std::string_view rest = strip_comment(line, false), keyword;
+    if (!next_field(rest, keyword, false) || keyword != "v") return true;
+    return take_point(scan_numbers(rest, false), line_number, xyz, error);
+}
+
+// The points of a column or OBJ file read line by line through a window (--stream).
+class TextPoints : public PointReader {
+public:
+    TextPoints(std::unique_ptr<FileWindow> file, bool obj) : file_(std::move(file)), obj_(obj) {}
+
+    bool next(double xyz[3], std::string& error) override {
+        std::string_view line;
+        point_.clear();
+        while (point_.empty()) {
+            if (!next_line(line)) {
+                error = file_->failure();
+                return false;
+            }
+            size_t number = file_->lines_first_line() + lines_.line_number() - 1;
+            bool ok = obj_ ? take_obj_line(line, number, point_, error)
+                           : columns_.take(line, number, point_, error);
+            if (!ok) return false;
+        }
+        for (size_t k = 0; k < 3; ++k) xyz[k] = point_[k];
+        return true;
+    }
+
+private:
+    bool next_line(std::string_view& line) {
+        std::string_view block;
+        while (!lines_.next(line)) {
+            if (!file_->next_lines(block)) return false;
+            lines_ = LineCursor(block);
+        }
+        return true;
+    }
+
+    std::unique_ptr<FileWindow> file_;
+    bool obj_;
+    LineCursor lines_{std::string_view()};
+    ColumnRows columns_;
+    std::vector<double> point_;
+};
+
 } // namespace
 
 bool is_off_keyword(std::string_view token) {
@@ -130,17 +198,10 @@ bool is_off_keyword(std::string_view token) {
 bool read_xyz(std::string_view data, std::vector<double>& xyz, std::string& error) {
     LineCursor lines(data);
     std::string_view line;
-    bool first_content = true;
+    ColumnRows rows;
     xyz.clear();
-    while (lines.next(line)) {
-        std::string_view content = strip_comment(line, true);
-        NumberRow row = scan_numbers(content, true);
-        if (row.fields == 0) continue;
-        bool column_names = first_content && row.all_start_with_letters;
-        first_content = false;
-        if (column_names || is_count_line(content)) continue;
-        if (!take_point(row, lines.line_number(), xyz, error)) return false;
-    }
+    while (lines.next(line))
+        if (!rows.take(line, lines.line_number(), xyz, error)) return false;
     if (!xyz.empty()) return true;
     error = "no points found (no line with 3 numbers)";
     return false;
@@ -156,16 +217,17 @@ bool read_off(std::string_view data, std::vector<double>& xyz, std::string& erro
 
 bool read_obj(std::string_view data, std::vector<double>& xyz, std::string& error) {
     LineCursor lines(data);
-    std::string_view line, keyword;
+    std::string_view line;
     xyz.clear();
-    while (lines.next(line)) {
-        std::string_view rest = strip_comment(line, false);
-        if (!next_field(rest, keyword, false) || keyword != "v") continue;
-        if (!take_point(scan_numbers(rest, false), lines.line_number(), xyz, error)) return false;
-    }
+    while (lines.next(line))
+        if (!take_obj_line(line, lines.line_number(), xyz, error)) return false;
     if (!xyz.empty()) return true;
     error = "no vertices found (no 'v' line)";
     return false;
+}
+
+std::unique_ptr<PointReader> open_text_points(std::unique_ptr<FileWindow> file, bool obj) {
+    return std::make_unique<TextPoints>(std::move(file), obj);
 }
 
 } // namespace stratmesh_cli

@@ -197,6 +197,18 @@ void write_options(JsonWriter& j, const RunRecord& r) {
     j.number(r.layer_height > 0 ? r.layer_height : std::numeric_limits<double>::quiet_NaN());
     j.flag_field("skip_invalid", r.skip_invalid);
     j.flag_field("cap", r.cap);
+    j.count_field("threads", r.threads);
+    j.flag_field("stream", r.stream);
+    j.key("stream_points");
+    if (r.stream)
+        j.integer(r.stream_points);
+    else
+        j.null();
+    j.key("origin");
+    if (r.origin_given)
+        j.numbers(r.origin, 3);
+    else
+        j.null();
     j.end_object();
 }
 
@@ -242,6 +254,17 @@ void write_counts(JsonWriter& j, const stratmesh::Report& rep, stratmesh::Status
     j.numbers_field("origin", rep.axis_origin, 3);
     j.end_object();
     j.count_field("layer_count", rep.layer_count);
+    j.count_field("parallel_layers", rep.parallel_layers);
+    j.count_field("points_held", rep.points_held);
+}
+
+void write_stream(JsonWriter& j, const RunRecord& r) {
+    j.key("stream");
+    if (!r.stream) return j.null();
+    j.begin_object();
+    j.count_field("pushes", r.stream_pushes);
+    j.numbers_field("batch_cuts", r.batch_cuts.data(), r.batch_cuts.size());
+    j.end_object();
 }
 
 void write_layer(JsonWriter& j, const stratmesh::LayerInfo& layer) {
@@ -283,6 +306,11 @@ void write_costs(JsonWriter& j, const RunRecord& r) {
     j.key("workspace_bytes_per_point");
     j.number(static_cast<double>(r.workspace_bytes) / points);
     j.count_field("triangle_buffer_bytes", r.triangle_buffer_bytes);
+    j.key("peak_rss_bytes");
+    if (r.peak_rss_bytes > 0)
+        j.integer(r.peak_rss_bytes);
+    else
+        j.null();
     j.end_object();
 }
 
@@ -306,6 +334,15 @@ RunRecord::RunRecord() {
     const double unknown = std::numeric_limits<double>::quiet_NaN();
     read_seconds = reconstruct_seconds = write_seconds = unknown;
     for (double& s : phase_seconds) s = unknown;
+}
+
+void RunRecord::take_report(stratmesh::Report outcome,
+                            std::vector<stratmesh::LayerInfo>& filled) {
+    if (outcome.layer_count < filled.size()) filled.resize(outcome.layer_count);
+    layers = std::move(filled);
+    outcome.layers = nullptr; // it pointed into `filled`
+    outcome.layer_capacity = 0;
+    report = outcome;
 }
 
 std::string json_string(std::string_view text) {
@@ -340,6 +377,7 @@ std::string run_record_json(const RunRecord& record) {
     write_status(j, record);
     write_counts(j, record.report, record.status);
     write_layers(j, record);
+    write_stream(j, record);
     write_costs(j, record);
     j.end_object();
     return j.text();

@@ -32,6 +32,15 @@ struct RunRecord {
     double layer_height = 0;  // --layer-height, 0 if not given
     bool skip_invalid = false;
     bool cap = false;
+    uint32_t threads = 1;
+    bool origin_given = false;
+    double origin[3] = {0, 0, 0};
+    bool stream = false;
+    uint64_t stream_points = 0; // --stream-points, with --stream
+    // With --stream: the layers pushed, and their tops but the last's (the --cuts of the
+    // equivalent run without --stream).
+    size_t stream_pushes = 0;
+    std::vector<double> batch_cuts;
     // The outcome. report.layers is not used: the filled entries are copied to `layers`.
     bool reconstructed = false; // reconstruct() ran (the input could be read)
     stratmesh::Status status = stratmesh::Status::ok;
@@ -42,8 +51,13 @@ struct RunRecord {
     double phase_seconds[kTimedPhases];
     size_t workspace_bytes = 0;
     size_t triangle_buffer_bytes = 0;
+    size_t peak_rss_bytes = 0; // the process's peak resident memory; 0 if unknown
 
     RunRecord();
+
+    // Records the library's report; the first `outcome.layer_count` (at most) entries of
+    // `filled`, which outcome.layers pointed at, move into `layers`.
+    void take_report(stratmesh::Report outcome, std::vector<stratmesh::LayerInfo>& filled);
 };
 
 // The record as a JSON document (UTF-8, numbers round-trip exactly, NaN/Inf as null).

@@ -45,7 +45,8 @@ std::string phase_times_text(const RunRecord& r) {
 void print_counts(std::FILE* out, const stratmesh::Report& rep) {
     std::fprintf(out, "  points     %zu read: %zu used, %zu duplicates, %zu rejected, %zu unused\n",
                  rep.points_in, rep.points_used, rep.duplicates, rep.rejected, rep.unused);
-    std::fprintf(out, "  layers     %zu\n", rep.layer_count);
+    std::fprintf(out, "  layers     %zu (%zu triangulated in parallel)\n", rep.layer_count,
+                 rep.parallel_layers);
     std::fprintf(out, "  triangles  %zu (%zu illegal removed, %zu folds)\n", rep.triangle_count,
                  rep.illegal_removed, rep.folds);
     if (rep.caps_closed + rep.caps_left_open > 0)
@@ -54,15 +55,23 @@ void print_counts(std::FILE* out, const stratmesh::Report& rep) {
 }
 
 void print_costs(std::FILE* out, const RunRecord& r) {
+    if (!r.stream) // the stream triangulates in order, whatever --threads says
+        std::fprintf(out, "  threads    %u\n", static_cast<unsigned>(r.threads));
     std::fprintf(out, "  time       read %s, reconstruct %s%s, write %s\n",
                  seconds_text(r.read_seconds).c_str(), seconds_text(r.reconstruct_seconds).c_str(),
                  phase_times_text(r).c_str(), seconds_text(r.write_seconds).c_str());
     double per_point = r.report.points_in ? static_cast<double>(r.workspace_bytes) /
                                                 static_cast<double>(r.report.points_in)
                                           : 0.0;
-    std::fprintf(out, "  memory     workspace %s (%zu bytes, %.0f bytes/point), triangles %s\n",
+    std::fprintf(out, "  memory     workspace %s (%zu bytes, %.0f bytes/point), triangles %s%s\n",
                  bytes_text(r.workspace_bytes).c_str(), r.workspace_bytes, per_point,
-                 bytes_text(r.triangle_buffer_bytes).c_str());
+                 bytes_text(r.triangle_buffer_bytes).c_str(),
+                 r.peak_rss_bytes ? (", peak resident " + bytes_text(r.peak_rss_bytes)).c_str()
+                                  : "");
+    if (r.stream)
+        std::fprintf(out, "  stream     %zu layers pushed, at most %zu points held (of %llu)\n",
+                     r.stream_pushes, r.report.points_held,
+                     static_cast<unsigned long long>(r.stream_points));
 }
 
 } // namespace

@@ -8,6 +8,8 @@
 //                        layers.0.top) and number literals are equal
 //         #a.b           (as a term) the length of the array at a.b
 //         a.b:text       the string at a.b is `text` (or true, false, null)
+//   stratmesh_cli_check same-mesh FILE FILE
+//       the two meshes read back with the same vertices and the same triangles, in order
 //   stratmesh_cli_check mesh FILE VERTICES [REPORT.json]
 //       the mesh (.ply .obj .off .stl) reads back, has VERTICES vertices (not checked for
 //       STL), at least one triangle, indices in range, and as many triangles as the
@@ -18,6 +20,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -73,6 +76,27 @@ std::string as_obj(const std::vector<double>& xyz) {
     return text;
 }
 
+// The cylinder sorted along z, as its text reads back, after a first point (20, 0, 0) below
+// the others: a known --origin for the batch run equivalent to --stream.
+std::vector<double> sorted_cylinder(const std::vector<double>& cylinder) {
+    std::vector<double> xyz = {20, 0, 0};
+    for (double v : cylinder) xyz.push_back(std::strtod(number_text(v).c_str(), nullptr));
+    return xyz;
+}
+
+// Binary little-endian PLY of doubles.
+std::string as_binary_ply(const std::vector<double>& xyz) {
+    std::string bytes = "ply\nformat binary_little_endian 1.0\nelement vertex " +
+                        std::to_string(xyz.size() / 3) +
+                        "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+    for (double v : xyz) {
+        uint64_t bits = 0;
+        std::memcpy(&bits, &v, sizeof bits);
+        for (int i = 0; i < 8; ++i) bytes += static_cast<char>((bits >> (8 * i)) & 0xffu);
+    }
+    return bytes;
+}
+
 std::string truncated_ply() {
     std::string text = "ply\nformat binary_little_endian 1.0\nelement vertex 100\n"
                        "property float x\nproperty float y\nproperty float z\nend_header\n";
@@ -83,6 +107,7 @@ int make_inputs(const std::string& dir) {
     std::error_code ignored;
     std::filesystem::create_directories(dir, ignored);
     std::vector<double> cylinder = cylinder_points(3000);
+    std::vector<double> sorted = sorted_cylinder(cylinder);
     bool ok = write_file(dir + "/garbage.xyz", "1 2 3\n4 5 6\n7 eight 9\n") &&
               write_file(dir + "/truncated.ply", truncated_ply()) &&
               write_file(dir + "/lying.ply",
@@ -92,7 +117,10 @@ int make_inputs(const std::string& dir) {
               write_file(dir + "/two_points.xyz", "0 0 0\n1 1 1\n") &&
               write_file(dir + "/cylinder.xyz", as_xyz(cylinder, 0)) &&
               write_file(dir + "/cylinder_nan.xyz", as_xyz(cylinder, 500)) &&
-              write_file(dir + "/cylinder_obj.ply", as_obj(cylinder));
+              write_file(dir + "/cylinder_obj.ply", as_obj(cylinder)) &&
+              write_file(dir + "/sorted.xyz", as_xyz(sorted, 0)) &&
+              write_file(dir + "/mesh.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 1\n3 0 1 2\n") &&
+              write_file(dir + "/sorted.ply", as_binary_ply(sorted));
     if (!ok) std::fprintf(stderr, "cannot write the inputs into %s\n", dir.c_str());
     return ok ? 0 : 1;
 }
@@ -227,6 +255,20 @@ bool is_oriented_manifold(const std::vector<uint32_t>& tris, std::string& why) {
     return true;
 }
 
+int check_same_mesh(char** argv) {
+    mini_mesh::Mesh a, b;
+    if (!mini_mesh::read(argv[2], a) || !mini_mesh::read(argv[3], b)) {
+        std::fprintf(stderr, "cannot read %s or %s\n", argv[2], argv[3]);
+        return 1;
+    }
+    if (a.xyz == b.xyz && a.tris == b.tris && !a.tris.empty()) return 0;
+    std::fprintf(stderr, "%s: %zu vertices, %zu triangles; %s: %zu vertices, %zu triangles; "
+                         "not the same mesh\n",
+                 argv[2], a.xyz.size() / 3, a.tris.size() / 3, argv[3], b.xyz.size() / 3,
+                 b.tris.size() / 3);
+    return 1;
+}
+
 int check_mesh(int argc, char** argv) {
     std::string path = argv[2];
     size_t vertices = std::strtoull(argv[3], nullptr, 10);
@@ -275,7 +317,8 @@ int main(int argc, char** argv) {
     if (command == "make-inputs" && argc == 3) return make_inputs(argv[2]);
     if (command == "json" && argc >= 3) return check_json(argc, argv);
     if (command == "mesh" && (argc == 4 || argc == 5)) return check_mesh(argc, argv);
+    if (command == "same-mesh" && argc == 4) return check_same_mesh(argv);
     std::fprintf(stderr, "usage: stratmesh_cli_check make-inputs DIR | json FILE [ASSERTION...] |"
-                         " mesh FILE VERTICES [REPORT.json]\n");
+                         " mesh FILE VERTICES [REPORT.json] | same-mesh FILE FILE\n");
     return 2;
 }

@@ -1,0 +1,219 @@
+#include "stream_run.h"
+
+#include "cloud_io.h"
+#include "mesh_io.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <new>
+#include <vector>
+
+namespace stratmesh_cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Per-layer details kept for the report (the stream's own memory does not depend on it).
+const size_t kLayerCapacity = 65536;
+
+// The unit axis the library measures heights along, for a non-automatic axis.
+void unit_axis(const stratmesh::Options& options, double axis[3]) {
+    for (size_t k = 0; k < 3; ++k) axis[k] = options.direction[k];
+    if (options.axis != stratmesh::Axis::direction) {
+        axis[0] = axis[1] = axis[2] = 0;
+        axis[static_cast<size_t>(options.axis) - static_cast<size_t>(stratmesh::Axis::x)] = 1;
+    }
+    double length = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+    for (size_t k = 0; k < 3; ++k) axis[k] /= length;
+}
+
+// Where the layers end: after the first point, the top of the layer a height falls in.
+class LayerTops {
+public:
+    explicit LayerTops(const CommandLine& line) : cuts_(line.cuts), height_(line.layer_height) {
+        std::sort(cuts_.begin(), cuts_.end());
+    }
+
+    void start(double first_height) { base_ = first_height; }
+
+    // The least top above `height` (a point on a cut belongs to the layer above it), or
+    // infinity for the last layer.
+    double top_above(double height) {
+        if (height_ > 0) {
+            double top = base_ + height_ * (std::floor((height - base_) / height_) + 1);
+            return top > height ? top : top + height_;
+        }
+        while (next_cut_ < cuts_.size() && cuts_[next_cut_] <= height) ++next_cut_;
+        return next_cut_ < cuts_.size() ? cuts_[next_cut_] : kInfinity;
+    }
+
+    static constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+private:
+    std::vector<double> cuts_;
+    double height_;
+    double base_ = 0;
+    size_t next_cut_ = 0;
+};
+
+void write_triangles(void* user, const uint32_t* triangles, size_t count) {
+    static_cast<MeshStreamWriter*>(user)->add_triangles(triangles, count);
+}
+
+class StreamRunner {
+public:
+    StreamRunner(const CommandLine& line, stratmesh::Options options, RunRecord& record)
+        : line_(line), options_(options), record_(record), tops_(line),
+          layers_(kLayerCapacity) {
+        unit_axis(options_, axis_);
+        report_.layers = layers_.data();
+        report_.layer_capacity = layers_.size();
+    }
+
+    StreamOutcome run(std::string& error) {
+        Clock::time_point start = Clock::now();
+        CloudInfo info;
+        std::unique_ptr<PointReader> reader = open_point_reader(line_.input, info, error);
+        if (!reader) return StreamOutcome::file_error;
+        record_.input_format = cloud_format_name(info.format);
+        record_.input_encoding = info.encoding;
+        if (!writer_.open(line_.output, mesh_format_from_extension(line_.output), line_.ascii,
+                          error))
+            return StreamOutcome::file_error;
+        StreamOutcome outcome = read_and_push(*reader, error);
+        if (outcome == StreamOutcome::done) outcome = close(error);
+        record_.take_report(report_, layers_);
+        record_.read_seconds = seconds_since(start) - stream_seconds_ - write_seconds_;
+        return outcome;
+    }
+
+private:
+    StreamOutcome read_and_push(PointReader& reader, std::string& error) {
+        double point[3];
+        while (reader.next(point, error)) {
+            bool valid =
+                std::isfinite(point[0]) && std::isfinite(point[1]) && std::isfinite(point[2]);
+            if (valid && !stream_ && !open_stream(point)) return StreamOutcome::refused;
+            double height = point[0] * axis_[0] + point[1] * axis_[1] + point[2] * axis_[2];
+            // Invalid points have no place in the order: they stay in the layer being read.
+            if (valid) {
+                if (height < highest_) {
+                    error = backwards_message(height);
+                    return StreamOutcome::unsorted;
+                }
+                if (height >= top_ && !push(top_)) return StreamOutcome::refused;
+                if (height >= top_ || !std::isfinite(highest_)) top_ = tops_.top_above(height);
+                highest_ = height;
+            }
+            layer_.insert(layer_.end(), point, point + 3);
+            ++points_read_;
+        }
+        if (error.empty()) return StreamOutcome::done;
+        error = line_.input + ": " + error;
+        return StreamOutcome::file_error;
+    }
+
+    // Opens the stream, its frame's origin at the first valid point unless --origin says.
+    bool open_stream(const double first[3]) {
+        if (!(options_.flags & stratmesh::origin_given))
+            for (size_t k = 0; k < 3; ++k) options_.origin[k] = first[k];
+        options_.flags |= stratmesh::origin_given;
+        for (size_t k = 0; k < 3; ++k) record_.origin[k] = options_.origin[k];
+        tops_.start(first[0] * axis_[0] + first[1] * axis_[1] + first[2] * axis_[2]);
+        record_.workspace_bytes = stratmesh::stream_workspace_size(line_.stream_points, options_);
+        workspace_.reset(new (std::nothrow) unsigned char[record_.workspace_bytes]);
+        record_.reconstructed = true;
+        if (!workspace_ || record_.workspace_bytes == 0) {
+            record_.status = stratmesh::Status::out_of_memory;
+            return false;
+        }
+        record_.status = stratmesh::stream_open(options_, workspace_.get(), record_.workspace_bytes,
+                                                &write_triangles, &writer_, &report_, &stream_);
+        return record_.status == stratmesh::Status::ok;
+    }
+
+    // Writes the layer's vertices (before any triangle can use them) and pushes it.
+    bool push(double top) {
+        if (layer_.empty()) return true;
+        Clock::time_point start = Clock::now();
+        writer_.add_vertices(layer_.data(), layer_.size() / 3);
+        Clock::time_point pushed = Clock::now();
+        write_seconds_ += std::chrono::duration<double>(pushed - start).count();
+        stratmesh::Cloud cloud = {layer_.data(), layer_.size() / 3, 0, stratmesh::Scalar::float64};
+        record_.status = stratmesh::stream_push(stream_, cloud, top);
+        stream_seconds_ += seconds_since(pushed);
+        ++record_.stream_pushes;
+        record_.batch_cuts.push_back(top);
+        layer_.clear();
+        return record_.status == stratmesh::Status::ok;
+    }
+
+    StreamOutcome close(std::string& error) {
+        // The last push's top only bounds its points.
+        double last_top = std::isfinite(highest_) ? highest_ : 0;
+        if (points_read_ > 0 && !push(last_top)) return StreamOutcome::refused;
+        if (!record_.batch_cuts.empty()) record_.batch_cuts.pop_back();
+        Clock::time_point start = Clock::now();
+        record_.status =
+            stream_ ? stratmesh::stream_close(stream_) : stratmesh::Status::too_few_points;
+        stream_seconds_ += seconds_since(start);
+        record_.reconstruct_seconds = stream_seconds_;
+        if (record_.status != stratmesh::Status::ok) return StreamOutcome::refused;
+        start = Clock::now();
+        bool written = writer_.finish(true, error);
+        write_seconds_ += seconds_since(start);
+        record_.write_seconds = write_seconds_;
+        record_.output_written = written;
+        return written ? StreamOutcome::done : StreamOutcome::file_error;
+    }
+
+    std::string backwards_message(double height) const {
+        return "point " + std::to_string(points_read_) + " (counting from 0) lies at height " +
+               number_text(height) + " along the axis, below the point before it (" +
+               number_text(highest_) +
+               "): --stream needs the points sorted along the axis, lowest first (for example "
+               "sort the columns of an XYZ file with 'sort -g -k3' for --axis z), or run "
+               "without --stream";
+    }
+
+    static std::string number_text(double value) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.17g", value);
+        return text;
+    }
+
+    const CommandLine& line_;
+    stratmesh::Options options_;
+    RunRecord& record_;
+    LayerTops tops_;
+    double axis_[3];
+    MeshStreamWriter writer_;
+    std::unique_ptr<unsigned char[]> workspace_;
+    stratmesh::Stream* stream_ = nullptr;
+    stratmesh::Report report_ = {};
+    std::vector<stratmesh::LayerInfo> layers_;
+    std::vector<double> layer_; // the points of the layer being read, x y z packed
+    double top_ = LayerTops::kInfinity;
+    double highest_ = -LayerTops::kInfinity; // the height of the last finite point
+    size_t points_read_ = 0;
+    double stream_seconds_ = 0, write_seconds_ = 0;
+};
+
+} // namespace
+
+StreamOutcome run_stream(const CommandLine& line, stratmesh::Options options, RunRecord& record,
+                         std::string& error) {
+    record.stream = true;
+    record.stream_points = line.stream_points;
+    return StreamRunner(line, options, record).run(error);
+}
+
+} // namespace stratmesh_cli

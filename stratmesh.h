@@ -55,6 +55,11 @@
 //                            Define it (e.g. to assert(cond)) to check internal
 //                            invariants in debug builds. Bad *data* never reaches an
 //                            assert: it returns a Status.
+//   STRATMESH_NO_PARALLEL_LAYERS   default: not defined. Define it where the implementation
+//                            is compiled to leave out the parallel-layers code (about
+//                            1.2 KiB on a Cortex-M7): Options::run_jobs is then ignored
+//                            and everything runs in order, with the same result. For
+//                            single-core targets.
 //
 // ==== Memory ===============================================================================
 //
@@ -4190,6 +4195,8 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
 // result is the sequential one whatever the jobs' order and threads. Jobs are contiguous runs
 // of such layers with about equal point counts, each with the scratch of its largest layer.
 
+#if !defined(STRATMESH_NO_PARALLEL_LAYERS)
+
 struct ParallelLayers {
     bool ready;                  // the jobs ran
     const CloudReader* reader;
@@ -4345,6 +4352,54 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
     p.ready = true;
 }
 
+// Starts the jobs for reconstruct(); returns the layers they triangulated.
+inline size_t start_parallel_layers(const Options& options, const CloudReader& reader,
+                                    const Frame& frame, const LayerQueue& queue, Arena& arena,
+                                    ParallelLayers& parallel) {
+    parallel.ready = false;
+    if (!options.run_jobs) return 0;
+    parallel.reader = &reader;
+    parallel.frame = &frame;
+    parallel.queue = &queue;
+    triangulate_ahead(options, parallel, arena);
+    size_t done = 0;
+    for (uint32_t slot = 0; parallel.ready && slot < parallel.slots; ++slot)
+        done += parallel.ahead[slot].done;
+    return done;
+}
+
+// What the layers done ahead add to the workspace bound: their results, which stay, in
+// `arena`; the jobs' scratch, which comes and goes before the groups' own, in *scratch.
+inline bool plan_parallel_workspace(size_t point_count, size_t layer_limit, Arena& arena,
+                                    size_t* scratch) {
+    ParallelLayers p;
+    uint32_t* triangles = nullptr;
+    uint32_t* loops = nullptr;
+    size_t slots = point_count / kMinLayerPoints + 1;
+    allocate_ahead(p, static_cast<uint32_t>(slots), point_count, layer_limit, arena, &triangles,
+                   &loops);
+    size_t jobs = job_scratch_bound(point_count);
+    if (jobs > *scratch) *scratch = jobs;
+    return jobs != 0;
+}
+
+#else  // STRATMESH_NO_PARALLEL_LAYERS: Options::run_jobs is ignored.
+
+struct ParallelLayers {
+    bool ready;
+    const LayerAhead* ahead_of(uint32_t) const { return nullptr; }
+};
+
+inline size_t start_parallel_layers(const Options&, const CloudReader&, const Frame&,
+                                    const LayerQueue&, Arena&, ParallelLayers& parallel) {
+    parallel.ready = false;
+    return 0;
+}
+
+inline bool plan_parallel_workspace(size_t, size_t, Arena&, size_t*) { return true; }
+
+#endif  // STRATMESH_NO_PARALLEL_LAYERS
+
 inline void notify(const Options& options, Phase phase, double fraction) {
     if (options.progress) options.progress(options.progress_user, phase, fraction);
 }
@@ -4437,19 +4492,11 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
     detail::plan_reconstruct(m, point_count, layer_limit, arena);
     size_t scratch = detail::reconstruct_scratch_size(point_count,
                                                       (options.flags & close_ends) != 0);
-    if (options.run_jobs) {
-        // The layers done ahead (at most one per kMinLayerPoints points, plus the last) stay
-        // while the groups are formed; the jobs' scratch comes and goes before.
-        detail::ParallelLayers p;
-        uint32_t* triangles = nullptr;
-        uint32_t* loops = nullptr;
-        size_t slots = point_count / detail::kMinLayerPoints + 1;
-        detail::allocate_ahead(p, static_cast<uint32_t>(slots), point_count, layer_limit, arena,
-                               &triangles, &loops);
-        size_t jobs = detail::job_scratch_bound(point_count);
-        if (jobs == 0) return 0;
-        if (jobs > scratch) scratch = jobs;
-    }
+    // With a runner, the layers done ahead (at most one per kMinLayerPoints points, plus the
+    // last) stay while the groups are formed.
+    if (options.run_jobs &&
+        !detail::plan_parallel_workspace(point_count, layer_limit, arena, &scratch))
+        return 0;
     if (arena.failed || scratch == 0 || scratch > SIZE_MAX - arena.required_bytes()) return 0;
     return arena.required_bytes() + scratch;
 }
@@ -4564,15 +4611,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     chain.output_id = nullptr;
     const LayerQueue queue = {m.order, m.layer_start, plan.bounds, plan.count, true};
     ParallelLayers parallel;
-    parallel.ready = false;
-    if (options.run_jobs) {
-        parallel.reader = &reader;
-        parallel.frame = &frame;
-        parallel.queue = &queue;
-        triangulate_ahead(options, parallel, arena);
-        for (uint32_t slot = 0; parallel.ready && slot < parallel.slots; ++slot)
-            rep.parallel_layers += parallel.ahead[slot].done;
-    }
+    rep.parallel_layers = start_parallel_layers(options, reader, frame, queue, arena, parallel);
     for (uint32_t first = 0; first < plan.count;) {
         GroupResult group;
         status = add_group(chain, queue, first, arena, sink, group,

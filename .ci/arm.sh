@@ -64,7 +64,7 @@ echo "the firmware program reconstructs its cloud (32-bit ARM, qemu-arm): ok"
 
 step "stack: worst-case depth on the Cortex-M7 from -fstack-usage and the call graph"
 arm-none-eabi-g++ -mcpu=cortex-m7 -mfpu=fpv5-d16 -mfloat-abi=hard -mthumb -Os -std=c++17 \
-  -fno-exceptions -fno-rtti -fcallgraph-info=su -I. -c stratmesh.cpp -o "$out/stack_m7.o" \
+  -fno-exceptions -fno-rtti -DSTRATMESH_NO_PARALLEL_LAYERS -fcallgraph-info=su -I. -c stratmesh.cpp -o "$out/stack_m7.o" \
   -dumpdir "$out/"
 python3 examples/firmware/stack_bound.py --limit 16384 "$out"/*stack_m7*.ci
 

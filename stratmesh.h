@@ -73,8 +73,9 @@
 // delaunay_2d needs 72 bytes per point plus about 10 KiB; its output is at most
 // 2n - 5 triangles (24 bytes per point). reconstruct needs about 114 bytes per point
 // (the triangulation of its largest possible layer with the layer's coordinates, plus the
-// layer grouping and boundary loops), about 118 with the close_ends flag; its output is at
-// most 2n triangles.
+// layer grouping and boundary loops), about 118 with the close_ends flag, about 154 with a
+// jobs runner (Options::run_jobs); its output is at most 2n triangles. A stream needs about
+// 190 bytes per point it holds at once, whatever the size of the whole cloud.
 //
 // Stack: no recursion anywhere. The exact incircle's expansions (about 8 KiB) live in the
 // workspace when called from the triangulation, and on the stack only when you call
@@ -94,7 +95,9 @@
 // ==== Threading ============================================================================
 //
 // No global or static mutable state. Functions are reentrant: threads may run them at
-// once with separate workspaces.
+// once with separate workspaces. The library starts no thread; Options::run_jobs lets the
+// caller run a reconstruction's layers on its own threads. A Stream belongs to one thread
+// at a time, and its callback must not call back into the stream.
 //
 // ==== Robustness contract ==================================================================
 //

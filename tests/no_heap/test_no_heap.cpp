@@ -15,6 +15,7 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -131,6 +132,10 @@ inline void progress_sink(void* user, stratmesh::Phase, double) {
     ++*static_cast<size_t*>(user);
 }
 
+inline void run_jobs_in_order(void*, uint32_t count, stratmesh::JobFunction job, void* context) {
+    for (uint32_t i = 0; i < count; ++i) job(context, i);
+}
+
 // reconstruct() inputs: ordinary shapes, layer options, float input, degenerate data and
 // every error status the data and memory can produce.
 inline std::vector<ReconstructCase> reconstruct_cases() {
@@ -152,6 +157,10 @@ inline std::vector<ReconstructCase> reconstruct_cases() {
     stratmesh::Options six = z_axis();
     six.layer_count = 6;
     add("bumpy tube, 6 layers", shapes::bumpy_tube(2000, Pose::z), six, Status::ok).prepare();
+    stratmesh::Options jobs = six;
+    jobs.run_jobs = run_jobs_in_order;
+    add("bumpy tube, 6 layers, triangulated ahead by jobs", shapes::bumpy_tube(2000, Pose::z), jobs,
+        Status::ok).prepare();
     stratmesh::Options automatic = {};
     add("vase tilted, automatic axis", shapes::vase(1200, Pose::tilted), automatic, Status::ok).prepare();
     stratmesh::Options height = z_axis();
@@ -315,6 +324,51 @@ TEST_CASE("reconstruct allocates nothing, on success and on every error status")
         total += n;
     }
     MESSAGE("reconstruct: " << cases.size() << " calls, " << total << " allocations");
+}
+
+namespace {
+
+// Counts the triangles a stream emits, into storage sized before.
+struct Emitted {
+    size_t count = 0;
+    static void take(void* user, const uint32_t*, size_t count) {
+        static_cast<Emitted*>(user)->count += count;
+    }
+};
+
+}  // namespace
+
+TEST_CASE("the stream allocates nothing: open, every push and close") {
+    const shapes::Shape s = shapes::bumpy_tube(3000, shapes::Pose::z);
+    // Ten pushes of points sorted along the axis.
+    std::vector<size_t> order(s.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return s.xyz[3 * a + 2] < s.xyz[3 * b + 2]; });
+    std::vector<double> sorted;
+    for (size_t i : order) sorted.insert(sorted.end(), &s.xyz[3 * i], &s.xyz[3 * i] + 3);
+    stratmesh::Options o = no_heap::z_axis();
+    std::vector<unsigned char> work(stratmesh::stream_workspace_size(s.size(), o));
+    stratmesh::Report report = {};
+    Emitted emitted;
+    std::vector<stratmesh::Status> statuses;
+    statuses.reserve(16);
+    size_t n = alloc_counter::allocations_during([&] {
+        stratmesh::Stream* stream = nullptr;
+        statuses.push_back(stratmesh::stream_open(o, work.data(), work.size(), Emitted::take, &emitted,
+                                                  &report, &stream));
+        const size_t per_push = s.size() / 10;
+        for (size_t k = 0; k < 10; ++k) {
+            size_t first = k * per_push, last = k == 9 ? s.size() : first + per_push;
+            double top = k == 9 ? sorted[3 * (last - 1) + 2] : sorted[3 * last + 2];
+            stratmesh::Cloud layer = {sorted.data() + 3 * first, last - first, 0, stratmesh::Scalar::float64};
+            statuses.push_back(stratmesh::stream_push(stream, layer, top));
+        }
+        statuses.push_back(stratmesh::stream_close(stream));
+    });
+    CHECK(n == 0);
+    for (stratmesh::Status st : statuses) CHECK(st == stratmesh::Status::ok);
+    CHECK(emitted.count == report.triangle_count);
+    CHECK(report.points_used == s.size());
 }
 
 TEST_CASE("delaunay_2d allocates nothing, on success and on every error status") {

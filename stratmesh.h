@@ -3112,7 +3112,9 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
 // layer below) as soon as the chunk is built, so that chunks are final when they leave
 // (the stream hands them out at once) and the net's memory follows the largest layer, not
 // the cloud. Chunks meet only along the layers' top loops, where each side gives a loop
-// vertex one chain of triangles ending on the loop's edges by construction.
+// vertex one chain of triangles ending on the loop's edges by construction; where the net
+// removed triangles, seal_seam makes sure the two sides still share an edge at every loop
+// vertex (else the upper side's triangles there go), so they never meet in a vertex alone.
 
 // In-place sort of packed (key, value) pairs: insertion sort for the small fans of almost
 // every vertex, heap sort (O(n log n), no recursion) for large ones.
@@ -3904,8 +3906,9 @@ struct SurfaceChain {
     Frame frame;
     CloudReader reader;
     const uint32_t* output_id;  // reader index -> output index; null: the same
-    // The last group's top loop (reader indices) with, per point, whether that group's own
-    // chunk left it without a triangle; two sets of buffers, swapped per group.
+    // The last group's top loop (reader indices) with, per point, kUnusedBelow and the loop
+    // edges its own chunk has (kHasNextEdge, kHasPreviousEdge); two sets of buffers, swapped
+    // per group.
     uint32_t* top;
     unsigned char* top_unused;
     uint32_t top_count;
@@ -3925,6 +3928,80 @@ inline bool allocate_chain(SurfaceChain& c, size_t points, Arena& arena) {
     c.top_count = 0;
     c.groups = c.duplicates = c.collisions = c.swaps = c.removed = c.used = c.trailing = 0;
     return !arena.failed;
+}
+
+// Per top-loop point of a group (SurfaceChain::top_unused): its own chunk left it without a
+// triangle; its own chunk (after the safety net) has the loop edge to the next loop point,
+// and the one from the previous.
+const unsigned char kUnusedBelow = 1, kHasNextEdge = 2, kHasPreviousEdge = 4;
+
+inline void count_corners(const uint32_t* tri, size_t count, uint32_t* degree, size_t vertices) {
+    std::memset(degree, 0, vertices * sizeof(uint32_t));
+    for (size_t k = 0; k < 3 * count; ++k) ++degree[tri[k]];
+}
+
+// For the loop whose point i has id `id_of(i)` (n points, in loop order): which of the
+// loop's edges the triangles use, as kHasNextEdge / kHasPreviousEdge bits added to flags[i].
+// position[v] is v's place in the loop or kNoIndex, for every id v in the triangles.
+inline void mark_loop_edges(const uint32_t* tri, size_t count, const uint32_t* position,
+                            uint32_t n, unsigned char* flags) {
+    for (size_t t = 0; t < count; ++t)
+        for (size_t k = 0; k < 3; ++k) {
+            uint32_t i = position[tri[3 * t + k]], j = position[tri[3 * t + (k + 1) % 3]];
+            if (i == kNoIndex || j == kNoIndex) continue;
+            if (j == (i + 1) % n) {
+                flags[i] |= kHasNextEdge;
+                flags[j] |= kHasPreviousEdge;
+            } else if (i == (j + 1) % n) {
+                flags[j] |= kHasNextEdge;
+                flags[i] |= kHasPreviousEdge;
+            }
+        }
+}
+
+// Keeps the seam between two chunks manifold. A point of the loop below has one chain of
+// triangles on each side (the safety net ran on each chunk); two chains around a point form
+// one fan when they share an edge, which can only be one of the loop's two edges at it. As
+// built they share both; where the net removed triangles on either side they may share
+// none, and then the point's triangles on this side go and the net runs again, until every
+// loop point with triangles on both sides shares an edge. `below` flags the loop points
+// from their own chunk; seam ids are below_count + i. Returns the triangles removed, or
+// SIZE_MAX if the arena is too small.
+inline size_t seal_seam(uint32_t* tri, size_t& count, size_t below_count, size_t vertices,
+                        const unsigned char* below, uint32_t* degree, Arena& arena) {
+    const uint32_t n = static_cast<uint32_t>(vertices - below_count);
+    size_t mark = arena.mark();
+    uint32_t* position = arena.alloc<uint32_t>(vertices);
+    unsigned char* above = arena.alloc<unsigned char>(n);
+    if (arena.failed) return SIZE_MAX;
+    for (size_t v = 0; v < vertices; ++v)
+        position[v] = v < below_count ? kNoIndex : static_cast<uint32_t>(v - below_count);
+    size_t removed = 0;
+    for (;;) {
+        count_corners(tri, count, degree, vertices);
+        std::memset(above, 0, n);
+        mark_loop_edges(tri, count, position, n, above);
+        auto loose = [&](uint32_t v) {
+            if (v < below_count || degree[v] == 0) return false;
+            const unsigned char lower = below[v - below_count], upper = above[v - below_count];
+            return !(lower & kUnusedBelow) && !(lower & upper & (kHasNextEdge | kHasPreviousEdge));
+        };
+        size_t kept = 0;
+        for (size_t t = 0; t < count; ++t) {
+            const uint32_t* v = tri + 3 * t;
+            if (loose(v[0]) || loose(v[1]) || loose(v[2])) continue;
+            for (size_t k = 0; k < 3; ++k) tri[3 * kept + k] = v[k];
+            ++kept;
+        }
+        if (kept == count) break;
+        removed += count - kept;
+        count = kept;
+        size_t more = enforce_manifold(tri, count, vertices, arena);
+        if (more == SIZE_MAX) return SIZE_MAX;
+        removed += more;
+    }
+    arena.rewind(mark);
+    return removed;
 }
 
 // Whether the safety net would remove nothing from the chunk, given that the fans of the
@@ -3952,20 +4029,38 @@ inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const Laye
     uint32_t* tri = sink.triangles + 3 * chunk_start;
     size_t count = sink.count - chunk_start;
     const size_t below = layer.count, vertices = layer.count + c.top_count;
+    size_t mark = arena.mark();
+    uint32_t* degree = arena.alloc<uint32_t>(vertices);
+    if (arena.failed) return Status::out_of_memory;
     size_t removed = 0;
     if (!interior_whole || !band_fans_are_one_piece(tri, count, below, vertices, loops, arena))
         removed = enforce_manifold(tri, count, vertices, arena);
     if (removed == SIZE_MAX) return Status::out_of_memory;
+    const unsigned char whole = kHasNextEdge | kHasPreviousEdge;
+    bool seam_as_built = removed == 0;
+    for (uint32_t i = 0; i < c.top_count; ++i)
+        seam_as_built = seam_as_built && ((c.top_unused[i] & whole) == whole);
+    if (!seam_as_built) {
+        size_t more = seal_seam(tri, count, below, vertices, c.top_unused, degree, arena);
+        if (more == SIZE_MAX) return Status::out_of_memory;
+        removed += more;
+    }
+    count_corners(tri, count, degree, vertices);
     sink.count = chunk_start + count;
     c.removed += removed;
-    size_t mark = arena.mark();
-    unsigned char* seen = arena.alloc<unsigned char>(vertices);
-    if (arena.failed) return Status::out_of_memory;
-    std::memset(seen, 0, vertices);
-    for (size_t k = 0; k < 3 * count; ++k) seen[tri[k]] = 1;
-    for (size_t l = 0; l < below; ++l) c.used += seen[l];
-    for (uint32_t i = 0; i < c.top_count; ++i) c.used += seen[below + i] & c.top_unused[i];
-    for (uint32_t i = 0; i < loops.top_count; ++i) c.next_unused[i] = !seen[loops.top[i]];
+    for (uint32_t i = 0; i < c.top_count; ++i)
+        c.used += degree[below + i] > 0 && (c.top_unused[i] & kUnusedBelow);
+    for (size_t l = 0; l < below; ++l) c.used += degree[l] > 0;
+    // The next seam's lower side: this chunk's triangles at the new top loop.
+    for (uint32_t i = 0; i < loops.top_count; ++i)
+        c.next_unused[i] = static_cast<unsigned char>(degree[loops.top[i]] == 0 ? kUnusedBelow
+                                                      : removed == 0 ? whole : 0);
+    if (removed > 0) {
+        uint32_t* position = degree;  // reused: the counts are taken
+        for (size_t v = 0; v < vertices; ++v) position[v] = kNoIndex;
+        for (uint32_t i = 0; i < loops.top_count; ++i) position[loops.top[i]] = i;
+        mark_loop_edges(tri, count, position, loops.top_count, c.next_unused);
+    }
     for (size_t k = 0; k < 3 * count; ++k) {
         uint32_t l = tri[k];
         uint32_t id = l < below ? layer.ids[l] : c.top[l - below];
@@ -4156,6 +4251,9 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
     // group's and the loop below's, at most `count` (the stream's window holds both), with
     // at most 2 triangles each.
     size_t triangles = 2 * count;
+    group.alloc<uint32_t>(count);  // finish_chunk's triangles per vertex
+    group.alloc<uint32_t>(count);  // seal_seam's loop positions and flags
+    group.alloc<unsigned char>(count);
     group.alloc<uint32_t>(count);
     group.alloc<unsigned char>(triangles);
     mark = group.mark();

@@ -14,6 +14,7 @@
 // reconstruct_max_triangles triangles, the mesh an oriented edge- and vertex-manifold
 // (tests/support/mesh_check.h), vertices only distinct valid points and points_used equal
 // to the vertices used; a second run on a differently-filled workspace gives the same bits.
+#include "fuzz_cloud.h"
 #include "fuzz_common.h"
 #include "known_bugs.h"
 
@@ -65,51 +66,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
 
     // ---- the cloud
     const bool strict = stratmesh_fuzz::strict();
-    const uint8_t cfg = in.u8();
-    const bool f32 = cfg & 1;
-    const size_t scalar_size = f32 ? 4 : 8;
-    const size_t pad = (cfg >> 1) & 7;  // 0: packed (stride 0)
-    const size_t stride = pad ? 3 * scalar_size + pad : 0;
-    const size_t step = stride ? stride : 3 * scalar_size;
-    const uint8_t point_mode = in.u8();  // 0..63 grid-ish, 64..127 mixed per point, else raw
-    const size_t n = in.below(3000);
-    const double grid = std::ldexp(1.0, in.centered(8));
-    const uint32_t grid_range = 1u + in.below(24);
-
-    std::vector<double> xyz(3 * n);  // the cloud as doubles, for checks
-    const size_t cloud_bytes = n ? (n - 1) * step + 3 * scalar_size : 0;
-    std::vector<unsigned char> buffer(cloud_bytes);
-    for (size_t i = 0; i < n; ++i) {
-        uint8_t kind = point_mode < 64 ? 0 : point_mode < 128 ? in.u8() % 4 : 3;
-        if (kind == 1 && i > 0) {  // repeat an earlier point
-            size_t j = in.below(static_cast<uint32_t>(i));
-            std::memcpy(&xyz[3 * i], &xyz[3 * j], 3 * sizeof(double));
-        } else if (kind == 3) {  // raw bits
-            for (size_t k = 0; k < 3; ++k) {
-                double v = f32 ? static_cast<double>(in.raw_float()) : in.raw_double();
-                xyz[3 * i + k] = v;
-            }
-        } else {  // a coarse grid on (and inside) a cylinder-ish column
-            int32_t a = in.centered(grid_range), b = in.centered(grid_range);
-            int32_t h = in.centered(4 * grid_range);
-            xyz[3 * i] = a * grid;
-            xyz[3 * i + 1] = b * grid;
-            xyz[3 * i + 2] = h * grid;
-        }
-        unsigned char* p = buffer.data() + i * step;
-        for (size_t k = 0; k < 3; ++k) {
-            if (f32) {
-                float v = static_cast<float>(xyz[3 * i + k]);
-                xyz[3 * i + k] = static_cast<double>(v);
-                std::memcpy(p + 4 * k, &v, 4);
-            } else {
-                std::memcpy(p + 8 * k, &xyz[3 * i + k], 8);
-            }
-        }
-        if (pad && i + 1 < n) std::memset(p + 3 * scalar_size, 0xEE, pad);  // NaN-ish padding
-    }
-    stratmesh::Cloud cloud = {n ? buffer.data() : nullptr, n, stride,
-                              f32 ? stratmesh::Scalar::float32 : stratmesh::Scalar::float64};
+    const stratmesh_fuzz::FuzzCloud fc = stratmesh_fuzz::read_cloud(in, 3000);
+    const size_t n = fc.n;
+    const std::vector<double>& xyz = fc.xyz;
+    const double grid = fc.grid;
+    const uint32_t grid_range = fc.grid_range;
+    const stratmesh::Cloud cloud = fc.cloud();
 
     // ---- the options
     stratmesh::Options options = {};

@@ -57,7 +57,7 @@
 //                            assert: it returns a Status.
 //   STRATMESH_NO_PARALLEL_LAYERS   default: not defined. Define it where the implementation
 //                            is compiled to leave out the parallel-layers code (about
-//                            1.2 KiB on a Cortex-M7): Options::run_jobs is then ignored
+//                            2 KiB on a Cortex-M7): Options::run_jobs is then ignored
 //                            and everything runs in order, with the same result. For
 //                            single-core targets.
 //
@@ -127,8 +127,9 @@
 //   outlier or a cloud at 1e-300 cannot break a sign.
 // - reconstruct's output is edge- and vertex-manifold and consistently oriented for every
 //   input it accepts: the layers and the bands between them form one annulus by
-//   construction, and a final safety net removes (and counts) any triangle that would
-//   break that. The output is not guaranteed free of self-intersections where a layer is
+//   construction, and a safety net, run on each layer with its band below as soon as they
+//   are built, removes (and counts) any triangle that would break that, keeping the seams
+//   between them manifold too. The stream's output has the same guarantee. The output is not guaranteed free of self-intersections where a layer is
 //   not star-shaped around its centre (Report::folds counts the triangles facing the
 //   axis there).
 
@@ -329,8 +330,9 @@ struct Options {
     void* progress_user;
     // Optional, reconstruct() only: with a runner, the layers are triangulated as
     // independent jobs (at most kMaxJobs of them, each over a run of consecutive layers with
-    // its own scratch in the workspace), and so are the safety net's passes over the
-    // chunks; the stitching between layers stays in order. The triangles and the report
+    // its own scratch in the workspace), which also run the safety net's check of each
+    // layer's own triangles; grouping layers, stitching them and the net at the bands stay
+    // in order. The triangles and the report
     // are the same bytes whatever the runner does, as long as it runs every job once.
     // reconstruct_workspace_size() grows with a runner (see there); a workspace too small
     // for the jobs' scratch runs them in order instead (Report::parallel_layers says how
@@ -577,6 +579,12 @@ const char* status_string(Status status) {
 namespace detail {
 
 static const uint32_t kNoIndex = 0xFFFFFFFFu;
+
+#if defined(STRATMESH_NO_PARALLEL_LAYERS)
+const bool kParallelLayers = false;
+#else
+const bool kParallelLayers = true;  // lets the compiler drop what only jobs' results reach
+#endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 
 #if defined(__GNUC__) || defined(__clang__)
@@ -4033,7 +4041,8 @@ inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const Laye
     uint32_t* degree = arena.alloc<uint32_t>(vertices);
     if (arena.failed) return Status::out_of_memory;
     size_t removed = 0;
-    if (!interior_whole || !band_fans_are_one_piece(tri, count, below, vertices, loops, arena))
+    if (!(kParallelLayers && interior_whole &&
+          band_fans_are_one_piece(tri, count, below, vertices, loops, arena)))
         removed = enforce_manifold(tri, count, vertices, arena);
     if (removed == SIZE_MAX) return Status::out_of_memory;
     const unsigned char whole = kHasNextEdge | kHasPreviousEdge;
@@ -4139,7 +4148,7 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
         const size_t n = q.start[last + 1] - q.start[first];
         const double h0 = q.bounds[first], h1 = q.bounds[last + 1];
         size_t mark = arena.mark();
-        const bool triangulated = ahead && ahead->done && last == first;
+        const bool triangulated = kParallelLayers && ahead && ahead->done && last == first;
         LoadedLayer layer = {ids, n, nullptr, triangulated ? ahead->cylinder : Cylinder{}};
         if (!triangulated && !load_layer(c.reader, c.frame, ids, n, h0, h1, arena, layer))
             return Status::out_of_memory;

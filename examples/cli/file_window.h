@@ -43,7 +43,7 @@ private:
     // at the end of the file or on a read error.
     bool fill();
 
-    static const size_t kBlock = 1 << 20;
+    static constexpr size_t kBlock = 1 << 20;
     std::FILE* file_;
     std::vector<char> buffer_;
     size_t pos_ = 0, end_ = 0;

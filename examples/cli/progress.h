@@ -39,7 +39,7 @@ private:
     std::FILE* terminal_;
     bool drawn_ = false;
     Clock::time_point begin_, end_, phase_start_, last_draw_;
-    static const size_t kNoPhase = SIZE_MAX;
+    static constexpr size_t kNoPhase = SIZE_MAX;
     size_t current_ = kNoPhase; // the phase running
     double seconds_[kTimedPhases] = {};
     bool seen_[kTimedPhases] = {};

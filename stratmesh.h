@@ -129,7 +129,8 @@
 //   input it accepts: the layers and the bands between them form one annulus by
 //   construction, and a safety net, run on each layer with its band below as soon as they
 //   are built, removes (and counts) any triangle that would break that, keeping the seams
-//   between them manifold too. The stream's output has the same guarantee. The output is not guaranteed free of self-intersections where a layer is
+//   between them manifold too. The stream's output has the same guarantee. The output is
+//   not guaranteed free of self-intersections where a layer is
 //   not star-shaped around its centre (Report::folds counts the triangles facing the
 //   axis there).
 
@@ -316,8 +317,8 @@ struct Options {
     // detail (the paper's rule; see "automatic layers" in >>layers). A layer with fewer
     // than 16 points, thinner than about one and a half rows of points around its own
     // radius, or whose points do not surround its centre, is merged with the next one (a
-    // remainder that small or thin, with the last); the report lists the layers actually used (Report::layers: bottom
-    // and top).
+    // remainder that small or thin, with the last); the report lists the layers actually
+    // used (Report::layers: bottom and top).
     const double* cuts;
     size_t cut_count;
     uint32_t layer_count;
@@ -332,8 +333,8 @@ struct Options {
     // independent jobs (at most kMaxJobs of them, each over a run of consecutive layers with
     // its own scratch in the workspace), which also run the safety net's check of each
     // layer's own triangles; grouping layers, stitching them and the net at the bands stay
-    // in order. The triangles and the report
-    // are the same bytes whatever the runner does, as long as it runs every job once.
+    // in order. The triangles and the report are the same bytes whatever the runner does,
+    // as long as it runs every job once.
     // reconstruct_workspace_size() grows with a runner (see there); a workspace too small
     // for the jobs' scratch runs them in order instead (Report::parallel_layers says how
     // many layers were triangulated by jobs). Jobs call no user code, not even progress.
@@ -395,9 +396,11 @@ struct Report {
 
 // A size in bytes that is always enough workspace for reconstruct() of point_count
 // points with these options. It assumes the worst layout (every point in one layer);
-// Report::workspace_used tells what a run really needed (measured on 2000-point tubes:
-// the bound is the peak for one layer, 2.1 to 2.3 times it with six or more layers).
-// 0 if no workspace can serve that many points (as for delaunay_2d_workspace_size).
+// Report::workspace_used tells what a run really needed, which follows its largest layer
+// (measured on 2000-point tubes: the bound is 1.05 times the peak for one layer, 3.1 to
+// 3.3 times it with six or more layers). With Options::run_jobs it also covers the
+// layers triangulated ahead and the jobs' scratch (about 154 bytes per point instead of
+// 114). 0 if no workspace can serve that many points (as for delaunay_2d_workspace_size).
 size_t reconstruct_workspace_size(size_t point_count, const Options& options);
 
 // The most triangles reconstruct() can produce for point_count points: 2n (0 if that does
@@ -498,8 +501,10 @@ size_t stream_workspace_size(size_t max_points_held, const Options& options);
 // the layers). emit receives the triangles; report (optional) is updated after every push
 // and at close, and must stay valid until then (its layer array too). On success *stream
 // is the handle, valid until stream_close or until the workspace is reused.
-// Returns ok, invalid_argument (a null emit or stream, close_ends, a null workspace),
-// invalid_axis, out_of_memory (workspace smaller than stream_workspace_size(3 + ...)).
+// Returns ok, invalid_argument (a null emit or stream, close_ends, a null workspace, a
+// workspace that shares a byte with the report or its layer array, a NaN or infinite
+// origin), invalid_axis, out_of_memory (a workspace too small to hold 16 points). The
+// stream uses as many points as the workspace holds.
 Status stream_open(const Options& options, void* workspace, size_t workspace_bytes,
                    TriangleCallback emit, void* emit_user, Report* report, Stream** stream);
 

@@ -13,7 +13,8 @@
 // every status; on ok, every index < n, no repeated index in a triangle, at most
 // reconstruct_max_triangles triangles, the mesh an oriented edge- and vertex-manifold
 // (tests/support/mesh_check.h), vertices only distinct valid points and points_used equal
-// to the vertices used; a second run on a differently-filled workspace gives the same bits.
+// to the vertices used; a second run on a differently-filled workspace, with the layers
+// triangulated ahead by jobs (Options::run_jobs, run in reverse order), gives the same bits.
 #include "fuzz_cloud.h"
 #include "fuzz_common.h"
 #include "known_bugs.h"
@@ -58,6 +59,10 @@ Run run(const stratmesh::Cloud& cloud, const stratmesh::Options& options, size_t
 }
 
 bool same_double(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+void run_jobs_in_reverse(void*, uint32_t count, stratmesh::JobFunction job, void* context) {
+    for (uint32_t i = count; i-- > 0;) job(context, i);
+}
 
 }  // namespace
 
@@ -233,8 +238,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         stratmesh_fuzz::fail("the mesh is not an oriented manifold", mr.summary().c_str());
     STRATMESH_FUZZ_CHECK(mr.vertices_used == rep.points_used, "report.points_used != vertices used");
 
-    // ---- determinism
-    Run second = run(cloud, options, capacity, layer_capacity, 0x5A);
+    // ---- determinism, and the same bytes with parallel layers
+    stratmesh::Options with_jobs = options;
+    with_jobs.run_jobs = run_jobs_in_reverse;
+    Run second = run(cloud, with_jobs, capacity, layer_capacity, 0x5A);
     STRATMESH_FUZZ_CHECK(second.status == first.status, "second run: different status");
     STRATMESH_FUZZ_CHECK(second.count == first.count, "second run: different count");
     STRATMESH_FUZZ_CHECK(second.triangles == first.triangles, "second run: different triangles");

@@ -32,7 +32,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <functional>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -118,27 +117,7 @@ mesh_check::Result check_mesh(const Shape& s, const uint32_t* triangles, size_t 
     return mesh_check::check(in);
 }
 
-// ---- the shapes and the ways of choosing layers -------------------------------------------
-
-struct ShapeKind {
-    const char* name;
-    std::function<Shape(size_t, Pose)> make;
-};
-
-const std::vector<ShapeKind>& shape_kinds() {
-    static const std::vector<ShapeKind> kinds = {
-        {"cylinder", [](size_t n, Pose p) { return shapes::cylinder(n, p); }},
-        {"elliptic tube", [](size_t n, Pose p) { return shapes::elliptic_tube(n, p); }},
-        {"bumpy tube", [](size_t n, Pose p) { return shapes::bumpy_tube(n, p); }},
-        {"cone", [](size_t n, Pose p) { return shapes::cone(n, p); }},
-        {"vase", [](size_t n, Pose p) { return shapes::vase(n, p); }},
-        {"scan grid", [](size_t n, Pose p) { return shapes::scan_grid(n, p); }},
-        {"CT slices", [](size_t n, Pose p) { return shapes::ct_slices(n, p); }},
-        {"noisy tube", [](size_t n, Pose p) { return shapes::noisy_tube(n, p); }},
-        {"head", [](size_t n, Pose p) { return shapes::head(n, p); }},
-    };
-    return kinds;
-}
+// ---- the ways of choosing layers ----------------------------------------------------------
 
 enum class Layering { single, equal, cuts, height, uneven, automatic };
 const Layering kLayerings[] = {Layering::single, Layering::equal, Layering::cuts,
@@ -348,17 +327,17 @@ struct ShapeRuns {
 };
 
 const ShapeRuns& shape_runs(size_t kind) {
-    static std::vector<std::unique_ptr<ShapeRuns>> cache(shape_kinds().size());
+    static std::vector<std::unique_ptr<ShapeRuns>> cache(shapes::kinds().size());
     std::unique_ptr<ShapeRuns>& slot = cache.at(kind);
     if (!slot) {
         slot.reset(new ShapeRuns);
         auto t0 = std::chrono::steady_clock::now();
         const Pose poses[] = {Pose::z, Pose::x, Pose::tilted};
         for (Pose pose : poses) {
-            Shape s = shape_kinds()[kind].make(kSmall, pose);
+            Shape s = shapes::kinds()[kind].make(kSmall, pose);
             for (Layering l : kLayerings) slot->small.push_back(run_case(s, l, true));
         }
-        Shape big = shape_kinds()[kind].make(kLarge, poses[kind % 3]);
+        Shape big = shapes::kinds()[kind].make(kLarge, poses[kind % 3]);
         slot->large.push_back(run_case(big, Layering::single, true));
         slot->large.push_back(run_case(big, Layering::equal, false));
         slot->large.push_back(run_case(big, Layering::cuts, false));
@@ -398,7 +377,7 @@ void check_shape(size_t kind) {
     double small_rec = 0, small_check = 0, large_rec = 0, large_check = 0;
     for (const Case& c : runs.small) small_rec += c.ms_reconstruct, small_check += c.ms_check;
     for (const Case& c : runs.large) large_rec += c.ms_reconstruct, large_check += c.ms_check;
-    MESSAGE(std::string(shape_kinds()[kind].name) << ": " << runs.small.size() << " runs at " << kSmall
+    MESSAGE(std::string(shapes::kinds()[kind].name) << ": " << runs.small.size() << " runs at " << kSmall
                                      << " points (reconstruct " << small_rec << " ms, check " << small_check
                                      << " ms), " << runs.large.size() << " at " << kLarge << " points (reconstruct "
                                      << large_rec << " ms, check " << large_check << " ms); "
@@ -610,7 +589,7 @@ TEST_CASE("reconstruction of the head, every pose, size and layering") { check_s
 // (points 1702, 270, 773, two below the cut at local height -0.7477, one above, spanning
 // 0.23 rad) faced the axis, cosine -0.91.
 TEST_CASE("reconstruction with several layers: every triangle faces outward, no self-intersection" * doctest::may_fail()) {
-    for (size_t kind = 0; kind < shape_kinds().size(); ++kind)
+    for (size_t kind = 0; kind < shapes::kinds().size(); ++kind)
         for_each_case(kind, [](const Case& c) {
             CHECK(c.mesh.inward == 0);
             CHECK(c.run.report.folds == 0);
@@ -1895,7 +1874,7 @@ TEST_CASE("close_ends: cylinder, vase, bumpy tube, head and CT slices become clo
     for (size_t kind : kinds) {
         for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
             for (size_t points : {size_t{200}, kSmall}) {
-                Shape s = shape_kinds()[kind].make(points, pose);
+                Shape s = shapes::kinds()[kind].make(points, pose);
                 for (Layering layering : layerings) {
                     std::vector<double> cuts;
                     Options open = layered_options(s, layering, cuts);
@@ -1944,7 +1923,7 @@ TEST_CASE("close_ends: cylinder, vase, bumpy tube, head and CT slices become clo
 
 TEST_CASE("close_ends at 20000 points: closed, oriented, the bound on triangles holds") {
     for (size_t kind : {size_t{2}, size_t{6}}) {
-        Shape s = shape_kinds()[kind].make(kLarge, Pose::tilted);
+        Shape s = shapes::kinds()[kind].make(kLarge, Pose::tilted);
         Options o = axis_options(s);
         o.flags = stratmesh::close_ends;
         Run run = reconstruct_guarded(cloud_of(s), o);

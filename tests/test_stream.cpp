@@ -159,30 +159,13 @@ void check_same(const Output& batch, const Output& stream) {
     }
 }
 
-struct StreamShape {
-    const char* name;
-    Shape (*make)(size_t, Pose);
-};
-
-const StreamShape kShapes[] = {
-    {"cylinder", [](size_t n, Pose p) { return shapes::cylinder(n, p); }},
-    {"elliptic tube", [](size_t n, Pose p) { return shapes::elliptic_tube(n, p); }},
-    {"bumpy tube", [](size_t n, Pose p) { return shapes::bumpy_tube(n, p); }},
-    {"cone", [](size_t n, Pose p) { return shapes::cone(n, p); }},
-    {"vase", [](size_t n, Pose p) { return shapes::vase(n, p); }},
-    {"scan grid", [](size_t n, Pose p) { return shapes::scan_grid(n, p); }},
-    {"CT slices", [](size_t n, Pose p) { return shapes::ct_slices(n, p); }},
-    {"noisy tube", [](size_t n, Pose p) { return shapes::noisy_tube(n, p); }},
-    {"head", [](size_t n, Pose p) { return shapes::head(n, p); }},
-};
-
 }  // namespace
 
 TEST_CASE("stream: the same triangles as reconstruct() on the same layers, every test shape") {
     // Equal layers; many thin pushes that must merge; uneven pushes with a thin last one.
     const std::vector<std::vector<double>> plans = {
         equal_fractions(6), equal_fractions(40), {0.03, 0.06, 0.85, 0.97}, {}};
-    for (const StreamShape& kind : kShapes) {
+    for (const shapes::Kind& kind : shapes::kinds()) {
         for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
             for (size_t n : {size_t(400), size_t(3000)}) {
                 const Shape s = kind.make(n, pose);

@@ -340,6 +340,28 @@ inline Shape ct_slices(size_t n, Pose pose, size_t slices = 20, uint64_t seed = 
     return s;
 }
 
+// The test shapes under the short names the suites log. Tests pick shapes by their index
+// here, so new shapes go at the end.
+struct Kind {
+    const char* name;
+    Shape (*make)(size_t n, Pose pose);
+};
+
+inline const std::vector<Kind>& kinds() {
+    static const std::vector<Kind> list = {
+        {"cylinder", [](size_t n, Pose p) { return cylinder(n, p); }},
+        {"elliptic tube", [](size_t n, Pose p) { return elliptic_tube(n, p); }},
+        {"bumpy tube", [](size_t n, Pose p) { return bumpy_tube(n, p); }},
+        {"cone", [](size_t n, Pose p) { return cone(n, p); }},
+        {"vase", [](size_t n, Pose p) { return vase(n, p); }},
+        {"scan grid", [](size_t n, Pose p) { return scan_grid(n, p); }},
+        {"CT slices", [](size_t n, Pose p) { return ct_slices(n, p); }},
+        {"noisy tube", [](size_t n, Pose p) { return noisy_tube(n, p); }},
+        {"head", [](size_t n, Pose p) { return head(n, p); }},
+    };
+    return list;
+}
+
 }  // namespace shapes
 
 #endif  // STRATMESH_TESTS_SUPPORT_SHAPES_H

@@ -331,9 +331,8 @@ struct Options {
     void* progress_user;
     // Optional, reconstruct() only: with a runner, the layers are triangulated as
     // independent jobs (at most kMaxJobs of them, each over a run of consecutive layers with
-    // its own scratch in the workspace), which also run the safety net's check of each
-    // layer's own triangles; grouping layers, stitching them and the net at the bands stay
-    // in order. The triangles and the report are the same bytes whatever the runner does,
+    // its own scratch in the workspace); grouping layers, stitching them and the safety net
+    // stay in order. The triangles and the report are the same bytes whatever the runner does,
     // as long as it runs every job once.
     // reconstruct_workspace_size() grows with a runner (see there); a workspace too small
     // for the jobs' scratch runs them in order instead (Report::parallel_layers says how
@@ -3128,6 +3127,16 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
 // vertex one chain of triangles ending on the loop's edges by construction; where the net
 // removed triangles, seal_seam makes sure the two sides still share an edge at every loop
 // vertex (else the upper side's triangles there go), so they never meet in a vertex alone.
+//
+// Within a chunk, only the vertices the band joins can break the manifold: a layer's
+// triangles are its planar triangulation (exact predicates) without the centre's star and
+// the outside of the hull. Around a vertex off the centre's link (the bottom loop) that
+// leaves its star minus the two ghost triangles at most: one fan. Off the hull, a
+// bottom-loop vertex loses the two triangles on its edge to the centre: one fan too. A
+// vertex on both loops can be left with two, and every band vertex is on a loop. So
+// finish_chunk checks the fans of the loop vertices (fans_are_one_piece) and runs the net
+// over the chunk only when one of them fails; on sound input it never does, and the net's
+// relabelling and sorting, most of its cost, is skipped.
 
 // In-place sort of packed (key, value) pairs: insertion sort for the small fans of almost
 // every vertex, heap sort (O(n log n), no recursion) for large ones.
@@ -3238,17 +3247,59 @@ inline size_t repair_fan(const uint32_t* tri, const uint32_t* incident, size_t b
     return removed;
 }
 
-// The common case, decided without sorting and without reading the triangles: a vertex's
-// corners as packed (leaving << 32 | arriving) neighbours, at most kSmallFan of them, none
-// repeating a leaving edge, forming one chain or one cycle. False sends the vertex to
-// repair_fan, which then decides as if this had not run. The corners sit together in
-// memory, where the triangles they come from are scattered: this is what keeps the safety
-// net from waiting on memory.
+// Whether a vertex's corners, packed (leaving << 32 | arriving) neighbours, form one chain
+// or one cycle with no leaving edge repeated: then the safety net has nothing to do there.
+// False sends the vertex to repair_fan, which then decides as if this had not run. The
+// corners sit together in memory, where the triangles they come from are scattered: this is
+// what keeps the safety net from waiting on memory. Fans of at most kSmallFan corners (all
+// but a few) are decided by branch-free scans; larger ones are sorted in place and walked.
 const size_t kSmallFan = 16;
 
-inline bool fan_is_one_piece(const uint64_t* corners, size_t size) {
+// A fan of any size: sorted by leaving neighbour, each corner's successor (the corner
+// leaving where it arrives) is found by binary search. One piece: every corner has one
+// and a walk from any corner comes back after all of them (a cycle), or all but one have
+// one and a walk from the corner nobody arrives at takes in all of them (a chain).
+inline bool large_fan_is_one_piece(uint64_t* corners, size_t size) {
+    sort_pairs(corners, size);
+    auto leaving = [&](size_t i) { return static_cast<uint32_t>(corners[i] >> 32); };
+    auto successor = [&](size_t i) {
+        const uint32_t arrive = static_cast<uint32_t>(corners[i]);
+        size_t lo = 0, hi = size;
+        while (lo < hi) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (leaving(mid) < arrive) lo = mid + 1;
+            else hi = mid;
+        }
+        return lo < size && leaving(lo) == arrive ? lo : size;
+    };
+    // The chain's first corner leaves along the one leaving neighbour no corner arrives at:
+    // the sum of the leaving neighbours less the arriving ones that some corner leaves along.
+    uint64_t first_leaving = 0;
+    size_t linked = 0;
+    for (size_t i = 0; i < size; ++i) {
+        if (i > 0 && leaving(i) == leaving(i - 1)) return false;
+        first_leaving += leaving(i);
+        if (successor(i) == size) continue;
+        ++linked;
+        first_leaving -= static_cast<uint32_t>(corners[i]);
+    }
+    size_t start = 0;
+    if (linked + 1 == size) {
+        while (start < size && leaving(start) != first_leaving) ++start;
+        if (start == size) return false;
+    } else if (linked != size) {
+        return false;
+    }
+    size_t walked = 1;
+    for (size_t at = successor(start); at != size && at != start && walked <= size;
+         at = successor(at))
+        ++walked;
+    return walked == size;
+}
+
+inline bool fan_is_one_piece(uint64_t* corners, size_t size) {
     if (size == 0) return true;
-    if (size > kSmallFan) return false;
+    if (size > kSmallFan) return large_fan_is_one_piece(corners, size);
     uint32_t leave[kSmallFan], next[kSmallFan];
     for (size_t j = 0; j < size; ++j) leave[j] = static_cast<uint32_t>(corners[j] >> 32);
     // Branch-free scans: which corner leaves where corner i arrives, and whether another
@@ -3283,7 +3334,7 @@ inline bool fan_is_one_piece(const uint64_t* corners, size_t size) {
 
 // Whether every vertex v with checked[v] != 0 passes fan_is_one_piece in tri[0 .. 3 count)
 // (indices below point_count): then the safety net would remove nothing at those vertices.
-// Lets the net's work be split (see ParallelLayers); the arena's failure answers false.
+// Lets finish_chunk skip the net where nothing can fail; the arena's failure answers false.
 inline bool fans_are_one_piece(const uint32_t* tri, size_t count, size_t point_count,
                                const unsigned char* checked, Arena& arena) {
     size_t mark = arena.mark();
@@ -4017,10 +4068,10 @@ inline size_t seal_seam(uint32_t* tri, size_t& count, size_t below_count, size_t
     return removed;
 }
 
-// Whether the safety net would remove nothing from the chunk, given that the fans of the
-// layer's vertices off its bottom loop were found whole by the job that triangulated it:
-// only the vertices the band touches are left to check.
-inline bool band_fans_are_one_piece(const uint32_t* tri, size_t count, size_t below,
+// Whether the safety net would remove nothing from the chunk: whether the fans of the
+// vertices the band joins (the layer's bottom loop, the loop below) are whole. The others
+// are by construction (see >>manifold).
+inline bool loop_fans_are_one_piece(const uint32_t* tri, size_t count, size_t below,
                                     size_t vertices, const LayerLoops& loops, Arena& arena) {
     size_t mark = arena.mark();
     unsigned char* checked = arena.alloc<unsigned char>(vertices);
@@ -4034,11 +4085,9 @@ inline bool band_fans_are_one_piece(const uint32_t* tri, size_t count, size_t be
 }
 
 // The safety net over the chunk sink[chunk_start ..), then its indices from layer-local and
-// band indices to output indices; counts the points that became vertices. `interior_whole`:
-// a job found the fans of the layer's vertices off its bottom loop whole.
+// band indices to output indices; counts the points that became vertices.
 inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                           bool interior_whole, size_t chunk_start, Arena& arena,
-                           TriangleSink& sink) {
+                           size_t chunk_start, Arena& arena, TriangleSink& sink) {
     uint32_t* tri = sink.triangles + 3 * chunk_start;
     size_t count = sink.count - chunk_start;
     const size_t below = layer.count, vertices = layer.count + c.top_count;
@@ -4046,8 +4095,7 @@ inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const Laye
     uint32_t* degree = arena.alloc<uint32_t>(vertices);
     if (arena.failed) return Status::out_of_memory;
     size_t removed = 0;
-    if (!(kParallelLayers && interior_whole &&
-          band_fans_are_one_piece(tri, count, below, vertices, loops, arena)))
+    if (!loop_fans_are_one_piece(tri, count, below, vertices, loops, arena))
         removed = enforce_manifold(tri, count, vertices, arena);
     if (removed == SIZE_MAX) return Status::out_of_memory;
     const unsigned char whole = kHasNextEdge | kHasPreviousEdge;
@@ -4102,7 +4150,6 @@ struct LayerAhead {
     uint32_t* bottom;
     uint32_t* top;
     uint32_t bottom_count, top_count;
-    bool interior_whole;     // the fans of the vertices off the bottom loop are whole
 };
 
 // What one step of the queue did.
@@ -4189,8 +4236,7 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
             // Past the caller's capacity only the count goes on (triangle_capacity follows).
             arena.rewind(mark);
             if (status == Status::ok && sink.count <= sink.capacity)
-                status = finish_chunk(c, layer, loops, triangulated && ahead->interior_whole,
-                                      chunk_start, arena, sink);
+                status = finish_chunk(c, layer, loops, chunk_start, arena, sink);
             if (status == Status::ok) {
                 for (uint32_t i = 0; i < loops.top_count; ++i) loops.top[i] = ids[loops.top[i]];
                 uint32_t* top = c.top;
@@ -4383,14 +4429,6 @@ inline void run_layer_job(void* context, uint32_t index) {
         a.folds = sink.folds;
         a.bottom_count = loops.bottom_count;
         a.top_count = loops.top_count;
-        a.interior_whole = false;
-        // The safety net's check of the vertices no band touches, done here in parallel.
-        unsigned char* checked = a.status == Status::ok ? arena.alloc<unsigned char>(n) : nullptr;
-        if (checked) {
-            std::memset(checked, 1, n);
-            for (uint32_t i = 0; i < loops.bottom_count; ++i) checked[loops.bottom[i]] = 0;
-            a.interior_whole = fans_are_one_piece(a.triangles, sink.count, n, checked, arena);
-        }
         a.done = true;
     }
 }

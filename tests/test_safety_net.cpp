@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -120,6 +121,14 @@ TEST_CASE("safety net: repeated, flipped and bow-tie triangles are removed until
         CHECK(r.removed == 5);  // the smaller fan goes
         CHECK(r.triangles == base);
     }
+    SUBCASE("two large fans sharing only their centre") {
+        std::vector<uint32_t> t = fan(20);
+        std::vector<uint32_t> second = fan(18, 21);
+        t.insert(t.end(), second.begin(), second.end());
+        NetResult r = run_net(t, 39);
+        CHECK(r.removed == 18);
+        CHECK(r.triangles == fan(20));
+    }
     SUBCASE("three triangles on one edge") {
         std::vector<uint32_t> t = {0, 1, 2, 1, 0, 3, 1, 0, 4};
         NetResult r = run_net(t, 5);
@@ -144,5 +153,60 @@ TEST_CASE("safety net: random triangle soups always come out manifold and in ord
         CHECK(r.triangles.size() + 3 * r.removed == t.size());
         check_manifold(r, points);
         CHECK(is_ordered_subset(r.triangles, t));
+    }
+}
+
+namespace {
+
+uint64_t corner(uint32_t leaving, uint32_t arriving) {
+    return static_cast<uint64_t>(leaving) << 32 | arriving;
+}
+
+// The corners of a cycle around a vertex through neighbours x[0 .. k) (each corner leaves
+// along x[i + 1] and arrives from x[i]), or of a chain through x[0 .. k] (k corners).
+std::vector<uint64_t> cycle(const std::vector<uint32_t>& x) {
+    std::vector<uint64_t> c;
+    for (size_t i = 0; i < x.size(); ++i) c.push_back(corner(x[(i + 1) % x.size()], x[i]));
+    return c;
+}
+std::vector<uint64_t> chain(const std::vector<uint32_t>& x) {
+    std::vector<uint64_t> c;
+    for (size_t i = 0; i + 1 < x.size(); ++i) c.push_back(corner(x[i + 1], x[i]));
+    return c;
+}
+
+bool one_piece(std::vector<uint64_t> corners, std::mt19937& rng) {
+    std::shuffle(corners.begin(), corners.end(), rng);
+    return stratmesh::detail::fan_is_one_piece(corners.data(), corners.size());
+}
+
+}  // namespace
+
+TEST_CASE("safety net: the fan test on its own, fans below and above the small-fan size") {
+    std::mt19937 rng(11);
+    for (uint32_t k = 3; k <= 48; ++k) {
+        INFO(k << " neighbours");
+        std::vector<uint32_t> x(2 * k + 2);
+        for (size_t i = 0; i < x.size(); ++i) x[i] = static_cast<uint32_t>(7 * i + 3 + rng() % 5);
+        const std::vector<uint32_t> first(x.begin(), x.begin() + k);
+        const std::vector<uint32_t> second(x.begin() + k, x.begin() + 2 * k);
+        CHECK(one_piece(cycle(first), rng));
+        CHECK(one_piece(chain(first), rng));
+        std::vector<uint64_t> cycle_twice = cycle(first), chain_and_cycle = chain(first),
+                             two_chains = chain(first), reversed = cycle(first),
+                             repeated = cycle(first), cut_twice = cycle(first);
+        for (uint64_t c : cycle(second)) cycle_twice.push_back(c);
+        for (uint64_t c : cycle(second)) chain_and_cycle.push_back(c);
+        for (uint64_t c : chain(second)) two_chains.push_back(c);
+        reversed[k / 2] = corner(first[k / 2], first[(k / 2 + 1) % k]);
+        repeated.push_back(repeated[k / 3]);
+        cut_twice.erase(cut_twice.begin() + k / 2);
+        cut_twice.erase(cut_twice.begin());
+        CHECK_FALSE(one_piece(cycle_twice, rng));
+        CHECK_FALSE(one_piece(chain_and_cycle, rng));
+        CHECK_FALSE(one_piece(two_chains, rng));
+        CHECK_FALSE(one_piece(reversed, rng));
+        CHECK_FALSE(one_piece(repeated, rng));
+        if (k >= 4) CHECK_FALSE(one_piece(cut_twice, rng));
     }
 }

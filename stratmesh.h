@@ -60,6 +60,13 @@
 //                            2 KiB on a Cortex-M7): Options::run_jobs is then ignored
 //                            and everything runs in order, with the same result. For
 //                            single-core targets.
+//   STRATMESH_SMALL_CODE     default: not defined. Leaves out all the code that only
+//                            makes reconstruction faster, for targets where code size
+//                            comes first (the Cortex-M7 build): the parallel layers, as
+//                            above, and the safety net's shortcut (a check of the loop
+//                            vertices that skips the net on sound chunks, about 0.4 KiB;
+//                            without it the net runs on every chunk, about 15% of the
+//                            time). The output is the same bytes either way.
 //
 // ==== Memory ===============================================================================
 //
@@ -584,10 +591,18 @@ namespace detail {
 
 static const uint32_t kNoIndex = 0xFFFFFFFFu;
 
+#if defined(STRATMESH_SMALL_CODE) && !defined(STRATMESH_NO_PARALLEL_LAYERS)
+#define STRATMESH_NO_PARALLEL_LAYERS
+#endif
 #if defined(STRATMESH_NO_PARALLEL_LAYERS)
 const bool kParallelLayers = false;
 #else
 const bool kParallelLayers = true;  // lets the compiler drop what only jobs' results reach
+#endif
+#if defined(STRATMESH_SMALL_CODE)
+const bool kNetShortcut = false;
+#else
+const bool kNetShortcut = true;  // finish_chunk checks the loop fans before running the net
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 
@@ -2119,29 +2134,25 @@ inline Vec3 principal_direction(const double m[3][3]) {
 // The frame: centroid origin, axis from the options (or PCA), e1/e2 completing it.
 inline Status choose_frame(const CloudReader& cloud, size_t count, const Options& options,
                            Frame& frame) {
-    Vec3 sum = {0, 0, 0}, low = {DBL_MAX, DBL_MAX, DBL_MAX}, high = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+    // Coordinates near the top of the double range overflow the sum: then the sum of the
+    // points scaled down by 2^-40 (exactly), which leaves room for 2^32 points, is used.
+    Vec3 sum = {0, 0, 0}, small_sum = {0, 0, 0};
+    Vec3 low = {DBL_MAX, DBL_MAX, DBL_MAX}, high = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
     size_t valid = 0;
     for (size_t i = 0; i < count; ++i) {
         if (!cloud.valid(i)) continue;
         Vec3 p = cloud.point(i);
         sum = {sum.x + p.x, sum.y + p.y, sum.z + p.z};
+        const Vec3 small = scaled(p, 0x1p-40);
+        small_sum = {small_sum.x + small.x, small_sum.y + small.y, small_sum.z + small.z};
         low = {p.x < low.x ? p.x : low.x, p.y < low.y ? p.y : low.y, p.z < low.z ? p.z : low.z};
         high = {p.x > high.x ? p.x : high.x, p.y > high.y ? p.y : high.y, p.z > high.z ? p.z : high.z};
         ++valid;
     }
-    if (!(is_finite(sum.x) && is_finite(sum.y) && is_finite(sum.z))) {
-        // Coordinates near the top of the double range: sum them scaled down by 2^-40,
-        // which leaves room for 2^32 points.
-        sum = {0, 0, 0};
-        for (size_t i = 0; i < count; ++i) {
-            if (!cloud.valid(i)) continue;
-            Vec3 p = scaled(cloud.point(i), 0x1p-40);
-            sum = {sum.x + p.x, sum.y + p.y, sum.z + p.z};
-        }
-        frame.origin = scaled(scaled(sum, 1.0 / static_cast<double>(valid)), 0x1p40);
-    } else {
+    if (!(is_finite(sum.x) && is_finite(sum.y) && is_finite(sum.z)))
+        frame.origin = scaled(scaled(small_sum, 1.0 / static_cast<double>(valid)), 0x1p40);
+    else
         frame.origin = valid ? scaled(sum, 1.0 / static_cast<double>(valid)) : Vec3{0, 0, 0};
-    }
     Vec3 size = valid ? high - low : Vec3{0, 0, 0};
     Vec3 half_size = valid ? scaled(high, 0.5) - scaled(low, 0.5) : Vec3{0, 0, 0};
     if (options.flags & origin_given) {
@@ -2545,7 +2556,7 @@ inline double exp_portable(double x) {
     double k = std::floor(x * 1.44269504088896338700 + 0.5);
     double r = (x - k * ln2_hi) - k * ln2_lo;  // |r| <= 0.35
     double p = 1.0 / 6227020800.0;             // 1/13!
-    const double inverse_factorials[13] = {1.0 / 479001600.0, 1.0 / 39916800.0,
+    static constexpr double inverse_factorials[13] = {1.0 / 479001600.0, 1.0 / 39916800.0,
                                            1.0 / 3628800.0,   1.0 / 362880.0,
                                            1.0 / 40320.0,     1.0 / 5040.0,
                                            1.0 / 720.0,       1.0 / 120.0,
@@ -3250,16 +3261,13 @@ inline size_t repair_fan(const uint32_t* tri, const uint32_t* incident, size_t b
 // Whether a vertex's corners, packed (leaving << 32 | arriving) neighbours, form one chain
 // or one cycle with no leaving edge repeated: then the safety net has nothing to do there.
 // False sends the vertex to repair_fan, which then decides as if this had not run. The
-// corners sit together in memory, where the triangles they come from are scattered: this is
-// what keeps the safety net from waiting on memory. Fans of at most kSmallFan corners (all
-// but a few) are decided by branch-free scans; larger ones are sorted in place and walked.
-const size_t kSmallFan = 16;
-
-// A fan of any size: sorted by leaving neighbour, each corner's successor (the corner
-// leaving where it arrives) is found by binary search. One piece: every corner has one
-// and a walk from any corner comes back after all of them (a cycle), or all but one have
-// one and a walk from the corner nobody arrives at takes in all of them (a chain).
-inline bool large_fan_is_one_piece(uint64_t* corners, size_t size) {
+// corners sit together in memory, where the triangles they come from are scattered, and are
+// sorted in place by leaving neighbour; each corner's successor (the corner leaving where it
+// arrives) is then found by binary search. One piece: every corner has one and a walk from
+// any corner comes back after all of them (a cycle), or all but one have one and a walk from
+// the corner nobody arrives at takes in all of them (a chain).
+inline bool fan_is_one_piece(uint64_t* corners, size_t size) {
+    if (size == 0) return true;
     sort_pairs(corners, size);
     auto leaving = [&](size_t i) { return static_cast<uint32_t>(corners[i] >> 32); };
     auto successor = [&](size_t i) {
@@ -3294,41 +3302,6 @@ inline bool large_fan_is_one_piece(uint64_t* corners, size_t size) {
     for (size_t at = successor(start); at != size && at != start && walked <= size;
          at = successor(at))
         ++walked;
-    return walked == size;
-}
-
-inline bool fan_is_one_piece(uint64_t* corners, size_t size) {
-    if (size == 0) return true;
-    if (size > kSmallFan) return large_fan_is_one_piece(corners, size);
-    uint32_t leave[kSmallFan], next[kSmallFan];
-    for (size_t j = 0; j < size; ++j) leave[j] = static_cast<uint32_t>(corners[j] >> 32);
-    // Branch-free scans: which corner leaves where corner i arrives, and whether another
-    // corner leaves where i does (a repeated directed edge).
-    uint32_t has_previous = 0, repeats = 0;
-    for (size_t i = 0; i < size; ++i) {
-        const uint32_t arrive = static_cast<uint32_t>(corners[i]);
-        uint32_t found = kNoIndex, same = 0;
-        for (size_t j = 0; j < size; ++j) {
-            const bool match = leave[j] == arrive;
-            found = match ? static_cast<uint32_t>(j) : found;
-            has_previous |= static_cast<uint32_t>(match) << j;
-            same += leave[j] == leave[i];
-        }
-        next[i] = found;
-        repeats |= same - 1;
-    }
-    if (repeats != 0) return false;
-    const uint32_t all = (1u << size) - 1;
-    const uint32_t starts = all & ~has_previous;
-    if (starts & (starts - 1)) return false;  // two chains or more
-    size_t start = 0;
-    while (starts && !(starts >> start & 1u)) ++start;
-    size_t walked = 0;
-    for (size_t at = start; at != kNoIndex && walked <= size;) {
-        ++walked;
-        at = next[at];
-        if (at == start) break;
-    }
     return walked == size;
 }
 
@@ -4095,7 +4068,7 @@ inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const Laye
     uint32_t* degree = arena.alloc<uint32_t>(vertices);
     if (arena.failed) return Status::out_of_memory;
     size_t removed = 0;
-    if (!loop_fans_are_one_piece(tri, count, below, vertices, loops, arena))
+    if (!(kNetShortcut && loop_fans_are_one_piece(tri, count, below, vertices, loops, arena)))
         removed = enforce_manifold(tri, count, vertices, arena);
     if (removed == SIZE_MAX) return Status::out_of_memory;
     const unsigned char whole = kHasNextEdge | kHasPreviousEdge;
@@ -4613,6 +4586,15 @@ inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& 
     }
 }
 
+inline void report_frame(const Frame& frame, Report& rep) {
+    rep.axis[0] = frame.axis.x;
+    rep.axis[1] = frame.axis.y;
+    rep.axis[2] = frame.axis.z;
+    rep.axis_origin[0] = frame.origin.x;
+    rep.axis_origin[1] = frame.origin.y;
+    rep.axis_origin[2] = frame.origin.z;
+}
+
 inline void describe_layer(const Frame& frame, const Cylinder& cyl, double bottom, double top,
                            size_t points, size_t triangles, size_t folds, LayerInfo& info) {
     info.bottom = frame.user_height(bottom);
@@ -4706,12 +4688,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     Frame frame;
     status = choose_frame(reader, cloud.count, options, frame);
     if (status != Status::ok) return status;
-    rep.axis[0] = frame.axis.x;
-    rep.axis[1] = frame.axis.y;
-    rep.axis[2] = frame.axis.z;
-    rep.axis_origin[0] = frame.origin.x;
-    rep.axis_origin[1] = frame.origin.y;
-    rep.axis_origin[2] = frame.origin.z;
+    report_frame(frame, rep);
     if (valid < 3 || !has_three_distinct_points(reader, cloud.count)) {
         rep.detail = "fewer than 3 distinct valid points";
         return Status::too_few_points;
@@ -4928,6 +4905,13 @@ inline void publish(Stream& s) {
     if (s.user_report) *s.user_report = s.rep;
 }
 
+// A push refused: the stream is as it was; the report says why.
+inline Status refuse_push(Stream& s, Status status, const char* detail) {
+    s.rep.detail = detail;
+    publish(s);
+    return status;
+}
+
 // Keeps the last group's top loop (moved to the front of the window) and the pushes after
 // planned layer `last`.
 inline void drop_group(Stream& s, uint32_t last) {
@@ -5065,10 +5049,10 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
             ++valid;
         } else if (!(s.options.flags & skip_invalid_points)) {
             s.rep.first_invalid_point = s.rep.points_in + i;
-            s.rep.detail = "a point has a NaN or infinite coordinate (see first_invalid_point; "
-                           "the skip_invalid_points flag skips such points instead)";
-            detail::publish(s);
-            return Status::invalid_point;
+            return detail::refuse_push(s, Status::invalid_point,
+                                       "a point has a NaN or infinite coordinate (see "
+                                       "first_invalid_point; the skip_invalid_points flag skips "
+                                       "such points instead)");
         }
     }
     if (!s.has_frame && valid == 0) {  // nothing to place yet: pushes before the first point
@@ -5084,11 +5068,9 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     }
     const double top_height = (top - detail::dot(frame.origin, frame.axis)) * frame.scale;
     auto slack = [](double h) { return 0x1p-40 * (1 + detail::abs_value(h)); };
-    if (s.has_frame && top_height < s.last_top) {
-        s.rep.detail = "a pushed layer's top is below the previous layer's top";
-        detail::publish(s);
-        return Status::out_of_order;
-    }
+    if (s.has_frame && top_height < s.last_top)
+        return detail::refuse_push(s, Status::out_of_order,
+                                   "a pushed layer's top is below the previous layer's top");
     double low = DBL_MAX, high = -DBL_MAX;
     for (size_t i = 0; i < points.count; ++i) {
         if (!reader.valid(i)) continue;
@@ -5097,39 +5079,30 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
               detail::abs_value(p.y) <= detail::kStreamRange &&
               detail::abs_value(p.h) <= detail::kStreamRange)) {
             s.rep.first_invalid_point = s.rep.points_in + i;
-            s.rep.detail = "a pushed point lies more than 2^60 times the first layer's size away "
-                           "from it";
-            detail::publish(s);
-            return Status::invalid_point;
+            return detail::refuse_push(s, Status::invalid_point,
+                                       "a pushed point lies more than 2^60 times the first "
+                                       "layer's size away from it");
         }
         if (p.h > top_height + slack(top_height) ||
-            (s.has_frame && p.h < s.last_top - slack(s.last_top))) {
-            s.rep.detail = "a pushed point lies outside its layer: below the previous layer's "
-                           "top or above its own";
-            detail::publish(s);
-            return Status::out_of_order;
-        }
+            (s.has_frame && p.h < s.last_top - slack(s.last_top)))
+            return detail::refuse_push(s, Status::out_of_order,
+                                       "a pushed point lies outside its layer: below the previous "
+                                       "layer's top or above its own");
         if (p.h < low) low = p.h;
         if (p.h > high) high = p.h;
     }
-    if (s.fill + valid > s.capacity || s.planned + 1 > s.slot_capacity) {
-        s.rep.detail = "the stream would hold more points or layers than its workspace: push "
-                       "thicker layers, or give more workspace (see Report::points_held)";
-        detail::publish(s);
-        return Status::out_of_memory;
-    }
+    if (s.fill + valid > s.capacity || s.planned + 1 > s.slot_capacity)
+        return detail::refuse_push(s, Status::out_of_memory,
+                                   "the stream would hold more points or layers than its workspace: "
+                                   "push thicker layers, or give more workspace (see "
+                                   "Report::points_held)");
     // Commit.
     if (!s.has_frame) {
         s.has_frame = true;
         s.chain.frame = frame;
         s.chain.reader = {reinterpret_cast<const unsigned char*>(s.points), sizeof(detail::Vec3), false};
         s.chain.output_id = s.global;
-        s.rep.axis[0] = frame.axis.x;
-        s.rep.axis[1] = frame.axis.y;
-        s.rep.axis[2] = frame.axis.z;
-        s.rep.axis_origin[0] = frame.origin.x;
-        s.rep.axis_origin[1] = frame.origin.y;
-        s.rep.axis_origin[2] = frame.origin.z;
+        detail::report_frame(frame, s.rep);
         s.lowest = low;
         s.highest = high;
         s.bounds[0] = low;

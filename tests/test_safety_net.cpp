@@ -182,7 +182,7 @@ bool one_piece(std::vector<uint64_t> corners, std::mt19937& rng) {
 
 }  // namespace
 
-TEST_CASE("safety net: the fan test on its own, fans below and above the small-fan size") {
+TEST_CASE("safety net: the fan test on its own, small fans and large ones") {
     std::mt19937 rng(11);
     for (uint32_t k = 3; k <= 48; ++k) {
         INFO(k << " neighbours");

@@ -11,10 +11,12 @@ root="$(cd "$(dirname "$0")/../.." && pwd)"
 out="${1:-$root/build-firmware}"
 mkdir -p "$out"
 cxx=arm-none-eabi-g++
-# A single core runs no parallel layers: that code is left out (see the header's
-# configuration macros); the full library's size is printed too.
+# Code size comes first here: STRATMESH_SMALL_CODE leaves out what only makes the
+# reconstruction faster (parallel layers, which a single core cannot use, and the safety
+# net's shortcut; see the header's configuration macros). The full library's size is
+# printed too.
 flags=(-mcpu=cortex-m7 -mfpu=fpv5-d16 -mfloat-abi=hard -mthumb -Os -std=c++17
-       -fno-exceptions -fno-rtti -DSTRATMESH_NO_PARALLEL_LAYERS
+       -fno-exceptions -fno-rtti -DSTRATMESH_SMALL_CODE
        -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wsign-conversion -Wdouble-promotion -Werror)
 
 # The library alone, as its own object.
@@ -37,9 +39,9 @@ ro=$(section_bytes "$out/stratmesh_m7.o" '^\.rodata')
 echo "library .text: $code bytes (limit 32768), .rodata: $ro bytes (strings and tables)"
 [ "$code" -le 32768 ] || { echo "FAIL: the library's code is above 32 KiB on the Cortex-M7"; exit 1; }
 full=()
-for flag in "${flags[@]}"; do [ "$flag" = -DSTRATMESH_NO_PARALLEL_LAYERS ] || full+=("$flag"); done
+for flag in "${flags[@]}"; do [ "$flag" = -DSTRATMESH_SMALL_CODE ] || full+=("$flag"); done
 "$cxx" "${full[@]}" -I"$root" -c "$root/stratmesh.cpp" -o "$out/stratmesh_m7_full.o"
-echo "with the parallel-layers code (not for single-core targets): .text $(section_bytes "$out/stratmesh_m7_full.o" '^\.text') bytes"
+echo "without STRATMESH_SMALL_CODE (parallel layers, the net's shortcut): .text $(section_bytes "$out/stratmesh_m7_full.o" '^\.text') bytes"
 
 echo "== symbols the library needs from outside (arm-none-eabi-nm -u)"
 arm-none-eabi-nm -u "$out/stratmesh_m7.o" | tr -s ' ' | sed 's/^ //'

@@ -684,13 +684,16 @@ struct Arena {
     // The bytes to ask the caller for: what was used, plus the worst alignment padding.
     size_t required_bytes() const { return high_water + kAlign - 1; }
 
-    template <class T> T* alloc(size_t count) {
+    template <class T> T* alloc(size_t count) { return static_cast<T*>(take(count, sizeof(T))); }
+
+    // alloc's one body, whatever the type (one copy of the code, not one per type).
+    void* take(size_t count, size_t size) {
         if (failed) return nullptr;
-        if (count > (SIZE_MAX - kAlign) / sizeof(T)) {
+        if (count > (SIZE_MAX - kAlign) / size) {
             failed = true;
             return nullptr;
         }
-        size_t bytes = (count * sizeof(T) + kAlign - 1) / kAlign * kAlign;
+        size_t bytes = (count * size + kAlign - 1) / kAlign * kAlign;
         if (bytes > capacity - used) {
             failed = true;
             return nullptr;
@@ -698,8 +701,8 @@ struct Arena {
         size_t offset = used;
         used += bytes;
         if (used > high_water) high_water = used;
-        if (is_measuring()) return reinterpret_cast<T*>(kAlign); // never dereferenced
-        return reinterpret_cast<T*>(base + offset);
+        if (is_measuring()) return reinterpret_cast<void*>(kAlign);  // never dereferenced
+        return base + offset;
     }
 
     size_t mark() const { return used; }
@@ -2555,17 +2558,15 @@ inline double exp_portable(double x) {
     const double ln2_lo = 1.90821492927058770002e-10;
     double k = std::floor(x * 1.44269504088896338700 + 0.5);
     double r = (x - k * ln2_hi) - k * ln2_lo;  // |r| <= 0.35
-    // The Taylor polynomial of degree 13 in Estrin's form: pairs, then pairs of pairs, so
-    // the multiplications overlap instead of waiting on each other as in Horner's.
-    const double r2 = r * r, r4 = r2 * r2, r8 = r4 * r4;
-    const double p01 = 1.0 + r, p23 = 1.0 / 2 + r * (1.0 / 6);
-    const double p45 = 1.0 / 24 + r * (1.0 / 120), p67 = 1.0 / 720 + r * (1.0 / 5040);
-    const double p89 = 1.0 / 40320 + r * (1.0 / 362880);
-    const double p1011 = 1.0 / 3628800 + r * (1.0 / 39916800);
-    const double p1213 = 1.0 / 479001600 + r * (1.0 / 6227020800.0);
-    const double low = (p01 + r2 * p23) + r4 * (p45 + r2 * p67);
-    const double high = (p89 + r2 * p1011) + r4 * p1213;
-    const double p = low + r8 * high;
+    double p = 1.0 / 6227020800.0;             // 1/13!
+    static constexpr double inverse_factorials[13] = {1.0 / 479001600.0, 1.0 / 39916800.0,
+                                           1.0 / 3628800.0,   1.0 / 362880.0,
+                                           1.0 / 40320.0,     1.0 / 5040.0,
+                                           1.0 / 720.0,       1.0 / 120.0,
+                                           1.0 / 24.0,        1.0 / 6.0,
+                                           0.5,               1.0,
+                                           1.0};
+    for (double c : inverse_factorials) p = p * r + c;
     uint64_t bits = static_cast<uint64_t>(static_cast<int64_t>(k) + 1023) << 52;
     double two_k;
     std::memcpy(&two_k, &bits, sizeof two_k);

@@ -2880,11 +2880,12 @@ inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& lay
 // paper's diagonal swap: a rung shared by an A-triangle and a B-triangle is swapped when
 // the opposite vertex lies in the circumcircle (Lawson flips, which terminate in one fixed
 // plane), or when the zipper folded a sliver that the swap unfolds. A swap only ever
-// exchanges adjacent A and B steps, so the band stays a band. The strip is periodic: a
-// vertex reached again after a full turn is shifted by the circumference. The rung that
-// closes the loop (first A vertex to first B vertex) is kept. The strip, not the annulus,
-// is used here because band triangles are long and flat: on the annulus the circle's
-// curvature would flip their orientation relative to the surface.
+// exchanges adjacent A and B steps, so the band stays a band; a clockwise step the swaps
+// cannot reach is then untangled across its run (see untangle_runs). The strip is
+// periodic: a vertex reached again after a full turn is shifted by the circumference. The
+// rung that closes the loop (first A vertex to first B vertex) is kept. The strip, not the
+// annulus, is used here because band triangles are long and flat: on the annulus the
+// circle's curvature would flip their orientation relative to the surface.
 
 // Rotates loop[0..n) and its strip coordinates so that entry `first` comes first; the
 // entries moved to the end are shifted by `turn` (one period of the strip), so angles
@@ -2956,6 +2957,14 @@ struct Band {
         if (a_then_b ? !proper_ab : !proper_ba) return true;
         if (a_then_b) return incircle_perturbed(a0, a1, b0, b1, scratch) > 0;
         return incircle_perturbed(a0, b1, b0, a1, scratch) > 0;
+    }
+
+    // Whether step t (state i, j before it) is counter-clockwise on the strip: an A step
+    // makes (a0 a1 b0), a B step (a0 b1 b0).
+    bool proper(uint32_t t, uint32_t i, uint32_t j) {
+        const double* a0 = pa(i, 0);
+        const double* b0 = pb(j, 2);
+        return orient2d_robust(a0, steps[t] == 0 ? pa(i + 1, 1) : pb(j + 1, 1), b0) > 0;
     }
 };
 
@@ -3039,6 +3048,58 @@ inline size_t swap_diagonals(Band& band) {
     return swaps;
 }
 
+// The swaps only exchange neighbouring A and B steps, so a clockwise step inside a run of
+// one loop stays (as does one whose swapped pair is clockwise too). Both loops hug the
+// cut, so band triangles are flat, and an A step (a0 a1 b0) turns clockwise, a sliver
+// facing the axis, when b0 lies below the line through a0 and a1: behind a0 with a1
+// dipping, or past a1 with a1 rising (a B step likewise). Moving the other loop's next
+// step back to it, or its previous step forward, across the run hangs the edge from the
+// other loop's next (or previous) vertex; only the triangles of that stretch change, and
+// the move is kept when they all turn counter-clockwise and the band keeps two runs of A.
+// Returns the adjacent exchanges made.
+inline size_t untangle_runs(Band& band) {
+    const uint32_t length = band.p + band.q;
+    unsigned char* steps = band.steps;
+    size_t moves = 0;
+    uint32_t i = 0, j = 0;
+    for (uint32_t t = 0; t < length; ++t) {
+        const unsigned char kind = steps[t];
+        unsigned char taken = kind;  // what step t adds to the state
+        if (!band.proper(t, i, j)) {
+            uint32_t next = t + 1, previous = t;
+            while (next < length && steps[next] == kind) ++next;
+            while (previous > 0 && steps[previous - 1] == kind) --previous;
+            const uint32_t run = t - previous;  // steps of the run before t
+            for (int backward = 0; backward < 2; ++backward) {
+                // Steps [lo, hi] change: the other loop's step goes from `from` to t.
+                const uint32_t lo = backward ? previous - 1 : t, hi = backward ? t : next;
+                const uint32_t from = backward ? lo : hi;
+                if (backward ? previous == 0 : next == length) continue;
+                const unsigned char other = steps[from];
+                for (uint32_t k = lo; k <= hi; ++k) steps[k] = kind;
+                steps[t] = other;
+                bool ok = count_a_runs(steps, length) >= 2;
+                // The state before lo: for a backward move, the run and that step undone.
+                uint32_t ik = backward ? i - (kind == 0 ? run : 1) : i;
+                uint32_t jk = backward ? j - (kind == 0 ? 1 : run) : j;
+                for (uint32_t k = lo; ok && k <= hi; ++k) {
+                    ok = band.proper(k, ik, jk);
+                    if (steps[k] == 0) ++ik; else ++jk;
+                }
+                if (ok) {
+                    moves += hi - lo;
+                    taken = backward ? kind : other;  // backward: the same steps up to t
+                    break;
+                }
+                for (uint32_t k = lo; k <= hi; ++k) steps[k] = kind;
+                steps[from] = other;
+            }
+        }
+        if (taken == 0) ++i; else ++j;
+    }
+    return moves;
+}
+
 // Stitches loop A (the lower layer's top loop: reader indices a_ids, cylinder ca) to the
 // loaded upper layer's bottom loop b (layer-local indices; the layer's cylinder has the
 // cut as h0). The band's triangles name the upper layer's points by layer-local index and
@@ -3107,6 +3168,7 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
         reverse(0, length);
         *swaps += swap_diagonals(band);
     }
+    *swaps += untangle_runs(band);
     uint32_t i = 0, j = 0;
     for (uint32_t t = 0; t < p + q; ++t) {
         uint32_t x, y, z;  // counter-clockwise on the annulus

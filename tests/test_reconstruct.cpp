@@ -13,9 +13,9 @@
 //   - several layers: the bands between layers hold a few triangles facing the axis (at
 //     most 2 a run in the matrix below, some of them strongly: normals up to 155 degrees
 //     from the outward direction), Report::folds counting them within 2, and some of those
-//     folds intersect their neighbours. The strict properties are asserted in test cases
-//     marked may_fail (a library defect: these layers are star-shaped about their centres,
-//     where the header promises outward normals), the bounded counts in passing ones;
+//     folds intersect their neighbours. The strict properties were asserted in a test case
+//     marked may_fail until untangle_runs left none in the matrix; they now hold strictly,
+//     the bounded counts are asserted too;
 //   - deviation from the true surface, in point spacings: at most 2.64 with one layer (the
 //     boundary loops are coarser than the spacing: the hull and the centre's link on the
 //     annulus skip points slightly inside them) and 1.3 off the boundary; up to 3.22
@@ -578,17 +578,19 @@ TEST_CASE("reconstruction of the CT slice stack, every pose, size and layering")
 TEST_CASE("reconstruction of the noisy tube, every pose, size and layering") { check_shape(7); }
 TEST_CASE("reconstruction of the head, every pose, size and layering") { check_shape(8); }
 
-// Library defect, kept strict: with several layers, the zipper bands hold triangles facing
-// the axis. Originally 16 several-layer runs of the matrix at 2000 points and 1 at 20000
-// points, one or two triangles each; untangling folded slivers and a second swap pass
-// around the band's closing rung brought it down to the cone alone (6 runs, one triangle
-// each). A band joins two loops coarser than the point spacing (the lower layer's hull and
-// the upper layer's centre link skip points close to the cut) and some of its triangles
-// stay clockwise on the unrolled strip when the swapped pair is not proper either.
-// Example (before the fixes): cone, 2000 points, axis X, layer_height 0.75: triangle 2305
-// (points 1702, 270, 773, two below the cut at local height -0.7477, one above, spanning
-// 0.23 rad) faced the axis, cosine -0.91.
-TEST_CASE("reconstruction with several layers: every triangle faces outward, no self-intersection" * doctest::may_fail()) {
+// With several layers, the zipper bands used to hold triangles facing the axis: originally
+// 16 several-layer runs of the matrix at 2000 points and 1 at 20000 points, one or two
+// triangles each; untangling folded slivers and a second swap pass around the band's
+// closing rung brought it down to the cone alone (6 runs, one triangle each), and
+// untangling clockwise steps inside a run of one loop (untangle_runs) to none. A band joins
+// two loops coarser than the point spacing (the lower layer's hull and the upper layer's
+// centre link skip points close to the cut), so its triangles are flat slivers on the
+// unrolled strip. Examples: cone, 2000 points, axis X, layer_height 0.75: triangle 2305
+// (points 1702, 270, 773) faced the axis, cosine -0.91 (before the first fixes); cone,
+// 2000 points, axis Z, 6 equal layers: triangle 2348 (points 513, 1462, 1124, two below
+// the cut at local height -0.9974, one above, spanning 0.27 rad) cosine -0.014, inside a
+// run of three A steps (before untangle_runs).
+TEST_CASE("reconstruction with several layers: every triangle faces outward, no self-intersection") {
     for (size_t kind = 0; kind < shapes::kinds().size(); ++kind)
         for_each_case(kind, [](const Case& c) {
             CHECK(c.mesh.inward == 0);

@@ -3058,8 +3058,18 @@ inline size_t swap_diagonals(Band& band) {
 // the move is kept when they all turn counter-clockwise and the band keeps two runs of A.
 // Returns the adjacent exchanges made.
 inline size_t untangle_runs(Band& band) {
+    // Longer runs (a fan from one vertex over many of the other loop) are left as they
+    // are: this bounds the work at kLongestUntangledRun steps per step of the band.
+    const uint32_t kLongestUntangledRun = 64;
     const uint32_t length = band.p + band.q;
     unsigned char* steps = band.steps;
+    uint32_t runs = count_a_runs(steps, length);
+    // Run starts at lo .. hi + 1: the only ones a change of steps [lo, hi] can move.
+    auto starts_near = [&](uint32_t lo, uint32_t hi) {
+        uint32_t starts = 0;
+        for (uint32_t k = lo; k <= hi + 1; ++k) starts += starts_a_run(steps, length, k);
+        return starts;
+    };
     size_t moves = 0;
     uint32_t i = 0, j = 0;
     for (uint32_t t = 0; t < length; ++t) {
@@ -3067,18 +3077,22 @@ inline size_t untangle_runs(Band& band) {
         unsigned char taken = kind;  // what step t adds to the state
         if (!band.proper(t, i, j)) {
             uint32_t next = t + 1, previous = t;
-            while (next < length && steps[next] == kind) ++next;
-            while (previous > 0 && steps[previous - 1] == kind) --previous;
+            while (next < length && steps[next] == kind && next - t <= kLongestUntangledRun) ++next;
+            while (previous > 0 && steps[previous - 1] == kind && t - previous <= kLongestUntangledRun)
+                --previous;
             const uint32_t run = t - previous;  // steps of the run before t
-            for (int backward = 0; backward < 2; ++backward) {
+            const bool short_run = next - previous <= kLongestUntangledRun;
+            for (int backward = 0; short_run && backward < 2; ++backward) {
                 // Steps [lo, hi] change: the other loop's step goes from `from` to t.
                 const uint32_t lo = backward ? previous - 1 : t, hi = backward ? t : next;
                 const uint32_t from = backward ? lo : hi;
                 if (backward ? previous == 0 : next == length) continue;
                 const unsigned char other = steps[from];
+                const uint32_t starts_before = starts_near(lo, hi);
                 for (uint32_t k = lo; k <= hi; ++k) steps[k] = kind;
                 steps[t] = other;
-                bool ok = count_a_runs(steps, length) >= 2;
+                const uint32_t runs_after = runs - starts_before + starts_near(lo, hi);
+                bool ok = runs_after >= 2;
                 // The state before lo: for a backward move, the run and that step undone.
                 uint32_t ik = backward ? i - (kind == 0 ? run : 1) : i;
                 uint32_t jk = backward ? j - (kind == 0 ? 1 : run) : j;
@@ -3087,6 +3101,7 @@ inline size_t untangle_runs(Band& band) {
                     if (steps[k] == 0) ++ik; else ++jk;
                 }
                 if (ok) {
+                    runs = runs_after;
                     moves += hi - lo;
                     taken = backward ? kind : other;  // backward: the same steps up to t
                     break;

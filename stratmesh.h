@@ -2090,6 +2090,8 @@ struct Frame {
         Vec3 d = offset(p);
         return {dot(d, e1), dot(d, e2), dot(d, axis)};
     }
+    // local(p).h alone, the same bits.
+    double height(Vec3 p) const { return dot(offset(p), axis); }
     // A frame height back as the user's coordinate along the axis, dot(point, axis).
     double user_height(double h) const { return h / scale + dot(origin, axis); }
 };
@@ -4657,11 +4659,11 @@ inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& 
                            const LayerPlan& plan, ReconstructMemory& m) {
     std::memset(m.layer_start, 0, sizeof(uint32_t) * (plan.count + 2));
     for (size_t i = 0; i < count; ++i)
-        if (cloud.valid(i)) ++m.layer_start[layer_of(plan, frame.local(cloud.point(i)).h) + 2];
+        if (cloud.valid(i)) ++m.layer_start[layer_of(plan, frame.height(cloud.point(i))) + 2];
     for (uint32_t k = 0; k < plan.count; ++k) m.layer_start[k + 2] += m.layer_start[k + 1];
     for (size_t i = 0; i < count; ++i) {
         if (!cloud.valid(i)) continue;
-        uint32_t k = layer_of(plan, frame.local(cloud.point(i)).h);
+        uint32_t k = layer_of(plan, frame.height(cloud.point(i)));
         m.order[m.layer_start[k + 1]++] = static_cast<uint32_t>(i);
     }
 }
@@ -4777,9 +4779,9 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     double lo = DBL_MAX, hi = -DBL_MAX;
     for (size_t i = 0; i < cloud.count; ++i) {
         if (!reader.valid(i)) continue;
-        Local p = frame.local(reader.point(i));
-        if (p.h < lo) lo = p.h;
-        if (p.h > hi) hi = p.h;
+        const double h = frame.height(reader.point(i));
+        if (h < lo) lo = h;
+        if (h > hi) hi = h;
     }
     if (!(hi > lo)) {
         rep.detail = "every point has the same height along the axis";

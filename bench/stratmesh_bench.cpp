@@ -21,6 +21,7 @@
 #include "thread_jobs.h"  // the tool's std::thread job runner (examples/cli)
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <climits>
 #include <cmath>
@@ -31,6 +32,7 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -124,7 +126,8 @@ enum class Kind {
     reconstruct,  // stratmesh::reconstruct on a 3D cloud, beside delaunay_2d on as many
                   // uniform 2D points (its reference cost)
     layered,      // the same, plus one line per layer of the result (the paper's cases)
-    threads,      // reconstruct without a job runner against a 2-thread runner
+    threads,      // reconstruct without a job runner against a 2-thread runner, and
+                  // two independent serial calls at once (the machine's ceiling)
     stream,       // the stream, pushed layer by layer, against reconstruct on the same layers
 };
 
@@ -765,6 +768,7 @@ struct Reconstructed {
     stratmesh::Status status = stratmesh::Status::ok;
     stratmesh::Report report = stratmesh::Report();
     std::vector<uint32_t> triangles;  // 3 per triangle
+    Clock::time_point start, stop;    // around the call only, not the triangle array's setup
     double seconds = 0;
 };
 
@@ -775,22 +779,24 @@ void run_reconstruct(const stratmesh::Cloud& cloud, const stratmesh::Options& op
     out.triangles.resize(3 * max_triangles);
     out.report = stratmesh::Report();
     size_t count = 0;
-    Clock::time_point start = Clock::now();
+    out.start = Clock::now();
     out.status = stratmesh::reconstruct(cloud, options, workspace, workspace_bytes,
                                         out.triangles.data(), max_triangles, &count, &out.report);
-    out.seconds = seconds_between(start, Clock::now());
+    out.stop = Clock::now();
+    out.seconds = seconds_between(out.start, out.stop);
     out.triangles.resize(3 * count);
 }
 
-// Runs `first` and `second` one after the other, `runs` times each, so both see the same
-// load; each returns its time.
-template <class First, class Second>
-void alternate(int runs, First first, Second second, std::vector<double>& first_times,
-               std::vector<double>& second_times) {
+// Runs the steps one after the other, in order, `runs` times each, so all see the same
+// load; each returns its time. The result holds each step's times, in the steps' order.
+template <class... Steps>
+std::array<std::vector<double>, sizeof...(Steps)> alternate(int runs, Steps... steps) {
+    std::array<std::vector<double>, sizeof...(Steps)> times;
     for (int run = 0; run < runs; ++run) {
-        first_times.push_back(first());
-        second_times.push_back(second());
+        size_t k = 0;
+        (times[k++].push_back(steps()), ...);  // a comma fold runs left to right
     }
+    return times;
 }
 
 // The fields every case line starts with.
@@ -802,8 +808,12 @@ JsonLine case_line(const std::string& name, size_t n, int runs) {
     return line;
 }
 
-// Times reconstruct() with no job runner and with a 2-thread runner, alternately, on one
-// workspace (sized for the runner, the larger bound), and compares their triangles.
+// Times reconstruct() with no job runner and with a 2-thread runner on one workspace
+// (sized for the runner, the larger bound), and compares their triangles. Alternating with
+// them, it times two serial calls at once, on the calling thread and one std::thread, each
+// with its own workspace and triangles: the throughput two cores give on two independent
+// copies of the same work. That is the ceiling for the runner's speedup on this machine,
+// below 2 where the work is bound by memory bandwidth rather than arithmetic.
 Result measure_threads(const std::string& name, const stratmesh::Cloud& cloud,
                        const Layering& layering, int runs) {
     stratmesh::Options serial = reconstruct_options(layering, nullptr);
@@ -813,10 +823,13 @@ Result measure_threads(const std::string& name, const stratmesh::Cloud& cloud,
     jobs.threads = 2;
     jobs.attach(threaded);
     size_t workspace_bytes = stratmesh::reconstruct_workspace_size(cloud.count, threaded);
+    size_t serial_bytes = stratmesh::reconstruct_workspace_size(cloud.count, serial);
     std::unique_ptr<unsigned char[]> workspace = allocate_touched(workspace_bytes);
-    Reconstructed one, two;
-    std::vector<double> one_times, two_times;
-    alternate(
+    // The pair's second call gets this one; the first reuses `workspace`, as the serial
+    // call does, so only one more serial workspace is held.
+    std::unique_ptr<unsigned char[]> other_workspace = allocate_touched(serial_bytes);
+    Reconstructed one, two, pair[2];
+    auto [one_times, two_times, pair_times] = alternate(
         runs,
         [&] {
             run_reconstruct(cloud, serial, workspace.get(), workspace_bytes, one);
@@ -826,23 +839,46 @@ Result measure_threads(const std::string& name, const stratmesh::Cloud& cloud,
             run_reconstruct(cloud, threaded, workspace.get(), workspace_bytes, two);
             return two.seconds;
         },
-        one_times, two_times);
-    bool ok = one.status == stratmesh::Status::ok && two.status == stratmesh::Status::ok;
-    Result result = {ok ? Outcome::ok : Outcome::failed, cloud.count, median(two_times),
+        [&] {
+            std::thread other([&] {
+                run_reconstruct(cloud, serial, other_workspace.get(), serial_bytes, pair[1]);
+            });
+            run_reconstruct(cloud, serial, workspace.get(), workspace_bytes, pair[0]);
+            other.join();
+            // From the first call's start to the last one's end; each triangle array's
+            // setup is outside its own call's clock.
+            return seconds_between(std::min(pair[0].start, pair[1].start),
+                                   std::max(pair[0].stop, pair[1].stop));
+        });
+    stratmesh::Status pair_status =
+        pair[0].status != stratmesh::Status::ok ? pair[0].status : pair[1].status;
+    bool ok = one.status == stratmesh::Status::ok && two.status == stratmesh::Status::ok &&
+              pair_status == stratmesh::Status::ok;
+    double seconds_no_runner = median(one_times);
+    double seconds_2_threads = median(two_times);
+    double seconds_2_independent = median(pair_times);
+    double speedup = seconds_no_runner / seconds_2_threads;
+    double speedup_ceiling = 2 * seconds_no_runner / seconds_2_independent;
+    Result result = {ok ? Outcome::ok : Outcome::failed, cloud.count, seconds_2_threads,
                      std::nan("")};
     JsonLine line = case_line(name, cloud.count, runs);
     line.add("layers", one.report.layer_count);
-    line.add("seconds_no_runner", median(one_times));
-    line.add("seconds_2_threads", median(two_times));
-    line.add("speedup", median(one_times) / median(two_times));
+    line.add("seconds_no_runner", seconds_no_runner);
+    line.add("seconds_2_threads", seconds_2_threads);
+    line.add("speedup", speedup);
+    line.add("seconds_2_independent", seconds_2_independent);
+    line.add("speedup_ceiling", speedup_ceiling);
+    line.add("share_of_ceiling", speedup / speedup_ceiling);
     line.add("parallel_layers", two.report.parallel_layers);
     line.add("identical", one.triangles == two.triangles);
+    line.add("independent_identical",
+             one.triangles == pair[0].triangles && one.triangles == pair[1].triangles);
     line.add("triangles", one.triangles.size() / 3);
-    line.add("workspace_bytes_no_runner",
-             stratmesh::reconstruct_workspace_size(cloud.count, serial));
+    line.add("workspace_bytes_no_runner", serial_bytes);
     line.add("workspace_bytes_2_threads", workspace_bytes);
     line.add("status", status_name(one.status));
     line.add("status_2_threads", status_name(two.status));
+    line.add("status_2_independent", status_name(pair_status));
     line.print();
     return result;
 }
@@ -929,8 +965,7 @@ Result measure_stream(const std::string& name, const std::vector<double>& coords
     std::unique_ptr<unsigned char[]> batch_workspace = allocate_touched(batch_bytes);
     Reconstructed streamed, whole;
     streamed.triangles.reserve(3 * stratmesh::reconstruct_max_triangles(cloud.count, batch));
-    std::vector<double> stream_times, batch_times;
-    alternate(
+    auto [stream_times, batch_times] = alternate(
         runs,
         [&] {
             run_stream(layered, options, stream_workspace.get(), stream_bytes, streamed);
@@ -939,8 +974,7 @@ Result measure_stream(const std::string& name, const std::vector<double>& coords
         [&] {
             run_reconstruct(cloud, batch, batch_workspace.get(), batch_bytes, whole);
             return whole.seconds;
-        },
-        stream_times, batch_times);
+        });
     bool ok = streamed.status == stratmesh::Status::ok && whole.status == stratmesh::Status::ok;
     Result result = {ok ? Outcome::ok : Outcome::failed, cloud.count, median(stream_times),
                      std::nan("")};
@@ -1161,9 +1195,16 @@ void print_help(std::FILE* out) {
         "  seconds_no_runner, seconds_2_threads   medians of reconstruct without a job\n"
         "                            runner and with a 2-thread std::thread runner\n"
         "  speedup                   seconds_no_runner / seconds_2_threads\n"
+        "  seconds_2_independent     median wall time of two serial reconstructs at once\n"
+        "                            on two threads, each with its own workspace\n"
+        "  speedup_ceiling           2 x seconds_no_runner / seconds_2_independent: what\n"
+        "                            two cores give on two independent copies of the work\n"
+        "  share_of_ceiling          speedup / speedup_ceiling\n"
         "  parallel_layers           Report::parallel_layers of the threaded run\n"
-        "  identical                 both triangle arrays are the same bytes\n"
+        "  identical                 the serial and threaded arrays are the same bytes\n"
+        "  independent_identical     both independent calls gave the serial call's bytes\n"
         "  workspace_bytes_no_runner, workspace_bytes_2_threads   the two bounds\n"
+        "  status, status_2_threads, status_2_independent   what the calls returned\n"
         "stream (case stream-tube-4e6: 100 equal layers along z):\n"
         "  stream_seconds, reconstruct_seconds   medians of the stream pushed layer by\n"
         "                            layer and of reconstruct with the same cuts and origin\n"

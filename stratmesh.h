@@ -4528,19 +4528,22 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
         p.slot_of_layer[k] = slot++;
     }
     const size_t results = arena.mark();
-    // Jobs: runs of slots with about equal point counts.
-    uint32_t most = slots < kMaxJobs ? slots : kMaxJobs;
-    const size_t share = (points + most - 1) / most;
+    // Jobs: runs of slots with about equal point counts. A slot goes to the share of the
+    // points its middle falls in, so equal layers get a job each (a threshold on a running
+    // count would put a layer slightly under the mean together with the next).
+    const uint32_t most = slots < kMaxJobs ? slots : kMaxJobs;
     uint32_t job = 0;
-    size_t in_job = 0;
+    uint64_t share_of_job = 0, before = 0;
     p.first_slot[0] = 0;
     for (uint32_t s = 0; s < slots; ++s) {
-        uint32_t k = p.layer_of_slot[s];
-        in_job += q.start[k + 1] - q.start[k];
-        if (in_job >= share && job + 1 < most && s + 1 < slots) {
-            p.first_slot[++job] = s + 1;
-            in_job = 0;
+        const uint32_t k = p.layer_of_slot[s];
+        const uint64_t n = q.start[k + 1] - q.start[k];
+        const uint64_t share = (before + n / 2) * most / points;
+        if (s > 0 && share > share_of_job) {
+            p.first_slot[++job] = s;
+            share_of_job = share;
         }
+        before += n;
     }
     p.job_count = job + 1;
     p.first_slot[p.job_count] = slots;

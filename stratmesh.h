@@ -80,7 +80,7 @@
 // delaunay_2d needs 72 bytes per point plus about 10 KiB; its output is at most
 // 2n - 5 triangles (24 bytes per point). reconstruct needs about 114 bytes per point
 // (the triangulation of its largest possible layer with the layer's coordinates, plus the
-// layer grouping and boundary loops), about 118 with the close_ends flag, about 154 with a
+// layer grouping and boundary loops), about 118 with the close_ends flag, about 162 with a
 // jobs runner (Options::run_jobs); its output is at most 2n triangles. A stream needs about
 // 190 bytes per point it holds at once, whatever the size of the whole cloud.
 //
@@ -405,7 +405,7 @@ struct Report {
 // Report::workspace_used tells what a run really needed, which follows its largest layer
 // (measured on 2000-point tubes: the bound is 1.05 times the peak for one layer, 3.1 to
 // 3.3 times it with six or more layers). With Options::run_jobs it also covers the
-// layers triangulated ahead and the jobs' scratch (about 154 bytes per point instead of
+// layers triangulated ahead and the jobs' scratch (about 162 bytes per point instead of
 // 114). 0 if no workspace can serve that many points (as for delaunay_2d_workspace_size).
 size_t reconstruct_workspace_size(size_t point_count, const Options& options);
 
@@ -4201,10 +4201,16 @@ struct LayerAhead {
     Cylinder cylinder;
     LayerCounts counts;
     size_t triangle_count, folds;
-    uint32_t* triangles;     // as the sink writes them, in layer-local indices
-    uint32_t* bottom;
+    uint32_t* triangles;     // as the sink writes them, in reader indices
+    uint32_t* bottom;        // the loops in layer-local indices
     uint32_t* top;
     uint32_t bottom_count, top_count;
+    // For replay_chunk: the triangles touching the bottom loop, in layer-local indices (at
+    // most border_capacity), and the vertices off the bottom loop with a triangle.
+    bool replayable;         // the border fits and every top-loop vertex off the bottom
+                             // loop has a triangle
+    uint32_t* border;
+    size_t border_count, border_capacity, interior_used;
 };
 
 // What one step of the queue did.
@@ -4234,6 +4240,60 @@ inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops
     loops.top_count = ahead.top_count;
     counts = ahead.counts;
     return Status::ok;
+}
+
+// finish_chunk for a layer a job triangulated, whose triangles are already in reader
+// indices, followed in the sink by the band (from chunk_start + ahead.triangle_count):
+// when the seam below is as built and the fans of the loop vertices are whole, the safety
+// net has nothing to do, and only the border triangles (those of ahead.border) and the
+// band are read. Returns false when that does not hold (nothing changed): the caller then
+// builds the chunk again in order, to the same triangles, and runs finish_chunk.
+inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
+                         const LayerAhead& ahead, size_t chunk_start, Arena& arena,
+                         TriangleSink& sink) {
+    const unsigned char whole = kHasNextEdge | kHasPreviousEdge;
+    bool seam_as_built = ahead.replayable && !c.output_id;
+    for (uint32_t i = 0; i < c.top_count; ++i)
+        seam_as_built = seam_as_built && ((c.top_unused[i] & whole) == whole);
+    if (!seam_as_built) return false;
+    uint32_t* band = sink.triangles + 3 * (chunk_start + ahead.triangle_count);
+    const size_t band_count = sink.count - chunk_start - ahead.triangle_count;
+    const size_t below = layer.count, vertices = below + c.top_count;
+    const size_t count = ahead.border_count + band_count;
+    size_t mark = arena.mark();
+    uint32_t* tri = arena.alloc<uint32_t>(3 * count);
+    uint32_t* degree = arena.alloc<uint32_t>(vertices);
+    if (arena.failed) {
+        arena.failed = false;
+        arena.rewind(mark);
+        return false;
+    }
+    std::memcpy(tri, ahead.border, 3 * ahead.border_count * sizeof(uint32_t));
+    std::memcpy(tri + 3 * ahead.border_count, band, 3 * band_count * sizeof(uint32_t));
+    if (!loop_fans_are_one_piece(tri, count, below, vertices, loops, arena)) {
+        arena.failed = false;
+        arena.rewind(mark);
+        return false;
+    }
+    count_corners(tri, count, degree, vertices);
+    size_t used = ahead.interior_used;
+    for (uint32_t i = 0; i < c.top_count; ++i)
+        used += degree[below + i] > 0 && (c.top_unused[i] & kUnusedBelow);
+    // A bottom-loop vertex's triangles are all here; kNoIndex marks one without any.
+    for (uint32_t i = 0; i < loops.bottom_count; ++i) {
+        uint32_t& d = degree[loops.bottom[i]];
+        used += d > 0;
+        d = d > 0 ? 1 : kNoIndex;
+    }
+    for (uint32_t i = 0; i < loops.top_count; ++i)
+        c.next_unused[i] = degree[loops.top[i]] == kNoIndex ? kUnusedBelow : whole;
+    for (size_t k = 0; k < 3 * band_count; ++k) {
+        uint32_t l = band[k];
+        band[k] = l < below ? layer.ids[l] : c.top[l - below];
+    }
+    c.used += used;
+    arena.rewind(mark);
+    return true;
 }
 
 // Forms the group starting at planned layer `first`, triangulates it, stitches it to the
@@ -4275,22 +4335,40 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
         Status status = Status::not_columnar;
         // Tiny or thin layers make coarse, folding bands: they join the next layer if any.
         if (group_stands(n, h1 - h0, layer.cyl.radius, final)) {
-            const size_t chunk_start = sink.count, folds = sink.folds;
+            const size_t chunk_start = sink.count, folds = sink.folds, swaps = c.swaps;
             LayerLoops loops = {c.bottom, 0, c.next_top, 0};
-            if (triangulated)
+            auto stitch = [&]() {
+                if (status == Status::ok && c.top_count > 0 &&
+                    !stitch_layers(c.reader, c.frame, c.top_cylinder, c.top, c.top_count, layer,
+                                   loops.bottom, loops.bottom_count, arena, sink, &c.swaps))
+                    status = Status::out_of_memory;
+            };
+            // A job's result goes in as it is when its chunk needs no safety net; else the
+            // layer is loaded and triangulated again, in order, to the same triangles.
+            // Past the caller's capacity only the count goes on (triangle_capacity follows).
+            bool finished = false;
+            if (triangulated) {
                 status = take_ahead(*ahead, sink, loops, result.counts);
-            else
+                stitch();
+                finished = status != Status::ok || sink.count > sink.capacity ||
+                           replay_chunk(c, layer, loops, *ahead, chunk_start, arena, sink);
+                if (!finished) {
+                    sink.count = chunk_start;
+                    sink.folds = folds;
+                    c.swaps = swaps;
+                    if (!load_layer(c.reader, c.frame, ids, n, h0, h1, arena, layer))
+                        return Status::out_of_memory;
+                }
+            }
+            if (!finished) {
                 status = triangulate_layer(c.reader, layer, arena, sink, loops, result.counts);
-            if (status == Status::ok && c.top_count > 0 &&
-                !stitch_layers(c.reader, c.frame, c.top_cylinder, c.top, c.top_count, layer,
-                               loops.bottom, loops.bottom_count, arena, sink, &c.swaps))
-                status = Status::out_of_memory;
+                stitch();
+            }
             result.triangles = sink.count - chunk_start;
             result.folds = sink.folds - folds;
             // The layer's points are no longer needed: the safety net takes their room.
-            // Past the caller's capacity only the count goes on (triangle_capacity follows).
             arena.rewind(mark);
-            if (status == Status::ok && sink.count <= sink.capacity)
+            if (!finished && status == Status::ok && sink.count <= sink.capacity)
                 status = finish_chunk(c, layer, loops, chunk_start, arena, sink);
             if (status == Status::ok) {
                 for (uint32_t i = 0; i < loops.top_count; ++i) loops.top[i] = ids[loops.top[i]];
@@ -4405,11 +4483,15 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
 //
 // With Options::run_jobs, every planned layer that could stand as a group on its own (at
 // least kMinLayerPoints points, or the last one) is loaded and, if group_stands, triangulated
-// ahead by a job, into its own part of the workspace. Then the groups are formed in order
-// as always; a group that is one planned layer takes the job's result instead of
-// triangulating (add_group), any other group (merged layers) is triangulated then. So the
-// result is the sequential one whatever the jobs' order and threads. Jobs are contiguous runs
-// of such layers with about equal point counts, each with the scratch of its largest layer.
+// ahead by a job, into its own part of the workspace; the job also keeps the triangles at
+// its bottom loop and turns the rest to reader indices (keep_border). Then the groups are
+// formed in order as always; a group that is one planned layer takes the job's result
+// (add_group), stitches it and, when the safety net has nothing to do there, finishes the
+// chunk reading only the band and that border (replay_chunk); any other group (merged
+// layers, a chunk the net must repair) is triangulated then. So the result is the
+// sequential one whatever the jobs' order and threads, and what runs in order is a small
+// part of each layer's work. Jobs are contiguous runs of such layers with about equal point
+// counts, each with the scratch of its largest layer.
 
 #if !defined(STRATMESH_NO_PARALLEL_LAYERS)
 
@@ -4436,14 +4518,20 @@ struct ParallelLayers {
 // Room for the results of `slots` layers holding `points` points in all, out of `layers`
 // planned layers.
 inline bool allocate_ahead(ParallelLayers& p, uint32_t slots, size_t points, size_t layers,
-                           Arena& arena, uint32_t** triangles, uint32_t** loops) {
+                           Arena& arena, uint32_t** triangles, uint32_t** loops,
+                           uint32_t** borders) {
     p.ahead = arena.alloc<LayerAhead>(slots);
     p.layer_of_slot = arena.alloc<uint32_t>(slots);
     p.slot_of_layer = arena.alloc<uint32_t>(layers);
     *triangles = arena.alloc<uint32_t>(3 * 2 * points);
     *loops = arena.alloc<uint32_t>(2 * points);
+    *borders = arena.alloc<uint32_t>(3 * (points / 4 + 4 * static_cast<size_t>(slots)));
     return !arena.failed;
 }
+
+// The border a layer of n points may keep for replay_chunk: its bottom loop holds a few
+// times the square root of n points in a sound layer, with two or three triangles each.
+inline size_t border_capacity(size_t n) { return n / 4 + 4; }
 
 inline bool may_stand_alone(const LayerQueue& q, uint32_t k) {
     size_t n = q.start[k + 1] - q.start[k];
@@ -4457,6 +4545,31 @@ inline size_t job_scratch_bound(size_t points) {
     const size_t slack = 1024;  // the rounding of every allocation, with room to spare
     if (whole == 0 || one > (SIZE_MAX - whole) / kMaxJobs - slack) return 0;
     return whole + kMaxJobs * (one + slack);
+}
+
+// What replay_chunk needs of a job's layer (see LayerAhead), then its triangles in reader
+// indices (`ids`).
+inline void keep_border(LayerAhead& a, const uint32_t* ids, size_t n, Arena& arena) {
+    const unsigned char on_bottom = 1, has_triangle = 2;
+    unsigned char* flags = arena.alloc<unsigned char>(n);
+    a.replayable = flags != nullptr;
+    a.border_count = a.interior_used = 0;
+    if (!flags) return;
+    std::memset(flags, 0, n);
+    for (uint32_t i = 0; i < a.bottom_count; ++i) flags[a.bottom[i]] = on_bottom;
+    for (size_t t = 0; t < a.triangle_count; ++t) {
+        uint32_t* v = a.triangles + 3 * t;
+        if ((flags[v[0]] | flags[v[1]] | flags[v[2]]) & on_bottom) {
+            if (a.border_count < a.border_capacity)
+                std::memcpy(a.border + 3 * a.border_count, v, 3 * sizeof(uint32_t));
+            ++a.border_count;
+        }
+        for (size_t k = 0; k < 3; ++k) flags[v[k]] |= has_triangle;
+    }
+    for (size_t v = 0; v < n; ++v) a.interior_used += flags[v] == has_triangle;
+    for (uint32_t i = 0; i < a.top_count; ++i) a.replayable = a.replayable && flags[a.top[i]] != 0;
+    a.replayable = a.replayable && a.border_count <= a.border_capacity;
+    for (size_t k = 0; k < 3 * a.triangle_count; ++k) a.triangles[k] = ids[a.triangles[k]];
 }
 
 inline void run_layer_job(void* context, uint32_t index) {
@@ -4484,6 +4597,7 @@ inline void run_layer_job(void* context, uint32_t index) {
         a.folds = sink.folds;
         a.bottom_count = loops.bottom_count;
         a.top_count = loops.top_count;
+        if (a.status == Status::ok) keep_border(a, q.ids + q.start[k], n, arena);
         a.done = true;
     }
 }
@@ -4510,10 +4624,12 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
     };
     uint32_t* triangles = nullptr;
     uint32_t* loops = nullptr;
-    if (!allocate_ahead(p, slots, points, q.planned, arena, &triangles, &loops)) return give_up();
+    uint32_t* borders = nullptr;
+    if (!allocate_ahead(p, slots, points, q.planned, arena, &triangles, &loops, &borders))
+        return give_up();
     p.slots = slots;
     uint32_t slot = 0;
-    size_t at = 0;
+    size_t at = 0, border_at = 0;
     for (uint32_t k = 0; k < q.planned; ++k) {
         p.slot_of_layer[k] = kNoIndex;
         if (!may_stand_alone(q, k)) continue;
@@ -4523,6 +4639,9 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
         a.triangles = triangles + 6 * at;
         a.bottom = loops + 2 * at;
         a.top = loops + 2 * at + n;
+        a.border = borders + 3 * border_at;
+        a.border_capacity = border_capacity(n);
+        border_at += a.border_capacity;
         at += n;
         p.layer_of_slot[slot] = k;
         p.slot_of_layer[k] = slot++;
@@ -4586,9 +4705,10 @@ inline bool plan_parallel_workspace(size_t point_count, size_t layer_limit, Aren
     ParallelLayers p;
     uint32_t* triangles = nullptr;
     uint32_t* loops = nullptr;
+    uint32_t* borders = nullptr;
     size_t slots = point_count / kMinLayerPoints + 1;
     allocate_ahead(p, static_cast<uint32_t>(slots), point_count, layer_limit, arena, &triangles,
-                   &loops);
+                   &loops, &borders);
     size_t jobs = job_scratch_bound(point_count);
     if (jobs > *scratch) *scratch = jobs;
     return jobs != 0;

@@ -4201,14 +4201,14 @@ struct LayerAhead {
     Cylinder cylinder;
     LayerCounts counts;
     size_t triangle_count, folds;
-    uint32_t* triangles;     // as the sink writes them, in reader indices
+    uint32_t* triangles;     // as the sink writes them; in reader indices if replayable
     uint32_t* bottom;        // the loops in layer-local indices
     uint32_t* top;
     uint32_t bottom_count, top_count;
     // For replay_chunk: the triangles touching the bottom loop, in layer-local indices (at
     // most border_capacity), and the vertices off the bottom loop with a triangle.
     bool replayable;         // the border fits and every top-loop vertex off the bottom
-                             // loop has a triangle
+                             // loop has a triangle (else the triangles stay layer-local)
     uint32_t* border;
     size_t border_count, border_capacity, interior_used;
 };
@@ -4245,16 +4245,20 @@ inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops
 // finish_chunk for a layer a job triangulated, whose triangles are already in reader
 // indices, followed in the sink by the band (from chunk_start + ahead.triangle_count):
 // when the seam below is as built and the fans of the loop vertices are whole, the safety
-// net has nothing to do, and only the border triangles (those of ahead.border) and the
-// band are read. Returns false when that does not hold (nothing changed): the caller then
+// net and seal_seam have nothing to do, and only the border triangles (those of
+// ahead.border) and the band are read. Returns false when that does not hold (nothing changed): the caller then
 // builds the chunk again in order, to the same triangles, and runs finish_chunk.
 inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
                          const LayerAhead& ahead, size_t chunk_start, Arena& arena,
                          TriangleSink& sink) {
+    // The seam is as built when every loop point below has both its loop edges there or no
+    // triangle at all: then seal_seam would find nothing to do either, since the band has
+    // every edge of the loop.
     const unsigned char whole = kHasNextEdge | kHasPreviousEdge;
     bool seam_as_built = ahead.replayable && !c.output_id;
     for (uint32_t i = 0; i < c.top_count; ++i)
-        seam_as_built = seam_as_built && ((c.top_unused[i] & whole) == whole);
+        seam_as_built = seam_as_built && ((c.top_unused[i] & kUnusedBelow) ||
+                                          (c.top_unused[i] & whole) == whole);
     if (!seam_as_built) return false;
     uint32_t* band = sink.triangles + 3 * (chunk_start + ahead.triangle_count);
     const size_t band_count = sink.count - chunk_start - ahead.triangle_count;
@@ -4343,24 +4347,28 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
                                    loops.bottom, loops.bottom_count, arena, sink, &c.swaps))
                     status = Status::out_of_memory;
             };
-            // A job's result goes in as it is when its chunk needs no safety net; else the
-            // layer is loaded and triangulated again, in order, to the same triangles.
-            // Past the caller's capacity only the count goes on (triangle_capacity follows).
-            bool finished = false;
+            // A job's result in reader indices goes in as it is when its chunk needs no
+            // safety net; else the layer is loaded and triangulated again, in order, to the
+            // same triangles. One the job left in layer-local indices (not replayable) goes
+            // through finish_chunk. Past the caller's capacity only the count goes on
+            // (triangle_capacity follows).
+            bool finished = false, retriangulate = !triangulated;
             if (triangulated) {
                 status = take_ahead(*ahead, sink, loops, result.counts);
                 stitch();
                 finished = status != Status::ok || sink.count > sink.capacity ||
-                           replay_chunk(c, layer, loops, *ahead, chunk_start, arena, sink);
-                if (!finished) {
+                           (ahead->replayable &&
+                            replay_chunk(c, layer, loops, *ahead, chunk_start, arena, sink));
+                if (!finished && ahead->replayable) {
                     sink.count = chunk_start;
                     sink.folds = folds;
                     c.swaps = swaps;
                     if (!load_layer(c.reader, c.frame, ids, n, h0, h1, arena, layer))
                         return Status::out_of_memory;
+                    retriangulate = true;
                 }
             }
-            if (!finished) {
+            if (retriangulate) {
                 status = triangulate_layer(c.reader, layer, arena, sink, loops, result.counts);
                 stitch();
             }
@@ -4531,6 +4539,7 @@ inline bool allocate_ahead(ParallelLayers& p, uint32_t slots, size_t points, siz
 
 // The border a layer of n points may keep for replay_chunk: its bottom loop holds a few
 // times the square root of n points in a sound layer, with two or three triangles each.
+// A thin layer's border can be most of its triangles: it is finished in order instead.
 inline size_t border_capacity(size_t n) { return n / 4 + 4; }
 
 inline bool may_stand_alone(const LayerQueue& q, uint32_t k) {
@@ -4547,8 +4556,8 @@ inline size_t job_scratch_bound(size_t points) {
     return whole + kMaxJobs * (one + slack);
 }
 
-// What replay_chunk needs of a job's layer (see LayerAhead), then its triangles in reader
-// indices (`ids`).
+// What replay_chunk needs of a job's layer (see LayerAhead), then, if it can replay them,
+// its triangles in reader indices (`ids`).
 inline void keep_border(LayerAhead& a, const uint32_t* ids, size_t n, Arena& arena) {
     const unsigned char on_bottom = 1, has_triangle = 2;
     unsigned char* flags = arena.alloc<unsigned char>(n);
@@ -4569,6 +4578,7 @@ inline void keep_border(LayerAhead& a, const uint32_t* ids, size_t n, Arena& are
     for (size_t v = 0; v < n; ++v) a.interior_used += flags[v] == has_triangle;
     for (uint32_t i = 0; i < a.top_count; ++i) a.replayable = a.replayable && flags[a.top[i]] != 0;
     a.replayable = a.replayable && a.border_count <= a.border_capacity;
+    if (!a.replayable) return;
     for (size_t k = 0; k < 3 * a.triangle_count; ++k) a.triangles[k] = ids[a.triangles[k]];
 }
 

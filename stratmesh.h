@@ -3079,11 +3079,11 @@ inline size_t untangle_runs(Band& band) {
         unsigned char taken = kind;  // what step t adds to the state
         if (!band.proper(t, i, j)) {
             uint32_t next = t + 1, previous = t;
-            while (next < length && steps[next] == kind && next - t <= kLongestUntangledRun) ++next;
-            while (previous > 0 && steps[previous - 1] == kind && t - previous <= kLongestUntangledRun)
-                --previous;
+            const uint32_t most = kLongestUntangledRun;
+            while (next < length && steps[next] == kind && next - t <= most) ++next;
+            while (previous > 0 && steps[previous - 1] == kind && t - previous <= most) --previous;
             const uint32_t run = t - previous;  // steps of the run before t
-            const bool short_run = next - previous <= kLongestUntangledRun;
+            const bool short_run = next - previous <= most;
             for (int backward = 0; short_run && backward < 2; ++backward) {
                 // Steps [lo, hi] change: the other loop's step goes from `from` to t.
                 const uint32_t lo = backward ? previous - 1 : t, hi = backward ? t : next;
@@ -4246,8 +4246,9 @@ inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops
 // indices, followed in the sink by the band (from chunk_start + ahead.triangle_count):
 // when the seam below is as built and the fans of the loop vertices are whole, the safety
 // net and seal_seam have nothing to do, and only the border triangles (those of
-// ahead.border) and the band are read. Returns false when that does not hold (nothing changed): the caller then
-// builds the chunk again in order, to the same triangles, and runs finish_chunk.
+// ahead.border) and the band are read. Returns false when that does not hold (nothing
+// changed): the caller then builds the chunk again in order, to the same triangles, and
+// runs finish_chunk.
 inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
                          const LayerAhead& ahead, size_t chunk_start, Arena& arena,
                          TriangleSink& sink) {

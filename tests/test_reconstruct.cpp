@@ -1401,11 +1401,13 @@ TEST_CASE("workspace: the bound suffices, the reported peak is exact, one byte s
         const size_t capacity = stratmesh::reconstruct_max_triangles(cloud.count, setup.options);
         std::vector<uint32_t> triangles(3 * capacity);
         auto run = [&](size_t bytes, Report& report) {
-            // new[] memory is aligned for any scalar, so the arena skips no padding: the peak
-            // does not depend on where the buffer lands.
-            std::unique_ptr<unsigned char[]> workspace(new unsigned char[bytes ? bytes : 1]);
+            // The buffer starts on a 16-byte boundary, so the arena skips no padding and the
+            // peak does not depend on where it lands (new[] gives only 8 on 32-bit ARM).
+            std::unique_ptr<unsigned char[]> storage(new unsigned char[bytes + 16]);
+            unsigned char* workspace =
+                storage.get() + (16 - reinterpret_cast<uintptr_t>(storage.get()) % 16) % 16;
             size_t count = 0;
-            return stratmesh::reconstruct(cloud, setup.options, workspace.get(), bytes,
+            return stratmesh::reconstruct(cloud, setup.options, workspace, bytes,
                                           triangles.data(), capacity, &count, &report);
         };
         Report full = {};

@@ -1555,6 +1555,11 @@ inline bool spatial_order(const unsigned char* xy, size_t stride, size_t count,
         scale[k] = (range > 0 && is_finite(range)) ? ((1u << kHilbertBits) - 1) / range : 0.0;
         if (!is_finite(scale[k])) scale[k] = 0.0;
     }
+    // One scale for both axes, the longer side's: square cells keep the curve local in the
+    // plane's own metric, and a long strip is ordered along its length. (Separate scales
+    // made a layer's unrolled strip, six times longer than high, a grid of cells six times
+    // wider than high: a walk crossed 5.8 triangles on the bumpy tube instead of 4.1.)
+    if (scale[0] > 0 && scale[1] > 0) scale[0] = scale[1] = scale[0] < scale[1] ? scale[0] : scale[1];
     // Rounds: the last holds about half the points, the first about 64.
     uint32_t rounds = 0;
     while (rounds < 24 && (count >> (rounds + 7)) > 0) ++rounds;
@@ -2827,12 +2832,15 @@ inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& lay
     if (arena.failed) return Status::out_of_memory;
     // The insertion order is taken on the unrolled strip (angle, height), where the points
     // are spread evenly: on the annulus their density falls off with the radius squared
-    // and a curve over its bounding box would lump the inner rings together.
+    // and a curve over its bounding box would lump the inner rings together. The strip has
+    // the cylinder's proportions (angle in radians, height over the radius), as the curve's
+    // cells are square.
+    const double quarter_turn = 1.57079632679489661923;  // pseudo_angle's unit, in radians
     xy[0] = xy[1] = 0;
-    BoundingBox2d box = {{0, 0}, {4, 0}};
+    BoundingBox2d box = {{0, 0}, {4 * quarter_turn, 0}};
     for (size_t i = 1; i < total; ++i) {
         const Local& p = points[i - 1];
-        xy[2 * i] = pseudo_angle(p.x - cyl.cx, p.y - cyl.cy);
+        xy[2 * i] = quarter_turn * pseudo_angle(p.x - cyl.cx, p.y - cyl.cy);
         xy[2 * i + 1] = (p.h - cyl.h0) * cyl.scale;
         if (xy[2 * i + 1] > box.max[1]) box.max[1] = xy[2 * i + 1];
     }

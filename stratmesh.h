@@ -2741,14 +2741,14 @@ struct LayerCounts {
 // Classifies the points the layer's triangulation found on an existing vertex.
 struct LayerDuplicates {
     const CloudReader* cloud;
-    const uint32_t* ids;    // layer-local id (1-based; 0 is the centre) -> original index
-    const uint32_t* order;  // insertion position -> layer-local id
+    const uint32_t* ids;    // layer-local index -> reader index
+    const uint32_t* order;  // vertex - 1 -> layer-local index (vertex 0 is the centre)
     LayerCounts* counts;
 
     static void report(void* context, uint32_t point, uint32_t vertex) {
         LayerDuplicates* d = static_cast<LayerDuplicates*>(context);
-        Vec3 p = d->cloud->point(d->ids[d->order[point] - 1]);
-        Vec3 v = d->cloud->point(d->ids[d->order[vertex] - 1]);
+        Vec3 p = d->cloud->point(d->ids[d->order[point - 1]]);
+        Vec3 v = d->cloud->point(d->ids[d->order[vertex - 1]]);
         if (p.x == v.x && p.y == v.y && p.z == v.z)
             ++d->counts->duplicates;
         else
@@ -2756,13 +2756,14 @@ struct LayerDuplicates {
     }
 };
 
-// Collects the link of vertex `centre` counter-clockwise into loop (layer-local indices).
-// False if the centre touches the hull: the layer does not surround its axis.
-inline bool centre_link(const Triangulation& tr, uint32_t centre, const uint32_t* order,
-                        uint32_t* loop, uint32_t* count) {
+// Collects the link of the centre (vertex 0) counter-clockwise into loop (layer-local
+// indices; vertex v is layer-local order[v - 1]). False if the centre touches the hull: the
+// layer does not surround its axis.
+inline bool centre_link(const Triangulation& tr, const uint32_t* order, uint32_t* loop,
+                        uint32_t* count) {
     uint32_t start = kNoIndex;
     for (uint32_t e = 0; e < 3 * tr.triangle_count; ++e)
-        if (tr.vertex[e] == centre) {
+        if (tr.vertex[e] == 0) {
             start = e;
             break;
         }
@@ -2772,7 +2773,7 @@ inline bool centre_link(const Triangulation& tr, uint32_t centre, const uint32_t
         uint32_t u = tr.vertex[next_edge(e)];
         if (u == kGhost || tr.vertex[prev_edge(e)] == kGhost || n > tr.triangle_count)
             return false;
-        loop[n++] = order[u] - 1;
+        loop[n++] = order[u - 1];
         e = tr.twin[prev_edge(e)];  // the next triangle counter-clockwise around the centre
     } while (e != start);
     *count = n;
@@ -2788,20 +2789,20 @@ inline void hull_loop(const Triangulation& tr, const uint32_t* order, uint32_t* 
     while (tr.vertex[start] != kGhost) ++start;
     uint32_t n = 0, e = start;
     do {
-        loop[n++] = order[tr.vertex[next_edge(e)]] - 1;
+        loop[n++] = order[tr.vertex[next_edge(e)] - 1];
         e = next_edge(tr.twin[e]);
     } while (e != start && n <= tr.triangle_count);
     *count = n;
 }
 
-// A layer's points in frame coordinates, read from the cloud once (every later pass, the
-// stitch and the fold test read this compact array instead of the cloud at random), and
-// the cylinder fitted to them. Triangles and loops name the points by their position in
-// `ids` (layer-local indices).
+// A layer's points in frame coordinates, read from the cloud once so that the fit, the
+// unrolling and the fold test read a compact array instead of the cloud at random, and the
+// cylinder fitted to them. Triangles and loops name the points by their position in `ids`
+// (layer-local indices).
 struct LoadedLayer {
     const uint32_t* ids;  // layer-local index -> reader index
     size_t count;
-    Local* points;
+    Local* points;        // ids' points, until triangulate_layer puts them in its own order
     Cylinder cyl;
 };
 
@@ -2819,43 +2820,47 @@ inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint3
 // Triangulates a loaded layer rolled onto the annulus of its cylinder plus the centre.
 // Emits the surface triangles and fills the loops, in layer-local indices. Returns ok,
 // not_columnar (the layer does not surround its axis, or is degenerate: the caller merges
-// it with the next one), out_of_memory or internal_error. Its scratch is released.
+// it with the next one), out_of_memory or internal_error. Its scratch is released; the
+// layer's points are left in insertion order (layer.points[k] is layer-local point
+// order[k], an order not kept).
 inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& layer,
                                 Arena& arena, TriangleSink& sink, LayerLoops& loops,
                                 LayerCounts& counts) {
-    const size_t total = layer.count + 1;  // triangulation vertex 0 is the centre
-    const Local* points = layer.points;
+    const size_t count = layer.count, total = count + 1;  // vertex 0 is the centre
+    Local* points = layer.points;
     const Cylinder& cyl = layer.cyl;
     size_t mark = arena.mark();
-    uint32_t* order = arena.alloc<uint32_t>(total);
+    uint32_t* order = arena.alloc<uint32_t>(count);  // vertex - 1 -> layer-local index
     double* xy = arena.alloc<double>(2 * total);
     if (arena.failed) return Status::out_of_memory;
     // The insertion order is taken on the unrolled strip (angle, height), where the points
     // are spread evenly: on the annulus their density falls off with the radius squared
     // and a curve over its bounding box would lump the inner rings together. The strip has
     // the cylinder's proportions (angle in radians, height over the radius), as the curve's
-    // cells are square.
+    // cells are square. The centre goes first.
     const double quarter_turn = 1.57079632679489661923;  // pseudo_angle's unit, in radians
-    xy[0] = xy[1] = 0;
     BoundingBox2d box = {{0, 0}, {4 * quarter_turn, 0}};
-    for (size_t i = 1; i < total; ++i) {
-        const Local& p = points[i - 1];
-        xy[2 * i] = quarter_turn * pseudo_angle(p.x - cyl.cx, p.y - cyl.cy);
-        xy[2 * i + 1] = (p.h - cyl.h0) * cyl.scale;
-        if (xy[2 * i + 1] > box.max[1]) box.max[1] = xy[2 * i + 1];
+    double* strip = xy + 2;
+    for (size_t i = 0; i < count; ++i) {
+        const Local& p = points[i];
+        strip[2 * i] = quarter_turn * pseudo_angle(p.x - cyl.cx, p.y - cyl.cy);
+        strip[2 * i + 1] = (p.h - cyl.h0) * cyl.scale;
+        if (strip[2 * i + 1] > box.max[1]) box.max[1] = strip[2 * i + 1];
     }
-    if (!spatial_order(reinterpret_cast<const unsigned char*>(xy), 2 * sizeof(double), total,
+    if (!spatial_order(reinterpret_cast<const unsigned char*>(strip), 2 * sizeof(double), count,
                        box, order, arena))
         return Status::out_of_memory;
-    uint32_t centre = 0;
-    for (size_t k = 0; k < total; ++k) {
-        if (order[k] == 0) {
-            centre = static_cast<uint32_t>(k);
-            xy[2 * k] = xy[2 * k + 1] = 0;
-        } else {
-            roll(cyl, points[order[k] - 1], xy + 2 * k);
-        }
-    }
+    // The points in insertion order, so that unrolling them and the fold test below read
+    // them in sequence, not at random (the copy's room is free again before the
+    // triangulation takes it).
+    size_t copy_mark = arena.mark();
+    Local* sorted = arena.alloc<Local>(count);
+    if (arena.failed) return Status::out_of_memory;
+    for (size_t k = 0; k < count; ++k) sorted[k] = points[order[k]];
+    std::memcpy(points, sorted, count * sizeof(Local));
+    arena.rewind(copy_mark);
+    xy[0] = xy[1] = 0;
+    for (size_t k = 0; k < count; ++k) roll(cyl, points[k], xy + 2 * (k + 1));
     Triangulation tr;
     tr.xy = xy;
     if (!allocate_triangulation(tr, total, arena)) return Status::out_of_memory;
@@ -2865,17 +2870,16 @@ inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& lay
     uint32_t inserted = 0;
     Status status = triangulate_points(tr, static_cast<uint32_t>(total), duplicates, &inserted);
     if (status == Status::internal_error) return status;
-    if (status != Status::ok ||
-        !centre_link(tr, centre, order, loops.bottom, &loops.bottom_count)) {
+    if (status != Status::ok || !centre_link(tr, order, loops.bottom, &loops.bottom_count)) {
         arena.rewind(mark);
         return Status::not_columnar;
     }
     hull_loop(tr, order, loops.top, &loops.top_count);
     for (uint32_t t = 0; t < tr.triangle_count; ++t) {
         const uint32_t* v = tr.vertex + 3 * t;
-        if (tr.is_ghost(t) || v[0] == centre || v[1] == centre || v[2] == centre) continue;
-        uint32_t a = order[v[0]] - 1, b = order[v[1]] - 1, c = order[v[2]] - 1;
-        sink.emit(a, b, c, points[a], points[b], points[c], cyl);
+        if (tr.is_ghost(t) || v[0] == 0 || v[1] == 0 || v[2] == 0) continue;
+        sink.emit(order[v[0] - 1], order[v[1] - 1], order[v[2] - 1], points[v[0] - 1],
+                  points[v[1] - 1], points[v[2] - 1], cyl);
     }
     arena.rewind(mark);
     return Status::ok;
@@ -3148,10 +3152,11 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
         a[i] = below + i;
         a_points[i] = frame.local(cloud.point(a_ids[i]));
     }
-    // The layer's points were loaded, unless a job triangulated it ahead (then read again).
+    // The layer's points are read again (the loaded ones are in triangulate_layer's order,
+    // or were never loaded when a job triangulated the layer): only the loop's are read.
     auto point = [&](uint32_t id) -> Local {
         if (id >= below) return a_points[id - below];
-        return layer.points ? layer.points[id] : frame.local(cloud.point(layer.ids[id]));
+        return frame.local(cloud.point(layer.ids[id]));
     };
     Cylinder shared;
     shared.cx = (ca.cx + cb.cx) / 2;
@@ -4446,10 +4451,12 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
     Arena group = Arena::measuring();
     group.alloc<Local>(count);
     size_t loaded = group.mark();
-    group.alloc<uint32_t>(total);
+    group.alloc<uint32_t>(count);
     group.alloc<double>(2 * total);
     size_t mark = group.mark();
-    for (int k = 0; k < 3; ++k) group.alloc<uint32_t>(total);  // the spatial sort
+    for (int k = 0; k < 3; ++k) group.alloc<uint32_t>(count);  // the spatial sort
+    group.rewind(mark);
+    group.alloc<Local>(count);  // the points reordered
     group.rewind(mark);
     Triangulation tr;
     allocate_triangulation(tr, total, group);

@@ -1549,17 +1549,14 @@ inline bool spatial_order(const unsigned char* xy, size_t stride, size_t count,
     uint32_t* keys_tmp = arena.alloc<uint32_t>(count);
     uint32_t* order_tmp = arena.alloc<uint32_t>(count);
     if (arena.failed) return false;
-    double scale[2];
-    for (int k = 0; k < 2; ++k) {
-        double range = box.max[k] - box.min[k];
-        scale[k] = (range > 0 && is_finite(range)) ? ((1u << kHilbertBits) - 1) / range : 0.0;
-        if (!is_finite(scale[k])) scale[k] = 0.0;
-    }
     // One scale for both axes, the longer side's: square cells keep the curve local in the
     // plane's own metric, and a long strip is ordered along its length. (Separate scales
     // made a layer's unrolled strip, six times longer than high, a grid of cells six times
     // wider than high: a walk crossed 5.8 triangles on the bumpy tube instead of 4.1.)
-    if (scale[0] > 0 && scale[1] > 0) scale[0] = scale[1] = scale[0] < scale[1] ? scale[0] : scale[1];
+    double width = box.max[0] - box.min[0], height = box.max[1] - box.min[1];
+    double range = width > height ? width : height;
+    double scale = (range > 0 && is_finite(range)) ? ((1u << kHilbertBits) - 1) / range : 0.0;
+    if (!is_finite(scale)) scale = 0.0;
     // Rounds: the last holds about half the points, the first about 64.
     uint32_t rounds = 0;
     while (rounds < 24 && (count >> (rounds + 7)) > 0) ++rounds;
@@ -1571,8 +1568,8 @@ inline bool spatial_order(const unsigned char* xy, size_t stride, size_t count,
         uint32_t zeros = 0;
         while (zeros < rounds && (h & (1u << zeros)) == 0) ++zeros;
         uint32_t round = rounds - zeros;
-        uint32_t curve = hilbert_index(quantize(x, box.min[0], scale[0]),
-                                       quantize(y, box.min[1], scale[1]));
+        uint32_t curve = hilbert_index(quantize(x, box.min[0], scale),
+                                       quantize(y, box.min[1], scale));
         // Odd rounds run the curve backwards, so each round starts where the last ended.
         if (round % 2 == 1) curve = curve_mask - curve;
         keys[i] = (round << (2 * kHilbertBits)) | curve;

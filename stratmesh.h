@@ -4482,11 +4482,15 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
     group.alloc<uint64_t>(triangles);
     for (int k = 0; k < 4; ++k) group.alloc<uint32_t>(triangles);
 
-    Arena profile = Arena::measuring();
+    // Planning the layers: the automatic layers' profile, then each point's layer while the
+    // points are grouped.
+    Arena planning = Arena::measuring();
     ProfileBin* bins = nullptr;
     BinRange* ranges = nullptr;
     double* cuts = nullptr;
-    allocate_profile(profile, profile_bin_count(count), &bins, &ranges, &cuts);
+    allocate_profile(planning, profile_bin_count(count), &bins, &ranges, &cuts);
+    planning.rewind(0);
+    planning.alloc<uint32_t>(count);
 
     // The caps: every point on a boundary loop, as many triangles as the output can hold.
     Arena caps = Arena::measuring();
@@ -4497,9 +4501,9 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
         allocate_cap_loop(loop, count, caps);
     }
 
-    if (group.failed || profile.failed || caps.failed) return 0;  // beyond size_t
+    if (group.failed || planning.failed || caps.failed) return 0;  // beyond size_t
     size_t most = group.high_water;
-    if (profile.high_water > most) most = profile.high_water;
+    if (planning.high_water > most) most = planning.high_water;
     if (caps.high_water > most) most = caps.high_water;
     return most;
 }
@@ -4804,18 +4808,18 @@ inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangle
     return Status::ok;
 }
 
-// Groups the valid points by layer (input order within a layer): counting sort.
+// Groups the valid points by layer (input order within a layer): a counting sort, with each
+// point's layer kept in `layer` (count entries of scratch) between its two passes.
 inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& frame,
-                           const LayerPlan& plan, ReconstructMemory& m) {
+                           const LayerPlan& plan, uint32_t* layer, ReconstructMemory& m) {
     std::memset(m.layer_start, 0, sizeof(uint32_t) * (plan.count + 2));
-    for (size_t i = 0; i < count; ++i)
-        if (cloud.valid(i)) ++m.layer_start[layer_of(plan, frame.height(cloud.point(i))) + 2];
-    for (uint32_t k = 0; k < plan.count; ++k) m.layer_start[k + 2] += m.layer_start[k + 1];
     for (size_t i = 0; i < count; ++i) {
-        if (!cloud.valid(i)) continue;
-        uint32_t k = layer_of(plan, frame.height(cloud.point(i)));
-        m.order[m.layer_start[k + 1]++] = static_cast<uint32_t>(i);
+        layer[i] = cloud.valid(i) ? layer_of(plan, frame.height(cloud.point(i))) : kNoIndex;
+        if (layer[i] != kNoIndex) ++m.layer_start[layer[i] + 2];
     }
+    for (uint32_t k = 0; k < plan.count; ++k) m.layer_start[k + 2] += m.layer_start[k + 1];
+    for (size_t i = 0; i < count; ++i)
+        if (layer[i] != kNoIndex) m.order[m.layer_start[layer[i] + 1]++] = static_cast<uint32_t>(i);
 }
 
 inline void report_frame(const Frame& frame, Report& rep) {
@@ -4963,7 +4967,13 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     } else {
         plan_layers(options, lo, hi, cloud.count, frame, plan);
     }
-    group_by_layer(reader, cloud.count, frame, plan, m);
+    {
+        size_t mark = arena.mark();
+        uint32_t* layer = arena.alloc<uint32_t>(cloud.count);
+        if (arena.failed) return finish(Status::out_of_memory);
+        group_by_layer(reader, cloud.count, frame, plan, layer, m);
+        arena.rewind(mark);
+    }
 
     notify(options, Phase::triangulate, 0);
     TriangleSink sink = {triangles, triangle_capacity, 0, 0};

@@ -85,6 +85,13 @@
 // jobs runner (Options::run_jobs); its output is at most 2n triangles. A stream needs about
 // 190 bytes per point it holds at once, whatever the size of the whole cloud.
 //
+// The whole workspace belongs to the call while it runs, including what it does not need:
+// without a runner, reconstruct keeps the points grouped by layer (24 bytes each) at the
+// end of the workspace when they fit above what it has taken, and loads each layer from
+// there as long as the layers before it have left that room untouched, instead of reading
+// the cloud at random once per layer. The output is the same either way, and
+// Report::workspace_used leaves that room out (it is the least workspace that suffices).
+//
 // Stack: no recursion anywhere. The exact incircle's expansions (about 8 KiB) live in the
 // workspace when called from the triangulation, and on the stack only when you call
 // incircle() yourself. Measured worst cases (CI checks them): reconstruct 2.3 KiB and
@@ -602,8 +609,10 @@ const bool kParallelLayers = true;  // lets the compiler drop what only jobs' re
 #endif
 #if defined(STRATMESH_SMALL_CODE)
 const bool kNetShortcut = false;
+const bool kStagePoints = false;
 #else
 const bool kNetShortcut = true;  // finish_chunk checks the loop fans before running the net
+const bool kStagePoints = true;  // reconstruct() keeps the grouped points in spare workspace
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 
@@ -708,6 +717,19 @@ struct Arena {
 
     size_t mark() const { return used; }
     void rewind(size_t m) { used = m; }
+
+    // The last `bytes` of the buffer (aligned), if they lie above everything allocated so
+    // far, for data that stays valid only while the arena does not reach it (see
+    // untouched); null if there is no such room. Allocations may later take it.
+    void* room_at_end(size_t bytes) const {
+        if (is_measuring() || bytes > capacity - used) return nullptr;
+        size_t offset = (capacity - bytes) / kAlign * kAlign;
+        return offset >= used ? base + offset : nullptr;
+    }
+    // Whether the arena has never reached p (in room_at_end's room).
+    bool untouched(const void* p) const {
+        return static_cast<const unsigned char*>(p) >= base + high_water;
+    }
 };
 
 // The caller's buffers as address ranges, so that arguments sharing memory are refused:
@@ -2803,13 +2825,20 @@ struct LoadedLayer {
     Cylinder cyl;
 };
 
+// `staged` (optional): the same points in frame coordinates, in the arena's end room
+// (LayerQueue::staged), read in sequence instead of the cloud at random while intact.
 inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint32_t* ids,
-                       size_t count, double h0, double h1, Arena& arena, LoadedLayer& layer) {
+                       const Local* staged, size_t count, double h0, double h1, Arena& arena,
+                       LoadedLayer& layer) {
+    const bool intact = staged && arena.untouched(staged);
     layer.ids = ids;
     layer.count = count;
     layer.points = arena.alloc<Local>(count);
     if (arena.failed) return false;
-    for (size_t i = 0; i < count; ++i) layer.points[i] = frame.local(cloud.point(ids[i]));
+    if (intact)
+        std::memmove(layer.points, staged, count * sizeof(Local));  // they may overlap
+    else
+        for (size_t i = 0; i < count; ++i) layer.points[i] = frame.local(cloud.point(ids[i]));
     layer.cyl = fit_cylinder(layer.points, count, h0, h1);
     return true;
 }
@@ -4028,6 +4057,9 @@ Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity, size_t 
 
 struct LayerQueue {
     const uint32_t* ids;    // reader indices of the planned layers' points, layer after layer
+    // ids' points in frame coordinates, or null: in the workspace's end room (see
+    // group_by_layer), valid as long as the arena has not reached them.
+    const Local* staged;
     const uint32_t* start;  // start[k]: first position in ids of planned layer k, k <= planned
     const double* bounds;   // planned layer k spans heights bounds[k] .. bounds[k + 1];
                             // bounds[planned] is the highest point so far
@@ -4336,7 +4368,8 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
         size_t mark = arena.mark();
         const bool triangulated = kParallelLayers && ahead && ahead->done && last == first;
         LoadedLayer layer = {ids, n, nullptr, triangulated ? ahead->cylinder : Cylinder{}};
-        if (!triangulated && !load_layer(c.reader, c.frame, ids, n, h0, h1, arena, layer))
+        const Local* staged = q.staged ? q.staged + q.start[first] : nullptr;
+        if (!triangulated && !load_layer(c.reader, c.frame, ids, staged, n, h0, h1, arena, layer))
             return Status::out_of_memory;
         if (!final) {
             size_t rest = q.start[q.planned] - q.start[last + 1];
@@ -4378,7 +4411,7 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
                     sink.count = chunk_start;
                     sink.folds = folds;
                     c.swaps = swaps;
-                    if (!load_layer(c.reader, c.frame, ids, n, h0, h1, arena, layer))
+                    if (!load_layer(c.reader, c.frame, ids, staged, n, h0, h1, arena, layer))
                         return Status::out_of_memory;
                     retriangulate = true;
                 }
@@ -4613,8 +4646,8 @@ inline void run_layer_job(void* context, uint32_t index) {
         const size_t n = q.start[k + 1] - q.start[k];
         arena.rewind(0);
         LoadedLayer layer;
-        if (!load_layer(*p.reader, *p.frame, q.ids + q.start[k], n, q.bounds[k], q.bounds[k + 1],
-                        arena, layer) ||
+        if (!load_layer(*p.reader, *p.frame, q.ids + q.start[k], nullptr, n, q.bounds[k],
+                        q.bounds[k + 1], arena, layer) ||
             !group_stands(n, q.bounds[k + 1] - q.bounds[k], layer.cyl.radius, k + 1 == q.planned))
             continue;
         TriangleSink sink = {a.triangles, 2 * n, 0, 0};
@@ -4809,17 +4842,24 @@ inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangle
 }
 
 // Groups the valid points by layer (input order within a layer): a counting sort, with each
-// point's layer kept in `layer` (count entries of scratch) between its two passes.
+// point's layer kept in `layer` (count entries of scratch) between its two passes. With
+// `staged` (optional, as many entries as valid points), the points in frame coordinates
+// go there in the same order.
 inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& frame,
-                           const LayerPlan& plan, uint32_t* layer, ReconstructMemory& m) {
+                           const LayerPlan& plan, uint32_t* layer, Local* staged,
+                           ReconstructMemory& m) {
     std::memset(m.layer_start, 0, sizeof(uint32_t) * (plan.count + 2));
     for (size_t i = 0; i < count; ++i) {
         layer[i] = cloud.valid(i) ? layer_of(plan, frame.height(cloud.point(i))) : kNoIndex;
         if (layer[i] != kNoIndex) ++m.layer_start[layer[i] + 2];
     }
     for (uint32_t k = 0; k < plan.count; ++k) m.layer_start[k + 2] += m.layer_start[k + 1];
-    for (size_t i = 0; i < count; ++i)
-        if (layer[i] != kNoIndex) m.order[m.layer_start[layer[i] + 1]++] = static_cast<uint32_t>(i);
+    for (size_t i = 0; i < count; ++i) {
+        if (layer[i] == kNoIndex) continue;
+        const uint32_t position = m.layer_start[layer[i] + 1]++;
+        m.order[position] = static_cast<uint32_t>(i);
+        if (staged) staged[position] = frame.local(cloud.point(i));
+    }
 }
 
 inline void report_frame(const Frame& frame, Report& rep) {
@@ -4967,11 +5007,20 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     } else {
         plan_layers(options, lo, hi, cloud.count, frame, plan);
     }
+    // Without a runner, the grouped points are also staged in the workspace's end room when
+    // there is room: each layer is then loaded in sequence instead of gathered from the
+    // whole cloud, for as long as the layers before it leave that room untouched. Either
+    // way the same coordinates are loaded.
+    Local* staged = nullptr;
     {
         size_t mark = arena.mark();
         uint32_t* layer = arena.alloc<uint32_t>(cloud.count);
         if (arena.failed) return finish(Status::out_of_memory);
-        group_by_layer(reader, cloud.count, frame, plan, layer, m);
+        if (kStagePoints && !(kParallelLayers && options.run_jobs)) {
+            const size_t bytes = saturating_product(valid, sizeof(Local));
+            staged = static_cast<Local*>(arena.room_at_end(bytes));
+        }
+        group_by_layer(reader, cloud.count, frame, plan, layer, staged, m);
         arena.rewind(mark);
     }
 
@@ -4981,7 +5030,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     chain.frame = frame;
     chain.reader = reader;
     chain.output_id = nullptr;
-    const LayerQueue queue = {m.order, m.layer_start, plan.bounds, plan.count, true};
+    const LayerQueue queue = {m.order, staged, m.layer_start, plan.bounds, plan.count, true};
     ParallelLayers parallel;
     rep.parallel_layers = start_parallel_layers(options, reader, frame, queue, arena, parallel);
     for (uint32_t first = 0; first < plan.count;) {
@@ -5185,7 +5234,7 @@ inline void drop_group(Stream& s, uint32_t last) {
 // Forms, emits and drops every group the held pushes decide.
 inline Status advance(Stream& s, bool complete) {
     while (s.planned > 0) {
-        const LayerQueue queue = {s.positions, s.start, s.bounds, s.planned, complete};
+        const LayerQueue queue = {s.positions, nullptr, s.start, s.bounds, s.planned, complete};
         GroupResult group;
         s.sink.count = 0;
         Status status = add_group(s.chain, queue, 0, s.arena, s.sink, group, nullptr);

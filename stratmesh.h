@@ -2830,7 +2830,7 @@ struct LoadedLayer {
 inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint32_t* ids,
                        const Local* staged, size_t count, double h0, double h1, Arena& arena,
                        LoadedLayer& layer) {
-    const bool intact = staged && arena.untouched(staged);
+    const bool intact = kStagePoints && staged && arena.untouched(staged);
     layer.ids = ids;
     layer.count = count;
     layer.points = arena.alloc<Local>(count);

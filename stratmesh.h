@@ -2166,19 +2166,24 @@ inline Status choose_frame(const CloudReader& cloud, size_t count, const Options
                            Frame& frame) {
     // Coordinates near the top of the double range overflow the sum: then the sum of the
     // points scaled down by 2^-40 (exactly), which leaves room for 2^32 points, is used.
-    Vec3 sum = {0, 0, 0}, small_sum = {0, 0, 0};
-    Vec3 low = {DBL_MAX, DBL_MAX, DBL_MAX}, high = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+    double total[3] = {0, 0, 0}, small_total[3] = {0, 0, 0};
+    double lowest[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, highest[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
     size_t valid = 0;
     for (size_t i = 0; i < count; ++i) {
         if (!cloud.valid(i)) continue;
-        Vec3 p = cloud.point(i);
-        sum = {sum.x + p.x, sum.y + p.y, sum.z + p.z};
-        const Vec3 small = scaled(p, 0x1p-40);
-        small_sum = {small_sum.x + small.x, small_sum.y + small.y, small_sum.z + small.z};
-        low = {p.x < low.x ? p.x : low.x, p.y < low.y ? p.y : low.y, p.z < low.z ? p.z : low.z};
-        high = {p.x > high.x ? p.x : high.x, p.y > high.y ? p.y : high.y, p.z > high.z ? p.z : high.z};
+        const Vec3 p = cloud.point(i);
+        const double c[3] = {p.x, p.y, p.z};
+        for (int k = 0; k < 3; ++k) {
+            total[k] += c[k];
+            small_total[k] += c[k] * 0x1p-40;
+            if (c[k] < lowest[k]) lowest[k] = c[k];
+            if (c[k] > highest[k]) highest[k] = c[k];
+        }
         ++valid;
     }
+    const Vec3 sum = {total[0], total[1], total[2]};
+    const Vec3 small_sum = {small_total[0], small_total[1], small_total[2]};
+    const Vec3 low = {lowest[0], lowest[1], lowest[2]}, high = {highest[0], highest[1], highest[2]};
     if (!(is_finite(sum.x) && is_finite(sum.y) && is_finite(sum.z)))
         frame.origin = scaled(scaled(small_sum, 1.0 / static_cast<double>(valid)), 0x1p40);
     else
@@ -2750,6 +2755,10 @@ struct LayerLoops {
     uint32_t bottom_count;
     uint32_t* top;
     uint32_t top_count;
+    // From triangulate_layer: where in the sink its triangles at the bottom loop begin (they
+    // come last), and how many of its points have a triangle but are off the bottom loop.
+    size_t border_start;
+    size_t interior_used;
 };
 
 struct LayerCounts {
@@ -2776,10 +2785,10 @@ struct LayerDuplicates {
 };
 
 // Collects the link of the centre (vertex 0) counter-clockwise into loop (layer-local
-// indices; vertex v is layer-local order[v - 1]). False if the centre touches the hull: the
-// layer does not surround its axis.
+// indices; vertex v is layer-local order[v - 1]) and sets on_link[v] to 1 for its vertices.
+// False if the centre touches the hull: the layer does not surround its axis.
 inline bool centre_link(const Triangulation& tr, const uint32_t* order, uint32_t* loop,
-                        uint32_t* count) {
+                        uint32_t* count, uint32_t* on_link) {
     uint32_t start = kNoIndex;
     for (uint32_t e = 0; e < 3 * tr.triangle_count; ++e)
         if (tr.vertex[e] == 0) {
@@ -2793,6 +2802,7 @@ inline bool centre_link(const Triangulation& tr, const uint32_t* order, uint32_t
         if (u == kGhost || tr.vertex[prev_edge(e)] == kGhost || n > tr.triangle_count)
             return false;
         loop[n++] = order[u - 1];
+        on_link[u] = 1;
         e = tr.twin[prev_edge(e)];  // the next triangle counter-clockwise around the centre
     } while (e != start);
     *count = n;
@@ -2896,17 +2906,36 @@ inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& lay
     uint32_t inserted = 0;
     Status status = triangulate_points(tr, static_cast<uint32_t>(total), duplicates, &inserted);
     if (status == Status::internal_error) return status;
-    if (status != Status::ok || !centre_link(tr, order, loops.bottom, &loops.bottom_count)) {
+    // The flip stack's room is free now: a flag per vertex, 1 on the bottom loop, 2 once in
+    // an emitted triangle.
+    uint32_t* flags = tr.stack;
+    std::memset(flags, 0, total * sizeof(uint32_t));
+    if (status != Status::ok ||
+        !centre_link(tr, order, loops.bottom, &loops.bottom_count, flags)) {
         arena.rewind(mark);
         return Status::not_columnar;
     }
     hull_loop(tr, order, loops.top, &loops.top_count);
-    for (uint32_t t = 0; t < tr.triangle_count; ++t) {
-        const uint32_t* v = tr.vertex + 3 * t;
-        if (tr.is_ghost(t) || v[0] == 0 || v[1] == 0 || v[2] == 0) continue;
-        sink.emit(order[v[0] - 1], order[v[1] - 1], order[v[2] - 1], points[v[0] - 1],
-                  points[v[1] - 1], points[v[2] - 1], cyl);
+    // The triangles at the bottom loop (the border) go last, so that a chunk's triangles at
+    // its loop vertices are one stretch of the sink with the band (see chunk_is_sound).
+    for (uint32_t at_border = 0; at_border < 2; ++at_border) {
+        if (at_border) loops.border_start = sink.count;
+        for (uint32_t t = 0; t < tr.triangle_count; ++t) {
+            const uint32_t* v = tr.vertex + 3 * t;
+            if (tr.is_ghost(t) || v[0] == 0 || v[1] == 0 || v[2] == 0 ||
+                ((flags[v[0]] | flags[v[1]] | flags[v[2]]) & 1) != at_border)
+                continue;
+            if (kNetShortcut) {
+                flags[v[0]] |= 2;
+                flags[v[1]] |= 2;
+                flags[v[2]] |= 2;
+            }
+            sink.emit(order[v[0] - 1], order[v[1] - 1], order[v[2] - 1], points[v[0] - 1],
+                      points[v[1] - 1], points[v[2] - 1], cyl);
+        }
     }
+    loops.interior_used = 0;
+    for (size_t v = 1; kNetShortcut && v < total; ++v) loops.interior_used += flags[v] == 2;
     arena.rewind(mark);
     return Status::ok;
 }
@@ -4185,6 +4214,57 @@ inline bool loop_fans_are_one_piece(const uint32_t* tri, size_t count, size_t be
     return whole;
 }
 
+// Triangles of a chunk from layer-local and band indices to output indices.
+inline void name_chunk_points(const SurfaceChain& c, const LoadedLayer& layer, uint32_t* tri,
+                              size_t count) {
+    for (size_t k = 0; k < 3 * count; ++k) {
+        uint32_t l = tri[k];
+        uint32_t id = l < layer.count ? layer.ids[l] : c.top[l - layer.count];
+        tri[k] = c.output_id ? c.output_id[id] : id;
+    }
+}
+
+// Whether the safety net and seal_seam would leave a chunk as it is, judged from its
+// triangles at the loop vertices alone: `at_loops` (count of them, in layer-local and band
+// indices) holds the layer's triangles at its bottom loop and the band, and interior_used
+// counts the layer's points with a triangle off that loop. It holds when the seam below is
+// as built and the fans of the loop vertices are whole (see >>manifold); then the chunk's
+// points that became vertices are counted and the next seam's flags set, as finish_chunk
+// would. Otherwise nothing changes.
+inline bool chunk_is_sound(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
+                           const uint32_t* at_loops, size_t count, size_t interior_used,
+                           Arena& arena) {
+    // The seam is as built when every loop point below has both its loop edges there or no
+    // triangle at all: then seal_seam would find nothing to do either, since the band has
+    // every edge of the loop.
+    const unsigned char whole = kHasNextEdge | kHasPreviousEdge;
+    for (uint32_t i = 0; i < c.top_count; ++i)
+        if (!(c.top_unused[i] & kUnusedBelow) && (c.top_unused[i] & whole) != whole) return false;
+    const size_t below = layer.count, vertices = below + c.top_count;
+    size_t mark = arena.mark();
+    uint32_t* degree = arena.alloc<uint32_t>(vertices);
+    if (arena.failed || !loop_fans_are_one_piece(at_loops, count, below, vertices, loops, arena)) {
+        arena.failed = false;
+        arena.rewind(mark);
+        return false;
+    }
+    count_corners(at_loops, count, degree, vertices);
+    size_t used = interior_used;
+    for (uint32_t i = 0; i < c.top_count; ++i)
+        used += degree[below + i] > 0 && (c.top_unused[i] & kUnusedBelow);
+    // A bottom-loop vertex's triangles are all here; kNoIndex marks one without any.
+    for (uint32_t i = 0; i < loops.bottom_count; ++i) {
+        uint32_t& d = degree[loops.bottom[i]];
+        used += d > 0;
+        d = d > 0 ? 1 : kNoIndex;
+    }
+    for (uint32_t i = 0; i < loops.top_count; ++i)
+        c.next_unused[i] = degree[loops.top[i]] == kNoIndex ? kUnusedBelow : whole;
+    c.used += used;
+    arena.rewind(mark);
+    return true;
+}
+
 // The safety net over the chunk sink[chunk_start ..), then its indices from layer-local and
 // band indices to output indices; counts the points that became vertices.
 inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
@@ -4224,11 +4304,7 @@ inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const Laye
         for (uint32_t i = 0; i < loops.top_count; ++i) position[loops.top[i]] = i;
         mark_loop_edges(tri, count, position, loops.top_count, c.next_unused);
     }
-    for (size_t k = 0; k < 3 * count; ++k) {
-        uint32_t l = tri[k];
-        uint32_t id = l < below ? layer.ids[l] : c.top[l - below];
-        tri[k] = c.output_id ? c.output_id[id] : id;
-    }
+    name_chunk_points(c, layer, tri, count);
     arena.rewind(mark);
     return Status::ok;
 }
@@ -4289,31 +4365,19 @@ inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops
 }
 
 // finish_chunk for a layer a job triangulated, whose triangles are already in reader
-// indices, followed in the sink by the band (from chunk_start + ahead.triangle_count):
-// when the seam below is as built and the fans of the loop vertices are whole, the safety
-// net and seal_seam have nothing to do, and only the border triangles (those of
-// ahead.border) and the band are read. Returns false when that does not hold (nothing
-// changed): the caller then builds the chunk again in order, to the same triangles, and
-// runs finish_chunk.
+// indices, followed in the sink by the band (from chunk_start + ahead.triangle_count): when
+// chunk_is_sound holds for the border the job kept and the band, only the band is named in
+// reader indices. Returns false when it does not (nothing changed): the caller then builds
+// the chunk again in order, to the same triangles, and runs finish_chunk.
 inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
                          const LayerAhead& ahead, size_t chunk_start, Arena& arena,
                          TriangleSink& sink) {
-    // The seam is as built when every loop point below has both its loop edges there or no
-    // triangle at all: then seal_seam would find nothing to do either, since the band has
-    // every edge of the loop.
-    const unsigned char whole = kHasNextEdge | kHasPreviousEdge;
-    bool seam_as_built = ahead.replayable && !c.output_id;
-    for (uint32_t i = 0; i < c.top_count; ++i)
-        seam_as_built = seam_as_built && ((c.top_unused[i] & kUnusedBelow) ||
-                                          (c.top_unused[i] & whole) == whole);
-    if (!seam_as_built) return false;
+    if (!ahead.replayable || c.output_id) return false;
     uint32_t* band = sink.triangles + 3 * (chunk_start + ahead.triangle_count);
     const size_t band_count = sink.count - chunk_start - ahead.triangle_count;
-    const size_t below = layer.count, vertices = below + c.top_count;
     const size_t count = ahead.border_count + band_count;
     size_t mark = arena.mark();
     uint32_t* tri = arena.alloc<uint32_t>(3 * count);
-    uint32_t* degree = arena.alloc<uint32_t>(vertices);
     if (arena.failed) {
         arena.failed = false;
         arena.rewind(mark);
@@ -4321,30 +4385,10 @@ inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerL
     }
     std::memcpy(tri, ahead.border, 3 * ahead.border_count * sizeof(uint32_t));
     std::memcpy(tri + 3 * ahead.border_count, band, 3 * band_count * sizeof(uint32_t));
-    if (!loop_fans_are_one_piece(tri, count, below, vertices, loops, arena)) {
-        arena.failed = false;
-        arena.rewind(mark);
-        return false;
-    }
-    count_corners(tri, count, degree, vertices);
-    size_t used = ahead.interior_used;
-    for (uint32_t i = 0; i < c.top_count; ++i)
-        used += degree[below + i] > 0 && (c.top_unused[i] & kUnusedBelow);
-    // A bottom-loop vertex's triangles are all here; kNoIndex marks one without any.
-    for (uint32_t i = 0; i < loops.bottom_count; ++i) {
-        uint32_t& d = degree[loops.bottom[i]];
-        used += d > 0;
-        d = d > 0 ? 1 : kNoIndex;
-    }
-    for (uint32_t i = 0; i < loops.top_count; ++i)
-        c.next_unused[i] = degree[loops.top[i]] == kNoIndex ? kUnusedBelow : whole;
-    for (size_t k = 0; k < 3 * band_count; ++k) {
-        uint32_t l = band[k];
-        band[k] = l < below ? layer.ids[l] : c.top[l - below];
-    }
-    c.used += used;
+    const bool sound = chunk_is_sound(c, layer, loops, tri, count, ahead.interior_used, arena);
     arena.rewind(mark);
-    return true;
+    if (sound) name_chunk_points(c, layer, band, band_count);
+    return sound;
 }
 
 // Forms the group starting at planned layer `first`, triangulates it, stitches it to the
@@ -4388,7 +4432,7 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
         // Tiny or thin layers make coarse, folding bands: they join the next layer if any.
         if (group_stands(n, h1 - h0, layer.cyl.radius, final)) {
             const size_t chunk_start = sink.count, folds = sink.folds, swaps = c.swaps;
-            LayerLoops loops = {c.bottom, 0, c.next_top, 0};
+            LayerLoops loops = {c.bottom, 0, c.next_top, 0, 0, 0};
             auto stitch = [&]() {
                 if (status == Status::ok && c.top_count > 0 &&
                     !stitch_layers(c.reader, c.frame, c.top_cylinder, c.top, c.top_count, layer,
@@ -4422,10 +4466,18 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
             }
             result.triangles = sink.count - chunk_start;
             result.folds = sink.folds - folds;
-            // The layer's points are no longer needed: the safety net takes their room.
+            // The layer's points are no longer needed: the safety net takes their room. A
+            // chunk triangulated here whose border and band show it sound is only renamed.
             arena.rewind(mark);
-            if (!finished && status == Status::ok && sink.count <= sink.capacity)
-                status = finish_chunk(c, layer, loops, chunk_start, arena, sink);
+            if (!finished && status == Status::ok && sink.count <= sink.capacity) {
+                uint32_t* chunk = sink.triangles + 3 * chunk_start;
+                if (kNetShortcut && retriangulate &&
+                    chunk_is_sound(c, layer, loops, sink.triangles + 3 * loops.border_start,
+                                   sink.count - loops.border_start, loops.interior_used, arena))
+                    name_chunk_points(c, layer, chunk, sink.count - chunk_start);
+                else
+                    status = finish_chunk(c, layer, loops, chunk_start, arena, sink);
+            }
             if (status == Status::ok) {
                 for (uint32_t i = 0; i < loops.top_count; ++i) loops.top[i] = ids[loops.top[i]];
                 uint32_t* top = c.top;
@@ -4651,7 +4703,7 @@ inline void run_layer_job(void* context, uint32_t index) {
             !group_stands(n, q.bounds[k + 1] - q.bounds[k], layer.cyl.radius, k + 1 == q.planned))
             continue;
         TriangleSink sink = {a.triangles, 2 * n, 0, 0};
-        LayerLoops loops = {a.bottom, 0, a.top, 0};
+        LayerLoops loops = {a.bottom, 0, a.top, 0, 0, 0};
         a.status = triangulate_layer(*p.reader, layer, arena, sink, loops, a.counts);
         // An annulus through n points has at most 2n triangles; anything else is redone in order.
         if ((a.status != Status::ok && a.status != Status::not_columnar) || sink.count > sink.capacity)

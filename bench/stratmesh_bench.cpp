@@ -249,6 +249,8 @@ struct Result {
     size_t n;
     double seconds;           // median
     double delaunay_seconds;  // median of the reference delaunay_2d (3D jobs)
+    double min_seconds;       // fastest run (3D jobs; NaN for the others)
+    double delaunay_min_seconds;
 };
 
 // ==== Timing ===============================================================================
@@ -700,9 +702,10 @@ Result measure_reconstruct(const ReconstructCase& job) {
         reference_times.push_back(reference.run());
     }
 
-    Result result = {Outcome::ok, n, median(times), median(reference_times)};
     double min_seconds = *std::min_element(times.begin(), times.end());
     double reference_min = *std::min_element(reference_times.begin(), reference_times.end());
+    Result result = {Outcome::ok, n, median(times), median(reference_times), min_seconds,
+                     reference_min};
     double per_point = n > 0 ? 1.0 / static_cast<double>(n) : 0.0;
     if (status != stratmesh::Status::ok || reference.status() != stratmesh::Status::ok)
         result.outcome = Outcome::failed;
@@ -860,7 +863,7 @@ Result measure_threads(const std::string& name, const stratmesh::Cloud& cloud,
     double speedup = seconds_no_runner / seconds_2_threads;
     double speedup_ceiling = 2 * seconds_no_runner / seconds_2_independent;
     Result result = {ok ? Outcome::ok : Outcome::failed, cloud.count, seconds_2_threads,
-                     std::nan("")};
+                     std::nan(""), std::nan(""), std::nan("")};
     JsonLine line = case_line(name, cloud.count, runs);
     line.add("layers", one.report.layer_count);
     line.add("seconds_no_runner", seconds_no_runner);
@@ -977,7 +980,7 @@ Result measure_stream(const std::string& name, const std::vector<double>& coords
         });
     bool ok = streamed.status == stratmesh::Status::ok && whole.status == stratmesh::Status::ok;
     Result result = {ok ? Outcome::ok : Outcome::failed, cloud.count, median(stream_times),
-                     std::nan("")};
+                     std::nan(""), std::nan(""), std::nan("")};
     JsonLine line = case_line(name, cloud.count, runs);
     line.add("pushes", layered.start.size() - 1);
     line.add("largest_push", largest);
@@ -1062,7 +1065,8 @@ const char* scalar_name(stratmesh::Scalar scalar) {
 
 // Times the reconstruction of a PLY file's points.
 Result measure_ply_file(const Job& job, const Options& options) {
-    Result result = {Outcome::bad_input, 0, std::nan(""), std::nan("")};
+    const double none = std::nan("");
+    Result result = {Outcome::bad_input, 0, none, none, none, none};
     bench::PlyCloud ply;
     std::string error;
     if (!bench::read_ply_file(job.path, ply, error)) {
@@ -1082,7 +1086,8 @@ Result measure_ply_file(const Job& job, const Options& options) {
 // Generates or loads the job's input and measures it.
 Result run_job(const Job& job, const Options& options) {
     if (job.input == Input::ply_file) return measure_ply_file(job, options);
-    Result result = {Outcome::bad_input, 0, std::nan(""), std::nan("")};
+    const double none = std::nan("");
+    Result result = {Outcome::bad_input, 0, none, none, none, none};
     std::vector<double> coords;
     if (job.input == Input::table) {
         job.spec->generate(job.spec->n, job.spec->seed, coords);
@@ -1132,6 +1137,8 @@ void print_growth(const Growth& growth, const Result& from, const Result& to) {
                                      std::log(static_cast<double>(from.n)));
     line.add("linear_prediction", n_ratio);
     line.add("delaunay_seconds_ratio", to.delaunay_seconds / from.delaunay_seconds);
+    line.add("min_seconds_ratio", to.min_seconds / from.min_seconds);
+    line.add("delaunay_min_seconds_ratio", to.delaunay_min_seconds / from.delaunay_min_seconds);
     line.print();
 }
 
@@ -1189,7 +1196,9 @@ void print_help(std::FILE* out) {
         "The paper cases (and every reconstruction with --layer-lines) print one line\n"
         "per layer first: name, layer, bottom, top, point_count, triangle_count,\n"
         "fold_count, radius. After tube-1e6 and tube-4e6, a growth line compares\n"
-        "their seconds_ratio with nlogn_prediction = 4 log(4e6) / log(1e6).\n"
+        "their seconds_ratio (of medians; min_seconds_ratio of the fastest runs, steadier\n"
+        "on a shared machine; delaunay_* the same for the reference) with\n"
+        "nlogn_prediction = 4 log(4e6) / log(1e6).\n"
         "\n"
         "threads (cases threads-tube-1e6, threads-tube-4e6: 8 layers):\n"
         "  seconds_no_runner, seconds_2_threads   medians of reconstruct without a job\n"

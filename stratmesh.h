@@ -611,7 +611,7 @@ const bool kParallelLayers = true;  // lets the compiler drop what only jobs' re
 const bool kNetShortcut = false;
 const bool kStagePoints = false;
 #else
-const bool kNetShortcut = true;  // finish_chunk checks the loop fans before running the net
+const bool kNetShortcut = true;  // a chunk whose loop fans are whole skips the net
 const bool kStagePoints = true;  // reconstruct() keeps the grouped points in spare workspace
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
@@ -3295,10 +3295,12 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
 // the outside of the hull. Around a vertex off the centre's link (the bottom loop) that
 // leaves its star minus the two ghost triangles at most: one fan. Off the hull, a
 // bottom-loop vertex loses the two triangles on its edge to the centre: one fan too. A
-// vertex on both loops can be left with two, and every band vertex is on a loop. So
-// finish_chunk checks the fans of the loop vertices (fans_are_one_piece) and runs the net
-// over the chunk only when one of them fails; on sound input it never does, and the net's
-// relabelling and sorting, most of its cost, is skipped.
+// vertex on both loops can be left with two, and every band vertex is on a loop. So only
+// the fans of the loop vertices are checked (fans_are_one_piece), and the net runs over
+// the chunk only when one of them fails; on sound input it never does, and the net's
+// relabelling and sorting, most of its cost, is skipped. A layer emits its triangles at
+// the bottom loop last, so those fans are read from one stretch of the chunk, its border
+// and band (chunk_is_sound); the rest of the chunk is only renamed.
 
 // In-place sort of packed (key, value) pairs: insertion sort for the small fans of almost
 // every vertex, heap sort (O(n log n), no recursion) for large ones.

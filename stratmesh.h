@@ -63,11 +63,12 @@
 //   STRATMESH_SMALL_CODE     default: not defined. Leaves out all the code that only
 //                            makes reconstruction faster, for targets where code size
 //                            comes first (the Cortex-M7 build): the parallel layers, as
-//                            above, and the safety net's shortcut (a check of the loop
+//                            above, the safety net's shortcut (a check of the loop
 //                            vertices that skips the net on sound chunks, about 0.4 KiB;
-//                            without it the net runs on every chunk: on x86-64, a 1e6-
-//                            point tube takes about 1.5 times as long). The output is the
-//                            same bytes either way.
+//                            without it the net runs on every chunk) and the staging of
+//                            the grouped points in spare workspace (see Memory). On
+//                            x86-64 a 1e6-point tube then takes 1.5 to 1.55 times as
+//                            long. The output is the same bytes either way.
 //
 // ==== Memory ===============================================================================
 //

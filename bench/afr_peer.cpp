@@ -23,6 +23,8 @@
 //
 // A benchmark tool only: CGAL never reaches the library.
 
+#include "bench_json.h"
+#include "bench_mesh.h"
 #include "bench_ply.h"
 
 #include <CGAL/Advancing_front_surface_reconstruction.h>
@@ -43,41 +45,6 @@ namespace {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
 using Facet = std::array<std::size_t, 3>;
-
-// The JSON form of a string: quotes, backslashes and control characters escaped.
-std::string json_string(const std::string& s) {
-    std::string out = "\"";
-    for (char c : s) {
-        if (c == '"' || c == '\\') {
-            out += '\\';
-            out += c;
-        } else if (static_cast<unsigned char>(c) < 0x20) {
-            char buffer[8];
-            std::snprintf(buffer, sizeof buffer, "\\u%04x", static_cast<unsigned>(c));
-            out += buffer;
-        } else {
-            out += c;
-        }
-    }
-    return out + "\"";
-}
-
-// Point i of a stratmesh::Cloud as read by bench::read_ply_file (float32 or float64
-// coordinates, packed or at a stride).
-Point cloud_point(const stratmesh::Cloud& cloud, size_t i) {
-    const bool is_float = cloud.scalar == stratmesh::Scalar::float32;
-    const size_t stride =
-        cloud.stride_bytes != 0 ? cloud.stride_bytes : (is_float ? 3 * sizeof(float) : 3 * sizeof(double));
-    const unsigned char* p = static_cast<const unsigned char*>(cloud.xyz) + i * stride;
-    if (is_float) {
-        float v[3];
-        std::memcpy(v, p, sizeof v);
-        return Point(static_cast<double>(v[0]), static_cast<double>(v[1]), static_cast<double>(v[2]));
-    }
-    double v[3];
-    std::memcpy(v, p, sizeof v);
-    return Point(v[0], v[1], v[2]);
-}
 
 bool ends_with(const std::string& s, const char* suffix) {
     const size_t n = std::strlen(suffix);
@@ -168,7 +135,11 @@ int main(int argc, char** argv) {
     }
     std::vector<Point> points;
     points.reserve(ply.cloud.count);
-    for (size_t i = 0; i < ply.cloud.count; ++i) points.push_back(cloud_point(ply.cloud, i));
+    for (size_t i = 0; i < ply.cloud.count; ++i) {
+        double p[3];
+        bench::cloud_point(ply.cloud, i, p);
+        points.emplace_back(p[0], p[1], p[2]);
+    }
 
     const double radius_ratio_bound = 5;  // CGAL's defaults, given explicitly to print them
     const double beta = 0.52;
@@ -197,11 +168,11 @@ int main(int argc, char** argv) {
     std::printf("{\"tool\": \"cgal_afr\", \"cgal_version\": \"%s\", \"input\": %s, \"output\": %s, "
                 "\"points\": %zu, \"triangles\": %zu, \"seconds\": %.9g, "
                 "\"radius_ratio_bound\": %g, \"beta\": %g, \"status\": %s",
-                CGAL_VERSION_STR, json_string(input).c_str(),
-                output.empty() ? "null" : json_string(output).c_str(), points.size(),
+                CGAL_VERSION_STR, bench::json_quoted(input).c_str(),
+                output.empty() ? "null" : bench::json_quoted(output).c_str(), points.size(),
                 facets.size(), seconds, radius_ratio_bound, beta,
                 failure.empty() ? "\"ok\"" : "\"error\"");
-    if (!failure.empty()) std::printf(", \"error\": %s", json_string(failure).c_str());
+    if (!failure.empty()) std::printf(", \"error\": %s", bench::json_quoted(failure).c_str());
     std::printf("}\n");
     return failure.empty() ? 0 : 1;
 }

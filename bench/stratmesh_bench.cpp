@@ -15,6 +15,7 @@
 #include "stratmesh.h"
 
 #include "bench_clouds.h"
+#include "bench_json.h"
 #include "bench_mesh.h"
 #include "bench_ply.h"
 #include "bench_random.h"
@@ -296,21 +297,7 @@ class JsonLine {
 public:
     void add(const char* key, const std::string& value) {
         start(key);
-        text_ += '"';
-        for (char c : value) {
-            unsigned char u = static_cast<unsigned char>(c);
-            if (c == '"' || c == '\\') {
-                text_ += '\\';
-                text_ += c;
-            } else if (u < 0x20) {
-                char escaped[8];
-                std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(u));
-                text_ += escaped;
-            } else {
-                text_ += c;
-            }
-        }
-        text_ += '"';
+        text_ += bench::json_quoted(value);
     }
     void add(const char* key, const char* value) { add(key, std::string(value)); }
     void add(const char* key, size_t value) {

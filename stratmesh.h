@@ -611,9 +611,11 @@ const bool kParallelLayers = true;  // lets the compiler drop what only jobs' re
 #if defined(STRATMESH_SMALL_CODE)
 const bool kNetShortcut = false;
 const bool kStagePoints = false;
+const bool kIntegerStages = false;
 #else
 const bool kNetShortcut = true;  // a chunk whose loop fans are whole skips the net
 const bool kStagePoints = true;  // reconstruct() keeps the grouped points in spare workspace
+const bool kIntegerStages = true;  // the predicates settle near-ties in integers first
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 
@@ -1186,7 +1188,8 @@ inline double orient2d_beyond_filter(const double* a, const double* b, const dou
     two_diff(b[0], c[0], differences[2], tails[2]);
     two_diff(b[1], c[1], differences[3], tails[3]);
     bool exact = tails[0] == 0 && tails[1] == 0 && tails[2] == 0 && tails[3] == 0;
-    if (exact && orient2d_from_integer_differences(differences, &det)) return det;
+    if (kIntegerStages && exact && orient2d_from_integer_differences(differences, &det))
+        return det;
     const double magnitudes[10] = {differences[0], differences[2], differences[1],
                                    differences[3], a[0], a[1], b[0], b[1], c[0], c[1]};
     double factor = rescaling_factor(magnitudes, 10, 400);
@@ -1358,7 +1361,8 @@ inline bool differences_to(const double* a, const double* b, const double* c, co
 inline double incircle_beyond_filter(const double* a, const double* b, const double* c,
                                      const double* d, double* scratch) {
     double rows[3][2], det = 0;
-    if (differences_to(a, b, c, d, rows) && incircle_from_integer_differences(rows, &det))
+    if (differences_to(a, b, c, d, rows) && kIntegerStages &&
+        incircle_from_integer_differences(rows, &det))
         return det;
     const double magnitudes[14] = {rows[0][0], rows[1][0], rows[2][0], rows[0][1],
                                    rows[1][1], rows[2][1], a[0], a[1], b[0], b[1],
@@ -2725,6 +2729,18 @@ inline bool faces_axis(const Local& pa, const Local& pb, const Local& pc, const 
     return n.x * rx + n.y * ry < 0;
 }
 
+// The surface triangles of a layer's triangulation (vertex v is points[v - 1]; vertex 0, the
+// centre, and the ghosts are not surface) that face its axis.
+inline size_t count_folds(const Triangulation& tr, const Local* points, const Cylinder& cyl) {
+    size_t folds = 0;
+    for (uint32_t t = 0; t < tr.triangle_count; ++t) {
+        const uint32_t* v = tr.vertex + 3 * t;
+        if (tr.is_ghost(t) || v[0] == 0 || v[1] == 0 || v[2] == 0) continue;
+        folds += faces_axis(points[v[2] - 1], points[v[1] - 1], points[v[0] - 1], cyl);
+    }
+    return folds;
+}
+
 // Where reconstructed triangles go: the caller's array, filled in order. Triangles are
 // built counter-clockwise on the annulus, where the outside of the surface faces down,
 // so they are written reversed. Counting continues past the capacity so the caller can
@@ -2735,16 +2751,20 @@ struct TriangleSink {
     size_t count;
     size_t folds;
 
-    // Emits abc, given counter-clockwise on the annulus (so written reversed), with the
-    // vertices' frame coordinates for the fold count.
-    void emit(uint32_t a, uint32_t b, uint32_t c, const Local& pa, const Local& pb,
-              const Local& pc, const Cylinder& cyl) {
+    // Writes abc, given counter-clockwise on the annulus (so written reversed).
+    void write(uint32_t a, uint32_t b, uint32_t c) {
         if (count < capacity) {
             triangles[3 * count] = a;
             triangles[3 * count + 1] = c;
             triangles[3 * count + 2] = b;
         }
         ++count;
+    }
+
+    // Writes abc and counts it if it is a fold (the vertices in frame coordinates).
+    void emit(uint32_t a, uint32_t b, uint32_t c, const Local& pa, const Local& pb,
+              const Local& pc, const Cylinder& cyl) {
+        write(a, b, c);
         if (faces_axis(pa, pc, pb, cyl)) ++folds;
     }
 };
@@ -2785,11 +2805,14 @@ struct LayerDuplicates {
     }
 };
 
-// Collects the link of the centre (vertex 0) counter-clockwise into loop (layer-local
-// indices; vertex v is layer-local order[v - 1]) and sets on_link[v] to 1 for its vertices.
-// False if the centre touches the hull: the layer does not surround its axis.
-inline bool centre_link(const Triangulation& tr, const uint32_t* order, uint32_t* loop,
-                        uint32_t* count, uint32_t* on_link) {
+// Per vertex of a layer's triangulation, in triangulate_layer (the flip stack's room).
+const uint32_t kOnBottomLoop = 1, kEmitted = 2, kOnTopLoop = 4;
+
+// Collects the link of the centre (vertex 0) counter-clockwise into loop, one entry per link
+// edge u -> w: the half-edge w -> u of the triangle beyond it. Flags its vertices
+// kOnBottomLoop. False if the centre touches the hull: the layer does not surround its axis.
+inline bool centre_link(const Triangulation& tr, uint32_t* loop, uint32_t* count,
+                        uint32_t* flags) {
     uint32_t start = kNoIndex;
     for (uint32_t e = 0; e < 3 * tr.triangle_count; ++e)
         if (tr.vertex[e] == 0) {
@@ -2802,27 +2825,105 @@ inline bool centre_link(const Triangulation& tr, const uint32_t* order, uint32_t
         uint32_t u = tr.vertex[next_edge(e)];
         if (u == kGhost || tr.vertex[prev_edge(e)] == kGhost || n > tr.triangle_count)
             return false;
-        loop[n++] = order[u - 1];
-        on_link[u] = 1;
+        loop[n++] = tr.twin[next_edge(e)];
+        flags[u] = kOnBottomLoop;
         e = tr.twin[prev_edge(e)];  // the next triangle counter-clockwise around the centre
     } while (e != start);
     *count = n;
     return true;
 }
 
-// Collects the convex hull counter-clockwise into loop (layer-local indices). A ghost
-// (a, b, G) holds G -> a; the twin of G -> a is a -> G in the ghost (z, a, G), whose next
-// half-edge is G -> z: the hull vertex after a.
-inline void hull_loop(const Triangulation& tr, const uint32_t* order, uint32_t* loop,
-                      uint32_t* count) {
+// Collects the convex hull counter-clockwise into loop, one entry per hull edge a -> b: that
+// half-edge, in the triangle inside. Flags its vertices kOnTopLoop. A ghost (a, b, G) holds
+// G -> a, then a -> b; the twin of G -> a is a -> G in the ghost (z, a, G), whose next
+// half-edge is G -> z: the next ghost along the hull.
+inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* count, uint32_t* flags) {
     uint32_t start = 0;
     while (tr.vertex[start] != kGhost) ++start;
     uint32_t n = 0, e = start;
     do {
-        loop[n++] = order[tr.vertex[next_edge(e)] - 1];
+        loop[n++] = tr.twin[next_edge(e)];
+        flags[tr.vertex[next_edge(e)]] |= kOnTopLoop;
         e = next_edge(tr.twin[e]);
     } while (e != start && n <= tr.triangle_count);
     *count = n;
+}
+
+// Both loops are convex hulls, each in its own picture: the top loop on the annulus, the
+// bottom loop on the annulus turned inside out (z -> 1/z maps the centre's link to the hull).
+// A hull's edges are chords over the points just inside it, several spacings long, and the
+// band to the next layer then spans them with long triangles that cut through the surface:
+// with 24 layers on a star-shaped tube the bands held 11% of the area, at 5 times the mean
+// distance from the true surface. The next layer's points lie beyond the chord, so in one
+// triangulation of both layers the chord's sliver would not be there. Hence a loop triangle
+// is peeled off the layer when its angle at the inner vertex x is obtuse on the surface (in
+// 3D), and x joins the loop, where the band's empty-circle swaps settle it with the other
+// layer's points. Only when x is on no loop (the loops stay simple and apart), lies between
+// the edge's ends in angle around the centre (the loop still turns monotonically), and the
+// two new loop edges rise at most kPeelSlope (the band hugs the cut: steep loop edges are
+// where no order of its rungs is counter-clockwise). And only in a layer without folds: where
+// the layer is not star-shaped around its centre the loops are not monotone around the band's
+// centre either, and longer loops gave the bands more self-intersections. The passes are
+// bounded: each peels every loop edge at most once.
+const uint32_t kPeelPasses = 8;
+const double kPeelSlope = 0.3;
+
+// Whether the triangle of loop entry g (see centre_link and hull_loop) is peeled.
+inline bool peels(const Triangulation& tr, const Local* points, const uint32_t* flags,
+                  uint32_t g, bool top) {
+    const uint32_t* v = tr.vertex + (g - g % 3);
+    if (tr.is_ghost(g / 3) || v[0] == 0 || v[1] == 0 || v[2] == 0) return false;
+    uint32_t from = tr.vertex[g], to = tr.vertex[next_edge(g)], x = tr.vertex[prev_edge(g)];
+    if (flags[x] & (kOnBottomLoop | kOnTopLoop)) return false;
+    if (!top) {  // the bottom loop runs against its entries' half-edges
+        uint32_t t = from;
+        from = to;
+        to = t;
+    }
+    const Local &a = points[from - 1], &b = points[to - 1], &p = points[x - 1];
+    auto gentle = [&p](const Local& q) {
+        double dh = q.h - p.h, dx = q.x - p.x, dy = q.y - p.y;
+        return dh * dh <= kPeelSlope * kPeelSlope * (dx * dx + dy * dy);
+    };
+    double dot = (a.x - p.x) * (b.x - p.x) + (a.y - p.y) * (b.y - p.y) + (a.h - p.h) * (b.h - p.h);
+    return dot < 0 && gentle(a) && gentle(b) &&
+           orient2d_robust(tr.xy, tr.xy + 2 * from, tr.xy + 2 * x) > 0 &&
+           orient2d_robust(tr.xy, tr.xy + 2 * x, tr.xy + 2 * to) > 0;
+}
+
+// Peels the loop's entries loop[0..n) (capacity: the layer's points, which no loop exceeds)
+// and returns its new length. A peeled triangle loses its first vertex to the centre, so
+// that it is no longer emitted. The pass reads the loop from the array's end, where it never
+// meets what it writes: both loops together hold each vertex at most once.
+inline uint32_t peel_loop(Triangulation& tr, const Local* points, uint32_t* flags, uint32_t* loop,
+                          uint32_t n, uint32_t capacity, bool top) {
+    for (uint32_t pass = 0; pass < kPeelPasses; ++pass) {
+        std::memmove(loop + (capacity - n), loop, n * sizeof(uint32_t));
+        const uint32_t* entries = loop + (capacity - n);
+        uint32_t m = 0;
+        for (uint32_t i = 0; i < n; ++i) {
+            const uint32_t g = entries[i];
+            if (m + 2 > capacity - n + i + 1 || !peels(tr, points, flags, g, top)) {
+                loop[m++] = g;
+                continue;
+            }
+            flags[tr.vertex[prev_edge(g)]] |= top ? kOnTopLoop : kOnBottomLoop;
+            const uint32_t before = tr.twin[prev_edge(g)], after = tr.twin[next_edge(g)];
+            loop[m++] = top ? before : after;
+            loop[m++] = top ? after : before;
+            tr.vertex[g - g % 3] = 0;
+        }
+        if (m == n) break;
+        n = m;
+    }
+    return n;
+}
+
+// Turns loop entries into the layer-local indices of the loop's vertices, in loop order.
+inline void name_loop(const Triangulation& tr, const uint32_t* order, uint32_t* loop, uint32_t n,
+                      bool top) {
+    for (uint32_t i = 0; i < n; ++i)
+        loop[i] = order[tr.vertex[top ? loop[i] : next_edge(loop[i])] - 1];
 }
 
 // A layer's points in frame coordinates, read from the cloud once so that the fit, the
@@ -2907,16 +3008,24 @@ inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& lay
     uint32_t inserted = 0;
     Status status = triangulate_points(tr, static_cast<uint32_t>(total), duplicates, &inserted);
     if (status == Status::internal_error) return status;
-    // The flip stack's room is free now: a flag per vertex, 1 on the bottom loop, 2 once in
-    // an emitted triangle.
+    // The flip stack's room is free now: a flag per vertex (kOnBottomLoop, kOnTopLoop,
+    // kEmitted).
     uint32_t* flags = tr.stack;
     std::memset(flags, 0, total * sizeof(uint32_t));
-    if (status != Status::ok ||
-        !centre_link(tr, order, loops.bottom, &loops.bottom_count, flags)) {
+    if (status != Status::ok || !centre_link(tr, loops.bottom, &loops.bottom_count, flags)) {
         arena.rewind(mark);
         return Status::not_columnar;
     }
-    hull_loop(tr, order, loops.top, &loops.top_count);
+    hull_loop(tr, loops.top, &loops.top_count, flags);
+    const size_t folds = count_folds(tr, points, cyl);
+    if (folds == 0) {
+        const uint32_t capacity = static_cast<uint32_t>(count);
+        loops.bottom_count = peel_loop(tr, points, flags, loops.bottom, loops.bottom_count,
+                                       capacity, false);
+        loops.top_count = peel_loop(tr, points, flags, loops.top, loops.top_count, capacity, true);
+    }
+    name_loop(tr, order, loops.bottom, loops.bottom_count, false);
+    name_loop(tr, order, loops.top, loops.top_count, true);
     // The triangles at the bottom loop (the border) go last, so that a chunk's triangles at
     // its loop vertices are one stretch of the sink with the band (see chunk_is_sound).
     for (uint32_t at_border = 0; at_border < 2; ++at_border) {
@@ -2924,19 +3033,20 @@ inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& lay
         for (uint32_t t = 0; t < tr.triangle_count; ++t) {
             const uint32_t* v = tr.vertex + 3 * t;
             if (tr.is_ghost(t) || v[0] == 0 || v[1] == 0 || v[2] == 0 ||
-                ((flags[v[0]] | flags[v[1]] | flags[v[2]]) & 1) != at_border)
+                ((flags[v[0]] | flags[v[1]] | flags[v[2]]) & kOnBottomLoop) != at_border)
                 continue;
             if (kNetShortcut) {
-                flags[v[0]] |= 2;
-                flags[v[1]] |= 2;
-                flags[v[2]] |= 2;
+                flags[v[0]] |= kEmitted;
+                flags[v[1]] |= kEmitted;
+                flags[v[2]] |= kEmitted;
             }
-            sink.emit(order[v[0] - 1], order[v[1] - 1], order[v[2] - 1], points[v[0] - 1],
-                      points[v[1] - 1], points[v[2] - 1], cyl);
+            sink.write(order[v[0] - 1], order[v[1] - 1], order[v[2] - 1]);
         }
     }
+    sink.folds += folds;
     loops.interior_used = 0;
-    for (size_t v = 1; kNetShortcut && v < total; ++v) loops.interior_used += flags[v] == 2;
+    for (size_t v = 1; kNetShortcut && v < total; ++v)
+        loops.interior_used += (flags[v] & (kOnBottomLoop | kEmitted)) == kEmitted;
     arena.rewind(mark);
     return Status::ok;
 }
@@ -2991,11 +3101,11 @@ inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
 }
 
 struct Band {
-    const uint32_t* a;  // loop A, band indices (see stitch_layers)
-    const double* xa;   // its strip coordinates, angles increasing from the smallest
+    uint32_t* a;        // loop A, band indices (see stitch_layers)
+    double* xa;   // its strip coordinates, angles increasing from the smallest
     uint32_t p;
-    const uint32_t* b;
-    const double* xb;
+    uint32_t* b;
+    double* xb;
     uint32_t q;
     double turn;        // the strip's period, 2 pi R
     unsigned char* steps;  // p + q: 0 = advance A, 1 = advance B
@@ -3186,6 +3296,96 @@ inline size_t untangle_runs(Band& band) {
     return moves;
 }
 
+// Rotates the band (its loops and steps) to start half-way round. False if the half-way
+// point does not fall between the ends of both loops (the band stays as it is).
+inline bool restart_half_way(Band& band) {
+    const uint32_t length = band.p + band.q, half = length / 2;
+    uint32_t i_half = 0, j_half = 0;
+    for (uint32_t t = 0; t < half; ++t) (band.steps[t] == 0 ? i_half : j_half) += 1;
+    if (!(i_half > 0 && i_half < band.p && j_half > 0 && j_half < band.q)) return false;
+    rotate_loop(band.a, band.xa, band.p, i_half, band.turn);
+    rotate_loop(band.b, band.xb, band.q, j_half, band.turn);
+    unsigned char* steps = band.steps;
+    auto reverse = [steps](uint32_t lo, uint32_t hi) {  // the range [lo, hi)
+        for (; hi > lo + 1; ++lo) {
+            --hi;
+            unsigned char c = steps[lo];
+            steps[lo] = steps[hi];
+            steps[hi] = c;
+        }
+    };
+    reverse(0, half);
+    reverse(half, length);
+    reverse(0, length);
+    return true;
+}
+
+// Whether every step of the band is counter-clockwise on the strip.
+inline bool band_is_proper(Band& band) {
+    uint32_t i = 0, j = 0;
+    for (uint32_t t = 0; t < band.p + band.q; ++t) {
+        if (!band.proper(t, i, j)) return false;
+        if (band.steps[t] == 0) ++i; else ++j;
+    }
+    return true;
+}
+
+// Zips the loops and settles the band: the empty-circle swaps, and the untangling of
+// clockwise steps. The closing rung is held fixed by both: the band restarts half-way round
+// and swaps again, so the quads around it get their test too, and where a clockwise step is
+// left next to it, untangles once more from there.
+inline void settle_band(Band& band, size_t* swaps) {
+    zip_by_angle(band);
+    *swaps += swap_diagonals(band);
+    if (restart_half_way(band)) *swaps += swap_diagonals(band);
+    *swaps += untangle_runs(band);
+    if (!band_is_proper(band) && restart_half_way(band)) *swaps += untangle_runs(band);
+}
+
+// Where no order of rungs is counter-clockwise everywhere (a loop dips into a notch that
+// the other loop's vertices cannot see over), the notch is closed by a triangle of three
+// consecutive vertices of that loop, and its middle vertex leaves the band. For the first
+// clockwise step: its edge's end nearer the other loop's far side (A: the lower, B: the
+// higher) is tried first, then the other end; the triangle must be counter-clockwise on the
+// strip, which puts it on the loop's own side of the cut, clear of the other loop. Writes
+// the triangle in band indices, counter-clockwise on the strip; false if there is none.
+inline bool clip_ear(Band& band, uint32_t ear[3]) {
+    uint32_t i = 0, j = 0;
+    for (uint32_t t = 0; t < band.p + band.q; ++t) {
+        if (band.proper(t, i, j)) {
+            if (band.steps[t] == 0) ++i; else ++j;
+            continue;
+        }
+        const bool on_a = band.steps[t] == 0;
+        uint32_t* loop = on_a ? band.a : band.b;
+        double* uv = on_a ? band.xa : band.xb;
+        uint32_t& n = on_a ? band.p : band.q;
+        const uint32_t k = on_a ? i : j;
+        auto at = [&](uint32_t m, int slot) { return on_a ? band.pa(m, slot) : band.pb(m, slot); };
+        const bool first_end = on_a ? at(k, 0)[1] < at(k + 1, 1)[1] : at(k, 0)[1] > at(k + 1, 1)[1];
+        for (uint32_t attempt = 0; attempt < 2 && n > 3; ++attempt) {
+            const uint32_t m = (attempt == 0) == first_end ? k : k + 1;
+            if (m == 0 || m >= n) continue;
+            const double *before = at(m - 1, 0), *middle = at(m, 1), *after = at(m + 1, 2);
+            const bool ccw = on_a ? orient2d_robust(before, middle, after) > 0
+                                  : orient2d_robust(before, after, middle) > 0;
+            if (!ccw) continue;
+            ear[0] = loop[m - 1];
+            ear[1] = on_a ? loop[m] : loop[(m + 1) % n];
+            ear[2] = on_a ? loop[(m + 1) % n] : loop[m];
+            for (uint32_t r = m; r + 1 < n; ++r) {
+                loop[r] = loop[r + 1];
+                uv[2 * r] = uv[2 * r + 2];
+                uv[2 * r + 1] = uv[2 * r + 3];
+            }
+            --n;
+            return true;
+        }
+        return false;
+    }
+    return false;
+}
+
 // Stitches loop A (the lower layer's top loop: reader indices a_ids, cylinder ca) to the
 // loaded upper layer's bottom loop b (layer-local indices; the layer's cylinder has the
 // cut as h0). The band's triangles name the upper layer's points by layer-local index and
@@ -3232,30 +3432,15 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
     rotate_to_first_angle(b, xb, q);
     const double two_pi = 6.28318530717958647693;
     Band band = {a, xa, p, b, xb, q, two_pi * unrolled_radius, steps, scratch, {}};
-    zip_by_angle(band);
-    *swaps += swap_diagonals(band);
-    // The closing rung was held fixed: restart the band half-way round and swap again, so
-    // the quads around it get their test too.
-    const uint32_t length = p + q, half = length / 2;
-    uint32_t i_half = 0, j_half = 0;
-    for (uint32_t t = 0; t < half; ++t) (steps[t] == 0 ? i_half : j_half) += 1;
-    if (i_half > 0 && i_half < p && j_half > 0 && j_half < q) {
-        rotate_loop(a, xa, p, i_half, band.turn);
-        rotate_loop(b, xb, q, j_half, band.turn);
-        auto reverse = [steps](uint32_t lo, uint32_t hi) {  // the range [lo, hi)
-            for (; hi > lo + 1; ++lo) {
-                --hi;
-                unsigned char c = steps[lo];
-                steps[lo] = steps[hi];
-                steps[hi] = c;
-            }
-        };
-        reverse(0, half);
-        reverse(half, length);
-        reverse(0, length);
-        *swaps += swap_diagonals(band);
+    settle_band(band, swaps);
+    const uint32_t kMostEars = 64;  // each settles the band again: bounds the work
+    uint32_t ear[3];
+    for (uint32_t ears = 0; ears < kMostEars && !band_is_proper(band) && clip_ear(band, ear); ++ears) {
+        sink.emit(ear[2], ear[1], ear[0], point(ear[2]), point(ear[1]), point(ear[0]), shared);
+        settle_band(band, swaps);
     }
-    *swaps += untangle_runs(band);
+    p = band.p;
+    q = band.q;
     uint32_t i = 0, j = 0;
     for (uint32_t t = 0; t < p + q; ++t) {
         uint32_t x, y, z;  // counter-clockwise on the annulus

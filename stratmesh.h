@@ -2776,10 +2776,14 @@ struct LayerLoops {
     uint32_t bottom_count;
     uint32_t* top;
     uint32_t top_count;
+    // Per top-loop vertex, set by triangulate_layer: the pass that peeled it onto the loop
+    // (kPassBit up; 0 on the hull); the bits below are the seam's (SurfaceChain::top_unused).
+    unsigned char* top_flags;
     // From triangulate_layer: where in the sink its triangles at the bottom loop begin (they
     // come last), and how many of its points have a triangle but are off the bottom loop.
     size_t border_start;
     size_t interior_used;
+    bool bottom_peeled;  // triangulate_layer peeled triangles off the bottom loop
 };
 
 struct LayerCounts {
@@ -2807,6 +2811,9 @@ struct LayerDuplicates {
 
 // Per vertex of a layer's triangulation, in triangulate_layer (the flip stack's room).
 const uint32_t kOnBottomLoop = 1, kEmitted = 2, kOnTopLoop = 4;
+const uint32_t kPassShift = 8;  // above it: the peeling pass that put a vertex on the top loop
+const uint32_t kPassBit = 3;    // where LayerLoops::top_flags keep that pass
+const unsigned char kPassBits = static_cast<unsigned char>(0xF << kPassBit);
 
 // Collects the link of the centre (vertex 0) counter-clockwise into loop, one entry per link
 // edge u -> w: the half-edge w -> u of the triangle beyond it. Flags its vertices
@@ -2849,24 +2856,28 @@ inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* count, 
     *count = n;
 }
 
-// Both loops are convex hulls, each in its own picture: the top loop on the annulus, the
-// bottom loop on the annulus turned inside out (z -> 1/z maps the centre's link to the hull).
-// A hull's edges are chords over the points just inside it, several spacings long, and the
-// band to the next layer then spans them with long triangles that cut through the surface:
-// with 24 layers on a star-shaped tube the bands held 11% of the area, at 5 times the mean
-// distance from the true surface. The next layer's points lie beyond the chord, so in one
-// triangulation of both layers the chord's sliver would not be there. Hence a loop triangle
-// is peeled off the layer when its angle at the inner vertex x is obtuse on the surface (in
-// 3D), and x joins the loop, where the band's empty-circle swaps settle it with the other
-// layer's points. Only when x is on no loop (the loops stay simple and apart), lies between
-// the edge's ends in angle around the centre (the loop still turns monotonically), and the
-// two new loop edges rise at most kPeelSlope (the band hugs the cut: steep loop edges are
-// where no order of its rungs is counter-clockwise). And only in a layer without folds: where
-// the layer is not star-shaped around its centre the loops are not monotone around the band's
-// centre either, and longer loops gave the bands more self-intersections. The passes are
-// bounded: each peels every loop edge at most once.
+// Peeling. Both loops are convex hulls, each in its own picture: the top loop on the annulus,
+// the bottom loop on the annulus turned inside out (z -> 1/z maps the centre's link to the
+// hull). A hull's edges are chords over the points just inside it, several spacings long,
+// and the band to the next layer spanned them with long triangles that cut through the
+// surface: with 24 layers on a star-shaped tube the bands held 11% of the area, at 5 times
+// the mean distance from the true surface. The next layer's points lie beyond the chord, so
+// in one triangulation of both layers the chord's sliver would not be there. Hence a loop
+// triangle is peeled off the layer when its angle at the inner vertex x is obtuse on the
+// surface (in 3D), and x joins the loop, where the band's empty-circle swaps settle it with
+// the other layer's points. Only when x is on no loop (the loops stay simple and apart), lies
+// between the edge's ends in angle around the centre (the loop still turns monotonically),
+// and the two new loop edges rise at most kPeelSlope (45 degrees; steeper loops also made
+// the caps fail on ragged ends). And only in a layer without folds: where the layer is not
+// star-shaped around its centre the loops are not monotone around the band's centre either,
+// and longer loops gave the bands more self-intersections. The passes are bounded: each
+// peels every loop edge at most once. The top loop keeps, per vertex, the pass that put it
+// there (LayerLoops::top_flags), so that the band above can put the peeled triangles back:
+// where a band between peeled loops folds (a peeled loop can dip where the other cannot
+// follow), the upper layer is triangulated again without peeling its bottom loop and the
+// band is stitched to the unpeeled loop below (see add_group), as without peeling.
 const uint32_t kPeelPasses = 8;
-const double kPeelSlope = 0.3;
+const double kPeelSlope = 1.0;
 
 // Whether the triangle of loop entry g (see centre_link and hull_loop) is peeled.
 inline bool peels(const Triangulation& tr, const Local* points, const uint32_t* flags,
@@ -2907,7 +2918,8 @@ inline uint32_t peel_loop(Triangulation& tr, const Local* points, uint32_t* flag
                 loop[m++] = g;
                 continue;
             }
-            flags[tr.vertex[prev_edge(g)]] |= top ? kOnTopLoop : kOnBottomLoop;
+            flags[tr.vertex[prev_edge(g)]] |= top ? kOnTopLoop | (pass + 1) << kPassShift
+                                                  : kOnBottomLoop;
             const uint32_t before = tr.twin[prev_edge(g)], after = tr.twin[next_edge(g)];
             loop[m++] = top ? before : after;
             loop[m++] = top ? after : before;
@@ -2919,11 +2931,15 @@ inline uint32_t peel_loop(Triangulation& tr, const Local* points, uint32_t* flag
     return n;
 }
 
-// Turns loop entries into the layer-local indices of the loop's vertices, in loop order.
-inline void name_loop(const Triangulation& tr, const uint32_t* order, uint32_t* loop, uint32_t n,
-                      bool top) {
-    for (uint32_t i = 0; i < n; ++i)
-        loop[i] = order[tr.vertex[top ? loop[i] : next_edge(loop[i])] - 1];
+// Turns loop entries into the layer-local indices of the loop's vertices, in loop order; for
+// the top loop, also each vertex's peeling pass into passes (0: on the hull).
+inline void name_loop(const Triangulation& tr, const uint32_t* order, const uint32_t* flags,
+                      uint32_t* loop, uint32_t n, unsigned char* passes) {
+    for (uint32_t i = 0; i < n; ++i) {
+        const uint32_t v = tr.vertex[passes ? loop[i] : next_edge(loop[i])];
+        if (passes) passes[i] = static_cast<unsigned char>(flags[v] >> kPassShift << kPassBit);
+        loop[i] = order[v - 1];
+    }
 }
 
 // A layer's points in frame coordinates, read from the cloud once so that the fit, the
@@ -2963,7 +2979,7 @@ inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint3
 // order[k], an order not kept).
 inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& layer,
                                 Arena& arena, TriangleSink& sink, LayerLoops& loops,
-                                LayerCounts& counts) {
+                                LayerCounts& counts, bool peel_bottom = true) {
     const size_t count = layer.count, total = count + 1;  // vertex 0 is the centre
     Local* points = layer.points;
     const Cylinder& cyl = layer.cyl;
@@ -3018,14 +3034,16 @@ inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& lay
     }
     hull_loop(tr, loops.top, &loops.top_count, flags);
     const size_t folds = count_folds(tr, points, cyl);
+    loops.bottom_peeled = false;
     if (folds == 0) {
-        const uint32_t capacity = static_cast<uint32_t>(count);
-        loops.bottom_count = peel_loop(tr, points, flags, loops.bottom, loops.bottom_count,
-                                       capacity, false);
+        const uint32_t capacity = static_cast<uint32_t>(count), link = loops.bottom_count;
+        if (peel_bottom)
+            loops.bottom_count = peel_loop(tr, points, flags, loops.bottom, link, capacity, false);
+        loops.bottom_peeled = loops.bottom_count != link;
         loops.top_count = peel_loop(tr, points, flags, loops.top, loops.top_count, capacity, true);
     }
-    name_loop(tr, order, loops.bottom, loops.bottom_count, false);
-    name_loop(tr, order, loops.top, loops.top_count, true);
+    name_loop(tr, order, flags, loops.bottom, loops.bottom_count, nullptr);
+    name_loop(tr, order, flags, loops.top, loops.top_count, loops.top_flags);
     // The triangles at the bottom loop (the border) go last, so that a chunk's triangles at
     // its loop vertices are one stretch of the sink with the band (see chunk_is_sound).
     for (uint32_t at_border = 0; at_border < 2; ++at_border) {
@@ -3342,58 +3360,14 @@ inline void settle_band(Band& band, size_t* swaps) {
     if (!band_is_proper(band) && restart_half_way(band)) *swaps += untangle_runs(band);
 }
 
-// Where no order of rungs is counter-clockwise everywhere (a loop dips into a notch that
-// the other loop's vertices cannot see over), the notch is closed by a triangle of three
-// consecutive vertices of that loop, and its middle vertex leaves the band. For the first
-// clockwise step: its edge's end nearer the other loop's far side (A: the lower, B: the
-// higher) is tried first, then the other end; the triangle must be counter-clockwise on the
-// strip, which puts it on the loop's own side of the cut, clear of the other loop. Writes
-// the triangle in band indices, counter-clockwise on the strip; false if there is none.
-inline bool clip_ear(Band& band, uint32_t ear[3]) {
-    uint32_t i = 0, j = 0;
-    for (uint32_t t = 0; t < band.p + band.q; ++t) {
-        if (band.proper(t, i, j)) {
-            if (band.steps[t] == 0) ++i; else ++j;
-            continue;
-        }
-        const bool on_a = band.steps[t] == 0;
-        uint32_t* loop = on_a ? band.a : band.b;
-        double* uv = on_a ? band.xa : band.xb;
-        uint32_t& n = on_a ? band.p : band.q;
-        const uint32_t k = on_a ? i : j;
-        auto at = [&](uint32_t m, int slot) { return on_a ? band.pa(m, slot) : band.pb(m, slot); };
-        const bool first_end = on_a ? at(k, 0)[1] < at(k + 1, 1)[1] : at(k, 0)[1] > at(k + 1, 1)[1];
-        for (uint32_t attempt = 0; attempt < 2 && n > 3; ++attempt) {
-            const uint32_t m = (attempt == 0) == first_end ? k : k + 1;
-            if (m == 0 || m >= n) continue;
-            const double *before = at(m - 1, 0), *middle = at(m, 1), *after = at(m + 1, 2);
-            const bool ccw = on_a ? orient2d_robust(before, middle, after) > 0
-                                  : orient2d_robust(before, after, middle) > 0;
-            if (!ccw) continue;
-            ear[0] = loop[m - 1];
-            ear[1] = on_a ? loop[m] : loop[(m + 1) % n];
-            ear[2] = on_a ? loop[(m + 1) % n] : loop[m];
-            for (uint32_t r = m; r + 1 < n; ++r) {
-                loop[r] = loop[r + 1];
-                uv[2 * r] = uv[2 * r + 2];
-                uv[2 * r + 1] = uv[2 * r + 3];
-            }
-            --n;
-            return true;
-        }
-        return false;
-    }
-    return false;
-}
-
 // Stitches loop A (the lower layer's top loop: reader indices a_ids, cylinder ca) to the
 // loaded upper layer's bottom loop b (layer-local indices; the layer's cylinder has the
 // cut as h0). The band's triangles name the upper layer's points by layer-local index and
 // the i-th point of A by layer.count + i.
 inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cylinder& ca,
-                          const uint32_t* a_ids, uint32_t p, const LoadedLayer& layer,
-                          uint32_t* b, uint32_t q, Arena& arena, TriangleSink& sink,
-                          size_t* swaps) {
+                          const uint32_t* a_ids, const unsigned char* a_flags, uint32_t p,
+                          bool unpeel, const LoadedLayer& layer, uint32_t* b, uint32_t q,
+                          Arena& arena, TriangleSink& sink, size_t* swaps) {
     const Cylinder& cb = layer.cyl;
     const uint32_t below = static_cast<uint32_t>(layer.count);
     size_t mark = arena.mark();
@@ -3404,8 +3378,10 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
     unsigned char* steps = arena.alloc<unsigned char>(static_cast<size_t>(p) + q);
     double* scratch = arena.alloc<double>(kIncircleScratch);
     if (arena.failed) return false;
-    for (uint32_t i = 0; i < p; ++i) {
-        a[i] = below + i;
+    const uint32_t loop_length = p;
+    p = 0;
+    for (uint32_t i = 0; i < loop_length; ++i) {
+        if (!unpeel || !(a_flags[i] & kPassBits)) a[p++] = below + i;
         a_points[i] = frame.local(cloud.point(a_ids[i]));
     }
     // The layer's points are read again (the loaded ones are in triangulate_layer's order,
@@ -3427,20 +3403,25 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
         uv[1] = l.h - shared.h0;
     };
     for (uint32_t i = 0; i < p; ++i) unroll(a[i], xa + 2 * i);
+    if (unpeel) {
+        // The lower layer's peeled triangles come back: x, peeled in pass k off the edge
+        // between the nearest loop vertices before and after it from earlier passes.
+        auto pass = [a_flags](uint32_t i) { return a_flags[i] & kPassBits; };
+        for (uint32_t x = 0; x < loop_length; ++x) {
+            if (!pass(x)) continue;
+            uint32_t before = x - 1, after = (x + 1) % loop_length;
+            while (pass(before) >= pass(x)) --before;  // entry 0 is on the hull
+            while (pass(after) >= pass(x)) after = (after + 1) % loop_length;
+            const uint32_t u = below + before, v = below + after, w = below + x;
+            sink.emit(u, v, w, point(u), point(v), point(w), shared);
+        }
+    }
     for (uint32_t j = 0; j < q; ++j) unroll(b[j], xb + 2 * j);
     rotate_to_first_angle(a, xa, p);
     rotate_to_first_angle(b, xb, q);
     const double two_pi = 6.28318530717958647693;
     Band band = {a, xa, p, b, xb, q, two_pi * unrolled_radius, steps, scratch, {}};
     settle_band(band, swaps);
-    const uint32_t kMostEars = 64;  // each settles the band again: bounds the work
-    uint32_t ear[3];
-    for (uint32_t ears = 0; ears < kMostEars && !band_is_proper(band) && clip_ear(band, ear); ++ears) {
-        sink.emit(ear[2], ear[1], ear[0], point(ear[2]), point(ear[1]), point(ear[0]), shared);
-        settle_band(band, swaps);
-    }
-    p = band.p;
-    q = band.q;
     uint32_t i = 0, j = 0;
     for (uint32_t t = 0; t < p + q; ++t) {
         uint32_t x, y, z;  // counter-clockwise on the annulus
@@ -4447,7 +4428,8 @@ inline bool chunk_is_sound(SurfaceChain& c, const LoadedLayer& layer, const Laye
         d = d > 0 ? 1 : kNoIndex;
     }
     for (uint32_t i = 0; i < loops.top_count; ++i)
-        c.next_unused[i] = degree[loops.top[i]] == kNoIndex ? kUnusedBelow : whole;
+        c.next_unused[i] = static_cast<unsigned char>(
+            (c.next_unused[i] & kPassBits) | (degree[loops.top[i]] == kNoIndex ? kUnusedBelow : whole));
     c.used += used;
     arena.rewind(mark);
     return true;
@@ -4484,8 +4466,9 @@ inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const Laye
     for (size_t l = 0; l < below; ++l) c.used += degree[l] > 0;
     // The next seam's lower side: this chunk's triangles at the new top loop.
     for (uint32_t i = 0; i < loops.top_count; ++i)
-        c.next_unused[i] = static_cast<unsigned char>(degree[loops.top[i]] == 0 ? kUnusedBelow
-                                                      : removed == 0 ? whole : 0);
+        c.next_unused[i] = static_cast<unsigned char>((c.next_unused[i] & kPassBits) |
+                                                      (degree[loops.top[i]] == 0 ? kUnusedBelow
+                                                       : removed == 0 ? whole : 0));
     if (removed > 0) {
         uint32_t* position = degree;  // reused: the counts are taken
         for (size_t v = 0; v < vertices; ++v) position[v] = kNoIndex;
@@ -4514,7 +4497,9 @@ struct LayerAhead {
     uint32_t* triangles;     // as the sink writes them; in reader indices if replayable
     uint32_t* bottom;        // the loops in layer-local indices
     uint32_t* top;
+    unsigned char* top_flags;  // LayerLoops::top_flags
     uint32_t bottom_count, top_count;
+    bool bottom_peeled;
     // For replay_chunk: the triangles touching the bottom loop, in layer-local indices (at
     // most border_capacity), and the vertices off the bottom loop with a triangle.
     bool replayable;         // the border fits and every top-loop vertex off the bottom
@@ -4546,8 +4531,10 @@ inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops
     sink.folds += ahead.folds;
     std::memcpy(loops.bottom, ahead.bottom, ahead.bottom_count * sizeof(uint32_t));
     std::memcpy(loops.top, ahead.top, ahead.top_count * sizeof(uint32_t));
+    std::memcpy(loops.top_flags, ahead.top_flags, ahead.top_count);
     loops.bottom_count = ahead.bottom_count;
     loops.top_count = ahead.top_count;
+    loops.bottom_peeled = ahead.bottom_peeled;
     counts = ahead.counts;
     return Status::ok;
 }
@@ -4620,12 +4607,29 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
         // Tiny or thin layers make coarse, folding bands: they join the next layer if any.
         if (group_stands(n, h1 - h0, layer.cyl.radius, final)) {
             const size_t chunk_start = sink.count, folds = sink.folds, swaps = c.swaps;
-            LayerLoops loops = {c.bottom, 0, c.next_top, 0, 0, 0};
-            auto stitch = [&]() {
+            LayerLoops loops = {c.bottom, 0, c.next_top, 0, c.next_unused, 0, 0, false};
+            // A band between peeled loops that folds (a peeled loop can dip where the other
+            // cannot follow) is given up: the layer is triangulated again without peeling
+            // its bottom loop, and the band is stitched to the loop below with the triangles
+            // peeled off it put back (see "peeling" in >>layer triangulation).
+            bool top_peeled = false, band_folds = false;
+            for (uint32_t i = 0; i < c.top_count; ++i) top_peeled |= (c.top_unused[i] & kPassBits) != 0;
+            auto stitch = [&](bool unpeel) {
+                const size_t before = sink.folds;
                 if (status == Status::ok && c.top_count > 0 &&
-                    !stitch_layers(c.reader, c.frame, c.top_cylinder, c.top, c.top_count, layer,
-                                   loops.bottom, loops.bottom_count, arena, sink, &c.swaps))
+                    !stitch_layers(c.reader, c.frame, c.top_cylinder, c.top, c.top_unused,
+                                   c.top_count, unpeel, layer, loops.bottom, loops.bottom_count,
+                                   arena, sink, &c.swaps))
                     status = Status::out_of_memory;
+                band_folds = status == Status::ok && !unpeel && sink.folds != before &&
+                             (top_peeled || loops.bottom_peeled);
+            };
+            auto start_again = [&]() {
+                arena.rewind(mark);
+                sink.count = chunk_start;
+                sink.folds = folds;
+                c.swaps = swaps;
+                return load_layer(c.reader, c.frame, ids, staged, n, h0, h1, arena, layer);
             };
             // A job's result in reader indices goes in as it is when its chunk needs no
             // safety net; else the layer is loaded and triangulated again, in order, to the
@@ -4635,22 +4639,27 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
             bool finished = false, retriangulate = !triangulated;
             if (triangulated) {
                 status = take_ahead(*ahead, sink, loops, result.counts);
-                stitch();
-                finished = status != Status::ok || sink.count > sink.capacity ||
-                           (ahead->replayable &&
-                            replay_chunk(c, layer, loops, *ahead, chunk_start, arena, sink));
-                if (!finished && ahead->replayable) {
-                    sink.count = chunk_start;
-                    sink.folds = folds;
-                    c.swaps = swaps;
-                    if (!load_layer(c.reader, c.frame, ids, staged, n, h0, h1, arena, layer))
-                        return Status::out_of_memory;
+                stitch(false);
+                finished = !band_folds &&
+                           (status != Status::ok || sink.count > sink.capacity ||
+                            (ahead->replayable &&
+                             replay_chunk(c, layer, loops, *ahead, chunk_start, arena, sink)));
+                if (!finished && (ahead->replayable || band_folds)) {
+                    if (!start_again()) return Status::out_of_memory;
                     retriangulate = true;
                 }
             }
             if (retriangulate) {
-                status = triangulate_layer(c.reader, layer, arena, sink, loops, result.counts);
-                stitch();
+                const bool unpeel = band_folds;
+                status = triangulate_layer(c.reader, layer, arena, sink, loops, result.counts,
+                                           !unpeel);
+                stitch(unpeel);
+                if (band_folds) {
+                    if (!start_again()) return Status::out_of_memory;
+                    status = triangulate_layer(c.reader, layer, arena, sink, loops, result.counts,
+                                               false);
+                    stitch(true);
+                }
             }
             result.triangles = sink.count - chunk_start;
             result.folds = sink.folds - folds;
@@ -4821,12 +4830,13 @@ struct ParallelLayers {
 // planned layers.
 inline bool allocate_ahead(ParallelLayers& p, uint32_t slots, size_t points, size_t layers,
                            Arena& arena, uint32_t** triangles, uint32_t** loops,
-                           uint32_t** borders) {
+                           unsigned char** top_flags, uint32_t** borders) {
     p.ahead = arena.alloc<LayerAhead>(slots);
     p.layer_of_slot = arena.alloc<uint32_t>(slots);
     p.slot_of_layer = arena.alloc<uint32_t>(layers);
     *triangles = arena.alloc<uint32_t>(3 * 2 * points);
     *loops = arena.alloc<uint32_t>(2 * points);
+    *top_flags = arena.alloc<unsigned char>(points);
     *borders = arena.alloc<uint32_t>(3 * (points / 4 + 4 * static_cast<size_t>(slots)));
     return !arena.failed;
 }
@@ -4891,7 +4901,7 @@ inline void run_layer_job(void* context, uint32_t index) {
             !group_stands(n, q.bounds[k + 1] - q.bounds[k], layer.cyl.radius, k + 1 == q.planned))
             continue;
         TriangleSink sink = {a.triangles, 2 * n, 0, 0};
-        LayerLoops loops = {a.bottom, 0, a.top, 0, 0, 0};
+        LayerLoops loops = {a.bottom, 0, a.top, 0, a.top_flags, 0, 0, false};
         a.status = triangulate_layer(*p.reader, layer, arena, sink, loops, a.counts);
         // An annulus through n points has at most 2n triangles; anything else is redone in order.
         if ((a.status != Status::ok && a.status != Status::not_columnar) || sink.count > sink.capacity)
@@ -4901,6 +4911,7 @@ inline void run_layer_job(void* context, uint32_t index) {
         a.folds = sink.folds;
         a.bottom_count = loops.bottom_count;
         a.top_count = loops.top_count;
+        a.bottom_peeled = loops.bottom_peeled;
         if (a.status == Status::ok) keep_border(a, q.ids + q.start[k], n, arena);
         a.done = true;
     }
@@ -4928,8 +4939,10 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
     };
     uint32_t* triangles = nullptr;
     uint32_t* loops = nullptr;
+    unsigned char* top_flags = nullptr;
     uint32_t* borders = nullptr;
-    if (!allocate_ahead(p, slots, points, q.planned, arena, &triangles, &loops, &borders))
+    if (!allocate_ahead(p, slots, points, q.planned, arena, &triangles, &loops, &top_flags,
+                        &borders))
         return give_up();
     p.slots = slots;
     uint32_t slot = 0;
@@ -4943,6 +4956,7 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
         a.triangles = triangles + 6 * at;
         a.bottom = loops + 2 * at;
         a.top = loops + 2 * at + n;
+        a.top_flags = top_flags + at;
         a.border = borders + 3 * border_at;
         a.border_capacity = border_capacity(n);
         border_at += a.border_capacity;
@@ -5009,10 +5023,11 @@ inline bool plan_parallel_workspace(size_t point_count, size_t layer_limit, Aren
     ParallelLayers p;
     uint32_t* triangles = nullptr;
     uint32_t* loops = nullptr;
+    unsigned char* top_flags = nullptr;
     uint32_t* borders = nullptr;
     size_t slots = point_count / kMinLayerPoints + 1;
     allocate_ahead(p, static_cast<uint32_t>(slots), point_count, layer_limit, arena, &triangles,
-                   &loops, &borders);
+                   &loops, &top_flags, &borders);
     size_t jobs = job_scratch_bound(point_count);
     if (jobs > *scratch) *scratch = jobs;
     return jobs != 0;

@@ -2776,14 +2776,15 @@ struct LayerLoops {
     uint32_t bottom_count;
     uint32_t* top;
     uint32_t top_count;
-    // Per top-loop vertex, set by triangulate_layer: the pass that peeled it onto the loop
-    // (kPassBit up; 0 on the hull); the bits below are the seam's (SurfaceChain::top_unused).
+    // Per loop vertex, set by triangulate_layer: the pass that peeled it onto the loop
+    // (kPassBit up; 0 on the centre's link or the hull); the bits below are the seam's
+    // (SurfaceChain::top_unused).
+    unsigned char* bottom_flags;
     unsigned char* top_flags;
     // From triangulate_layer: where in the sink its triangles at the bottom loop begin (they
     // come last), and how many of its points have a triangle but are off the bottom loop.
     size_t border_start;
     size_t interior_used;
-    bool bottom_peeled;  // triangulate_layer peeled triangles off the bottom loop
 };
 
 struct LayerCounts {
@@ -2918,8 +2919,8 @@ inline uint32_t peel_loop(Triangulation& tr, const Local* points, uint32_t* flag
                 loop[m++] = g;
                 continue;
             }
-            flags[tr.vertex[prev_edge(g)]] |= top ? kOnTopLoop | (pass + 1) << kPassShift
-                                                  : kOnBottomLoop;
+            flags[tr.vertex[prev_edge(g)]] |= (top ? kOnTopLoop : kOnBottomLoop) |
+                                              (pass + 1) << kPassShift;
             const uint32_t before = tr.twin[prev_edge(g)], after = tr.twin[next_edge(g)];
             loop[m++] = top ? before : after;
             loop[m++] = top ? after : before;
@@ -2931,13 +2932,13 @@ inline uint32_t peel_loop(Triangulation& tr, const Local* points, uint32_t* flag
     return n;
 }
 
-// Turns loop entries into the layer-local indices of the loop's vertices, in loop order; for
-// the top loop, also each vertex's peeling pass into passes (0: on the hull).
+// Turns loop entries into the layer-local indices of the loop's vertices, in loop order, and
+// sets each vertex's peeling pass in passes (0: on the centre's link or the hull).
 inline void name_loop(const Triangulation& tr, const uint32_t* order, const uint32_t* flags,
-                      uint32_t* loop, uint32_t n, unsigned char* passes) {
+                      uint32_t* loop, uint32_t n, unsigned char* passes, bool top) {
     for (uint32_t i = 0; i < n; ++i) {
-        const uint32_t v = tr.vertex[passes ? loop[i] : next_edge(loop[i])];
-        if (passes) passes[i] = static_cast<unsigned char>(flags[v] >> kPassShift << kPassBit);
+        const uint32_t v = tr.vertex[top ? loop[i] : next_edge(loop[i])];
+        passes[i] = static_cast<unsigned char>(flags[v] >> kPassShift << kPassBit);
         loop[i] = order[v - 1];
     }
 }
@@ -2979,7 +2980,7 @@ inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint3
 // order[k], an order not kept).
 inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& layer,
                                 Arena& arena, TriangleSink& sink, LayerLoops& loops,
-                                LayerCounts& counts, bool peel_bottom = true) {
+                                LayerCounts& counts) {
     const size_t count = layer.count, total = count + 1;  // vertex 0 is the centre
     Local* points = layer.points;
     const Cylinder& cyl = layer.cyl;
@@ -3034,16 +3035,14 @@ inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& lay
     }
     hull_loop(tr, loops.top, &loops.top_count, flags);
     const size_t folds = count_folds(tr, points, cyl);
-    loops.bottom_peeled = false;
     if (folds == 0) {
-        const uint32_t capacity = static_cast<uint32_t>(count), link = loops.bottom_count;
-        if (peel_bottom)
-            loops.bottom_count = peel_loop(tr, points, flags, loops.bottom, link, capacity, false);
-        loops.bottom_peeled = loops.bottom_count != link;
+        const uint32_t capacity = static_cast<uint32_t>(count);
+        loops.bottom_count = peel_loop(tr, points, flags, loops.bottom, loops.bottom_count,
+                                       capacity, false);
         loops.top_count = peel_loop(tr, points, flags, loops.top, loops.top_count, capacity, true);
     }
-    name_loop(tr, order, flags, loops.bottom, loops.bottom_count, nullptr);
-    name_loop(tr, order, flags, loops.top, loops.top_count, loops.top_flags);
+    name_loop(tr, order, flags, loops.bottom, loops.bottom_count, loops.bottom_flags, false);
+    name_loop(tr, order, flags, loops.top, loops.top_count, loops.top_flags, true);
     // The triangles at the bottom loop (the border) go last, so that a chunk's triangles at
     // its loop vertices are one stretch of the sink with the band (see chunk_is_sound).
     for (uint32_t at_border = 0; at_border < 2; ++at_border) {
@@ -3360,30 +3359,55 @@ inline void settle_band(Band& band, size_t* swaps) {
     if (!band_is_proper(band) && restart_half_way(band)) *swaps += untangle_runs(band);
 }
 
+// Emits the triangles peeled off a loop (see "peeling" in >>layer triangulation): vertex x,
+// peeled in pass k, came off the edge between the nearest loop vertices before and after it
+// from earlier passes (entry 0 is on the hull or the link). id(i) is entry i's band index,
+// point(id) its point.
+template <class IdOf, class PointOf>
+inline void put_back_peeled(const unsigned char* flags, uint32_t n, bool top, const IdOf& id,
+                            const PointOf& point, const Cylinder& cyl, TriangleSink& sink) {
+    auto pass = [flags](uint32_t i) { return flags[i] & kPassBits; };
+    for (uint32_t x = 0; x < n; ++x) {
+        if (!pass(x)) continue;
+        uint32_t before = x - 1, after = (x + 1) % n;
+        while (pass(before) >= pass(x)) --before;
+        while (pass(after) >= pass(x)) after = (after + 1) % n;
+        // Counter-clockwise on the annulus: the top loop's edge ran before -> after, the
+        // bottom loop's after -> before.
+        uint32_t u = id(top ? before : after), v = id(top ? after : before), w = id(x);
+        sink.emit(u, v, w, point(u), point(v), point(w), cyl);
+    }
+}
+
 // Stitches loop A (the lower layer's top loop: reader indices a_ids, cylinder ca) to the
 // loaded upper layer's bottom loop b (layer-local indices; the layer's cylinder has the
 // cut as h0). The band's triangles name the upper layer's points by layer-local index and
 // the i-th point of A by layer.count + i.
 inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cylinder& ca,
                           const uint32_t* a_ids, const unsigned char* a_flags, uint32_t p,
-                          bool unpeel, const LoadedLayer& layer, uint32_t* b, uint32_t q,
+                          const LoadedLayer& layer, const LayerLoops& loops, bool unpeel,
                           Arena& arena, TriangleSink& sink, size_t* swaps) {
     const Cylinder& cb = layer.cyl;
     const uint32_t below = static_cast<uint32_t>(layer.count);
     size_t mark = arena.mark();
+    uint32_t q = loops.bottom_count;
     uint32_t* a = arena.alloc<uint32_t>(p);
+    uint32_t* b = arena.alloc<uint32_t>(q);
     Local* a_points = arena.alloc<Local>(p);
     double* xa = arena.alloc<double>(2 * static_cast<size_t>(p));
     double* xb = arena.alloc<double>(2 * static_cast<size_t>(q));
     unsigned char* steps = arena.alloc<unsigned char>(static_cast<size_t>(p) + q);
     double* scratch = arena.alloc<double>(kIncircleScratch);
     if (arena.failed) return false;
-    const uint32_t loop_length = p;
+    const uint32_t a_length = p;
     p = 0;
-    for (uint32_t i = 0; i < loop_length; ++i) {
+    for (uint32_t i = 0; i < a_length; ++i) {
         if (!unpeel || !(a_flags[i] & kPassBits)) a[p++] = below + i;
         a_points[i] = frame.local(cloud.point(a_ids[i]));
     }
+    q = 0;
+    for (uint32_t j = 0; j < loops.bottom_count; ++j)
+        if (!unpeel || !(loops.bottom_flags[j] & kPassBits)) b[q++] = loops.bottom[j];
     // The layer's points are read again (the loaded ones are in triangulate_layer's order,
     // or were never loaded when a job triangulated the layer): only the loop's are read.
     auto point = [&](uint32_t id) -> Local {
@@ -3404,17 +3428,10 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
     };
     for (uint32_t i = 0; i < p; ++i) unroll(a[i], xa + 2 * i);
     if (unpeel) {
-        // The lower layer's peeled triangles come back: x, peeled in pass k off the edge
-        // between the nearest loop vertices before and after it from earlier passes.
-        auto pass = [a_flags](uint32_t i) { return a_flags[i] & kPassBits; };
-        for (uint32_t x = 0; x < loop_length; ++x) {
-            if (!pass(x)) continue;
-            uint32_t before = x - 1, after = (x + 1) % loop_length;
-            while (pass(before) >= pass(x)) --before;  // entry 0 is on the hull
-            while (pass(after) >= pass(x)) after = (after + 1) % loop_length;
-            const uint32_t u = below + before, v = below + after, w = below + x;
-            sink.emit(u, v, w, point(u), point(v), point(w), shared);
-        }
+        put_back_peeled(a_flags, a_length, true, [below](uint32_t i) { return below + i; },
+                        point, shared, sink);
+        put_back_peeled(loops.bottom_flags, loops.bottom_count, false,
+                        [&loops](uint32_t j) { return loops.bottom[j]; }, point, shared, sink);
     }
     for (uint32_t j = 0; j < q; ++j) unroll(b[j], xb + 2 * j);
     rotate_to_first_angle(a, xa, p);
@@ -4279,6 +4296,7 @@ struct SurfaceChain {
     uint32_t* next_top;
     unsigned char* next_unused;
     uint32_t* bottom;
+    unsigned char* bottom_flags;
     size_t groups, duplicates, collisions, swaps, removed, used, trailing;
 };
 
@@ -4286,6 +4304,7 @@ inline bool allocate_chain(SurfaceChain& c, size_t points, Arena& arena) {
     c.top = arena.alloc<uint32_t>(points);
     c.next_top = arena.alloc<uint32_t>(points);
     c.bottom = arena.alloc<uint32_t>(points);
+    c.bottom_flags = arena.alloc<unsigned char>(points);
     c.top_unused = arena.alloc<unsigned char>(points);
     c.next_unused = arena.alloc<unsigned char>(points);
     c.top_count = 0;
@@ -4497,9 +4516,9 @@ struct LayerAhead {
     uint32_t* triangles;     // as the sink writes them; in reader indices if replayable
     uint32_t* bottom;        // the loops in layer-local indices
     uint32_t* top;
-    unsigned char* top_flags;  // LayerLoops::top_flags
+    unsigned char* bottom_flags;  // LayerLoops::bottom_flags, top_flags
+    unsigned char* top_flags;
     uint32_t bottom_count, top_count;
-    bool bottom_peeled;
     // For replay_chunk: the triangles touching the bottom loop, in layer-local indices (at
     // most border_capacity), and the vertices off the bottom loop with a triangle.
     bool replayable;         // the border fits and every top-loop vertex off the bottom
@@ -4531,10 +4550,10 @@ inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops
     sink.folds += ahead.folds;
     std::memcpy(loops.bottom, ahead.bottom, ahead.bottom_count * sizeof(uint32_t));
     std::memcpy(loops.top, ahead.top, ahead.top_count * sizeof(uint32_t));
+    std::memcpy(loops.bottom_flags, ahead.bottom_flags, ahead.bottom_count);
     std::memcpy(loops.top_flags, ahead.top_flags, ahead.top_count);
     loops.bottom_count = ahead.bottom_count;
     loops.top_count = ahead.top_count;
-    loops.bottom_peeled = ahead.bottom_peeled;
     counts = ahead.counts;
     return Status::ok;
 }
@@ -4607,29 +4626,30 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
         // Tiny or thin layers make coarse, folding bands: they join the next layer if any.
         if (group_stands(n, h1 - h0, layer.cyl.radius, final)) {
             const size_t chunk_start = sink.count, folds = sink.folds, swaps = c.swaps;
-            LayerLoops loops = {c.bottom, 0, c.next_top, 0, c.next_unused, 0, 0, false};
+            LayerLoops loops = {c.bottom, 0, c.next_top, 0, c.bottom_flags, c.next_unused, 0, 0};
             // A band between peeled loops that folds (a peeled loop can dip where the other
-            // cannot follow) is given up: the layer is triangulated again without peeling
-            // its bottom loop, and the band is stitched to the loop below with the triangles
-            // peeled off it put back (see "peeling" in >>layer triangulation).
-            bool top_peeled = false, band_folds = false;
-            for (uint32_t i = 0; i < c.top_count; ++i) top_peeled |= (c.top_unused[i] & kPassBits) != 0;
-            auto stitch = [&](bool unpeel) {
-                const size_t before = sink.folds;
-                if (status == Status::ok && c.top_count > 0 &&
-                    !stitch_layers(c.reader, c.frame, c.top_cylinder, c.top, c.top_unused,
-                                   c.top_count, unpeel, layer, loops.bottom, loops.bottom_count,
-                                   arena, sink, &c.swaps))
-                    status = Status::out_of_memory;
-                band_folds = status == Status::ok && !unpeel && sink.folds != before &&
-                             (top_peeled || loops.bottom_peeled);
-            };
-            auto start_again = [&]() {
-                arena.rewind(mark);
-                sink.count = chunk_start;
-                sink.folds = folds;
-                c.swaps = swaps;
-                return load_layer(c.reader, c.frame, ids, staged, n, h0, h1, arena, layer);
+            // cannot follow) is stitched again between the loops as they were before peeling,
+            // with the triangles peeled off them put back (see "peeling" in >>layer
+            // triangulation).
+            auto stitch = [&]() {
+                if (status != Status::ok || c.top_count == 0) return;
+                const size_t band_start = sink.count, band_folds = sink.folds, band_swaps = c.swaps;
+                bool peeled = false;
+                for (uint32_t i = 0; i < c.top_count; ++i) peeled |= (c.top_unused[i] & kPassBits) != 0;
+                for (uint32_t j = 0; j < loops.bottom_count; ++j)
+                    peeled |= (loops.bottom_flags[j] & kPassBits) != 0;
+                for (int unpeel = 0; unpeel < 2; ++unpeel) {
+                    sink.count = band_start;
+                    sink.folds = band_folds;
+                    c.swaps = band_swaps;
+                    if (!stitch_layers(c.reader, c.frame, c.top_cylinder, c.top, c.top_unused,
+                                       c.top_count, layer, loops, unpeel != 0, arena, sink,
+                                       &c.swaps)) {
+                        status = Status::out_of_memory;
+                        return;
+                    }
+                    if (!peeled || sink.folds == band_folds) return;
+                }
             };
             // A job's result in reader indices goes in as it is when its chunk needs no
             // safety net; else the layer is loaded and triangulated again, in order, to the
@@ -4639,27 +4659,22 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
             bool finished = false, retriangulate = !triangulated;
             if (triangulated) {
                 status = take_ahead(*ahead, sink, loops, result.counts);
-                stitch(false);
-                finished = !band_folds &&
-                           (status != Status::ok || sink.count > sink.capacity ||
-                            (ahead->replayable &&
-                             replay_chunk(c, layer, loops, *ahead, chunk_start, arena, sink)));
-                if (!finished && (ahead->replayable || band_folds)) {
-                    if (!start_again()) return Status::out_of_memory;
+                stitch();
+                finished = status != Status::ok || sink.count > sink.capacity ||
+                           (ahead->replayable &&
+                            replay_chunk(c, layer, loops, *ahead, chunk_start, arena, sink));
+                if (!finished && ahead->replayable) {
+                    sink.count = chunk_start;
+                    sink.folds = folds;
+                    c.swaps = swaps;
+                    if (!load_layer(c.reader, c.frame, ids, staged, n, h0, h1, arena, layer))
+                        return Status::out_of_memory;
                     retriangulate = true;
                 }
             }
             if (retriangulate) {
-                const bool unpeel = band_folds;
-                status = triangulate_layer(c.reader, layer, arena, sink, loops, result.counts,
-                                           !unpeel);
-                stitch(unpeel);
-                if (band_folds) {
-                    if (!start_again()) return Status::out_of_memory;
-                    status = triangulate_layer(c.reader, layer, arena, sink, loops, result.counts,
-                                               false);
-                    stitch(true);
-                }
+                status = triangulate_layer(c.reader, layer, arena, sink, loops, result.counts);
+                stitch();
             }
             result.triangles = sink.count - chunk_start;
             result.folds = sink.folds - folds;
@@ -4830,13 +4845,13 @@ struct ParallelLayers {
 // planned layers.
 inline bool allocate_ahead(ParallelLayers& p, uint32_t slots, size_t points, size_t layers,
                            Arena& arena, uint32_t** triangles, uint32_t** loops,
-                           unsigned char** top_flags, uint32_t** borders) {
+                           unsigned char** loop_flags, uint32_t** borders) {
     p.ahead = arena.alloc<LayerAhead>(slots);
     p.layer_of_slot = arena.alloc<uint32_t>(slots);
     p.slot_of_layer = arena.alloc<uint32_t>(layers);
     *triangles = arena.alloc<uint32_t>(3 * 2 * points);
     *loops = arena.alloc<uint32_t>(2 * points);
-    *top_flags = arena.alloc<unsigned char>(points);
+    *loop_flags = arena.alloc<unsigned char>(2 * points);
     *borders = arena.alloc<uint32_t>(3 * (points / 4 + 4 * static_cast<size_t>(slots)));
     return !arena.failed;
 }
@@ -4901,7 +4916,7 @@ inline void run_layer_job(void* context, uint32_t index) {
             !group_stands(n, q.bounds[k + 1] - q.bounds[k], layer.cyl.radius, k + 1 == q.planned))
             continue;
         TriangleSink sink = {a.triangles, 2 * n, 0, 0};
-        LayerLoops loops = {a.bottom, 0, a.top, 0, a.top_flags, 0, 0, false};
+        LayerLoops loops = {a.bottom, 0, a.top, 0, a.bottom_flags, a.top_flags, 0, 0};
         a.status = triangulate_layer(*p.reader, layer, arena, sink, loops, a.counts);
         // An annulus through n points has at most 2n triangles; anything else is redone in order.
         if ((a.status != Status::ok && a.status != Status::not_columnar) || sink.count > sink.capacity)
@@ -4911,7 +4926,6 @@ inline void run_layer_job(void* context, uint32_t index) {
         a.folds = sink.folds;
         a.bottom_count = loops.bottom_count;
         a.top_count = loops.top_count;
-        a.bottom_peeled = loops.bottom_peeled;
         if (a.status == Status::ok) keep_border(a, q.ids + q.start[k], n, arena);
         a.done = true;
     }
@@ -4939,9 +4953,9 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
     };
     uint32_t* triangles = nullptr;
     uint32_t* loops = nullptr;
-    unsigned char* top_flags = nullptr;
+    unsigned char* loop_flags = nullptr;
     uint32_t* borders = nullptr;
-    if (!allocate_ahead(p, slots, points, q.planned, arena, &triangles, &loops, &top_flags,
+    if (!allocate_ahead(p, slots, points, q.planned, arena, &triangles, &loops, &loop_flags,
                         &borders))
         return give_up();
     p.slots = slots;
@@ -4956,7 +4970,8 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
         a.triangles = triangles + 6 * at;
         a.bottom = loops + 2 * at;
         a.top = loops + 2 * at + n;
-        a.top_flags = top_flags + at;
+        a.bottom_flags = loop_flags + 2 * at;
+        a.top_flags = loop_flags + 2 * at + n;
         a.border = borders + 3 * border_at;
         a.border_capacity = border_capacity(n);
         border_at += a.border_capacity;
@@ -5023,11 +5038,11 @@ inline bool plan_parallel_workspace(size_t point_count, size_t layer_limit, Aren
     ParallelLayers p;
     uint32_t* triangles = nullptr;
     uint32_t* loops = nullptr;
-    unsigned char* top_flags = nullptr;
+    unsigned char* loop_flags = nullptr;
     uint32_t* borders = nullptr;
     size_t slots = point_count / kMinLayerPoints + 1;
     allocate_ahead(p, static_cast<uint32_t>(slots), point_count, layer_limit, arena, &triangles,
-                   &loops, &top_flags, &borders);
+                   &loops, &loop_flags, &borders);
     size_t jobs = job_scratch_bound(point_count);
     if (jobs > *scratch) *scratch = jobs;
     return jobs != 0;

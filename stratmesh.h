@@ -65,10 +65,13 @@
 //                            comes first (the Cortex-M7 build): the parallel layers, as
 //                            above, the safety net's shortcut (a check of the loop
 //                            vertices that skips the net on sound chunks, about 0.4 KiB;
-//                            without it the net runs on every chunk) and the staging of
-//                            the grouped points in spare workspace (see Memory). On
+//                            without it the net runs on every chunk), the staging of
+//                            the grouped points in spare workspace (see Memory), and the
+//                            predicates' integer stage (near-ties go to the expansion
+//                            stages, which give the same signs; about 1.7 KiB). On
 //                            x86-64 a 1e6-point tube then takes 1.5 to 1.55 times as
-//                            long. The output is the same bytes either way.
+//                            long (scanner grids, full of exact ties, longer). The
+//                            output is the same bytes either way.
 //
 // ==== Memory ===============================================================================
 //
@@ -80,9 +83,9 @@
 // the input.
 //
 // delaunay_2d needs 72 bytes per point plus about 10 KiB; its output is at most
-// 2n - 5 triangles (24 bytes per point). reconstruct needs about 114 bytes per point
+// 2n - 5 triangles (24 bytes per point). reconstruct needs about 115 bytes per point
 // (the triangulation of its largest possible layer with the layer's coordinates, plus the
-// layer grouping and boundary loops), about 118 with the close_ends flag, about 162 with a
+// layer grouping and boundary loops), about 121 with the close_ends flag, about 166 with a
 // jobs runner (Options::run_jobs); its output is at most 2n triangles. A stream needs about
 // 190 bytes per point it holds at once, whatever the size of the whole cloud.
 //
@@ -414,8 +417,8 @@ struct Report {
 // Report::workspace_used tells what a run really needed, which follows its largest layer
 // (measured on 2000-point tubes: the bound is 1.05 times the peak for one layer, 3.1 to
 // 3.3 times it with six or more layers). With Options::run_jobs it also covers the
-// layers triangulated ahead and the jobs' scratch (about 162 bytes per point instead of
-// 114). 0 if no workspace can serve that many points (as for delaunay_2d_workspace_size).
+// layers triangulated ahead and the jobs' scratch (about 166 bytes per point instead of
+// 115). 0 if no workspace can serve that many points (as for delaunay_2d_workspace_size).
 size_t reconstruct_workspace_size(size_t point_count, const Options& options);
 
 // The most triangles reconstruct() can produce for point_count points: 2n (0 if that does
@@ -2872,11 +2875,11 @@ inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* count, 
 // the caps fail on ragged ends). And only in a layer without folds: where the layer is not
 // star-shaped around its centre the loops are not monotone around the band's centre either,
 // and longer loops gave the bands more self-intersections. The passes are bounded: each
-// peels every loop edge at most once. The top loop keeps, per vertex, the pass that put it
-// there (LayerLoops::top_flags), so that the band above can put the peeled triangles back:
-// where a band between peeled loops folds (a peeled loop can dip where the other cannot
-// follow), the upper layer is triangulated again without peeling its bottom loop and the
-// band is stitched to the unpeeled loop below (see add_group), as without peeling.
+// peels every loop edge at most once. Each loop keeps, per vertex, the pass that put it
+// there (LayerLoops::bottom_flags, top_flags), so that the band can put the peeled
+// triangles back: where a band between peeled loops folds (a peeled loop can dip where the
+// other cannot follow), add_group stitches it again between the loops as they were, with
+// the triangles peeled off both put back (put_back_peeled): the seam as without peeling.
 const uint32_t kPeelPasses = 8;
 const double kPeelSlope = 1.0;
 
@@ -3081,9 +3084,13 @@ inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& lay
 // exchanges adjacent A and B steps, so the band stays a band; a clockwise step the swaps
 // cannot reach is then untangled across its run (see untangle_runs). The strip is
 // periodic: a vertex reached again after a full turn is shifted by the circumference. The
-// rung that closes the loop (first A vertex to first B vertex) is kept. The strip, not the
-// annulus, is used here because band triangles are long and flat: on the annulus the
-// circle's curvature would flip their orientation relative to the surface.
+// rung that closes the loop (first A vertex to first B vertex) is kept by both, so the band
+// restarts half-way round for a second pass of each. The strip, not the annulus, is used
+// here because band triangles are long and flat: on the annulus the circle's curvature would
+// flip their orientation relative to the surface. The loops come peeled (see "peeling" in
+// >>layer triangulation): they hug the cut, so the band's triangles join points about one
+// spacing apart; where a band between peeled loops still folds, add_group stitches it again
+// from the loops as they were, with the peeled triangles put back.
 
 // Rotates loop[0..n) and its strip coordinates so that entry `first` comes first; the
 // entries moved to the end are shifted by `turn` (one period of the strip), so angles

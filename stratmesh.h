@@ -2815,8 +2815,8 @@ struct LayerDuplicates {
 
 // Per vertex of a layer's triangulation, in triangulate_layer (the flip stack's room).
 const uint32_t kOnBottomLoop = 1, kEmitted = 2, kOnTopLoop = 4;
-const uint32_t kPassShift = 8;  // above it: the peeling pass that put a vertex on the top loop
-const uint32_t kPassBit = 3;    // where LayerLoops::top_flags keep that pass
+const uint32_t kPassShift = 8;  // above it: the peeling pass that put a vertex on its loop
+const uint32_t kPassBit = 3;    // where LayerLoops::bottom_flags and top_flags keep that pass
 const unsigned char kPassBits = static_cast<unsigned char>(0xF << kPassBit);
 
 // Collects the link of the centre (vertex 0) counter-clockwise into loop, one entry per link
@@ -3042,7 +3042,8 @@ inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& lay
         const uint32_t capacity = static_cast<uint32_t>(count);
         loops.bottom_count = peel_loop(tr, points, flags, loops.bottom, loops.bottom_count,
                                        capacity, false);
-        loops.top_count = peel_loop(tr, points, flags, loops.top, loops.top_count, capacity, true);
+        loops.top_count =
+            peel_loop(tr, points, flags, loops.top, loops.top_count, capacity, true);
     }
     name_loop(tr, order, flags, loops.bottom, loops.bottom_count, loops.bottom_flags, false);
     name_loop(tr, order, flags, loops.top, loops.top_count, loops.top_flags, true);
@@ -3126,7 +3127,7 @@ inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
 
 struct Band {
     uint32_t* a;        // loop A, band indices (see stitch_layers)
-    double* xa;   // its strip coordinates, angles increasing from the smallest
+    double* xa;         // its strip coordinates, angles increasing from the smallest
     uint32_t p;
     uint32_t* b;
     double* xb;
@@ -3386,10 +3387,11 @@ inline void put_back_peeled(const unsigned char* flags, uint32_t n, bool top, co
     }
 }
 
-// Stitches loop A (the lower layer's top loop: reader indices a_ids, cylinder ca) to the
-// loaded upper layer's bottom loop b (layer-local indices; the layer's cylinder has the
-// cut as h0). The band's triangles name the upper layer's points by layer-local index and
-// the i-th point of A by layer.count + i.
+// Stitches loop A (the lower layer's top loop: reader indices a_ids with their seam flags,
+// cylinder ca) to the loaded upper layer's bottom loop (loops.bottom, layer-local indices;
+// the layer's cylinder has the cut as h0). With `unpeel`, both loops as they were before
+// peeling, and the peeled triangles put back. The band's triangles name the upper layer's
+// points by layer-local index and the i-th point of A by layer.count + i.
 inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cylinder& ca,
                           const uint32_t* a_ids, const unsigned char* a_flags, uint32_t p,
                           const LoadedLayer& layer, const LayerLoops& loops, bool unpeel,
@@ -4455,7 +4457,8 @@ inline bool chunk_is_sound(SurfaceChain& c, const LoadedLayer& layer, const Laye
     }
     for (uint32_t i = 0; i < loops.top_count; ++i)
         c.next_unused[i] = static_cast<unsigned char>(
-            (c.next_unused[i] & kPassBits) | (degree[loops.top[i]] == kNoIndex ? kUnusedBelow : whole));
+            (c.next_unused[i] & kPassBits) |
+            (degree[loops.top[i]] == kNoIndex ? kUnusedBelow : whole));
     c.used += used;
     arena.rewind(mark);
     return true;
@@ -4633,16 +4636,19 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
         // Tiny or thin layers make coarse, folding bands: they join the next layer if any.
         if (group_stands(n, h1 - h0, layer.cyl.radius, final)) {
             const size_t chunk_start = sink.count, folds = sink.folds, swaps = c.swaps;
-            LayerLoops loops = {c.bottom, 0, c.next_top, 0, c.bottom_flags, c.next_unused, 0, 0};
+            LayerLoops loops = {c.bottom, 0, c.next_top, 0, c.bottom_flags, c.next_unused,
+                                0, 0};
             // A band between peeled loops that folds (a peeled loop can dip where the other
             // cannot follow) is stitched again between the loops as they were before peeling,
             // with the triangles peeled off them put back (see "peeling" in >>layer
             // triangulation).
             auto stitch = [&]() {
                 if (status != Status::ok || c.top_count == 0) return;
-                const size_t band_start = sink.count, band_folds = sink.folds, band_swaps = c.swaps;
+                const size_t band_start = sink.count, band_folds = sink.folds;
+                const size_t band_swaps = c.swaps;
                 bool peeled = false;
-                for (uint32_t i = 0; i < c.top_count; ++i) peeled |= (c.top_unused[i] & kPassBits) != 0;
+                for (uint32_t i = 0; i < c.top_count; ++i)
+                    peeled |= (c.top_unused[i] & kPassBits) != 0;
                 for (uint32_t j = 0; j < loops.bottom_count; ++j)
                     peeled |= (loops.bottom_flags[j] & kPassBits) != 0;
                 for (int unpeel = 0; unpeel < 2; ++unpeel) {

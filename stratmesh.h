@@ -2732,13 +2732,20 @@ inline bool faces_axis(const Local& pa, const Local& pb, const Local& pc, const 
     return n.x * rx + n.y * ry < 0;
 }
 
-// The surface triangles of a layer's triangulation (vertex v is points[v - 1]; vertex 0, the
-// centre, and the ghosts are not surface) that face its axis.
+// Whether triangle t of a layer's triangulation is on the surface: neither a ghost nor at
+// vertex 0, the centre (nor peeled: see peel_loop).
+inline bool on_surface(const Triangulation& tr, uint32_t t) {
+    const uint32_t* v = tr.vertex + 3 * t;
+    return !tr.is_ghost(t) && v[0] != 0 && v[1] != 0 && v[2] != 0;
+}
+
+// The surface triangles of a layer's triangulation (vertex v is points[v - 1]) that face its
+// axis.
 inline size_t count_folds(const Triangulation& tr, const Local* points, const Cylinder& cyl) {
     size_t folds = 0;
     for (uint32_t t = 0; t < tr.triangle_count; ++t) {
         const uint32_t* v = tr.vertex + 3 * t;
-        if (tr.is_ghost(t) || v[0] == 0 || v[1] == 0 || v[2] == 0) continue;
+        if (!on_surface(tr, t)) continue;
         folds += faces_axis(points[v[2] - 1], points[v[1] - 1], points[v[0] - 1], cyl);
     }
     return folds;
@@ -2886,8 +2893,7 @@ const double kPeelSlope = 1.0;
 // Whether the triangle of loop entry g (see centre_link and hull_loop) is peeled.
 inline bool peels(const Triangulation& tr, const Local* points, const uint32_t* flags,
                   uint32_t g, bool top) {
-    const uint32_t* v = tr.vertex + (g - g % 3);
-    if (tr.is_ghost(g / 3) || v[0] == 0 || v[1] == 0 || v[2] == 0) return false;
+    if (!on_surface(tr, g / 3)) return false;
     uint32_t from = tr.vertex[g], to = tr.vertex[next_edge(g)], x = tr.vertex[prev_edge(g)];
     if (flags[x] & (kOnBottomLoop | kOnTopLoop)) return false;
     if (!top) {  // the bottom loop runs against its entries' half-edges
@@ -3053,7 +3059,7 @@ inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& lay
         if (at_border) loops.border_start = sink.count;
         for (uint32_t t = 0; t < tr.triangle_count; ++t) {
             const uint32_t* v = tr.vertex + 3 * t;
-            if (tr.is_ghost(t) || v[0] == 0 || v[1] == 0 || v[2] == 0 ||
+            if (!on_surface(tr, t) ||
                 ((flags[v[0]] | flags[v[1]] | flags[v[2]]) & kOnBottomLoop) != at_border)
                 continue;
             if (kNetShortcut) {
@@ -4646,11 +4652,13 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
                 if (status != Status::ok || c.top_count == 0) return;
                 const size_t band_start = sink.count, band_folds = sink.folds;
                 const size_t band_swaps = c.swaps;
-                bool peeled = false;
-                for (uint32_t i = 0; i < c.top_count; ++i)
-                    peeled |= (c.top_unused[i] & kPassBits) != 0;
-                for (uint32_t j = 0; j < loops.bottom_count; ++j)
-                    peeled |= (loops.bottom_flags[j] & kPassBits) != 0;
+                auto peeled = [&]() {
+                    for (uint32_t i = 0; i < c.top_count; ++i)
+                        if (c.top_unused[i] & kPassBits) return true;
+                    for (uint32_t j = 0; j < loops.bottom_count; ++j)
+                        if (loops.bottom_flags[j] & kPassBits) return true;
+                    return false;
+                };
                 for (int unpeel = 0; unpeel < 2; ++unpeel) {
                     sink.count = band_start;
                     sink.folds = band_folds;
@@ -4661,7 +4669,7 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
                         status = Status::out_of_memory;
                         return;
                     }
-                    if (!peeled || sink.folds == band_folds) return;
+                    if (sink.folds == band_folds || !peeled()) return;
                 }
             };
             // A job's result in reader indices goes in as it is when its chunk needs no
@@ -4768,8 +4776,8 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
     Triangulation tr;
     allocate_triangulation(tr, total, group);
     group.rewind(loaded);
-    group.alloc<uint32_t>(count);  // the band: loop A's band indices and points
-    group.alloc<Local>(count);
+    group.alloc<uint32_t>(count);  // the band: both loops' indices (together at most count)
+    group.alloc<Local>(count);  // loop A's points
     group.alloc<double>(2 * count);
     group.alloc<double>(2);  // the second loop's alignment
     group.alloc<unsigned char>(count);

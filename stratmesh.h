@@ -69,9 +69,10 @@
 //                            the grouped points in spare workspace (see Memory), and the
 //                            predicates' integer stage (near-ties go to the expansion
 //                            stages, which give the same signs; about 1.7 KiB). On
-//                            x86-64 a 1e6-point tube then takes 1.5 to 1.55 times as
-//                            long (scanner grids, full of exact ties, longer). The
-//                            output is the same bytes either way.
+//                            x86-64 reconstruction then takes 1.4 to 1.55 times as long
+//                            (a 400,000-point bumpy tube and a scan grid of as many
+//                            points, full of exact ties, 1.4; a 1e6-point tube 1.5 to
+//                            1.55). The output is the same bytes either way.
 //
 // ==== Memory ===============================================================================
 //

@@ -615,11 +615,13 @@ const bool kParallelLayers = true;  // lets the compiler drop what only jobs' re
 #if defined(STRATMESH_SMALL_CODE)
 const bool kNetShortcut = false;
 const bool kStagePoints = false;
-const bool kIntegerStages = false;
+const bool kFastExactStages = false;
 #else
 const bool kNetShortcut = true;  // a chunk whose loop fans are whole skips the net
 const bool kStagePoints = true;  // reconstruct() keeps the grouped points in spare workspace
-const bool kIntegerStages = true;  // the predicates settle near-ties in integers first
+// The predicates settle near-ties in integers, then from exact differences, before the
+// general exact stage.
+const bool kFastExactStages = true;
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 
@@ -1192,7 +1194,7 @@ inline double orient2d_beyond_filter(const double* a, const double* b, const dou
     two_diff(b[0], c[0], differences[2], tails[2]);
     two_diff(b[1], c[1], differences[3], tails[3]);
     bool exact = tails[0] == 0 && tails[1] == 0 && tails[2] == 0 && tails[3] == 0;
-    if (kIntegerStages && exact && orient2d_from_integer_differences(differences, &det))
+    if (kFastExactStages && exact && orient2d_from_integer_differences(differences, &det))
         return det;
     const double magnitudes[10] = {differences[0], differences[2], differences[1],
                                    differences[3], a[0], a[1], b[0], b[1], c[0], c[1]};
@@ -1208,7 +1210,7 @@ inline double orient2d_beyond_filter(const double* a, const double* b, const dou
     two_diff(b[0], c[0], bcx, t1);
     two_diff(a[1], c[1], acy, t2);
     two_diff(b[1], c[1], bcy, t3);
-    if (t0 == 0 && t1 == 0 && t2 == 0 && t3 == 0) {
+    if (kFastExactStages && t0 == 0 && t1 == 0 && t2 == 0 && t3 == 0) {
         double d[4];
         cross_exact(acx, acy, bcx, bcy, d);
         return expansion_top(4, d);
@@ -1365,8 +1367,8 @@ inline bool differences_to(const double* a, const double* b, const double* c, co
 inline double incircle_beyond_filter(const double* a, const double* b, const double* c,
                                      const double* d, double* scratch) {
     double rows[3][2], det = 0;
-    if (differences_to(a, b, c, d, rows) && kIntegerStages &&
-        incircle_from_integer_differences(rows, &det))
+    const bool exact = differences_to(a, b, c, d, rows);
+    if (kFastExactStages && exact && incircle_from_integer_differences(rows, &det))
         return det;
     const double magnitudes[14] = {rows[0][0], rows[1][0], rows[2][0], rows[0][1],
                                    rows[1][1], rows[2][1], a[0], a[1], b[0], b[1],
@@ -1379,7 +1381,8 @@ inline double incircle_beyond_filter(const double* a, const double* b, const dou
     b = points[1];
     c = points[2];
     d = points[3];
-    if (differences_to(a, b, c, d, rows)) return incircle_from_differences(rows, scratch);
+    if (kFastExactStages && differences_to(a, b, c, d, rows))
+        return incircle_from_differences(rows, scratch);
     return incircle_exact(a, b, c, d, scratch);
 }
 
@@ -2722,12 +2725,21 @@ inline Cylinder fit_cylinder(const Local* points, size_t count, double h0, doubl
     return c;
 }
 
+// Triangle abc's normal, twice its area long.
+inline Vec3 normal_of(const Local& pa, const Local& pb, const Local& pc) {
+    return cross(Vec3{pb.x - pa.x, pb.y - pa.y, pb.h - pa.h},
+                 Vec3{pc.x - pa.x, pc.y - pa.y, pc.h - pa.h});
+}
+
+inline double doubled_area(const Local& pa, const Local& pb, const Local& pc) {
+    Vec3 n = normal_of(pa, pb, pc);
+    return std::sqrt(dot(n, n));
+}
+
 // Whether triangle abc (counter-clockwise seen from outside) has its normal pointing
 // towards the cylinder's axis: a fold.
 inline bool faces_axis(const Local& pa, const Local& pb, const Local& pc, const Cylinder& cyl) {
-    Vec3 u = {pb.x - pa.x, pb.y - pa.y, pb.h - pa.h};
-    Vec3 v = {pc.x - pa.x, pc.y - pa.y, pc.h - pa.h};
-    Vec3 n = cross(u, v);
+    Vec3 n = normal_of(pa, pb, pc);
     double rx = (pa.x + pb.x + pc.x) / 3 - cyl.cx;
     double ry = (pa.y + pb.y + pc.y) / 3 - cyl.cy;
     return n.x * rx + n.y * ry < 0;
@@ -2740,14 +2752,18 @@ inline bool on_surface(const Triangulation& tr, uint32_t t) {
     return !tr.is_ghost(t) && v[0] != 0 && v[1] != 0 && v[2] != 0;
 }
 
-// The surface triangles of a layer's triangulation (vertex v is points[v - 1]) that face its
-// axis.
-inline size_t count_folds(const Triangulation& tr, const Local* points, const Cylinder& cyl) {
+// The surface triangles of a layer's triangulation that face its axis; vertex v is
+// points[(v - 1) * stride]. Adds their doubled areas to *area if given.
+inline size_t count_folds(const Triangulation& tr, const Local* points, size_t stride,
+                          const Cylinder& cyl, double* area) {
     size_t folds = 0;
     for (uint32_t t = 0; t < tr.triangle_count; ++t) {
         const uint32_t* v = tr.vertex + 3 * t;
         if (!on_surface(tr, t)) continue;
-        folds += faces_axis(points[v[2] - 1], points[v[1] - 1], points[v[0] - 1], cyl);
+        const Local &a = points[(v[2] - 1) * stride], &b = points[(v[1] - 1) * stride],
+                    &c = points[(v[0] - 1) * stride];
+        folds += faces_axis(a, b, c, cyl);
+        if (area) *area += doubled_area(a, b, c);
     }
     return folds;
 }
@@ -2982,16 +2998,95 @@ inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint3
     return true;
 }
 
-// Triangulates a loaded layer rolled onto the annulus of its cylinder plus the centre.
+// ---- the centre search ----
+//
+// A layer that is not star-shaped around its centre (a C-shaped cross-section, a condyle
+// beside a shaft) folds: its rays from the centre cross the surface twice, and the
+// unrolled triangulation bridges the two sheets. Another centre may see more of it. When
+// a sample of the layer folds around the fitted centre, the 24 other centres of a 5 x 5
+// grid around it (steps of kCentreStep radii, the nearer ring first) are tried on the
+// sample and the one whose sample folds least is kept (the fitted one on ties); the radius
+// and scale stay the fitted ones. The sample is every k-th point, at most
+// kCentreSamplePoints: the search costs at most 25 triangulations of
+// that many points per layer, one for a layer that does not fold, and needs less
+// workspace than the layer's own triangulation.
+
+const size_t kCentreSamplePoints = 1024;
+const int32_t kCentreRings = 2;  // the candidates: a 5 x 5 grid around the fitted centre
+const double kCentreStep = 0.3;
+
+inline void ignore_duplicate(void*, uint32_t, uint32_t) {}
+
+// The folds of the sample points[0], points[stride], ... (count of them) rolled around
+// cyl's centre; SIZE_MAX where the centre does not lie inside the sample's hull (it does
+// not surround that centre). Its scratch is released.
+inline size_t sample_folds(const Local* points, size_t count, size_t stride,
+                           const Cylinder& cyl, Arena& arena, double* area) {
+    *area = 0;
+    size_t mark = arena.mark(), folds = SIZE_MAX;
+    double* xy = arena.alloc<double>(2 * (count + 1));
+    Triangulation tr;
+    tr.xy = xy;
+    uint32_t inserted = 0;
+    if (allocate_triangulation(tr, count + 1, arena)) {
+        xy[0] = xy[1] = 0;
+        for (size_t k = 0; k < count; ++k) roll(cyl, points[k * stride], xy + 2 * (k + 1));
+        if (triangulate_points(tr, static_cast<uint32_t>(count + 1),
+                               DuplicateSink{ignore_duplicate, nullptr}, &inserted) == Status::ok)
+            folds = 0;
+    }
+    for (uint32_t t = 0; folds == 0 && t < tr.triangle_count; ++t) {
+        const uint32_t* v = tr.vertex + 3 * t;
+        if (tr.is_ghost(t) && (v[0] == 0 || v[1] == 0 || v[2] == 0)) folds = SIZE_MAX;
+    }
+    if (folds == 0) folds = count_folds(tr, points, stride, cyl, area);
+    arena.rewind(mark);
+    return folds;
+}
+
+// Moves layer.cyl's centre where a sample of the layer folds least (see above).
+inline void choose_centre(LoadedLayer& layer, Arena& arena) {
+    const size_t stride = layer.count / kCentreSamplePoints + 1;
+    const size_t count = (layer.count + stride - 1) / stride;
+    const Cylinder fitted = layer.cyl;
+    size_t fitted_folds = 0, fewest = 0;
+    double least = 0;
+    // Ring 0 is the fitted centre; rings 1 and 2 are the borders of the 3 x 3 and 5 x 5 grids.
+    for (int32_t ring = 0; ring <= kCentreRings; ++ring)
+        for (int32_t dy = -ring; dy <= ring; ++dy)
+            for (int32_t dx = -ring; dx <= ring; ++dx) {
+                if (dx != ring && dx != -ring && dy != ring && dy != -ring) continue;
+                Cylinder candidate = fitted;
+                candidate.cx += kCentreStep * fitted.radius * dx;
+                candidate.cy += kCentreStep * fitted.radius * dy;
+                double area = 0;
+                const size_t folds =
+                    sample_folds(layer.points, count, stride, candidate, arena, &area);
+                if (ring == 0) {
+                    if (folds == 0) return;
+                    fitted_folds = fewest = folds;
+                    least = area;
+                } else if (folds < fewest ||
+                           (folds == fewest && fewest < fitted_folds && area < least)) {
+                    // Fewer folds; as few and less area, once the fitted centre is beaten.
+                    fewest = folds;
+                    least = area;
+                    layer.cyl = candidate;
+                }
+            }
+}
+
+// Triangulates a loaded layer rolled onto the annulus of its cylinder plus the centre (the
+// centre moved first if the layer folds less around another: see choose_centre).
 // Emits the surface triangles and fills the loops, in layer-local indices. Returns ok,
 // not_columnar (the layer does not surround its axis, or is degenerate: the caller merges
 // it with the next one), out_of_memory or internal_error. Its scratch is released; the
 // layer's points are left in insertion order (layer.points[k] is layer-local point
 // order[k], an order not kept).
-inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& layer,
-                                Arena& arena, TriangleSink& sink, LayerLoops& loops,
-                                LayerCounts& counts) {
+inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Arena& arena,
+                                TriangleSink& sink, LayerLoops& loops, LayerCounts& counts) {
     const size_t count = layer.count, total = count + 1;  // vertex 0 is the centre
+    choose_centre(layer, arena);
     Local* points = layer.points;
     const Cylinder& cyl = layer.cyl;
     size_t mark = arena.mark();
@@ -3044,7 +3139,7 @@ inline Status triangulate_layer(const CloudReader& cloud, const LoadedLayer& lay
         return Status::not_columnar;
     }
     hull_loop(tr, loops.top, &loops.top_count, flags);
-    const size_t folds = count_folds(tr, points, cyl);
+    const size_t folds = count_folds(tr, points, 1, cyl, nullptr);
     if (folds == 0) {
         const uint32_t capacity = static_cast<uint32_t>(count);
         loops.bottom_count = peel_loop(tr, points, flags, loops.bottom, loops.bottom_count,
@@ -3431,8 +3526,6 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
         return frame.local(cloud.point(layer.ids[id]));
     };
     Cylinder shared;
-    shared.cx = (ca.cx + cb.cx) / 2;
-    shared.cy = (ca.cy + cb.cy) / 2;
     shared.radius = (ca.radius + cb.radius) / 2;
     shared.h0 = cb.h0;
     shared.scale = (ca.scale + cb.scale) / 2;
@@ -3442,31 +3535,67 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
         uv[0] = unrolled_radius * polar_angle(l.x - shared.cx, l.y - shared.cy);
         uv[1] = l.h - shared.h0;
     };
-    for (uint32_t i = 0; i < p; ++i) unroll(a[i], xa + 2 * i);
+    const double two_pi = 6.28318530717958647693;
+    Band band = {a, xa, p, b, xb, q, two_pi * unrolled_radius, steps, scratch, {}};
+    // Walks the settled band: returns its folds, adds its doubled area to *area and, with
+    // `emit`, writes its triangles to the sink.
+    auto walk_band = [&](bool emit, double* area) {
+        size_t folds = 0;
+        uint32_t i = 0, j = 0;
+        for (uint32_t t = 0; t < p + q; ++t) {
+            uint32_t x, y, z;  // counter-clockwise on the annulus
+            if (steps[t] == 0) {
+                x = a[(i + 1) % p], y = a[i % p], z = b[j % q];
+                ++i;
+            } else {
+                x = b[j % q], y = b[(j + 1) % q], z = a[i % p];
+                ++j;
+            }
+            const Local px = point(x), py = point(y), pz = point(z);
+            folds += faces_axis(px, pz, py, shared);
+            *area += doubled_area(px, py, pz);
+            if (emit) sink.write(x, y, z);
+        }
+        return folds;
+    };
+    // The strip's centre: the cylinders' midpoint; where the band folds around it (the loops
+    // turn back around it: after choose_centre moved one of the centres, the midpoint may
+    // lie outside what both loops are star-shaped around), the one of the midpoint and the
+    // two layers' centres whose settled band has the least area. Trial 3 settles the band
+    // again around that one, unless it was the last tried.
+    const Cylinder* centres[3] = {nullptr, &ca, &cb};  // 0: the midpoint
+    double least = 0;
+    uint32_t best = 0;
+    size_t best_swaps = 0;
+    for (uint32_t trial = 0; trial < 4 && !(trial == 3 && best == 2); ++trial) {
+        const uint32_t k = trial < 3 ? trial : best;
+        shared.cx = k ? centres[k]->cx : (ca.cx + cb.cx) / 2;
+        shared.cy = k ? centres[k]->cy : (ca.cy + cb.cy) / 2;
+        for (uint32_t i = 0; i < p; ++i) unroll(a[i], xa + 2 * i);
+        for (uint32_t j = 0; j < q; ++j) unroll(b[j], xb + 2 * j);
+        rotate_to_first_angle(a, xa, p);
+        rotate_to_first_angle(b, xb, q);
+        size_t trial_swaps = 0;
+        settle_band(band, &trial_swaps);
+        if (trial == 3) break;
+        double area = 0;
+        const size_t folds = walk_band(false, &area);
+        if (trial == 0 || area < least) {
+            least = area;
+            best = k;
+            best_swaps = trial_swaps;
+        }
+        if (folds == 0 && trial == 0) break;
+    }
+    *swaps += best_swaps;
     if (unpeel) {
         put_back_peeled(a_flags, a_length, true, [below](uint32_t i) { return below + i; },
                         point, shared, sink);
         put_back_peeled(loops.bottom_flags, loops.bottom_count, false,
                         [&loops](uint32_t j) { return loops.bottom[j]; }, point, shared, sink);
     }
-    for (uint32_t j = 0; j < q; ++j) unroll(b[j], xb + 2 * j);
-    rotate_to_first_angle(a, xa, p);
-    rotate_to_first_angle(b, xb, q);
-    const double two_pi = 6.28318530717958647693;
-    Band band = {a, xa, p, b, xb, q, two_pi * unrolled_radius, steps, scratch, {}};
-    settle_band(band, swaps);
-    uint32_t i = 0, j = 0;
-    for (uint32_t t = 0; t < p + q; ++t) {
-        uint32_t x, y, z;  // counter-clockwise on the annulus
-        if (steps[t] == 0) {
-            x = a[(i + 1) % p], y = a[i % p], z = b[j % q];
-            ++i;
-        } else {
-            x = b[j % q], y = b[(j + 1) % q], z = a[i % p];
-            ++j;
-        }
-        sink.emit(x, y, z, point(x), point(y), point(z), shared);
-    }
+    double area = 0;
+    sink.folds += walk_band(true, &area);
     arena.rewind(mark);
     return true;
 }

@@ -121,6 +121,21 @@ int main() {
     std::vector<double> grid = shapes::scan_grid(2000, Pose::z).xyz;
     reconstruct_case("scan grid, 1 layer", grid, axis_z(1));
     reconstruct_case("scan grid, 5 layers", grid, axis_z(5));
+    // Not star-shaped around the fitted centres: the outline of a disc and a growing lobe
+    // (the centre search moves centres, and a band joins a moved and an unmoved one).
+    shapes::Rng lobe_rng(2026);
+    std::vector<double> lobe;
+    while (lobe.size() < 3 * 3000) {
+        const double t = lobe_rng.uniform(0, 2 * shapes::kPi), z = lobe_rng.uniform(0, 2);
+        const double radius = 0.4 + 0.2 * z, centre = 0.8 + radius;
+        const bool on_lobe = lobe_rng.uniform() < radius / (1 + radius);
+        const double x = on_lobe ? centre + radius * std::cos(t) : std::cos(t);
+        const double y = (on_lobe ? radius : 1) * std::sin(t);
+        if (on_lobe ? std::hypot(x, y) < 1 : std::hypot(x - centre, y) < radius) continue;
+        lobe.insert(lobe.end(), {x, y, z});
+    }
+    reconstruct_case("disc and lobe, 1 layer", lobe, axis_z(1));
+    reconstruct_case("disc and lobe, 2 layers", lobe, axis_z(2));
 
     shapes::Rng rng(2024);
     std::vector<double> random;

@@ -67,12 +67,13 @@
 //                            vertices that skips the net on sound chunks, about 0.4 KiB;
 //                            without it the net runs on every chunk), the staging of
 //                            the grouped points in spare workspace (see Memory), and the
-//                            predicates' integer stage (near-ties go to the expansion
-//                            stages, which give the same signs; about 1.7 KiB). On
-//                            x86-64 reconstruction then takes 1.4 to 1.55 times as long
-//                            (a 400,000-point bumpy tube and a scan grid of as many
-//                            points, full of exact ties, 1.4; a 1e6-point tube 1.5 to
-//                            1.55). The output is the same bytes either way.
+//                            predicates' fast exact stages (in integers, and from exact
+//                            coordinate differences: near-ties go to the general
+//                            expansion stage, which gives the same signs; about 2.7
+//                            KiB). On x86-64 reconstruction then takes 1.4 to 1.55 times
+//                            as long on tubes (400,000 points 1.4, 1e6 points 1.5 to
+//                            1.55) and about 1.8 times on a scan grid of 400,000 points,
+//                            full of near-ties. The output is the same bytes either way.
 //
 // ==== Memory ===============================================================================
 //
@@ -152,7 +153,8 @@
 //   between them manifold too. The stream's output has the same guarantee. The output is
 //   not guaranteed free of self-intersections where a layer is
 //   not star-shaped around its centre (Report::folds counts the triangles facing the
-//   axis there).
+//   axis there); a layer that folds is unrolled around the centre, of 25 tried, where it
+//   folds least (see "the centre search" in >>layer triangulation).
 
 #ifndef STRATMESH_H
 #define STRATMESH_H
@@ -367,6 +369,7 @@ const uint32_t kMaxJobs = 64;
 struct LayerInfo {
     double bottom, top;      // extent along the axis, as dot(point, axis)
     double centre[3];        // the axis of the unrolling cylinder passes through this
+                             // (the fitted centre, or the one the centre search chose)
     double radius;           // the unrolling radius (see >>unroll in the implementation)
     uint32_t point_count;    // distinct valid points in the layer
     uint32_t triangle_count; // the layer's own triangles plus the band joining it to the
@@ -1185,8 +1188,9 @@ inline bool incircle_from_integer_differences(const double rows[3][2], double* d
 }
 
 // orient2d once the filter has failed: the differences are tried for exactness (in the
-// integer stage, then with rescaling in expansions), then the raw coordinates are used.
-// Kept apart from the filter so that the common, filtered call stays small.
+// integer stage, then with rescaling in expansions), then the raw coordinates are used
+// (with STRATMESH_SMALL_CODE at once, after the rescaling: kFastExactStages). Kept apart
+// from the filter so that the common, filtered call stays small.
 inline double orient2d_beyond_filter(const double* a, const double* b, const double* c) {
     double differences[4], tails[4], det = 0;
     two_diff(a[0], c[0], differences[0], tails[0]);
@@ -1362,8 +1366,9 @@ inline bool differences_to(const double* a, const double* b, const double* c, co
 
 // incircle once the filter has failed. The integer stage goes first: the differences of
 // nearby points are nearly always exact and narrow enough, and it needs no rescaling
-// (there is no underflow to avoid). Kept apart from the filter so that the common, filtered
-// call stays small.
+// (there is no underflow to avoid); then the differences after rescaling; then the raw
+// coordinates (with STRATMESH_SMALL_CODE only these: kFastExactStages). Kept apart from
+// the filter so that the common, filtered call stays small.
 inline double incircle_beyond_filter(const double* a, const double* b, const double* c,
                                      const double* d, double* scratch) {
     double rows[3][2], det = 0;
@@ -2587,7 +2592,9 @@ inline uint32_t layer_of(const LayerPlan& plan, double h) {
 // Centre: the mean of per-sector mean positions (kSectors sectors around the centroid), so
 // a side scanned more densely does not pull the centre towards it. Radius: the mean
 // distance of the points from that centre: it sets the unrolled aspect (arc length r theta
-// against height), so triangles are well shaped on the surface, not only in the plane.
+// against height), so triangles are well shaped on the surface, not only in the plane. A
+// layer that folds around that centre may be unrolled around another (see "the centre
+// search" in >>layer triangulation); the radius stays.
 
 const uint32_t kSectors = 32;
 
@@ -3001,15 +3008,27 @@ inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint3
 // ---- the centre search ----
 //
 // A layer that is not star-shaped around its centre (a C-shaped cross-section, a condyle
-// beside a shaft) folds: its rays from the centre cross the surface twice, and the
-// unrolled triangulation bridges the two sheets. Another centre may see more of it. When
-// a sample of the layer folds around the fitted centre, the 24 other centres of a 5 x 5
-// grid around it (steps of kCentreStep radii, the nearer ring first) are tried on the
-// sample and the one whose sample folds least is kept (the fitted one on ties); the radius
-// and scale stay the fitted ones. The sample is every k-th point, at most
-// kCentreSamplePoints: the search costs at most 25 triangulations of
-// that many points per layer, one for a layer that does not fold, and needs less
-// workspace than the layer's own triangulation.
+// beside a shaft) folds: rays from the centre cross its surface twice, and the unrolled
+// triangulation bridges the two sheets. Another centre may see more of it. The layer's
+// sample (every k-th point, at most kCentreSamplePoints) is triangulated around the fitted
+// centre; if it folds, around each of the 24 other centres of a 5 x 5 grid (steps of
+// kCentreStep radii, the inner ring first) too, and the layer is unrolled around the
+// centre whose sample folds least; among centres with as few folds, the one whose sample
+// has the least area (bridges add area), and the fitted centre on ties with it. Radius and
+// scale stay the fitted ones, and a centre outside the sample's hull is never taken (the
+// layer must surround it). The search needs less workspace than the layer's own
+// triangulation. Cost: one triangulation of the sample per layer (about 1% of a
+// 1e6-point tube's time: its layers do not fold), 25 for a layer that folds: about 10
+// times the time of the whole reconstruction on a 3,900-point femur whose 8 layers all
+// fold (0.04 s against 0.004 s), at most about 25,000 insertions per layer on large ones.
+// Measured on the real clouds of the README (femur, hand, kitten, bust; 64 runs of 4 to 48
+// layers, axis z and automatic), with the band's centre choice in >>stitch: 63% fewer
+// self-intersecting triangle pairs, mean distance to the reference 14% (femur) and 31%
+// (hand) smaller; samples of 256 or 128 points lost most of that. A layer that bridges a
+// concavity without folding (a membrane over the neck between two lobes) is not searched:
+// searching every layer by area improved such synthetic layers 3 to 4 times but cost a
+// third more time on a 1e6-point tube and gave the real clouds no fewer
+// self-intersections.
 
 const size_t kCentreSamplePoints = 1024;
 const int32_t kCentreRings = 2;  // the candidates: a 5 x 5 grid around the fitted centre
@@ -3018,8 +3037,9 @@ const double kCentreStep = 0.3;
 inline void ignore_duplicate(void*, uint32_t, uint32_t) {}
 
 // The folds of the sample points[0], points[stride], ... (count of them) rolled around
-// cyl's centre; SIZE_MAX where the centre does not lie inside the sample's hull (it does
-// not surround that centre). Its scratch is released.
+// cyl's centre and triangulated, with the doubled area of its surface in *area; SIZE_MAX
+// where the centre does not lie inside the sample's hull (it does not surround that
+// centre). Its scratch is released.
 inline size_t sample_folds(const Local* points, size_t count, size_t stride,
                            const Cylinder& cyl, Arena& arena, double* area) {
     *area = 0;
@@ -3179,7 +3199,10 @@ inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Ar
 // Two neighbouring layers meet at a cut: the top loop A of the lower layer and the bottom
 // loop B of the upper one are closed loops around the axis. Both are unrolled onto one
 // strip (u, v) = (R theta, h - cut) around the average of the two cylinders: A below the
-// cut, B above it. A zipper merges the loops by angle: each step adds a triangle on the
+// cut, B above it. (Where the band settled on that strip folds, it is settled again around
+// each layer's own centre and the band with the least area is kept: once the centre
+// search has moved a centre, the midpoint may lie outside what both loops are star-shaped
+// around.) A zipper merges the loops by angle: each step adds a triangle on the
 // next edge of A or of B, so the band is a manifold annulus by construction. Then the
 // paper's diagonal swap: a rung shared by an A-triangle and a B-triangle is swapped when
 // the opposite vertex lies in the circumcircle (Lawson flips, which terminate in one fixed

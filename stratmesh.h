@@ -72,7 +72,7 @@
 //                            expansion stage, which gives the same signs; about 2.7
 //                            KiB). On x86-64 reconstruction then takes 1.4 to 1.55 times
 //                            as long on tubes (400,000 points 1.4, 1e6 points 1.5 to
-//                            1.55) and about 1.8 times on a scan grid of 400,000 points,
+//                            1.55) and about 2 times on a scan grid of 400,000 points,
 //                            full of near-ties. The output is the same bytes either way.
 //
 // ==== Memory ===============================================================================

@@ -3034,8 +3034,6 @@ const size_t kCentreSamplePoints = 1024;
 const int32_t kCentreRings = 2;  // the candidates: a 5 x 5 grid around the fitted centre
 const double kCentreStep = 0.3;
 
-inline void ignore_duplicate(void*, uint32_t, uint32_t) {}
-
 // The folds of the sample points[0], points[stride], ... (count of them) rolled around
 // cyl's centre and triangulated, with the doubled area of its surface in *area; SIZE_MAX
 // where the centre does not lie inside the sample's hull (it does not surround that
@@ -3052,7 +3050,7 @@ inline size_t sample_folds(const Local* points, size_t count, size_t stride,
         xy[0] = xy[1] = 0;
         for (size_t k = 0; k < count; ++k) roll(cyl, points[k * stride], xy + 2 * (k + 1));
         if (triangulate_points(tr, static_cast<uint32_t>(count + 1),
-                               DuplicateSink{ignore_duplicate, nullptr}, &inserted) == Status::ok)
+                               DuplicateSink{nullptr, nullptr}, &inserted) == Status::ok)
             folds = 0;
     }
     for (uint32_t t = 0; folds == 0 && t < tr.triangle_count; ++t) {

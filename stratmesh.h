@@ -300,8 +300,10 @@ enum Flags : uint32_t {
     // Closes the surface's boundary loops with caps, so a tube becomes a closed, edge- and
     // vertex-manifold, consistently oriented surface (Euler characteristic 2, normals
     // outward: the bottom cap faces -axis, the top one +axis). A cap is a triangulation of
-    // its loop over the loop's own vertices (no new vertex): the constrained Delaunay
-    // triangulation of the loop's projection across the axis (Report::axis), avoiding any
+    // its loop over the loop's own vertices (no new vertex): a triangulation of the loop's
+    // projection across the axis (Report::axis), the bottom cap as low and the top cap as
+    // high along the axis as the loop allows (so that a wall leaning over a ragged loop
+    // stays clear of it), constrained Delaunay where the loop is planar, avoiding any
     // diagonal that is already an edge of the surface. A loop whose projection is not a
     // simple polygon stays open: the call still returns ok, Report::caps_left_open counts
     // it and Report::detail says so. Caps do not cross one another; like the rest of the

@@ -4414,9 +4414,9 @@ struct CapCounts {
 };
 
 // Caps every boundary loop of the surface tri[0 .. 3 count), appending the cap triangles
-// (count grows). project(id, xy, height) gives a vertex's coordinates across the axis and its
-// height along it. Returns ok;
-// out_of_memory; or triangle_capacity with *needed the triangles every cap closing would take.
+// (count grows). project(id, xy, height) gives a vertex's coordinates across the axis and
+// its height along it. Returns ok; out_of_memory; or triangle_capacity with *needed the
+// triangles every cap closing would take.
 template <class Project>
 Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity, size_t point_count,
                           const Project& project, Arena& arena, CapCounts& caps, size_t* needed) {
@@ -4449,8 +4449,9 @@ Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity, size_t 
             ++caps.left_open;
             continue;
         }
-        double height = 0;
-        for (uint32_t i = 0; i < length; ++i) project(ids[i], c.xy + 2 * static_cast<size_t>(i), &height);
+        double height = 0;  // wanted once the clipping arrays are free (below)
+        for (uint32_t i = 0; i < length; ++i)
+            project(ids[i], c.xy + 2 * static_cast<size_t>(i), &height);
         if (!polygon_is_simple(c.xy, length, c.sweep)) {
             ++caps.left_open;
             continue;
@@ -4471,7 +4472,7 @@ Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity, size_t 
             ++caps.left_open;
             continue;
         }
-        double xy[2];
+        double xy[2];  // c.xy holds them, mirrored
         for (uint32_t i = 0; kLiftedCaps && i < length; ++i) project(ids[i], xy, c.height + i);
         cap.settle_diagonals();
         for (size_t k = 0; k < 3 * static_cast<size_t>(cap.triangles()); ++k)

@@ -4286,6 +4286,7 @@ public:
     // or until the budget of flips is spent.
     void settle_diagonals() {
         uint32_t depth = 0;
+        // No overflow: a loop takes more than 64 bytes of workspace per vertex.
         size_t budget = static_cast<size_t>(kCapFlipsPerCorner) * length_;
         for (uint32_t t = 0; t < triangles_; ++t) c_.flags[t] = 0;
         for (uint32_t t = 0; t < triangles_; ++t) queue(t, depth);

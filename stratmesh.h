@@ -3981,14 +3981,18 @@ struct CapGraph {
     bool has_edge(uint32_t a, uint32_t b) const { return leads_to(a, b) || leads_to(b, a); }
 };
 
-// A loop edge keyed by its smaller x, for the simplicity sweep.
-struct SweepEdge {
-    double x;
-    uint32_t edge;
-    bool operator>(const SweepEdge& other) const {
-        return x > other.x || (x == other.x && edge > other.edge);
-    }
-};
+// The simplicity sweep keys a loop edge by its smaller x and its index, packed in 64 bits:
+// the high 32 bits of an unsigned integer that orders as x does (finite, -0 as +0), then
+// the index. Coarser than x, the key still never orders an edge before one whose smaller x
+// is below its own, so the sweep meets every pair whose x ranges overlap (and a few more,
+// which the exact test settles).
+inline uint32_t sweep_key(double x) {
+    x += 0.0;
+    uint64_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    bits = (bits >> 63) ? ~bits : bits | (uint64_t{1} << 63);
+    return static_cast<uint32_t>(bits >> 32);
+}
 
 // The arrays of one loop, sized for all boundary vertices together (every loop fits).
 // Positions are the loop's vertices in cap order, 0 .. length - 1.
@@ -4000,7 +4004,7 @@ struct CapLoop {
                               // the clipping arrays' memory)
     unsigned char* flags;     // per position while clipping, per cap triangle while flipping
     double* scratch;          // for incircle
-    SweepEdge* sweep;         // per edge; shares its memory with the arrays below
+    uint64_t* sweep;          // per edge (sweep_key); shares its memory with the arrays below
     uint32_t* prev;           // per position: the neighbours in the polygon left to clip
     uint32_t* next;
     uint32_t* reflex;         // positions that were not strictly convex when last checked
@@ -4033,7 +4037,7 @@ inline bool allocate_cap_loop(CapLoop& c, size_t length, Arena& arena) {
     // The sweep is over before clipping starts: the clipping arrays reuse its memory; and
     // the heights, filled once the clipping is over, reuse the clipping arrays'.
     size_t mark = arena.mark();
-    c.sweep = arena.alloc<SweepEdge>(length);
+    c.sweep = arena.alloc<uint64_t>(length);
     arena.rewind(mark);
     c.height = arena.alloc<double>(length);
     arena.rewind(mark);
@@ -4166,7 +4170,7 @@ inline bool segments_meet(const double* p, const double* q, const double* r, con
 // Whether the closed polygon xy[0 .. length) is simple: no repeated point, no edge folding
 // back onto the next, no two other edges meeting. Edges are swept in order of their
 // smaller x; each is tested against those whose x range reaches into its own.
-inline bool polygon_is_simple(const double* xy, uint32_t length, SweepEdge* sweep) {
+inline bool polygon_is_simple(const double* xy, uint32_t length, uint64_t* sweep) {
     if (length < 3) return false;
     auto at = [&](uint32_t i) { return xy + 2 * static_cast<size_t>(i); };
     for (uint32_t i = 0; i < length; ++i) {
@@ -4182,17 +4186,17 @@ inline bool polygon_is_simple(const double* xy, uint32_t length, SweepEdge* swee
     for (uint32_t e = 0; e < length; ++e) {
         const double* a = at(e);
         const double* b = at(e + 1 == length ? 0 : e + 1);
-        sweep[e] = {a[0] < b[0] ? a[0] : b[0], e};
+        sweep[e] = uint64_t{sweep_key(a[0] < b[0] ? a[0] : b[0])} << 32 | e;
     }
     heap_sort(sweep, length);
     for (uint32_t i = 0; i < length; ++i) {
-        uint32_t e = sweep[i].edge, e_end = e + 1 == length ? 0 : e + 1;
+        uint32_t e = static_cast<uint32_t>(sweep[i]), e_end = e + 1 == length ? 0 : e + 1;
         const double* a = at(e);
         const double* b = at(e_end);
-        double right = a[0] < b[0] ? b[0] : a[0];
+        const uint32_t right = sweep_key(a[0] < b[0] ? b[0] : a[0]);
         double low = a[1] < b[1] ? a[1] : b[1], high = a[1] < b[1] ? b[1] : a[1];
-        for (uint32_t j = i + 1; j < length && sweep[j].x <= right; ++j) {
-            uint32_t f = sweep[j].edge, f_end = f + 1 == length ? 0 : f + 1;
+        for (uint32_t j = i + 1; j < length && (sweep[j] >> 32) <= right; ++j) {
+            uint32_t f = static_cast<uint32_t>(sweep[j]), f_end = f + 1 == length ? 0 : f + 1;
             if (f == e_end || f_end == e) continue;  // neighbours: checked above
             const double* c = at(f);
             const double* d = at(f_end);

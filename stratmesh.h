@@ -78,7 +78,8 @@
 //                            lowering and raising along the axis (see >>caps; 0.3 KiB),
 //                            so its caps are the Delaunay triangulation of each loop's
 //                            projection, which crosses a wall leaning over a ragged loop
-//                            more often.
+//                            more often. It leaves out cap_ends() too (not declared:
+//                            0.6 KiB on the Cortex-M7); reconstruct()'s close_ends stays.
 //
 // ==== Memory ===============================================================================
 //
@@ -94,7 +95,9 @@
 // (the triangulation of its largest possible layer with the layer's coordinates, plus the
 // layer grouping and boundary loops), about 121 with the close_ends flag, about 166 with a
 // jobs runner (Options::run_jobs); its output is at most 2n triangles. A stream needs about
-// 190 bytes per point it holds at once, whatever the size of the whole cloud.
+// 190 bytes per point it holds at once, whatever the size of the whole cloud; cap_ends()
+// 78 bytes per point of the whole cloud (its loops may pass through every point) plus 12
+// per triangle: about 102 per point for a tube.
 //
 // The whole workspace belongs to the call while it runs, including what it does not need:
 // without a runner, reconstruct keeps the points grouped by layer (24 bytes each) at the
@@ -309,7 +312,8 @@ enum Flags : uint32_t {
     // it and Report::detail says so. Caps do not cross one another; like the rest of the
     // surface, they are not checked against the tube. The workspace bound grows by about 6
     // bytes per point with this flag; reconstruct_max_triangles() still suffices (a closed
-    // surface through V vertices has 2V - 4 triangles).
+    // surface through V vertices has 2V - 4 triangles). The stream refuses the flag: its
+    // surface is capped afterwards by cap_ends().
     close_ends = 1u << 1,
     // The frame's reference point is Options::origin instead of the centroid of the cloud
     // (reconstruct) or of the first layer (the stream). The reference point changes only
@@ -504,7 +508,7 @@ Status reconstruct(const Cloud& cloud, const Options& options,
 // the same global indices (checked on every test shape), provided no point lies within
 // 2^-40 of the height range below a cut (reconstruct() counts such a point in the layer
 // above) and no cut lies outside the points' height range. The stream makes no caps (the
-// close_ends flag is refused): cap the two boundary loops yourself, or run reconstruct().
+// close_ends flag is refused): cap_ends() closes its surface afterwards (below).
 //
 // Memory: stream_workspace_size(max_points_held) bytes, about 190 per point held. The
 // stream holds the last layer's top loop, the layer being formed (pushes that join it
@@ -555,6 +559,50 @@ Status stream_push(Stream* stream, const Cloud& points, double top);
 // reconstruct() for the same cloud (too_few_points, flat_cloud, not_columnar, ...). The
 // stream cannot be pushed to afterwards.
 Status stream_close(Stream* stream);
+
+// ---- Caps for a surface you hold ----
+//
+// cap_ends() closes the boundary loops of a surface the caller holds with caps, as the
+// close_ends flag does inside reconstruct(): made for the stream, whose triangles leave
+// through the callback before its last loop is known. Collect them, close the stream, then
+//
+//     size_t count = tris.size() / 3;  // the triangles collected from the callback
+//     std::vector<unsigned char> work(stratmesh::cap_ends_workspace_size(n, count));
+//     tris.resize(3 * stratmesh::reconstruct_max_triangles(n, options));  // 2n suffice
+//     stratmesh::cap_ends(all_points, options, work.data(), work.size(), tris.data(),
+//                         tris.size() / 3, &count, &report);
+//
+// With the stream's triangles, the same Options and `cloud` the concatenated pushes (every
+// point pushed, in order: the triangles' global indices), the result is reconstruct()'s
+// with close_ends for the same cuts, triangle for triangle: the same caps, appended last.
+// The frame is chosen from the whole cloud as reconstruct() chooses it, so the caps do not
+// depend on how the cloud was pushed. Any other surface works too: each boundary loop is
+// projected across the axis and capped if that projection is a simple polygon (see
+// close_ends). The result is edge- and vertex-manifold and consistently oriented if the
+// input was (as stratmesh's output is); on any other input the call stays within its
+// buffers but the caps may join edges that were already full.
+
+#if !defined(STRATMESH_SMALL_CODE)
+// Bytes of workspace cap_ends() needs for a surface of triangle_count triangles over
+// point_count points; 0 if that is beyond what this platform can address.
+size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count);
+
+// Appends caps to triangles[0 .. 3 * *triangle_count) (global indices into `cloud`) and
+// sets *triangle_count to the new total. options: axis, direction, origin (with
+// origin_given) and skip_invalid_points as given to the stream or reconstruct(); the rest
+// is not used. report (optional): only caps_closed, caps_left_open, cap_triangles,
+// workspace_used and detail are set, so the stream's report can be passed as it is.
+// Returns ok (loops whose projection is not simple stay open: caps_left_open);
+// invalid_argument (a null triangle_count, triangles or workspace where needed, a bad
+// stride or scalar, *triangle_count above triangle_capacity, an index outside the cloud or
+// naming an invalid point, buffers sharing a byte); too_many_points; invalid_point (a NaN
+// or infinite point without skip_invalid_points); invalid_axis; out_of_memory (a workspace
+// below cap_ends_workspace_size()); triangle_capacity (*triangle_count set to the
+// triangles needed; nothing written). On every status but ok the triangles are unchanged.
+Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
+                size_t workspace_bytes, uint32_t* triangles, size_t triangle_capacity,
+                size_t* triangle_count, Report* report);
+#endif
 
 } // namespace stratmesh
 
@@ -4418,13 +4466,20 @@ struct CapCounts {
     size_t closed, left_open, triangles;
 };
 
-// Caps every boundary loop of the surface tri[0 .. 3 count), appending the cap triangles
-// (count grows). project(id, xy, height) gives a vertex's coordinates across the axis and
-// its height along it. Returns ok; out_of_memory; or triangle_capacity with *needed the
-// triangles every cap closing would take.
-template <class Project>
-Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity, size_t point_count,
-                          const Project& project, Arena& arena, CapCounts& caps, size_t* needed) {
+// Caps every boundary loop of the surface tri[0 .. 3 count) over the cloud's points,
+// appending the cap triangles (count grows); each loop is projected across the frame's
+// axis. Returns ok; out_of_memory; or triangle_capacity with *needed the triangles every
+// cap closing would take, and nothing written.
+inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
+                                 const CloudReader& cloud, size_t point_count,
+                                 const Frame& frame, Arena& arena, CapCounts& caps,
+                                 size_t* needed) {
+    auto project = [&](uint32_t id, double* xy, double* height) {
+        const Local p = frame.local(cloud.point(id));
+        xy[0] = p.x;
+        xy[1] = p.y;
+        *height = p.h;
+    };
     caps = {0, 0, 0};
     size_t mark = arena.mark();
     CapGraph g;
@@ -5359,6 +5414,31 @@ inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangle
     return Status::ok;
 }
 
+// Reads a cloud that passed check_reconstruct_arguments.
+inline CloudReader reader_of(const Cloud& cloud) {
+    size_t scalar = cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double);
+    return {static_cast<const unsigned char*>(cloud.xyz),
+            cloud.stride_bytes ? cloud.stride_bytes : 3 * scalar, cloud.scalar == Scalar::float32};
+}
+
+// Counts the points with a NaN or infinite coordinate in rep.rejected, or stops at the
+// first one with invalid_point unless the skip_invalid_points flag is given.
+inline Status reject_invalid_points(const CloudReader& reader, size_t count,
+                                    const Options& options, Report& rep) {
+    for (size_t i = 0; i < count; ++i) {
+        if (reader.valid(i)) continue;
+        if (!(options.flags & skip_invalid_points)) {
+            rep.first_invalid_point = i;
+            rep.rejected = count;
+            rep.detail = "a point has a NaN or infinite coordinate (see first_invalid_point; "
+                         "the skip_invalid_points flag skips such points instead)";
+            return Status::invalid_point;
+        }
+        ++rep.rejected;
+    }
+    return Status::ok;
+}
+
 // Groups the valid points by layer (input order within a layer): a counting sort, with each
 // point's layer kept in `layer` (count entries of scratch) between its two passes. With
 // `staged` (optional, as many entries as valid points), the points in frame coordinates
@@ -5461,21 +5541,9 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
                                                 triangle_count, workspace, rep);
     if (status != Status::ok) return status;
     notify(options, Phase::validate, 0);
-    size_t scalar = cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double);
-    CloudReader reader = {static_cast<const unsigned char*>(cloud.xyz),
-                          cloud.stride_bytes ? cloud.stride_bytes : 3 * scalar,
-                          cloud.scalar == Scalar::float32};
-    for (size_t i = 0; i < cloud.count; ++i) {
-        if (reader.valid(i)) continue;
-        if (!(options.flags & skip_invalid_points)) {
-            rep.first_invalid_point = i;
-            rep.rejected = cloud.count;
-            rep.detail = "a point has a NaN or infinite coordinate (see first_invalid_point; "
-                         "the skip_invalid_points flag skips such points instead)";
-            return Status::invalid_point;
-        }
-        ++rep.rejected;
-    }
+    const CloudReader reader = reader_of(cloud);
+    status = reject_invalid_points(reader, cloud.count, options, rep);
+    if (status != Status::ok) return status;
     size_t valid = cloud.count - rep.rejected;
     status = validate_layer_options(options);
     if (status != Status::ok) return status;
@@ -5588,15 +5656,9 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     size_t count = sink.count;
     CapCounts caps = {0, 0, 0};
     if (options.flags & close_ends) {
-        auto project = [&](uint32_t id, double* xy, double* height) {
-            Local p = frame.local(reader.point(id));
-            xy[0] = p.x;
-            xy[1] = p.y;
-            *height = p.h;
-        };
         size_t needed = 0;
-        status = cap_boundary_loops(triangles, count, triangle_capacity, cloud.count, project,
-                                    arena, caps, &needed);
+        status = cap_boundary_loops(triangles, count, triangle_capacity, reader, cloud.count,
+                                    frame, arena, caps, &needed);
         if (status == Status::triangle_capacity) {
             *triangle_count = needed;
             rep.triangle_count = needed;
@@ -5978,6 +6040,78 @@ Status stream_close(Stream* stream) {
     detail::publish(s);
     return status;
 }
+
+#if !defined(STRATMESH_SMALL_CODE)
+// >>cap ends ================================================================================
+//
+// cap_ends() is reconstruct()'s last step on a surface the caller holds: the same checks of
+// the cloud, the same frame (chosen from the whole cloud), the same caps.
+
+size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count) {
+    if (point_count > detail::kMaxPoints - 1) return 0;
+    detail::Arena arena = detail::Arena::measuring();
+    detail::CapGraph graph;
+    detail::CapLoop loop;
+    detail::allocate_cap_graph(graph, point_count, triangle_count, arena);
+    detail::allocate_cap_loop(loop, point_count, arena);  // every point on a loop at most
+    return arena.failed ? 0 : arena.required_bytes();
+}
+
+Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
+                size_t workspace_bytes, uint32_t* triangles, size_t triangle_capacity,
+                size_t* triangle_count, Report* report) {
+    if (detail::reconstruct_buffers_overlap(cloud, workspace, workspace_bytes, triangles,
+                                            triangle_capacity, triangle_count, report))
+        return Status::invalid_argument;
+    Report checks = {};  // what the shared checks write, copied out in part
+    detail::CapCounts caps = {0, 0, 0};
+    detail::Arena arena = detail::Arena::over(workspace, workspace_bytes);
+    const size_t given = triangle_count ? *triangle_count : 0;
+    size_t count = given, needed = 0;
+    auto finish = [&](Status status) {
+        if (report) {
+            report->caps_closed = caps.closed;
+            report->caps_left_open = caps.left_open;
+            report->cap_triangles = caps.triangles;
+            report->workspace_used = arena.peak_from_buffer();
+            report->detail = checks.detail;
+        }
+        if (status == Status::ok) *triangle_count = count;
+        if (status == Status::triangle_capacity) *triangle_count = needed;
+        return status;
+    };
+    Status status = detail::check_reconstruct_arguments(cloud, triangles, triangle_capacity,
+                                                        triangle_count, workspace, checks);
+    if (status != Status::ok) return finish(status);
+    if (given > triangle_capacity) {
+        checks.detail = "triangle_count is above triangle_capacity";
+        return finish(Status::invalid_argument);
+    }
+    const detail::CloudReader reader = detail::reader_of(cloud);
+    status = detail::reject_invalid_points(reader, cloud.count, options, checks);
+    if (status != Status::ok) return finish(status);
+    for (size_t k = 0; k < 3 * given; ++k)
+        if (triangles[k] >= cloud.count || !reader.valid(triangles[k])) {
+            checks.detail = "a triangle names a point outside the cloud, or an invalid one";
+            return finish(Status::invalid_argument);
+        }
+    detail::Frame frame;
+    status = detail::choose_frame(reader, cloud.count, options, frame);
+    if (status != Status::ok) return finish(status);
+    status = detail::cap_boundary_loops(triangles, count, triangle_capacity, reader,
+                                        cloud.count, frame, arena, caps, &needed);
+    if (status == Status::out_of_memory)
+        checks.detail = "the workspace is smaller than cap_ends_workspace_size()";
+    else if (status == Status::triangle_capacity)
+        checks.detail = "the triangle array is too small for the caps; triangle_count says how "
+                        "many are needed";
+    else if (caps.left_open > 0)
+        checks.detail = "a boundary loop's projection across the axis is not a simple polygon "
+                        "(or each of its ears would repeat an edge of the surface): it is left "
+                        "open";
+    return finish(status);
+}
+#endif
 
 }  // namespace stratmesh
 

@@ -11,6 +11,9 @@
 // points_used of them; and, when the pushes were sorted, all accepted, no point lies near a
 // cut and the origin was given, the output equals reconstruct() of the accepted points
 // with cuts at the pushes' tops, triangle for triangle (the documented equivalence).
+// Then cap_ends() on the emitted mesh: an oriented manifold still, its loops closed or
+// counted open, and with the equivalence, reconstruct()'s close_ends triangles; on a soup
+// made of the mesh by moving corners, a documented status and no write past its buffers.
 #include "fuzz_cloud.h"
 #include "fuzz_common.h"
 
@@ -225,7 +228,46 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     STRATMESH_FUZZ_CHECK(r.nonmanifold_edges == 0 && r.inconsistent_edges == 0, "not an oriented edge-manifold");
     STRATMESH_FUZZ_CHECK(r.nonmanifold_vertices == 0, "not vertex-manifold");
 
-    // ---- the same as reconstruct() on the same layers
+    // ---- its caps: cap_ends() keeps it an oriented manifold and closes its loops, or says
+    // which stay open; on a soup made of it by moving some corners, it stays in its buffers
+    const stratmesh::Cloud whole = {accepted_points.empty() ? nullptr : accepted_points.data(), m, fc.stride,
+                                    fc.f32 ? stratmesh::Scalar::float32 : stratmesh::Scalar::float64};
+    std::vector<uint32_t> capped(t);
+    const bool soup = in.remaining() > 0 && in.u8() % 4 == 0;
+    for (size_t k = 0; soup && k < capped.size() && in.remaining() > 0; k += 1 + in.below(16))
+        capped[k] = in.below(static_cast<uint32_t>(m));
+    const size_t surface = capped.size() / 3;
+    capped.resize(3 * stratmesh::reconstruct_max_triangles(m, options) + 3, 0xFEFEFEFEu);
+    std::vector<unsigned char> cap_work(stratmesh::cap_ends_workspace_size(m, surface));
+    stratmesh::Report cap_report = {};
+    size_t capped_count = surface;
+    const Status capping = stratmesh::cap_ends(whole, options, cap_work.data(), cap_work.size(), capped.data(),
+                                               capped.size() / 3 - 1, &capped_count, &cap_report);
+    if (soup) {
+        STRATMESH_FUZZ_CHECK(capping == Status::ok || capping == Status::invalid_argument,
+                             "cap_ends on a soup: an undocumented status");
+    } else {
+        STRATMESH_FUZZ_CHECK(capping == Status::ok, "cap_ends fails on the stream's surface");
+    }
+    STRATMESH_FUZZ_CHECK(capped.back() == 0xFEFEFEFEu, "cap_ends wrote past the capacity");
+    STRATMESH_FUZZ_CHECK(cap_report.workspace_used <= cap_work.size(), "cap_ends beyond its workspace");
+    if (capping == Status::ok) {
+        STRATMESH_FUZZ_CHECK(capped_count == surface + cap_report.cap_triangles, "cap triangles miscounted");
+        for (size_t k = 3 * surface; k < 3 * capped_count; ++k)
+            STRATMESH_FUZZ_CHECK(capped[k] < m && valid[capped[k]], "a cap corner outside the valid points");
+    }
+    if (capping == Status::ok && !soup) {
+        mi.triangles = capped.data();
+        mi.triangle_count = capped_count;
+        const mesh_check::Result c = mesh_check::check(mi);
+        STRATMESH_FUZZ_CHECK(c.bad_indices == 0 && c.degenerate == 0, "caps: bad or degenerate triangles");
+        STRATMESH_FUZZ_CHECK(c.nonmanifold_edges == 0 && c.inconsistent_edges == 0,
+                             "caps: not an oriented edge-manifold");
+        STRATMESH_FUZZ_CHECK(c.nonmanifold_vertices == 0, "caps: not vertex-manifold");
+        STRATMESH_FUZZ_CHECK(c.boundary_loops == cap_report.caps_left_open, "caps: loops neither closed nor counted");
+    }
+
+    // ---- the same as reconstruct() on the same layers (with close_ends: the caps too)
     if (!(sorted && all_accepted && origin_given && tops.size() >= 1)) return 0;
     double lo = HUGE_VAL, hi = -HUGE_VAL;
     for (size_t i = 0; i < m; ++i)
@@ -248,8 +290,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (!(cuts[k] > cuts[k - 1] + margin)) return 0;
     options.cuts = cuts.empty() ? nullptr : cuts.data();
     options.cut_count = cuts.size();
-    const stratmesh::Cloud whole = {accepted_points.empty() ? nullptr : accepted_points.data(), m, fc.stride,
-                                    fc.f32 ? stratmesh::Scalar::float32 : stratmesh::Scalar::float64};
+    options.flags |= stratmesh::close_ends;
     std::vector<unsigned char> batch_work(stratmesh::reconstruct_workspace_size(m, options));
     std::vector<uint32_t> batch(3 * stratmesh::reconstruct_max_triangles(m, options) + 3);
     size_t batch_count = 0;
@@ -257,6 +298,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                                       batch.size() / 3, &batch_count, nullptr);
     STRATMESH_FUZZ_CHECK(b == Status::ok, "reconstruct fails where the stream succeeded");
     batch.resize(3 * batch_count);
-    STRATMESH_FUZZ_CHECK(batch == t, "the stream's triangles differ from reconstruct()'s on the same layers");
+    STRATMESH_FUZZ_CHECK(batch.size() >= t.size() && std::equal(t.begin(), t.end(), batch.begin()),
+                         "the stream's triangles differ from reconstruct()'s on the same layers");
+    if (soup) return 0;
+    capped.resize(3 * capped_count);
+    STRATMESH_FUZZ_CHECK(batch == capped, "cap_ends' caps differ from reconstruct()'s with close_ends");
     return 0;
 }

@@ -257,3 +257,216 @@ TEST_CASE("stream: the output is a manifold tube through every point") {
     CHECK(out.report.points_used == s.size());
     CHECK(out.report.layer_count == 10);
 }
+
+#if !defined(STRATMESH_SMALL_CODE)  // cap_ends() is left out there (see the header's Config)
+namespace {
+
+struct Capped {
+    Status status = Status::internal_error;
+    std::vector<uint32_t> triangles;
+    Report report{};
+    size_t count = 0;
+};
+
+// cap_ends() on `surface` over the layered cloud's points, with room for 2n triangles.
+Capped cap_surface(const Layered& l, const Options& o, const std::vector<uint32_t>& surface) {
+    Capped out;
+    const Cloud cloud = {l.xyz.data(), l.size(), 0, Scalar::float64};
+    out.triangles = surface;
+    out.triangles.resize(3 * stratmesh::reconstruct_max_triangles(cloud.count, o));
+    std::vector<unsigned char> work(stratmesh::cap_ends_workspace_size(cloud.count, surface.size() / 3));
+    out.count = surface.size() / 3;
+    out.status = stratmesh::cap_ends(cloud, o, work.data(), work.size(), out.triangles.data(),
+                                     out.triangles.size() / 3, &out.count, &out.report);
+    if (out.status == Status::ok) out.triangles.resize(3 * out.count);
+    CHECK(out.report.workspace_used <= work.size());
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("cap_ends: the stream's surface capped is reconstruct()'s with close_ends, triangle for triangle") {
+    const std::vector<std::vector<double>> plans = {equal_fractions(6), {0.03, 0.06, 0.85, 0.97}, {}};
+    size_t compared = 0, closed = 0;
+    for (const shapes::Kind& kind : shapes::kinds()) {
+        for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
+            for (size_t n : {size_t(400), size_t(3000)}) {
+                const Shape s = kind.make(n, pose);
+                double axis[3];
+                s.axis_direction(axis);
+                for (size_t plan = 0; plan < plans.size(); ++plan) {
+                    INFO(kind.name << " (" << shapes::pose_name(pose) << "), " << n
+                                   << " points, plan " << plan);
+                    const Layered l = layer_cloud(s.xyz, axis, plans[plan]);
+                    const Options o = shared_origin(s);
+                    Options closing = o;
+                    closing.flags |= stratmesh::close_ends;
+                    const Output batch = run_batch(l, closing);
+                    const Output stream = run_stream(l, o, l.size());
+                    REQUIRE(stream.status == batch.status);
+                    if (batch.status != Status::ok) continue;
+                    const Capped capped = cap_surface(l, o, stream.triangles);
+                    REQUIRE(capped.status == Status::ok);
+                    CHECK(capped.triangles == batch.triangles);
+                    CHECK(capped.report.caps_closed == batch.report.caps_closed);
+                    CHECK(capped.report.caps_left_open == batch.report.caps_left_open);
+                    CHECK(capped.report.cap_triangles == batch.report.cap_triangles);
+                    // Only the cap fields are set: the stream's counts stay.
+                    CHECK(capped.report.points_in == 0);
+                    ++compared;
+                    closed += batch.report.caps_closed;
+                }
+            }
+        }
+    }
+    // The comparison means something only if most runs had caps to make (measured: 162
+    // runs, 318 caps).
+    CHECK(compared >= 150);
+    CHECK(closed >= 3 * compared / 2);
+}
+
+TEST_CASE("cap_ends: the capped stream output is a closed manifold through every point") {
+    const Shape s = shapes::vase(5000, Pose::tilted);
+    double axis[3];
+    s.axis_direction(axis);
+    const Layered l = layer_cloud(s.xyz, axis, equal_fractions(10));
+    const Options o = axis_options(s);
+    const Output out = run_stream(l, o, l.size());
+    REQUIRE(out.status == Status::ok);
+    const Capped capped = cap_surface(l, o, out.triangles);
+    REQUIRE(capped.status == Status::ok);
+    CHECK(capped.report.caps_closed == 2);
+    CHECK(capped.report.caps_left_open == 0);
+    CHECK(capped.count == out.triangles.size() / 3 + capped.report.cap_triangles);
+    // The surface comes first, unchanged.
+    CHECK(std::equal(out.triangles.begin(), out.triangles.end(), capped.triangles.begin()));
+    Shape reordered = s;
+    reordered.xyz = l.xyz;
+    mesh_check::Input in;
+    in.points = reordered.xyz.data();
+    in.point_count = reordered.size();
+    in.triangles = capped.triangles.data();
+    in.triangle_count = capped.count;
+    reordered.axis_point(in.axis_point);
+    reordered.axis_direction(in.axis_direction);
+    in.self_intersections = true;
+    const mesh_check::Result r = mesh_check::check(in);
+    INFO(r.summary());
+    CHECK(r.bad_indices == 0);
+    CHECK(r.nonmanifold_edges == 0);
+    CHECK(r.nonmanifold_vertices == 0);
+    CHECK(r.inconsistent_edges == 0);
+    CHECK(r.components == 1);
+    CHECK(r.boundary_loops == 0);
+    CHECK(r.euler == 2);
+    CHECK(r.vertices_used == s.size());
+    CHECK(r.intersecting_pairs == 0);
+}
+
+TEST_CASE("cap_ends: bad arguments get their status and leave the triangles as they were") {
+    const Shape s = shapes::cylinder(600, Pose::z);
+    double axis[3];
+    s.axis_direction(axis);
+    const Layered l = layer_cloud(s.xyz, axis, equal_fractions(3));
+    const Options o = axis_options(s);
+    const Output out = run_stream(l, o, l.size());
+    REQUIRE(out.status == Status::ok);
+    const size_t n = l.size(), surface = out.triangles.size() / 3;
+    const Cloud cloud = {l.xyz.data(), n, 0, Scalar::float64};
+    std::vector<unsigned char> work(stratmesh::cap_ends_workspace_size(n, surface));
+    REQUIRE(!work.empty());
+    // Runs cap_ends on a copy of the surface with `capacity` triangles of room; checks that
+    // a refusal changed no triangle.
+    auto attempt = [&](const Cloud& c, const std::vector<uint32_t>& tris, size_t capacity,
+                       size_t given, size_t work_bytes, size_t* count_out, size_t* used = nullptr) {
+        std::vector<uint32_t> room = tris;
+        room.resize(3 * std::max(capacity, tris.size() / 3), 0xABABABABu);
+        const std::vector<uint32_t> before = room;
+        size_t count = given;
+        Report report{};
+        report.points_in = 77;
+        const Status status = stratmesh::cap_ends(c, o, work.data(), work_bytes, room.data(),
+                                                  capacity, &count, &report);
+        if (status != Status::ok) CHECK(room == before);
+        CHECK(report.points_in == 77);
+        if (status != Status::ok && status != Status::triangle_capacity) CHECK(count == given);
+        CHECK((status == Status::ok) == (report.detail == nullptr));
+        if (count_out) *count_out = count;
+        if (used) *used = report.workspace_used;
+        return status;
+    };
+    size_t count = 0, used = 0;
+    REQUIRE(attempt(cloud, out.triangles, 2 * n, surface, work.size(), &count, &used) == Status::ok);
+    CHECK(used <= work.size());
+    const size_t closed = count;
+    CHECK(closed > surface);
+    SUBCASE("too little room for the caps: triangle_capacity and the count needed") {
+        CHECK(attempt(cloud, out.triangles, closed - 1, surface, work.size(), &count) ==
+              Status::triangle_capacity);
+        CHECK(count == closed);
+    }
+    SUBCASE("a workspace below what the call used: out_of_memory") {
+        for (size_t bytes : {size_t(0), size_t(64), used / 2, used - 1})
+            CHECK(attempt(cloud, out.triangles, 2 * n, surface, bytes, nullptr) == Status::out_of_memory);
+    }
+    SUBCASE("an index outside the cloud, or more triangles than the capacity: invalid_argument") {
+        std::vector<uint32_t> wrong = out.triangles;
+        wrong[7] = static_cast<uint32_t>(n);
+        CHECK(attempt(cloud, wrong, 2 * n, surface, work.size(), nullptr) == Status::invalid_argument);
+        CHECK(attempt(cloud, out.triangles, surface - 1, surface, work.size(), nullptr) ==
+              Status::invalid_argument);
+        CHECK(stratmesh::cap_ends(cloud, o, work.data(), work.size(), nullptr, 0, nullptr, nullptr) ==
+              Status::invalid_argument);
+    }
+    SUBCASE("buffers that share bytes: invalid_argument") {
+        std::vector<uint32_t> room = out.triangles;
+        room.resize(6 * n);
+        size_t given = surface;
+        CHECK(stratmesh::cap_ends(cloud, o, room.data() + 3 * surface, 4 * (3 * n - 3 * surface),
+                                  room.data(), 2 * n, &given, nullptr) == Status::invalid_argument);
+        CHECK(given == surface);
+    }
+    SUBCASE("a NaN point: invalid_point, unless skipped; a triangle naming it: invalid_argument") {
+        Layered with_nan = l;
+        with_nan.xyz[3 * 5] = std::nan("");
+        const Cloud nan_cloud = {with_nan.xyz.data(), n, 0, Scalar::float64};
+        CHECK(attempt(nan_cloud, out.triangles, 2 * n, surface, work.size(), nullptr) ==
+              Status::invalid_point);
+        Options skipping = o;
+        skipping.flags |= stratmesh::skip_invalid_points;
+        std::vector<uint32_t> room = out.triangles;
+        room.resize(6 * n);
+        size_t given = surface;
+        CHECK(stratmesh::cap_ends(nan_cloud, skipping, work.data(), work.size(), room.data(), 2 * n,
+                                  &given, nullptr) == Status::invalid_argument);
+        CHECK(given == surface);
+    }
+}
+
+TEST_CASE("cap_ends: any triangle soup over the cloud stays within the buffers") {
+    const Shape s = shapes::bumpy_tube(300, Pose::tilted);
+    const Options o = axis_options(s);
+    const Cloud cloud = {s.xyz.data(), s.size(), 0, Scalar::float64};
+    shapes::Rng rng(11);
+    for (size_t trial = 0; trial < 200; ++trial) {
+        const size_t soup = 1 + trial % 40;
+        const uint32_t spread = 4 + static_cast<uint32_t>(trial % 9) * 37;  // few or many distinct indices
+        std::vector<uint32_t> room(3 * 2 * s.size() + 3, 0xCDCDCDCDu);
+        for (size_t k = 0; k < 3 * soup; ++k)
+            room[k] = static_cast<uint32_t>(rng.uniform(0, spread)) % static_cast<uint32_t>(s.size());
+        const std::vector<uint32_t> before = room;
+        std::vector<unsigned char> work(stratmesh::cap_ends_workspace_size(s.size(), soup));
+        size_t count = soup;
+        Report report{};
+        const Status status = stratmesh::cap_ends(cloud, o, work.data(), work.size(), room.data(),
+                                                  2 * s.size(), &count, &report);
+        INFO("trial " << trial);
+        REQUIRE(status == Status::ok);
+        CHECK(count == soup + report.cap_triangles);
+        CHECK(std::equal(before.begin(), before.begin() + 3 * static_cast<std::ptrdiff_t>(soup), room.begin()));
+        CHECK(room.back() == 0xCDCDCDCDu);  // nothing past the capacity
+        for (size_t k = 3 * soup; k < 3 * count; ++k) CHECK(room[k] < s.size());
+        CHECK(report.workspace_used <= work.size());
+    }
+}
+#endif

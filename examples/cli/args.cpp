@@ -209,7 +209,10 @@ std::string stream_conflict(const CommandLine& line) {
     if (line.cuts.empty() && line.layer_height <= 0)
         return "--stream needs --cuts or --layer-height: the layers are formed as the points "
                "arrive (--layers and automatic layers need the whole cloud's height)";
-    if (line.cap) return "--stream cannot --cap: the stream makes no caps";
+    if (line.cap)
+        return "--stream cannot --cap: caps need the whole cloud (the library's cap_ends() "
+               "closes a stream's surface afterwards), which --stream does not keep: run "
+               "without --stream";
     if (mesh_format_from_extension(line.output) == MeshFormat::stl)
         return "--stream cannot write STL (its triangles repeat their corners' coordinates, "
                "which the stream no longer holds): write PLY, OBJ or OFF";

@@ -328,17 +328,21 @@ TEST_CASE("reconstruct allocates nothing, on success and on every error status")
 
 namespace {
 
-// Counts the triangles a stream emits, into storage sized before.
+// Keeps the triangles a stream emits, in storage sized before.
 struct Emitted {
     size_t count = 0;
-    static void take(void* user, const uint32_t*, size_t count) {
-        static_cast<Emitted*>(user)->count += count;
+    std::vector<uint32_t>* triangles = nullptr;  // capacity reserved: no allocation
+    static void take(void* user, const uint32_t* t, size_t count) {
+        Emitted& e = *static_cast<Emitted*>(user);
+        for (size_t k = 0; k < 3 * count && 3 * e.count + k < e.triangles->size(); ++k)
+            (*e.triangles)[3 * e.count + k] = t[k];
+        e.count += count;
     }
 };
 
 }  // namespace
 
-TEST_CASE("the stream allocates nothing: open, every push and close") {
+TEST_CASE("the stream and its caps allocate nothing: open, every push, close, cap_ends") {
     const shapes::Shape s = shapes::bumpy_tube(3000, shapes::Pose::z);
     // Ten pushes of points sorted along the axis.
     std::vector<size_t> order(s.size());
@@ -349,7 +353,11 @@ TEST_CASE("the stream allocates nothing: open, every push and close") {
     stratmesh::Options o = no_heap::z_axis();
     std::vector<unsigned char> work(stratmesh::stream_workspace_size(s.size(), o));
     stratmesh::Report report = {};
+    std::vector<uint32_t> triangles(3 * stratmesh::reconstruct_max_triangles(s.size(), o));
     Emitted emitted;
+    emitted.triangles = &triangles;
+    std::vector<unsigned char> capping(stratmesh::cap_ends_workspace_size(s.size(), s.size() * 2));
+    size_t capped = 0;
     std::vector<stratmesh::Status> statuses;
     statuses.reserve(16);
     size_t n = alloc_counter::allocations_during([&] {
@@ -364,11 +372,17 @@ TEST_CASE("the stream allocates nothing: open, every push and close") {
             statuses.push_back(stratmesh::stream_push(stream, layer, top));
         }
         statuses.push_back(stratmesh::stream_close(stream));
+        capped = emitted.count;
+        stratmesh::Cloud all = {sorted.data(), s.size(), 0, stratmesh::Scalar::float64};
+        statuses.push_back(stratmesh::cap_ends(all, o, capping.data(), capping.size(), triangles.data(),
+                                               triangles.size() / 3, &capped, &report));
     });
     CHECK(n == 0);
     for (stratmesh::Status st : statuses) CHECK(st == stratmesh::Status::ok);
     CHECK(emitted.count == report.triangle_count);
     CHECK(report.points_used == s.size());
+    CHECK(report.caps_closed == 2);
+    CHECK(capped == emitted.count + report.cap_triangles);
 }
 
 TEST_CASE("delaunay_2d allocates nothing, on success and on every error status") {
@@ -395,6 +409,7 @@ TEST_CASE("the sizing functions, predicates and status strings allocate nothing"
         sink = sink + stratmesh::reconstruct_max_triangles(100000, o);
         sink = sink + stratmesh::delaunay_2d_workspace_size(100000);
         sink = sink + stratmesh::delaunay_2d_max_triangles(100000);
+        sink = sink + stratmesh::cap_ends_workspace_size(100000, 200000);
         sink = sink + (stratmesh::orient2d(a, b, c) > 0) + (stratmesh::incircle(a, b, c, d) > 0);
         sink = sink + (stratmesh::status_string(stratmesh::Status::collinear)[0] != 0);
     });

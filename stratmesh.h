@@ -591,7 +591,8 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count);
 // sets *triangle_count to the new total. options: axis, direction, origin (with
 // origin_given) and skip_invalid_points as given to the stream or reconstruct(); the rest
 // is not used. report (optional): only caps_closed, caps_left_open, cap_triangles,
-// workspace_used and detail are set, so the stream's report can be passed as it is.
+// workspace_used (this call's) and detail are set, the rest left as it is: the stream's
+// report can be passed, its counts kept (its workspace_used replaced).
 // Returns ok (loops whose projection is not simple stay open: caps_left_open);
 // invalid_argument (a null triangle_count, triangles or workspace where needed, a bad
 // stride or scalar, *triangle_count above triangle_capacity, an index outside the cloud or

@@ -889,7 +889,4 @@ TEST_CASE("command line: usage errors") {
         "--stream needs --cuts or --layer-height"));
     CHECK(contains(usage_error({"a.ply", "-o", "m.stl", "--stream", "--axis", "z", "--cuts", "1"}),
                    "--stream cannot write STL"));
-    CHECK(contains(usage_error({"a.ply", "-o", "m.ply", "--stream", "--axis", "z", "--cuts", "1",
-                                "--cap"}),
-                   "--stream cannot --cap"));
 }

@@ -60,7 +60,10 @@ const char kUsage[] =
     "                        sorted along the axis, input PLY, XYZ or OBJ, output PLY, OBJ\n"
     "                        or OFF (not STL). The same triangles as the run without\n"
     "                        --stream given --cuts at the layer tops reached (the report's\n"
-    "                        stream.batch_cuts) and --origin at that first point\n"
+    "                        stream.batch_cuts) and --origin at that first point. With\n"
+    "                        --cap it keeps every point and triangle until the end (about\n"
+    "                        140 bytes a point more) and caps them as the run without\n"
+    "                        --stream would\n"
     "  --stream-points N     the most points the stream may hold at once (default\n"
     "                        3000000, about 190 bytes each); about three layers' worth\n"
     "  -q, --quiet           no progress and no summary on stderr (errors still are)\n"
@@ -209,10 +212,6 @@ std::string stream_conflict(const CommandLine& line) {
     if (line.cuts.empty() && line.layer_height <= 0)
         return "--stream needs --cuts or --layer-height: the layers are formed as the points "
                "arrive (--layers and automatic layers need the whole cloud's height)";
-    if (line.cap)
-        return "--stream cannot --cap: caps need the whole cloud (the library's cap_ends() "
-               "closes a stream's surface afterwards), which --stream does not keep: run "
-               "without --stream";
     if (mesh_format_from_extension(line.output) == MeshFormat::stl)
         return "--stream cannot write STL (its triangles repeat their corners' coordinates, "
                "which the stream no longer holds): write PLY, OBJ or OFF";

@@ -64,15 +64,13 @@ private:
     size_t next_cut_ = 0;
 };
 
-void write_triangles(void* user, const uint32_t* triangles, size_t count) {
-    static_cast<MeshStreamWriter*>(user)->add_triangles(triangles, count);
-}
-
 class StreamRunner {
 public:
     StreamRunner(const CommandLine& line, stratmesh::Options options, RunRecord& record)
         : line_(line), options_(options), record_(record), tops_(line),
           layers_(kLayerCapacity) {
+        // The stream refuses close_ends: --cap runs cap_ends() once it is closed.
+        options_.flags &= ~static_cast<uint32_t>(stratmesh::close_ends);
         unit_axis(options_, axis_);
         report_.layers = layers_.data();
         report_.layer_capacity = layers_.size();
@@ -136,8 +134,16 @@ private:
             return false;
         }
         record_.status = stratmesh::stream_open(options_, workspace_.get(), record_.workspace_bytes,
-                                                &write_triangles, &writer_, &report_, &stream_);
+                                                &StreamRunner::take_triangles, this, &report_,
+                                                &stream_);
         return record_.status == stratmesh::Status::ok;
+    }
+
+    // Writes the triangles as they come; with --cap, keeps them for the caps too.
+    static void take_triangles(void* user, const uint32_t* triangles, size_t count) {
+        StreamRunner& runner = *static_cast<StreamRunner*>(user);
+        runner.writer_.add_triangles(triangles, count);
+        if (runner.line_.cap) runner.kept_.insert(runner.kept_.end(), triangles, triangles + 3 * count);
     }
 
     // Writes the layer's vertices (before any triangle can use them) and pushes it.
@@ -145,6 +151,7 @@ private:
         if (layer_.empty()) return true;
         Clock::time_point start = Clock::now();
         writer_.add_vertices(layer_.data(), layer_.size() / 3);
+        if (line_.cap) all_points_.insert(all_points_.end(), layer_.begin(), layer_.end());
         Clock::time_point pushed = Clock::now();
         write_seconds_ += std::chrono::duration<double>(pushed - start).count();
         stratmesh::Cloud cloud = {layer_.data(), layer_.size() / 3, 0, stratmesh::Scalar::float64};
@@ -165,6 +172,7 @@ private:
         record_.status =
             stream_ ? stratmesh::stream_close(stream_) : stratmesh::Status::too_few_points;
         stream_seconds_ += seconds_since(start);
+        if (record_.status == stratmesh::Status::ok && line_.cap) record_.status = close_with_caps();
         record_.reconstruct_seconds = stream_seconds_;
         if (record_.status != stratmesh::Status::ok) return StreamOutcome::refused;
         start = Clock::now();
@@ -173,6 +181,32 @@ private:
         record_.write_seconds = write_seconds_;
         record_.output_written = written;
         return written ? StreamOutcome::done : StreamOutcome::file_error;
+    }
+
+    // --cap: closes the kept surface over every point read, as the run without --stream
+    // does (the same frame: the cloud's, with the stream's origin), and writes the caps.
+    stratmesh::Status close_with_caps() {
+        Clock::time_point start = Clock::now();
+        const size_t n = all_points_.size() / 3, surface = kept_.size() / 3;
+        const size_t bytes = stratmesh::cap_ends_workspace_size(n, surface);
+        std::unique_ptr<unsigned char[]> work(new (std::nothrow) unsigned char[bytes]);
+        if (!work || bytes == 0) return stratmesh::Status::out_of_memory;
+        kept_.resize(3 * stratmesh::reconstruct_max_triangles(n, options_));
+        size_t count = surface;
+        const stratmesh::Cloud cloud = {all_points_.data(), n, 0, stratmesh::Scalar::float64};
+        stratmesh::Report caps = {};  // its workspace_used is the caps' alone
+        const stratmesh::Status status =
+            stratmesh::cap_ends(cloud, options_, work.get(), bytes, kept_.data(),
+                                kept_.size() / 3, &count, &caps);
+        stream_seconds_ += seconds_since(start);
+        if (caps.detail) report_.detail = caps.detail;
+        if (status != stratmesh::Status::ok) return status;
+        writer_.add_triangles(kept_.data() + 3 * surface, count - surface);
+        report_.caps_closed = caps.caps_closed;
+        report_.caps_left_open = caps.caps_left_open;
+        report_.cap_triangles = caps.cap_triangles;
+        report_.triangle_count = count;
+        return status;
     }
 
     std::string backwards_message(double height) const {
@@ -201,6 +235,8 @@ private:
     stratmesh::Report report_ = {};
     std::vector<stratmesh::LayerInfo> layers_;
     std::vector<double> layer_; // the points of the layer being read, x y z packed
+    std::vector<double> all_points_; // with --cap: every point pushed, x y z packed
+    std::vector<uint32_t> kept_;     // with --cap: every triangle emitted
     double top_ = LayerTops::kInfinity;
     double highest_ = -LayerTops::kInfinity; // the height of the last finite point
     size_t points_read_ = 0;

@@ -965,7 +965,31 @@ Result measure_stream(const std::string& name, const std::vector<double>& coords
             run_reconstruct(cloud, batch, batch_workspace.get(), batch_bytes, whole);
             return whole.seconds;
         });
-    bool ok = streamed.status == stratmesh::Status::ok && whole.status == stratmesh::Status::ok;
+    // The stream's surface closed afterwards by cap_ends(), against reconstruct() with
+    // close_ends on the same cuts (once each: they run after the timed alternation).
+    const size_t surface = streamed.triangles.size() / 3;
+    const size_t cap_bytes = stratmesh::cap_ends_workspace_size(cloud.count, surface);
+    std::unique_ptr<unsigned char[]> cap_workspace = allocate_touched(cap_bytes);
+    std::vector<uint32_t> capped = streamed.triangles;
+    capped.resize(3 * stratmesh::reconstruct_max_triangles(cloud.count, batch));
+    size_t capped_count = surface;
+    stratmesh::Report cap_report = stratmesh::Report();
+    Clock::time_point cap_start = Clock::now();
+    const stratmesh::Status cap_status =
+        stratmesh::cap_ends(cloud, options, cap_workspace.get(), cap_bytes, capped.data(),
+                            capped.size() / 3, &capped_count, &cap_report);
+    const double cap_seconds = seconds_between(cap_start, Clock::now());
+    capped.resize(3 * capped_count);
+    stratmesh::Options closing = batch;
+    closing.flags |= stratmesh::close_ends;
+    const size_t closing_bytes = stratmesh::reconstruct_workspace_size(cloud.count, closing);
+    batch_workspace.reset();
+    std::unique_ptr<unsigned char[]> closing_workspace = allocate_touched(closing_bytes);
+    Reconstructed closed;
+    run_reconstruct(cloud, closing, closing_workspace.get(), closing_bytes, closed);
+
+    bool ok = streamed.status == stratmesh::Status::ok && whole.status == stratmesh::Status::ok &&
+              cap_status == stratmesh::Status::ok && closed.status == stratmesh::Status::ok;
     Result result = {ok ? Outcome::ok : Outcome::failed, cloud.count, median(stream_times),
                      std::nan(""), std::nan(""), std::nan("")};
     JsonLine line = case_line(name, cloud.count, runs);
@@ -990,6 +1014,16 @@ Result measure_stream(const std::string& name, const std::vector<double>& coords
     line.add("status", status_name(whole.status));
     line.add("stream_status", status_name(streamed.status));
     if (streamed.report.detail) line.add("stream_detail", streamed.report.detail);
+    line.add("cap_ends_seconds", cap_seconds);
+    line.add("cap_ends_workspace_bytes", cap_bytes);
+    line.add("cap_ends_bytes_per_point",
+             static_cast<double>(cap_bytes) / static_cast<double>(cloud.count));
+    line.add("cap_ends_status", status_name(cap_status));
+    line.add("caps_closed", cap_report.caps_closed);
+    line.add("close_ends_seconds", closed.seconds);
+    line.add("stream_and_cap_ends_over_close_ends",
+             (median(stream_times) + cap_seconds) / closed.seconds);
+    line.add("capped_identical", capped == closed.triangles);
     line.print();
     return result;
 }
@@ -1209,6 +1243,12 @@ void print_help(std::FILE* out) {
         "  stream_workspace_used, reconstruct_workspace_used, workspace_used_ratio\n"
         "                            Report::workspace_used of each\n"
         "  points_held, identical    the stream's Report::points_held; same triangles\n"
+        "  cap_ends_seconds, cap_ends_workspace_bytes, cap_ends_bytes_per_point,\n"
+        "  cap_ends_status, caps_closed   cap_ends() on the stream's triangles, once\n"
+        "  close_ends_seconds        reconstruct with close_ends on the same cuts, once\n"
+        "  stream_and_cap_ends_over_close_ends   (stream_seconds + cap_ends_seconds) /\n"
+        "                            close_ends_seconds\n"
+        "  capped_identical          cap_ends' output equals close_ends', triangle for triangle\n"
         "\n"
         "  --case NAME   run only this case or family (repeatable, or a comma list);\n"
         "                see --list. Without --case, --xy or --cloud, every case runs.\n"

@@ -574,7 +574,8 @@ Status stream_close(Stream* stream);
 //
 // With the stream's triangles, the same Options and `cloud` the concatenated pushes (every
 // point pushed, in order: the triangles' global indices), the result is reconstruct()'s
-// with close_ends for the same cuts, triangle for triangle: the same caps, appended last.
+// with close_ends for the same cuts, triangle for triangle, wherever the stream gives
+// reconstruct()'s triangles (origin_given; see the stream above): the caps come last.
 // The frame is chosen from the whole cloud as reconstruct() chooses it, so the caps do not
 // depend on how the cloud was pushed. Any other surface works too: each boundary loop is
 // projected across the axis and capped if that projection is a simple polygon (see

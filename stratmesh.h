@@ -4468,6 +4468,13 @@ struct CapCounts {
     size_t closed, left_open, triangles;
 };
 
+// Report::detail for the caps, from reconstruct() and cap_ends() alike.
+const char* const kCapsTooLargeDetail =
+    "the triangle array is too small for the caps; triangle_count says how many are needed";
+const char* const kLoopLeftOpenDetail =
+    "a boundary loop's projection across the axis is not a simple polygon (or each of its "
+    "ears would repeat an edge of the surface): it is left open";
+
 // Caps every boundary loop of the surface tri[0 .. 3 count) over the cloud's points,
 // appending the cap triangles (count grows); each loop is projected across the frame's
 // axis. Returns ok; out_of_memory; or triangle_capacity with *needed the triangles every
@@ -5664,8 +5671,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
         if (status == Status::triangle_capacity) {
             *triangle_count = needed;
             rep.triangle_count = needed;
-            rep.detail = "the triangle array is too small for the caps; triangle_count says how "
-                         "many are needed";
+            rep.detail = kCapsTooLargeDetail;
         }
         if (status != Status::ok) return finish(status);
     }
@@ -5676,9 +5682,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     rep.triangle_count = count;
     rep.folds = sink.folds;
     report_chain(chain, valid, rep);
-    if (!rep.detail && caps.left_open > 0)
-        rep.detail = "a boundary loop's projection across the axis is not a simple polygon (or "
-                     "each of its ears would repeat an edge of the surface): it is left open";
+    if (!rep.detail && caps.left_open > 0) rep.detail = kLoopLeftOpenDetail;
     notify(options, Phase::done, 1);
     return finish(Status::ok);
 }
@@ -6105,12 +6109,9 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
     if (status == Status::out_of_memory)
         checks.detail = "the workspace is smaller than cap_ends_workspace_size()";
     else if (status == Status::triangle_capacity)
-        checks.detail = "the triangle array is too small for the caps; triangle_count says how "
-                        "many are needed";
+        checks.detail = detail::kCapsTooLargeDetail;
     else if (caps.left_open > 0)
-        checks.detail = "a boundary loop's projection across the axis is not a simple polygon "
-                        "(or each of its ears would repeat an edge of the surface): it is left "
-                        "open";
+        checks.detail = detail::kLoopLeftOpenDetail;
     return finish(status);
 }
 #endif

@@ -159,12 +159,10 @@ void check_same(const Output& batch, const Output& stream) {
     }
 }
 
-}  // namespace
-
-TEST_CASE("stream: the same triangles as reconstruct() on the same layers, every test shape") {
-    // Equal layers; many thin pushes that must merge; uneven pushes with a thin last one.
-    const std::vector<std::vector<double>> plans = {
-        equal_fractions(6), equal_fractions(40), {0.03, 0.06, 0.85, 0.97}, {}};
+// Runs check(layered cloud, options with a shared origin) on every test shape, in 3 poses,
+// at 400 and 3000 points, cut by each plan of layer fractions.
+template <class Check>
+void for_every_shape(const std::vector<std::vector<double>>& plans, const Check& check) {
     for (const shapes::Kind& kind : shapes::kinds()) {
         for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
             for (size_t n : {size_t(400), size_t(3000)}) {
@@ -174,16 +172,25 @@ TEST_CASE("stream: the same triangles as reconstruct() on the same layers, every
                 for (size_t plan = 0; plan < plans.size(); ++plan) {
                     INFO(kind.name << " (" << shapes::pose_name(pose) << "), " << n
                                    << " points, plan " << plan);
-                    const Layered l = layer_cloud(s.xyz, axis, plans[plan]);
-                    const Options o = shared_origin(s);
-                    const Output batch = run_batch(l, o);
-                    // Room for the whole cloud: the stream's grouping is tested, not its memory.
-                    const Output stream = run_stream(l, o, l.size());
-                    check_same(batch, stream);
+                    check(layer_cloud(s.xyz, axis, plans[plan]), shared_origin(s));
                 }
             }
         }
     }
+}
+
+}  // namespace
+
+TEST_CASE("stream: the same triangles as reconstruct() on the same layers, every test shape") {
+    // Equal layers; many thin pushes that must merge; uneven pushes with a thin last one.
+    const std::vector<std::vector<double>> plans = {
+        equal_fractions(6), equal_fractions(40), {0.03, 0.06, 0.85, 0.97}, {}};
+    for_every_shape(plans, [](const Layered& l, const Options& o) {
+        const Output batch = run_batch(l, o);
+        // Room for the whole cloud: the stream's grouping is tested, not its memory.
+        const Output stream = run_stream(l, o, l.size());
+        check_same(batch, stream);
+    });
 }
 
 TEST_CASE("stream: pushes of one contour each (CT slices) merge into layers as reconstruct() does") {
@@ -288,37 +295,24 @@ Capped cap_surface(const Layered& l, const Options& o, const std::vector<uint32_
 TEST_CASE("cap_ends: the stream's surface capped is reconstruct()'s with close_ends, triangle for triangle") {
     const std::vector<std::vector<double>> plans = {equal_fractions(6), {0.03, 0.06, 0.85, 0.97}, {}};
     size_t compared = 0, closed = 0;
-    for (const shapes::Kind& kind : shapes::kinds()) {
-        for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
-            for (size_t n : {size_t(400), size_t(3000)}) {
-                const Shape s = kind.make(n, pose);
-                double axis[3];
-                s.axis_direction(axis);
-                for (size_t plan = 0; plan < plans.size(); ++plan) {
-                    INFO(kind.name << " (" << shapes::pose_name(pose) << "), " << n
-                                   << " points, plan " << plan);
-                    const Layered l = layer_cloud(s.xyz, axis, plans[plan]);
-                    const Options o = shared_origin(s);
-                    Options closing = o;
-                    closing.flags |= stratmesh::close_ends;
-                    const Output batch = run_batch(l, closing);
-                    const Output stream = run_stream(l, o, l.size());
-                    REQUIRE(stream.status == batch.status);
-                    if (batch.status != Status::ok) continue;
-                    const Capped capped = cap_surface(l, o, stream.triangles);
-                    REQUIRE(capped.status == Status::ok);
-                    CHECK(capped.triangles == batch.triangles);
-                    CHECK(capped.report.caps_closed == batch.report.caps_closed);
-                    CHECK(capped.report.caps_left_open == batch.report.caps_left_open);
-                    CHECK(capped.report.cap_triangles == batch.report.cap_triangles);
-                    // Only the cap fields are set: the stream's counts stay.
-                    CHECK(capped.report.points_in == 0);
-                    ++compared;
-                    closed += batch.report.caps_closed;
-                }
-            }
-        }
-    }
+    for_every_shape(plans, [&](const Layered& l, const Options& o) {
+        Options closing = o;
+        closing.flags |= stratmesh::close_ends;
+        const Output batch = run_batch(l, closing);
+        const Output stream = run_stream(l, o, l.size());
+        REQUIRE(stream.status == batch.status);
+        if (batch.status != Status::ok) return;
+        const Capped capped = cap_surface(l, o, stream.triangles);
+        REQUIRE(capped.status == Status::ok);
+        CHECK(capped.triangles == batch.triangles);
+        CHECK(capped.report.caps_closed == batch.report.caps_closed);
+        CHECK(capped.report.caps_left_open == batch.report.caps_left_open);
+        CHECK(capped.report.cap_triangles == batch.report.cap_triangles);
+        // Only the cap fields are set: the stream's counts stay.
+        CHECK(capped.report.points_in == 0);
+        ++compared;
+        closed += batch.report.caps_closed;
+    });
     // The comparison means something only if most runs had caps to make (measured: 162
     // runs, 318 caps).
     CHECK(compared >= 150);

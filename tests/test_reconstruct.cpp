@@ -579,6 +579,7 @@ TEST_CASE("reconstruction of the cylindrical scan grid, every pose, size and lay
 TEST_CASE("reconstruction of the CT slice stack, every pose, size and layering") { check_shape(6); }
 TEST_CASE("reconstruction of the noisy tube, every pose, size and layering") { check_shape(7); }
 TEST_CASE("reconstruction of the head, every pose, size and layering") { check_shape(8); }
+TEST_CASE("reconstruction of the slanted tube, every pose, size and layering") { check_shape(9); }
 
 // With several layers, the zipper bands used to hold triangles facing the axis: originally
 // 16 several-layer runs of the matrix at 2000 points and 1 at 20000 points, one or two
@@ -1278,6 +1279,62 @@ TEST_CASE("a flat cloud gives flat_cloud") {
 // tube with a strip across the open side (60 of 3973 triangles there face the true axis at
 // 2000 points, one layer). Only a cloud whose points cannot surround any centre (a plane
 // through the axis, or points on the axis) gives not_columnar.
+// The widest angle around the shape's true axis (degrees) that none of the points of s
+// with dot(p, axis) in [bottom, top) falls in.
+double widest_empty_angle(const Shape& s, double bottom, double top) {
+    std::vector<double> angles;
+    for (size_t i = 0; i < s.size(); ++i) {
+        double local[3];
+        s.transform.unapply(s.point(i), local);
+        double a[3];
+        s.axis_direction(a);
+        const double* p = s.point(i);
+        const double h = p[0] * a[0] + p[1] * a[1] + p[2] * a[2];
+        if (h >= bottom && h < top) angles.push_back(std::atan2(local[1], local[0]) * 180 / shapes::kPi);
+    }
+    if (angles.empty()) return 360;
+    std::sort(angles.begin(), angles.end());
+    double widest = angles.front() + 360 - angles.back();
+    for (size_t i = 1; i < angles.size(); ++i) widest = std::max(widest, angles[i] - angles[i - 1]);
+    return widest;
+}
+
+// Equal layers of a tube cut at a slant: the end layers hold crescents (widest empty angle
+// about 80 degrees with 12 layers), which used to be closed by a membrane across the tube.
+TEST_CASE("a crescent end layer joins its neighbour, a half cylinder keeps its layers") {
+    for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
+        for (uint32_t planned : {6u, 12u, 24u}) {
+            Shape s = shapes::slanted_tube(kSmall, pose);
+            Options o = axis_options(s);
+            o.layer_count = planned;
+            Run run = reconstruct_guarded(cloud_of(s), o);
+            CAPTURE(s.name);
+            CAPTURE(planned);
+            REQUIRE(run.status == Status::ok);
+            CHECK(run.report.layer_count < planned);
+            double widest = 0;
+            for (const LayerInfo& layer : run.layers)
+                widest = std::max(widest, widest_empty_angle(s, layer.bottom, layer.top));
+            CHECK(widest < 45);
+            mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, true);
+            INFO(m.summary());
+            CHECK(m.manifold());
+            CHECK(m.boundary_loops == 2);
+            CHECK(m.unused_expected == 0);
+            CHECK(m.max_deviation() <= kLayeredDeviation * s.spacing);
+            CHECK(m.intersecting_pairs == 0);
+        }
+    }
+    for (uint32_t planned : {6u, 12u}) {
+        Shape s = shapes::half_cylinder(kLarge, Pose::tilted);
+        Options o = axis_options(s);
+        o.layer_count = planned;
+        Run run = reconstruct_guarded(cloud_of(s), o);
+        REQUIRE(run.status == Status::ok);
+        CHECK(run.report.layer_count == planned);
+    }
+}
+
 TEST_CASE("clouds that do not surround the axis: not_columnar, or ok with a manifold annulus") {
     SUBCASE("half-cylinder: ok, one manifold annulus through every point") {
         for (uint32_t layers : {1u, 6u}) {

@@ -296,6 +296,22 @@ inline Shape slit_cylinder(size_t n, Pose pose, double gap, uint64_t seed = 19) 
                          2 * kPi - gap);
 }
 
+// The unit cylinder cut at both ends by planes leaning 35 degrees from the cross-section
+// (a limb or a pipe scanned with slanted ends): z in [-3, 3] + tan(35 deg) cos(theta), so
+// a layer thinner than 1.4 near either end holds a crescent, not a ring.
+inline Shape slanted_tube(size_t n, Pose pose, uint64_t seed = 22) {
+    const double slant = std::tan(35 * kPi / 180);
+    Shape s = detail::start("slanted tube", pose, cylinder_radius, -3 - slant, 3 + slant);
+    s.spacing = std::sqrt(2 * kPi * 6 / static_cast<double>(n));
+    Rng rng(seed);
+    s.xyz.reserve(3 * n);
+    for (size_t i = 0; i < n; ++i) {
+        double theta = rng.uniform(0, 2 * kPi);
+        s.add_local(theta, rng.uniform(-3, 3) + slant * std::cos(theta), 1.0);
+    }
+    return s;
+}
+
 // A cylindrical range scan: a regular (theta, z) grid on the unit cylinder over
 // z in [-3, 3], with about n points in rows of equal angular and vertical spacing. Every
 // grid cell is a rectangle: four cocircular points, everywhere.
@@ -358,6 +374,7 @@ inline const std::vector<Kind>& kinds() {
         {"CT slices", [](size_t n, Pose p) { return ct_slices(n, p); }},
         {"noisy tube", [](size_t n, Pose p) { return noisy_tube(n, p); }},
         {"head", [](size_t n, Pose p) { return head(n, p); }},
+        {"slanted tube", [](size_t n, Pose p) { return slanted_tube(n, p); }},
     };
     return list;
 }

@@ -509,13 +509,14 @@ Status reconstruct(const Cloud& cloud, const Options& options,
 // the stream forms layers from pushes by the rules reconstruct() applies to its planned
 // layers (a push too small, too thin, not surrounding its axis or next to a crescent joins
 // the next; a last rest too small or thin joins the layer below it), waiting for later
-// pushes where a rule needs them. So reconstruct() of the concatenated pushes, with Options::cuts at the tops
-// of all pushes but the last, the same axis, the same origin (flag origin_given) and the
-// points of each push in the same order, gives the same triangles in the same order, with
-// the same global indices (checked on every test shape), provided no point lies within
-// 2^-40 of the height range below a cut (reconstruct() counts such a point in the layer
-// above) and no cut lies outside the points' height range. The stream makes no caps (the
-// close_ends flag is refused): cap_ends() closes its surface afterwards (below).
+// pushes where a rule needs them. So reconstruct() of the concatenated pushes, with
+// Options::cuts at the tops of all pushes but the last, the same axis, the same origin
+// (flag origin_given) and the points of each push in the same order, gives the same
+// triangles in the same order, with the same global indices (checked on every test shape),
+// provided no point lies within 2^-40 of the height range below a cut (reconstruct()
+// counts such a point in the layer above) and no cut lies outside the points' height
+// range. The stream makes no caps (the close_ends flag is refused): cap_ends() closes its
+// surface afterwards (below).
 //
 // Memory: stream_workspace_size(max_points_held) bytes, about 190 per point held. The
 // stream holds the last layer's top loop, the layer being formed (pushes that join it

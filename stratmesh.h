@@ -4892,10 +4892,11 @@ inline uint32_t planned_sectors(const SurfaceChain& c, const LayerQueue& q, uint
 // The widest gap of `held` when it exceeds kRingGap and chance alone would leave a gap
 // that wide among the count points sampled from a ring less than once in a hundred (m
 // points uniform on a circle leave g of its 32 sectors empty in a row with probability
-// below m (1 - g/32)^(m-1)): a sparse layer's gaps are not crescents. Else 0.
+// below m (1 - g/32)^(m-1)): a sparse layer's gaps are not crescents, nor is an empty
+// one. Else 0.
 inline uint32_t crescent_gap(uint32_t held, size_t count) {
     const uint32_t gap = widest_gap(held);
-    if (gap <= kRingGap) return 0;
+    if (gap <= kRingGap || count == 0) return 0;
     const size_t sampled = (count + count / kGapSamplePoints) / (count / kGapSamplePoints + 1);
     const double stays_empty = 1 - static_cast<double>(gap) / kSectors;
     double chance = static_cast<double>(sampled);

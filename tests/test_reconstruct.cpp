@@ -1283,11 +1283,11 @@ TEST_CASE("a flat cloud gives flat_cloud") {
 // with dot(p, axis) in [bottom, top) falls in.
 double widest_empty_angle(const Shape& s, double bottom, double top) {
     std::vector<double> angles;
+    double a[3];
+    s.axis_direction(a);
     for (size_t i = 0; i < s.size(); ++i) {
         double local[3];
         s.transform.unapply(s.point(i), local);
-        double a[3];
-        s.axis_direction(a);
         const double* p = s.point(i);
         const double h = p[0] * a[0] + p[1] * a[1] + p[2] * a[2];
         if (h >= bottom && h < top) angles.push_back(std::atan2(local[1], local[0]) * 180 / shapes::kPi);

@@ -2764,10 +2764,12 @@ inline void roll(const Cylinder& c, const Local& p, double* out) {
 // neighbour then costs 1% of a tube's time instead of 10%.
 const size_t kGapSamplePoints = 1024;
 
+inline size_t gap_sample_stride(size_t count) { return count / kGapSamplePoints + 1; }
+
 template <class PointAt>
 inline uint32_t sectors_held(const PointAt& point_at, size_t count, double cx, double cy) {
     uint32_t held = 0;
-    const size_t stride = count / kGapSamplePoints + 1;
+    const size_t stride = gap_sample_stride(count);
     for (size_t i = 0; i < count; i += stride) {
         const Local& p = point_at(i);
         uint32_t s = static_cast<uint32_t>(pseudo_angle(p.x - cx, p.y - cy) * (kSectors / 4.0));
@@ -4897,7 +4899,8 @@ inline uint32_t planned_sectors(const SurfaceChain& c, const LayerQueue& q, uint
 inline uint32_t crescent_gap(uint32_t held, size_t count) {
     const uint32_t gap = widest_gap(held);
     if (gap <= kRingGap || count == 0) return 0;
-    const size_t sampled = (count + count / kGapSamplePoints) / (count / kGapSamplePoints + 1);
+    const size_t stride = gap_sample_stride(count);
+    const size_t sampled = (count + stride - 1) / stride;  // the points sectors_held read
     const double stays_empty = 1 - static_cast<double>(gap) / kSectors;
     double chance = static_cast<double>(sampled);
     for (size_t i = 1; i < sampled && chance >= 0.01; ++i) chance *= stays_empty;

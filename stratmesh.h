@@ -84,7 +84,10 @@
 //                            crescent rule (a layer next to a slanted end of the tube
 //                            joins it, see Options and kRingGap; 1.2 KiB): a slanted end
 //                            is then closed across by a membrane, and there the layers
-//                            and triangles differ from the full build's.
+//                            and triangles differ from the full build's. So do closed
+//                            ends (a dome or a flat base at the cloud's end, see
+//                            kPoleDepth), which it unrolls on the cylinder like the rest:
+//                            a flat base folds and its loop runs through its points.
 //
 // ==== Memory ===============================================================================
 //
@@ -450,7 +453,9 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // Reconstructs a triangle mesh through the points of a columnar cloud: one surface,
 // edge- and vertex-manifold, consistently oriented, an open tube (two boundary loops) on
 // columnar input, closed by two caps with the close_ends flag, with every valid distinct
-// point a vertex unless the report says why not.
+// point a vertex unless the report says why not. Where the cloud's end is closed (points
+// across it: a dome, a flat base), the surface goes across it too, and that end's loop is
+// a small one around the axis (see "closed ends" in >>unroll).
 //
 // cloud           the points (see Cloud), at most 2^32 - 3. They are only read.
 // options         see Options; `Options options = {};` gives the defaults.
@@ -687,6 +692,7 @@ const bool kStagePoints = false;
 const bool kFastExactStages = false;
 const bool kLiftedCaps = false;
 const bool kCrescentLayers = false;
+const bool kClosedEnds = false;
 #else
 const bool kNetShortcut = true;  // a chunk whose loop fans are whole skips the net
 const bool kStagePoints = true;  // reconstruct() keeps the grouped points in spare workspace
@@ -698,6 +704,8 @@ const bool kFastExactStages = true;
 const bool kLiftedCaps = true;
 // A crescent layer (the slanted end of a tube) joins its neighbour (see kRingGap).
 const bool kCrescentLayers = true;
+// A closed end of the surface is unrolled around a pole (see "closed ends" in >>unroll).
+const bool kClosedEnds = true;
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 
@@ -2668,6 +2676,22 @@ inline uint32_t layer_of(const LayerPlan& plan, double h) {
 // against height), so triangles are well shaped on the surface, not only in the plane. A
 // layer that folds around that centre may be unrolled around another (see "the centre
 // search" in >>layer triangulation); the radius stays.
+//
+// Closed ends. A scan of a closed object (a bone, a bust on its base, a head's crown) has
+// points across its ends, at about one height: on the cylinder a flat base puts every
+// point of a radius on one place of the annulus, and a dome's top folds. So where the
+// first or the last layer of the surface holds such an end (see find_closed_ends), the
+// points beyond a pole height, one radius in from the end, are projected from the pole (the
+// point of the axis at that height) instead, onto the sphere around it, and that sphere
+// is mapped stereographically: the direction at angle phi from the end's side of the axis
+// goes to radius e^{(pole - h0)/r} tan(phi / 2) on the annulus (the bottom; the top
+// inverts it). At the pole height both maps agree, with the same derivative, so the
+// picture stays conformal across it for a dome of the layer's radius; the end's point
+// nearest the axis becomes the centre's link (the bottom) or the hull (the top): the
+// surface's boundary loop is a small loop around the pole instead of the end's rim, and
+// the end is meshed across. On a flat-ended cylinder of 10,000 points the mean distance
+// to the true surface fell 7.5 times with one layer (to CGAL's advancing front's), 5.3
+// times over 1 to 24 layers; on half-sphere ends 20%. Open ends are not touched.
 
 const uint32_t kSectors = 32;
 
@@ -2733,21 +2757,41 @@ struct Cylinder {
     double radius;   // unrolling radius
     double h0;       // height mapped to the unit circle
     double scale;    // 1 / max(radius, height / kMaxTurns)
+    uint32_t poles;  // kLowPole, kHighPole: the ends projected from a pole (closed ends)
+    double pole_low, pole_high;  // the poles' heights: below pole_low, above pole_high
 };
+
+const uint32_t kLowPole = 1, kHighPole = 2;
 
 // Direction components smaller than this become 0. No scan resolves angles of 1e-18
 // radians, and it keeps the annulus inside the predicates' exact range: radii in
-// [e^-64, e^64] (2^-92 to 2^92) times components in [2^-60, 1] give coordinates, and
+// [e^-64, e^64] (2^-92 to 2^92; beyond a pole, tan(phi / 2) is kept in [2^-60, 1], so
+// radii stay in [2^-60, e^24 2^60]) times components in [2^-60, 1] give coordinates, and
 // coordinate differences, within a span of 2^296 < 2^320. Without it a cloud with one far
 // outlier puts components near 2^-900 on the annulus, where the signs are not exact.
 const double kSmallestDirection = 0x1p-60;
 
-// The point's place on the annulus: e^{(h - h0) * scale} times its direction from the
-// centre (points on the centre line take direction e1).
+// The annulus radius of a point of height h at distance r from the axis: e^{(h - h0) *
+// scale}, or beyond a pole the stereographic radius of its direction from the pole (see
+// "closed ends" above).
+inline double annulus_radius(const Cylinder& c, double h, double r) {
+    const bool low = kClosedEnds && (c.poles & kLowPole) && h < c.pole_low;
+    const bool high = kClosedEnds && (c.poles & kHighPole) && h > c.pole_high;
+    if (!low && !high) return exp_portable((h - c.h0) * c.scale);
+    const double pole = low ? c.pole_low : c.pole_high, depth = low ? pole - h : h - pole;
+    // tan(phi / 2) = sin(phi) / (1 + cos(phi)), phi from the axis beyond the pole.
+    double half_tangent = r > 0 && is_finite(r) ? r / (depth + std::sqrt(r * r + depth * depth)) : 0;
+    if (!(half_tangent > kSmallestDirection)) half_tangent = kSmallestDirection;
+    const double at_pole = exp_portable((pole - c.h0) * c.scale);
+    return low ? at_pole * half_tangent : at_pole / half_tangent;
+}
+
+// The point's place on the annulus: annulus_radius times its direction from the centre
+// (points on the centre line take direction e1).
 inline void roll(const Cylinder& c, const Local& p, double* out) {
     double dx = p.x - c.cx, dy = p.y - c.cy;
     double r = std::sqrt(dx * dx + dy * dy);
-    double rho = exp_portable((p.h - c.h0) * c.scale);
+    double rho = annulus_radius(c, p.h, r);
     if (r > 0 && is_finite(r)) {
         double u = dx / r, v = dy / r;
         out[0] = abs_value(u) < kSmallestDirection ? 0.0 : rho * u;
@@ -2837,6 +2881,8 @@ inline Cylinder fit_cylinder(const PointAt& point_at, size_t count, double h0, d
     double r = c.radius > floor_radius ? c.radius : floor_radius;
     c.scale = r > 0 && is_finite(r) ? 1.0 / r : 1.0;
     if (!is_finite(c.scale)) c.scale = 1.0;  // a subnormal radius
+    c.poles = 0;
+    c.pole_low = c.pole_high = h0;
     return c;
 }
 
@@ -2852,12 +2898,15 @@ inline double doubled_area(const Local& pa, const Local& pb, const Local& pc) {
 }
 
 // Whether triangle abc (counter-clockwise seen from outside) has its normal pointing
-// towards the cylinder's axis: a fold.
+// towards the cylinder's axis (beyond a pole: towards the pole): a fold.
 inline bool faces_axis(const Local& pa, const Local& pb, const Local& pc, const Cylinder& cyl) {
     Vec3 n = normal_of(pa, pb, pc);
     double rx = (pa.x + pb.x + pc.x) / 3 - cyl.cx;
     double ry = (pa.y + pb.y + pc.y) / 3 - cyl.cy;
-    return n.x * rx + n.y * ry < 0;
+    double h = (pa.h + pb.h + pc.h) / 3, rh = 0;
+    if (kClosedEnds && (cyl.poles & kLowPole) && h < cyl.pole_low) rh = h - cyl.pole_low;
+    if (kClosedEnds && (cyl.poles & kHighPole) && h > cyl.pole_high) rh = h - cyl.pole_high;
+    return n.x * rx + n.y * ry + n.z * rh < 0;
 }
 
 // Whether triangle t of a layer's triangulation is on the surface: neither a ghost nor at
@@ -3121,6 +3170,68 @@ inline uint32_t layer_sectors(const LoadedLayer& layer) {
     const Local* points = layer.points;
     return sectors_held([points](size_t i) -> const Local& { return points[i]; }, layer.count,
                         layer.cyl.cx, layer.cyl.cy);
+}
+
+// ---- closed ends ----
+//
+// Whether the layer, an end of the surface (`ends`: kLowPole for the first layer, kHighPole
+// for the last), holds a closed end there (see "closed ends" in >>unroll): among the points
+// within kEndSlab radii of that end, a twentieth or more (and at least 3) lie within
+// kAcrossEnd times their mean distance from the axis, more than twice the share among the
+// points between the two ends' slabs. An open end has none there; a section that is not star-shaped around the
+// centre (two lobes, a condyle) has as many all along the layer, so it is left as it was
+// (its folds are the centre search's). Sets layer.cyl's poles, kPoleDepth radii in from
+// the ends (at most half-way). Measured over the 16 layerings of bench/layer_sweep.sh: the
+// femur's mean distance 4% smaller and 103 self-intersecting pairs (111 before), the hand
+// and the bust within 1%, open star-shaped tubes unchanged; poles on every end layer
+// instead made open tubes 19% farther from their surface.
+const double kPoleDepth = 1.0;
+const double kEndSlab = 0.5;
+const double kAcrossEnd = 0.5;
+
+inline void find_closed_ends(LoadedLayer& layer, uint32_t ends) {
+    Cylinder& c = layer.cyl;
+    const Local* points = layer.points;
+    const size_t n = layer.count;
+    if (!kClosedEnds || !ends || n == 0) return;
+    double lo = points[0].h, hi = lo;
+    for (size_t i = 1; i < n; ++i) {
+        lo = points[i].h < lo ? points[i].h : lo;
+        hi = points[i].h > hi ? points[i].h : hi;
+    }
+    const double reach = 1 / c.scale, mid = lo + (hi - lo) / 2;
+    const double slab = kEndSlab * reach < (hi - lo) / 4 ? kEndSlab * reach : (hi - lo) / 4;
+    auto end_of = [&](const Local& p) { return p.h < lo + slab ? 0 : p.h > hi - slab ? 1 : -1; };
+    auto distance = [&](const Local& p) {
+        const double dx = p.x - c.cx, dy = p.y - c.cy;
+        return std::sqrt(dx * dx + dy * dy);
+    };
+    // Each slab's mean distance from the axis: "across" is measured against the end's own
+    // width, so the narrow open end of a widening layer (a vase) is not taken for a closed one.
+    double in_slab[2] = {0, 0}, slab_radius[2] = {0, 0};
+    for (size_t i = 0; i < n; ++i) {
+        const int end = end_of(points[i]);
+        if (end < 0) continue;
+        in_slab[end] += 1;
+        slab_radius[end] += distance(points[i]);
+    }
+    double across_slab[2] = {0, 0}, across_rest[2] = {0, 0}, in_rest = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const int end = end_of(points[i]);
+        const double d = distance(points[i]);
+        for (int e = 0; e < 2; ++e) {
+            const bool across = in_slab[e] > 0 && d < kAcrossEnd * slab_radius[e] / in_slab[e];
+            if (end == e) across_slab[e] += across;
+            if (end < 0) across_rest[e] += across;
+        }
+        in_rest += end < 0;
+    }
+    for (int end = 0; end < 2; ++end)
+        if ((ends & (1u << end)) && across_slab[end] >= 3 && 20 * across_slab[end] >= in_slab[end] &&
+            across_slab[end] * in_rest > 2 * across_rest[end] * in_slab[end])
+            c.poles |= 1u << end;
+    c.pole_low = lo + kPoleDepth * reach < mid ? lo + kPoleDepth * reach : mid;
+    c.pole_high = hi - kPoleDepth * reach > mid ? hi - kPoleDepth * reach : mid;
 }
 
 // ---- the centre search ----
@@ -3665,6 +3776,7 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
         return frame.local(cloud.point(layer.ids[id]));
     };
     Cylinder shared;
+    shared.poles = 0;
     shared.radius = (ca.radius + cb.radius) / 2;
     shared.h0 = cb.h0;
     shared.scale = (ca.scale + cb.scale) / 2;
@@ -4942,6 +5054,7 @@ struct LayerAhead {
     Cylinder cylinder;
     Cylinder fitted;         // the cylinder before the centre search, and its layer_sectors
     uint32_t sectors;
+    uint32_t ends;           // the ends of the surface it was taken for (find_closed_ends)
     LayerCounts counts;
     size_t triangle_count, folds;
     uint32_t* triangles;     // as the sink writes them; in reader indices if replayable
@@ -5035,7 +5148,10 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
         const size_t n = q.start[last + 1] - q.start[first];
         const double h0 = q.bounds[first], h1 = q.bounds[last + 1];
         size_t mark = arena.mark();
-        const bool triangulated = kParallelLayers && ahead && ahead->done && last == first;
+        // The surface's ends: its first group, and the group that takes the last planned layer.
+        const uint32_t ends = (c.top_count == 0 ? kLowPole : 0) | (final ? kHighPole : 0);
+        const bool triangulated = kParallelLayers && ahead && ahead->done && last == first &&
+                                  ahead->ends == ends;
         LoadedLayer layer = {ids, n, nullptr, triangulated ? ahead->cylinder : Cylinder{}};
         const Local* staged = q.staged ? q.staged + q.start[first] : nullptr;
         if (!triangulated && !load_layer(c.reader, c.frame, ids, staged, n, h0, h1, arena, layer))
@@ -5117,6 +5233,7 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
                 }
             }
             if (retriangulate) {
+                find_closed_ends(layer, ends);
                 status = triangulate_layer(c.reader, layer, arena, sink, loops, result.counts);
                 stitch();
             }
@@ -5361,6 +5478,9 @@ inline void run_layer_job(void* context, uint32_t index) {
             continue;
         a.fitted = layer.cyl;
         a.sectors = kCrescentLayers ? layer_sectors(layer) : 0;
+        // The ends as add_group will see them if this layer is a group of its own.
+        a.ends = (k == 0 ? kLowPole : 0) | (k + 1 == q.planned ? kHighPole : 0);
+        find_closed_ends(layer, a.ends);
         TriangleSink sink = {a.triangles, 2 * n, 0, 0};
         LayerLoops loops = {a.bottom, 0, a.top, 0, a.bottom_flags, a.top_flags, 0, 0};
         a.status = triangulate_layer(*p.reader, layer, arena, sink, loops, a.counts);

@@ -21,6 +21,7 @@
 #ifndef STRATMESH_TESTS_SUPPORT_SHAPES_H
 #define STRATMESH_TESTS_SUPPORT_SHAPES_H
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -119,6 +120,9 @@ struct Shape {
     double noise = 0;            // standard deviation of the Gaussian noise, 0 if exact
     std::vector<double> xyz;     // world coordinates, packed
     std::vector<double> planes;  // local heights of the contour planes or grid rows, if any
+    // For a closed surface (ends included), its signed distance at a local point (positive
+    // outside); deviation() then uses it instead of the radial one.
+    std::function<double(const double* local)> closed_distance;
 
     size_t size() const { return xyz.size() / 3; }
     const double* point(size_t i) const { return xyz.data() + 3 * i; }
@@ -143,6 +147,7 @@ struct Shape {
     double deviation(const double* p) const {
         double local[3];
         transform.unapply(p, local);
+        if (closed_distance) return closed_distance(local);
         double rho = std::sqrt(local[0] * local[0] + local[1] * local[1]);
         return rho - radius(std::atan2(local[1], local[0]), local[2]);
     }
@@ -308,6 +313,49 @@ inline Shape slanted_tube(size_t n, Pose pose, uint64_t seed = 22) {
     for (size_t i = 0; i < n; ++i) {
         double theta = rng.uniform(0, 2 * kPi);
         s.add_local(theta, rng.uniform(-3, 3) + slant * std::cos(theta), 1.0);
+    }
+    return s;
+}
+
+// Closed objects, scanned all round: ends included, n points spread evenly over the area.
+// The unit cylinder over z in [-3, 3] closed by two flat discs (a bust's base, a cut
+// bone), and a capsule: the unit cylinder over z in [-2, 2] closed by two half spheres (a
+// bone's ends, a crown). deviation() is their signed distance.
+inline Shape closed_cylinder(size_t n, Pose pose, uint64_t seed = 23) {
+    Shape s = detail::start("closed cylinder", pose, cylinder_radius, -3, 3);
+    s.closed_distance = [](const double* p) {
+        double rho = std::hypot(p[0], p[1]), dz = std::fabs(p[2]) - 3;
+        if (rho <= 1 && dz <= 0) return -std::min(1 - rho, -dz);
+        return std::hypot(std::max(rho - 1, 0.0), std::max(dz, 0.0));
+    };
+    const double wall = 2 * kPi * 6, disc = kPi;
+    s.spacing = std::sqrt((wall + 2 * disc) / static_cast<double>(n));
+    Rng rng(seed);
+    while (s.size() < n) {
+        double theta = rng.uniform(0, 2 * kPi), u = rng.uniform(0, wall + 2 * disc);
+        if (u < wall)
+            s.add_local(theta, rng.uniform(-3, 3), 1.0);
+        else
+            s.add_local(theta, u < wall + disc ? -3 : 3, std::sqrt(rng.uniform()));
+    }
+    return s;
+}
+inline Shape capsule(size_t n, Pose pose, uint64_t seed = 24) {
+    Shape s = detail::start("capsule", pose, cylinder_radius, -3, 3);
+    s.closed_distance = [](const double* p) {
+        return std::hypot(std::hypot(p[0], p[1]), p[2] - std::max(-2.0, std::min(2.0, p[2]))) - 1;
+    };
+    const double wall = 2 * kPi * 4, sphere = 4 * kPi;
+    s.spacing = std::sqrt((wall + sphere) / static_cast<double>(n));
+    Rng rng(seed);
+    while (s.size() < n) {
+        double theta = rng.uniform(0, 2 * kPi), u = rng.uniform(0, wall + sphere);
+        if (u < wall) {
+            s.add_local(theta, rng.uniform(-2, 2), 1.0);
+        } else {  // a sphere's height is uniform over its area (Archimedes)
+            double z = rng.uniform(-1, 1);
+            s.add_local(theta, z + (z < 0 ? -2 : 2), std::sqrt(1 - z * z));
+        }
     }
     return s;
 }

@@ -74,13 +74,15 @@
 //                            as long on tubes (400,000 points 1.4, 1e6 points 1.5 to
 //                            1.55) and about 2 times on a scan grid of 400,000 points,
 //                            full of near-ties. The output is the same bytes either way,
-//                            except for caps (close_ends) and slanted ends (below): it
-//                            also leaves out the caps' lowering and raising along the
-//                            axis (see >>caps; 0.3 KiB), so its caps are the Delaunay
+//                            except for caps (close_ends) and slanted and closed ends
+//                            (below): it also leaves out the caps' lowering and raising
+//                            along the axis (see >>caps; 0.3 KiB), so its caps are the Delaunay
 //                            triangulation of each loop's projection, which crosses a
-//                            wall leaning over a ragged loop more often. It leaves out
-//                            cap_ends() too (not declared: 0.6 KiB on the Cortex-M7);
-//                            reconstruct()'s close_ends stays. And it leaves out the
+//                            wall leaning over a ragged loop more often, and their ear
+//                            clipping's restarts (kCapEarStarts), so a few more loops
+//                            are left open. It leaves out cap_ends() too (not
+//                            declared: 0.6 KiB on the Cortex-M7); reconstruct()'s
+//                            close_ends stays. And it leaves out the
 //                            crescent rule (a layer next to a slanted end of the tube
 //                            joins it, see Options and kRingGap; 1.2 KiB): a slanted end
 //                            is then closed across by a membrane, and there the layers
@@ -316,8 +318,9 @@ enum Flags : uint32_t {
     // high along the axis as the loop allows (so that a wall leaning over a ragged loop
     // stays clear of it), constrained Delaunay where the loop is planar, avoiding any
     // diagonal that is already an edge of the surface. A loop whose projection is not a
-    // simple polygon stays open: the call still returns ok, Report::caps_left_open counts
-    // it and Report::detail says so. Caps do not cross one another; like the rest of the
+    // simple polygon, or that no ear clipping tried closes without repeating such an edge,
+    // stays open: the call still returns ok, Report::caps_left_open counts it and
+    // Report::detail says so. Caps do not cross one another; like the rest of the
     // surface, they are not checked against the tube. The workspace bound grows by about 6
     // bytes per point with this flag; reconstruct_max_triangles() still suffices (a closed
     // surface through V vertices has 2V - 4 triangles). The stream refuses the flag: its
@@ -424,7 +427,8 @@ struct Report {
     size_t workspace_used;
     size_t diagonal_swaps;   // band diagonals swapped when stitching layers (paper's step 4)
     // With close_ends: boundary loops closed by a cap, loops left open (their projection
-    // across the axis is not a simple polygon), and the cap triangles, which are the last
+    // across the axis is not a simple polygon, or its ears would repeat edges of the
+    // surface), and the cap triangles, which are the last
     // cap_triangles of the output (included in triangle_count). All 0 without the flag.
     size_t caps_closed;
     size_t caps_left_open;
@@ -693,6 +697,7 @@ const bool kFastExactStages = false;
 const bool kLiftedCaps = false;
 const bool kCrescentLayers = false;
 const bool kClosedEnds = false;
+const uint32_t kCapEarStarts = 1;
 #else
 const bool kNetShortcut = true;  // a chunk whose loop fans are whole skips the net
 const bool kStagePoints = true;  // reconstruct() keeps the grouped points in spare workspace
@@ -706,6 +711,8 @@ const bool kLiftedCaps = true;
 const bool kCrescentLayers = true;
 // A closed end of the surface is unrolled around a pole (see "closed ends" in >>unroll).
 const bool kClosedEnds = true;
+// A cap whose ear clipping gets stuck is clipped again from other corners (see >>caps).
+const uint32_t kCapEarStarts = 8;
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 
@@ -4453,6 +4460,13 @@ inline double depth_below_plane(const double* a, const double* b, const double* 
 
 const uint32_t kCapFlipsPerCorner = 64;
 
+// Ear clipping is greedy: where the surface holds some of a loop's diagonals (its
+// triangles with three corners on the loop), the ears taken first can leave a remainder
+// whose every ear would repeat one, where another order would not (the bundled bust's
+// neck loop, whose single layer's loops are peeled: 6 corners left of 249). So a failed
+// clipping starts again from other corners, kCapEarStarts spread around the loop in all
+// (see the configuration; 1 with STRATMESH_SMALL_CODE).
+
 // Triangulates one loop, already checked simple and counter-clockwise. ids: the loop's
 // vertices, whose diagonals must not be edges of the surface; lower: the cap is a bottom
 // one (it faces -axis), to be made as low as the loop allows (a top one as high). Returns
@@ -4463,7 +4477,7 @@ public:
                      bool lower)
         : c_(c), ids_(ids), length_(length), g_(g), lower_(lower) {}
 
-    bool clip_ears() {
+    bool clip_ears(uint32_t start) {
         uint32_t reflex_count = 0;
         for (uint32_t i = 0; i < length_; ++i) {
             c_.prev[i] = i == 0 ? length_ - 1 : i - 1;
@@ -4476,7 +4490,7 @@ public:
             c_.flags[i] = kReflex;
             c_.reflex[reflex_count++] = i;
         }
-        uint32_t remaining = length_, v = 0, misses = 0;
+        uint32_t remaining = length_, v = start, misses = 0;
         triangles_ = 0;
         while (remaining > 3) {
             if (!is_ear(v, reflex_count)) {
@@ -4706,7 +4720,10 @@ inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
             for (uint32_t i = 0; i < length; ++i) c.xy[2 * static_cast<size_t>(i)] = -c.xy[2 * static_cast<size_t>(i)];
         // A loop turning clockwise seen from +axis is capped facing -axis: a bottom cap.
         CapTriangulation cap(c, ids, length, g, turn < 0);
-        if (turn == 0 || !cap.clip_ears()) {
+        bool clipped = false;
+        for (uint32_t k = 0; turn != 0 && !clipped && k < kCapEarStarts; ++k)
+            clipped = cap.clip_ears(static_cast<uint32_t>(uint64_t{k} * length / kCapEarStarts));
+        if (!clipped) {
             ++caps.left_open;
             continue;
         }

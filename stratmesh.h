@@ -390,6 +390,13 @@ struct Options {
 // The most jobs reconstruct() hands to Options::run_jobs at once.
 const uint32_t kMaxJobs = 64;
 
+// LayerInfo::closed_ends. The surface's first layer (closed_bottom) or last layer
+// (closed_top) that holds a closed end of the object (a dome, a skull, a flat base: points
+// across the end, not only around its rim) is meshed across that end, up to a small loop
+// around its pole (see "closed ends" in >>unroll). An end left open as a tube's rim, any
+// other layer, and every layer with STRATMESH_SMALL_CODE report 0.
+enum ClosedEnd : uint32_t { closed_bottom = 1u << 0, closed_top = 1u << 1 };
+
 struct LayerInfo {
     double bottom, top;      // extent along the axis, as dot(point, axis)
     double centre[3];        // the axis of the unrolling cylinder passes through this
@@ -399,6 +406,7 @@ struct LayerInfo {
     uint32_t triangle_count; // the layer's own triangles plus the band joining it to the
                              // layer below, before the safety net
     uint32_t fold_count;     // of those, triangles facing the axis
+    uint32_t closed_ends;    // ClosedEnd bits: which of the layer's ends closes the surface
 };
 
 struct Report {
@@ -2685,20 +2693,20 @@ inline uint32_t layer_of(const LayerPlan& plan, double h) {
 // search" in >>layer triangulation); the radius stays.
 //
 // Closed ends. A scan of a closed object (a bone, a bust on its base, a head's crown) has
-// points across its ends, at about one height: on the cylinder a flat base puts every
-// point of a radius on one place of the annulus, and a dome's top folds. So where the
-// first or the last layer of the surface holds such an end (see find_closed_ends), the
-// points beyond a pole height, one radius in from the end, are projected from the pole (the
-// point of the axis at that height) instead, onto the sphere around it, and that sphere
-// is mapped stereographically: the direction at angle phi from the end's side of the axis
-// goes to radius e^{(pole - h0)/r} tan(phi / 2) on the annulus (the bottom; the top
-// inverts it). At the pole height both maps agree, with the same derivative, so the
-// picture stays conformal across it for a dome of the layer's radius; the end's point
-// nearest the axis becomes the centre's link (the bottom) or the hull (the top): the
-// surface's boundary loop is a small loop around the pole instead of the end's rim, and
-// the end is meshed across. On a flat-ended cylinder of 10,000 points the mean distance
-// to the true surface fell 7.5 times with one layer (to CGAL's advancing front's), 5.3
-// times over 1 to 24 layers; on half-sphere ends 20%. Open ends are not touched.
+// points across its ends, at about one height: on the cylinder a flat base puts every point
+// of a radius on one place of the annulus, and a dome's top folds. So where the first or
+// the last layer of the surface holds such an end (see find_closed_ends), the points beyond
+// a pole height, one radius in from the end (at most three quarters of the layer), are
+// projected from the pole (the point of the axis at that height) instead, onto the sphere
+// around it, and that sphere is mapped stereographically: the direction at angle phi from
+// the end's side of the axis goes to radius e^{(pole - h0)/r} tan(phi / 2) on the annulus
+// (the bottom; the top inverts it). At the pole height both maps agree, with the same
+// derivative, so the picture stays conformal across it for a dome of the layer's radius;
+// the end's point nearest the axis becomes the centre's link (the bottom) or the hull (the
+// top): the surface's boundary loop is a small loop around the pole instead of the end's
+// rim, and the end is meshed across. On a flat-ended cylinder of 10,000 points the mean
+// distance to the true surface fell 7.5 times with one layer (to CGAL's advancing front's),
+// 5.6 times over 1 to 24 layers; on half-sphere ends 20%. Open ends are not touched.
 
 const uint32_t kSectors = 32;
 
@@ -2768,7 +2776,7 @@ struct Cylinder {
     double pole_low, pole_high;  // the poles' heights: below pole_low, above pole_high
 };
 
-const uint32_t kLowPole = 1, kHighPole = 2;
+const uint32_t kLowPole = closed_bottom, kHighPole = closed_top;
 
 // Direction components smaller than this become 0. No scan resolves angles of 1e-18
 // radians, and it keeps the annulus inside the predicates' exact range: radii in
@@ -3183,15 +3191,23 @@ inline uint32_t layer_sectors(const LoadedLayer& layer) {
 //
 // Whether the layer, an end of the surface (`ends`: kLowPole for the first layer, kHighPole
 // for the last), holds a closed end there (see "closed ends" in >>unroll): among the points
-// within kEndSlab radii of that end, a twentieth or more (and at least 3) lie within
-// kAcrossEnd times their mean distance from the axis, more than twice the share among the
-// points between the two ends' slabs. An open end has none there; a section that is not star-shaped around the
-// centre (two lobes, a condyle) has as many all along the layer, so it is left as it was
-// (its folds are the centre search's). Sets layer.cyl's poles, kPoleDepth radii in from
-// the ends (at most half-way). Measured over the 16 layerings of bench/layer_sweep.sh: the
-// femur's mean distance 4% smaller and 103 self-intersecting pairs (111 before), the hand
-// and the bust within 1%, open star-shaped tubes unchanged; poles on every end layer
-// instead made open tubes 19% farther from their surface.
+// within kEndSlab radii of that end (at most a third of the layer), a twentieth or more
+// (and at least 3) lie within kAcrossEnd times their mean distance from the axis, more
+// than twice the share among the points between the two ends' slabs. An open end has none
+// there; a section that is not star-shaped around the centre (two lobes, a condyle) has
+// as many all along the layer, so it is left as it was (its folds are the centre
+// search's). Sets layer.cyl's poles, kPoleDepth radii in from the ends: at most half-way
+// when the layer holds both ends, else at most three quarters of the way, so the
+// layer's far quarter keeps the cylinder's picture and its loop there still hugs the cut
+// (with the pole beyond the layer, one run of the femur's 16 crossed itself in 4 pairs).
+// Measured over the 16 layerings of bench/layer_sweep.sh: the femur's mean distance 4%
+// smaller and 103 self-intersecting pairs (111 before), the hand and the bust within 1%,
+// open star-shaped tubes unchanged; poles on every end layer instead made open tubes 19%
+// farther from their surface. Thin end layers: a slab of a quarter of the layer (at most)
+// missed the dome of the test suite's capsule cut in 12 layers (2 points across of 34), and
+// poles at most half-way left a flat end in a thin layer twice as far from its surface as
+// in a thick one; a third and three quarters bring a flat-ended cylinder 5% closer over 1
+// to 24 layers (10% with 24), and leave the real clouds within 0.4%.
 const double kPoleDepth = 1.0;
 const double kEndSlab = 0.5;
 const double kAcrossEnd = 0.5;
@@ -3207,7 +3223,7 @@ inline void find_closed_ends(LoadedLayer& layer, uint32_t ends) {
         hi = points[i].h > hi ? points[i].h : hi;
     }
     const double reach = 1 / c.scale, mid = lo + (hi - lo) / 2;
-    const double slab = kEndSlab * reach < (hi - lo) / 4 ? kEndSlab * reach : (hi - lo) / 4;
+    const double slab = kEndSlab * reach < (hi - lo) / 3 ? kEndSlab * reach : (hi - lo) / 3;
     auto end_of = [&](const Local& p) { return p.h < lo + slab ? 0 : p.h > hi - slab ? 1 : -1; };
     auto distance = [&](const Local& p) {
         const double dx = p.x - c.cx, dy = p.y - c.cy;
@@ -3237,8 +3253,10 @@ inline void find_closed_ends(LoadedLayer& layer, uint32_t ends) {
         if ((ends & (1u << end)) && across_slab[end] >= 3 && 20 * across_slab[end] >= in_slab[end] &&
             across_slab[end] * in_rest > 2 * across_rest[end] * in_slab[end])
             c.poles |= 1u << end;
-    c.pole_low = lo + kPoleDepth * reach < mid ? lo + kPoleDepth * reach : mid;
-    c.pole_high = hi - kPoleDepth * reach > mid ? hi - kPoleDepth * reach : mid;
+    const double low_limit = (c.poles & kHighPole) ? mid : hi - (hi - lo) / 4;
+    const double high_limit = (c.poles & kLowPole) ? mid : lo + (hi - lo) / 4;
+    c.pole_low = lo + kPoleDepth * reach < low_limit ? lo + kPoleDepth * reach : low_limit;
+    c.pole_high = hi - kPoleDepth * reach > high_limit ? hi - kPoleDepth * reach : high_limit;
 }
 
 // ---- the centre search ----
@@ -5764,6 +5782,7 @@ inline void describe_layer(const Frame& frame, const Cylinder& cyl, double botto
     info.point_count = static_cast<uint32_t>(points);
     info.triangle_count = static_cast<uint32_t>(triangles);
     info.fold_count = static_cast<uint32_t>(folds);
+    info.closed_ends = cyl.poles;
 }
 
 }  // namespace detail

@@ -153,6 +153,7 @@ void check_same(const Output& batch, const Output& stream) {
     for (size_t k = 0; k < batch.report.layer_count && k < batch.layers.size(); ++k) {
         CHECK(stream.layers[k].point_count == batch.layers[k].point_count);
         CHECK(stream.layers[k].triangle_count == batch.layers[k].triangle_count);
+        CHECK(stream.layers[k].closed_ends == batch.layers[k].closed_ends);
         CHECK(stream.layers[k].bottom == doctest::Approx(batch.layers[k].bottom));
         CHECK(stream.layers[k].top == doctest::Approx(batch.layers[k].top));
         CHECK(stream.layers[k].radius == doctest::Approx(batch.layers[k].radius));

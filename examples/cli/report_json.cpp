@@ -276,6 +276,8 @@ void write_layer(JsonWriter& j, const stratmesh::LayerInfo& layer) {
     j.count_field("points", layer.point_count);
     j.count_field("triangles", layer.triangle_count);
     j.count_field("folds", layer.fold_count);
+    j.flag_field("closed_bottom", layer.closed_ends & stratmesh::closed_bottom);
+    j.flag_field("closed_top", layer.closed_ends & stratmesh::closed_top);
     j.end_object();
 }
 

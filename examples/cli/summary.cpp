@@ -42,11 +42,23 @@ std::string phase_times_text(const RunRecord& r) {
     return text.empty() ? text : " (" + text + ")";
 }
 
-void print_counts(std::FILE* out, const stratmesh::Report& rep) {
+// The surface's ends: a closed end (a crown, a base) is meshed across to a small loop at
+// its pole; an open one is the rim of the tube. Known only when every layer was recorded.
+void print_ends(std::FILE* out, const RunRecord& r) {
+    if (r.layers.empty() || r.layers.size() != r.report.layer_count) return;
+    const bool bottom = r.layers.front().closed_ends & stratmesh::closed_bottom;
+    const bool top = r.layers.back().closed_ends & stratmesh::closed_top;
+    std::fprintf(out, "  ends       bottom %s, top %s\n", bottom ? "closed" : "open",
+                 top ? "closed" : "open");
+}
+
+void print_counts(std::FILE* out, const RunRecord& r) {
+    const stratmesh::Report& rep = r.report;
     std::fprintf(out, "  points     %zu read: %zu used, %zu duplicates, %zu rejected, %zu unused\n",
                  rep.points_in, rep.points_used, rep.duplicates, rep.rejected, rep.unused);
     std::fprintf(out, "  layers     %zu (%zu triangulated in parallel)\n", rep.layer_count,
                  rep.parallel_layers);
+    print_ends(out, r);
     std::fprintf(out, "  triangles  %zu (%zu illegal removed, %zu folds)\n", rep.triangle_count,
                  rep.illegal_removed, rep.folds);
     if (rep.caps_closed + rep.caps_left_open > 0)
@@ -81,7 +93,7 @@ void print_summary(std::FILE* out, const RunRecord& record) {
                  record.input_format.c_str(), record.input_encoding.c_str(),
                  record.output_path.c_str(), record.output_format.c_str(),
                  record.output_ascii ? " text" : "");
-    print_counts(out, record.report);
+    print_counts(out, record);
     print_costs(out, record);
 }
 

@@ -124,6 +124,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const bool small_capacity = (ocfg & 0x40) != 0;
     const size_t capacity = small_capacity ? std::min<size_t>(max_tris, in.below(64)) : max_tris;
     const size_t layer_capacity = in.below(8);
+    // Read last, so that the corpus's older inputs keep their meaning.
+    if (in.u8() & 1) options.flags |= stratmesh::drop_outliers;
+    const bool dropping = (options.flags & stratmesh::drop_outliers) != 0;
 
     Run first = run(cloud, options, capacity, layer_capacity, 0xA5);
     const stratmesh::Report& rep = first.report;
@@ -177,7 +180,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     STRATMESH_FUZZ_CHECK(count <= max_tris, "more triangles than reconstruct_max_triangles");
     STRATMESH_FUZZ_CHECK(count <= capacity, "more triangles than the capacity");
     STRATMESH_FUZZ_CHECK(rep.triangle_count == count, "report.triangle_count != triangle count");
-    STRATMESH_FUZZ_CHECK(rep.rejected == invalid, "report.rejected != NaN/Inf points");
+    STRATMESH_FUZZ_CHECK(rep.rejected == invalid + rep.outliers, "report.rejected != NaN/Inf points + outliers");
+    STRATMESH_FUZZ_CHECK(dropping || rep.outliers == 0, "outliers without drop_outliers");
     const uint32_t* t = first.triangles.data();
     for (size_t k = 0; k < count; ++k) {
         uint32_t a = t[3 * k], b = t[3 * k + 1], c = t[3 * k + 2];
@@ -209,7 +213,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                                  xyz[3 * j + 1], xyz[3 * j + 2], xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
             }
         }
-        if (strict)
+        if (dropping)  // repeats of an outlier are outliers
+            STRATMESH_FUZZ_CHECK(rep.duplicates <= dups && rep.duplicates + rep.unused + rep.outliers >= dups,
+                                 "report.duplicates inconsistent with repeated points and outliers");
+        else if (strict)
             STRATMESH_FUZZ_CHECK(rep.duplicates == dups, "report.duplicates != repeated points");
         else  // known bug E: repeats of a point that is not used count as unused
             STRATMESH_FUZZ_CHECK(rep.duplicates <= dups && rep.duplicates + rep.unused >= dups,
@@ -247,7 +254,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     STRATMESH_FUZZ_CHECK(second.triangles == first.triangles, "second run: different triangles");
     const stratmesh::Report& r2 = second.report;
     STRATMESH_FUZZ_CHECK(r2.points_used == rep.points_used && r2.duplicates == rep.duplicates &&
-                             r2.rejected == rep.rejected && r2.unused == rep.unused &&
+                             r2.rejected == rep.rejected && r2.outliers == rep.outliers && r2.unused == rep.unused &&
                              r2.illegal_removed == rep.illegal_removed && r2.folds == rep.folds &&
                              r2.layer_count == rep.layer_count,
                          "second run: different report");

@@ -32,6 +32,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -1252,6 +1253,119 @@ TEST_CASE("NaN and infinite points: invalid_point with the first index, or skipp
     }
 }
 
+// Stray points around a shape: `far` single ones at 1 to 3 bounding-box diagonals from its
+// centre, and a speck of `speck` points within a tenth of the spacing of one another, two
+// diagonals away; appended after the shape's own points.
+std::vector<double> with_strays(const Shape& s, size_t far, size_t speck, uint64_t seed) {
+    double low[3] = {1e300, 1e300, 1e300}, high[3] = {-1e300, -1e300, -1e300};
+    for (size_t i = 0; i < s.size(); ++i)
+        for (size_t k = 0; k < 3; ++k) {
+            low[k] = std::min(low[k], s.point(i)[k]);
+            high[k] = std::max(high[k], s.point(i)[k]);
+        }
+    const double diagonal = std::hypot(high[0] - low[0], high[1] - low[1], high[2] - low[2]);
+    shapes::Rng rng(seed);
+    auto direction = [&rng](double* d) {
+        double len = 0;
+        do {
+            for (size_t k = 0; k < 3; ++k) d[k] = rng.uniform(-1, 1);
+            len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        } while (len < 0.1 || len > 1);
+        for (size_t k = 0; k < 3; ++k) d[k] /= len;
+    };
+    std::vector<double> xyz = s.xyz;
+    for (size_t i = 0; i < far + speck; ++i) {
+        double d[3];
+        direction(d);
+        const double reach = i < far ? rng.uniform(1, 3) * diagonal : 2 * diagonal;
+        for (size_t k = 0; k < 3; ++k) {
+            const double centre = (low[k] + high[k]) / 2;
+            xyz.push_back(i < far ? centre + reach * d[k] : centre + reach + 0.1 * s.spacing * d[k]);
+        }
+    }
+    return xyz;
+}
+
+TEST_CASE("drop_outliers: stray points are left out and counted, the rest is meshed as without them") {
+    const std::vector<std::function<Shape(Pose)>> makers = {
+        [](Pose p) { return shapes::cylinder(kSmall, p); },
+        [](Pose p) { return shapes::bumpy_tube(kSmall, p); },
+        [](Pose p) { return shapes::vase(kSmall, p); },
+        [](Pose p) { return shapes::scan_grid(kSmall, p); },
+        [](Pose p) { return shapes::ct_slices(kSmall, p); },
+        [](Pose p) { return shapes::noisy_tube(kSmall, p); },
+        [](Pose p) { return shapes::head(kSmall, p); },
+        [](Pose p) { return shapes::capsule(kSmall, p); },
+        [](Pose p) { return shapes::bumpy_tube(kLarge, p); },
+    };
+    const size_t far = 12, speck = 5;
+    for (const auto& make : makers) {
+        for (Pose pose : {Pose::z, Pose::tilted}) {
+            const Shape s = make(pose);
+            CAPTURE(s.name);
+            for (bool automatic : {true, false}) {
+                CAPTURE(automatic);
+                Options plain = axis_options(s);
+                if (automatic) plain.axis = Axis::automatic;
+                Options dropping = plain;
+                dropping.flags = stratmesh::drop_outliers;
+                const Run clean = reconstruct_guarded(cloud_of(s), plain);
+                REQUIRE(clean.status == Status::ok);
+                // No point of a clean sample is taken for an outlier.
+                const Run kept = reconstruct_guarded(cloud_of(s), dropping);
+                REQUIRE(kept.status == Status::ok);
+                CHECK(kept.report.outliers == 0);
+                CHECK(kept.report.rejected == 0);
+                CHECK(kept.triangles == clean.triangles);
+                // Every stray is left out, counted, and the surface is the clean one: the
+                // frame, the axis and the layers come from the same points.
+                const Shape dirty = with_points(s, with_strays(s, far, speck, 31), ", with strays");
+                const Run dropped = reconstruct_guarded(cloud_of(dirty), dropping);
+                REQUIRE(dropped.status == Status::ok);
+                CHECK(dropped.report.outliers == far + speck);
+                CHECK(dropped.report.rejected == far + speck);
+                CHECK(dropped.report.points_used == clean.report.points_used);
+                CHECK(dropped.report.points_in == dropped.report.points_used + dropped.report.duplicates +
+                                                      dropped.report.rejected + dropped.report.unused);
+                CHECK(dropped.triangles == clean.triangles);
+                CHECK(dropped.workspace_guard_intact);
+                // Without the flag every stray is a vertex, and the surface stays one
+                // oriented manifold (its shape is another matter: spikes).
+                const Run spiked = reconstruct_guarded(cloud_of(dirty), plain);
+                REQUIRE(spiked.status == Status::ok);
+                CHECK(spiked.report.unused == 0);
+                CHECK(spiked.report.outliers == 0);
+                mesh_check::Result m = check_mesh(dirty, spiked.triangles.data(), spiked.count, false);
+                INFO(m.summary());
+                CHECK(m.nonmanifold_edges == 0);
+                CHECK(m.nonmanifold_vertices == 0);
+                CHECK(m.inconsistent_edges == 0);
+            }
+        }
+    }
+}
+
+TEST_CASE("drop_outliers: the stream refuses it, and too small a workspace is out_of_memory") {
+    const Shape& s = reference_cylinder();
+    Options o = axis_options(s);
+    o.flags = stratmesh::drop_outliers;
+    std::vector<unsigned char> work(stratmesh::stream_workspace_size(s.size(), o));
+    stratmesh::Stream* stream = nullptr;
+    CHECK(stratmesh::stream_open(o, work.data(), work.size(), [](void*, const uint32_t*, size_t) {},
+                                 nullptr, nullptr, &stream) == Status::invalid_argument);
+    const size_t bytes = stratmesh::reconstruct_workspace_size(s.size(), o);
+    o.flags = 0;
+    CHECK(bytes > stratmesh::reconstruct_workspace_size(s.size(), o));  // its bitmap
+    o.flags = stratmesh::drop_outliers;
+    std::vector<unsigned char> small(s.size() * 8);
+    std::vector<uint32_t> triangles(3 * stratmesh::reconstruct_max_triangles(s.size(), o));
+    size_t count = 0;
+    stratmesh::Report report = {};
+    CHECK(stratmesh::reconstruct(cloud_of(s), o, small.data(), small.size(), triangles.data(),
+                                 triangles.size() / 3, &count, &report) == Status::out_of_memory);
+    CHECK(report.points_in == report.points_used + report.duplicates + report.rejected + report.unused);
+}
+
 TEST_CASE("a flat cloud gives flat_cloud") {
     shapes::Rng rng(5);
     std::vector<double> xyz;
@@ -1678,6 +1792,9 @@ TEST_CASE("workspace: the bound suffices, the reported peak is exact, one byte s
         Options six_closed = six;
         six_closed.flags = stratmesh::close_ends;
         setups.push_back({"six layers, close_ends", s, six_closed});
+        Options six_dropping = six;
+        six_dropping.flags = stratmesh::drop_outliers;
+        setups.push_back({"six layers, drop_outliers", s, six_dropping});
     }
     {
         Shape s = shapes::cylinder(kSmall, Pose::tilted);

@@ -48,6 +48,9 @@ const char kUsage[] =
     "  --ascii               text PLY or STL\n"
     "  --skip-invalid        skip points with NaN or infinite coordinates (they stay in\n"
     "                        the output, unused) instead of refusing the input\n"
+    "  --drop-outliers       leave out points far from the rest of the cloud (stray\n"
+    "                        returns, specks of fewer than 8 points); they stay in the\n"
+    "                        output, unused, counted as rejected (outliers)\n"
     "  --cap                 close the tube's ends with caps over its boundary loops: a\n"
     "                        closed, watertight surface (a loop that cannot be capped\n"
     "                        stays open; the summary and the report count it)\n"
@@ -193,6 +196,7 @@ bool apply_flag(std::string_view name, CommandLine& line) {
     if (name == "--ascii") line.ascii = true;
     if (name == "--skip-invalid") line.skip_invalid = true;
     if (name == "--cap") line.cap = true;
+    if (name == "--drop-outliers") line.drop_outliers = true;
     if (name == "--quiet") line.quiet = true;
     if (name == "--stream") line.stream = true;
     return true;
@@ -201,8 +205,8 @@ bool apply_flag(std::string_view name, CommandLine& line) {
 const char* const kValuedOptions[] = {"--output",  "--report",        "--axis",
                                       "--cuts",    "--layers",        "--layer-height",
                                       "--threads", "--stream-points", "--origin"};
-const char* const kFlags[] = {"--ascii", "--skip-invalid", "--cap",    "--quiet",
-                              "--help",  "--version",      "--stream"};
+const char* const kFlags[] = {"--ascii", "--skip-invalid", "--cap",     "--quiet",
+                              "--help",  "--version",      "--stream", "--drop-outliers"};
 
 // What --stream cannot do, or an empty string.
 std::string stream_conflict(const CommandLine& line) {
@@ -212,6 +216,9 @@ std::string stream_conflict(const CommandLine& line) {
     if (line.cuts.empty() && line.layer_height <= 0)
         return "--stream needs --cuts or --layer-height: the layers are formed as the points "
                "arrive (--layers and automatic layers need the whole cloud's height)";
+    if (line.drop_outliers)
+        return "--stream cannot --drop-outliers: an outlier is told from the whole cloud's "
+               "spacing, which the stream never holds";
     if (mesh_format_from_extension(line.output) == MeshFormat::stl)
         return "--stream cannot write STL (its triangles repeat their corners' coordinates, "
                "which the stream no longer holds): write PLY, OBJ or OFF";

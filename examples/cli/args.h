@@ -22,6 +22,7 @@ struct CommandLine {
     bool ascii = false;
     bool skip_invalid = false;
     bool cap = false;              // --cap: close the ends (stratmesh::close_ends)
+    bool drop_outliers = false;    // --drop-outliers (stratmesh::drop_outliers)
     bool quiet = false;
     uint32_t threads = 1;           // --threads (default: the hardware's threads, at least 1)
     bool stream = false;            // --stream: read and reconstruct layer by layer

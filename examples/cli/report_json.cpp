@@ -197,6 +197,7 @@ void write_options(JsonWriter& j, const RunRecord& r) {
     j.number(r.layer_height > 0 ? r.layer_height : std::numeric_limits<double>::quiet_NaN());
     j.flag_field("skip_invalid", r.skip_invalid);
     j.flag_field("cap", r.cap);
+    j.flag_field("drop_outliers", r.drop_outliers);
     j.count_field("threads", r.threads);
     j.flag_field("stream", r.stream);
     j.key("stream_points");
@@ -232,6 +233,7 @@ void write_counts(JsonWriter& j, const stratmesh::Report& rep, stratmesh::Status
     j.count_field("used", rep.points_used);
     j.count_field("duplicates", rep.duplicates);
     j.count_field("rejected", rep.rejected);
+    j.count_field("outliers", rep.outliers);
     j.count_field("unused", rep.unused);
     j.key("first_invalid");
     if (status == stratmesh::Status::invalid_point)

@@ -32,6 +32,7 @@ struct RunRecord {
     double layer_height = 0;  // --layer-height, 0 if not given
     bool skip_invalid = false;
     bool cap = false;
+    bool drop_outliers = false;
     uint32_t threads = 1;
     bool origin_given = false;
     double origin[3] = {0, 0, 0};

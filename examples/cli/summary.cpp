@@ -54,8 +54,10 @@ void print_ends(std::FILE* out, const RunRecord& r) {
 
 void print_counts(std::FILE* out, const RunRecord& r) {
     const stratmesh::Report& rep = r.report;
-    std::fprintf(out, "  points     %zu read: %zu used, %zu duplicates, %zu rejected, %zu unused\n",
-                 rep.points_in, rep.points_used, rep.duplicates, rep.rejected, rep.unused);
+    std::fprintf(out, "  points     %zu read: %zu used, %zu duplicates, %zu rejected%s, %zu unused\n",
+                 rep.points_in, rep.points_used, rep.duplicates, rep.rejected,
+                 rep.outliers ? (" (" + std::to_string(rep.outliers) + " outliers)").c_str() : "",
+                 rep.unused);
     std::fprintf(out, "  layers     %zu (%zu triangulated in parallel)\n", rep.layer_count,
                  rep.parallel_layers);
     print_ends(out, r);

@@ -58,6 +58,14 @@ std::vector<double> cylinder_points(size_t count) {
     return xyz;
 }
 
+// The cylinder and 9 stray points: 6 single ones 3 to 10 heights away, and a speck of 3
+// points 0.1 apart above it.
+std::vector<double> with_strays(std::vector<double> xyz) {
+    xyz.insert(xyz.end(), {500, 0, 50, -400, 300, 200, 0, -700, -300, 350, 350, 900,
+                           -1000, 0, 40, 0, 20, -500, 0, 0, 600, 0.1, 0, 600, 0, 0.1, 600});
+    return xyz;
+}
+
 std::string as_xyz(const std::vector<double>& xyz, size_t nan_every) {
     std::string text = "# a wavy cylinder\n";
     for (size_t i = 0; i < xyz.size() / 3; ++i) {
@@ -117,6 +125,7 @@ int make_inputs(const std::string& dir) {
               write_file(dir + "/two_points.xyz", "0 0 0\n1 1 1\n") &&
               write_file(dir + "/cylinder.xyz", as_xyz(cylinder, 0)) &&
               write_file(dir + "/cylinder_nan.xyz", as_xyz(cylinder, 500)) &&
+              write_file(dir + "/cylinder_strays.xyz", as_xyz(with_strays(cylinder), 0)) &&
               write_file(dir + "/cylinder_obj.ply", as_obj(cylinder)) &&
               write_file(dir + "/sorted.xyz", as_xyz(sorted, 0)) &&
               write_file(dir + "/mesh.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 1\n3 0 1 2\n") &&

@@ -1345,6 +1345,35 @@ TEST_CASE("drop_outliers: stray points are left out and counted, the rest is mes
     }
 }
 
+TEST_CASE("drop_outliers: a speck of 7 points is left out and one of 8 kept, repeats of a stray too") {
+    const Shape& s = reference_cylinder();
+    // Far from the cylinder, points a hundredth of its spacing apart: one cell of the grid.
+    auto with_speck = [&s](size_t points, size_t repeats_of_first) {
+        std::vector<double> xyz = s.xyz;
+        for (size_t i = 0; i < points; ++i)
+            for (size_t k = 0; k < 3; ++k) xyz.push_back(50 + (k == i % 3 ? 0.01 * s.spacing * static_cast<double>(i) : 0));
+        for (size_t r = 0; r < repeats_of_first; ++r) xyz.insert(xyz.end(), {50, 50, 50});
+        return with_points(s, xyz, ", with a speck");
+    };
+    Options o = axis_options(s);
+    o.flags = stratmesh::drop_outliers;
+    for (size_t points : {1u, 7u, 8u, 12u}) {
+        CAPTURE(points);
+        const Shape speck = with_speck(points, 0);
+        const Run run = reconstruct_guarded(cloud_of(speck), o);
+        REQUIRE(run.status == Status::ok);
+        CHECK(run.report.outliers == (points < 8 ? points : 0));
+        CHECK(run.report.points_in == run.report.points_used + run.report.duplicates +
+                                          run.report.rejected + run.report.unused);
+    }
+    // A stray read three times: all three copies are outliers, none a duplicate.
+    const Run repeated = reconstruct_guarded(cloud_of(with_speck(1, 2)), o);
+    REQUIRE(repeated.status == Status::ok);
+    CHECK(repeated.report.outliers == 3);
+    CHECK(repeated.report.duplicates == 0);
+    CHECK(repeated.report.points_used == s.size());
+}
+
 TEST_CASE("drop_outliers: the stream refuses it, and too small a workspace is out_of_memory") {
     const Shape& s = reference_cylinder();
     Options o = axis_options(s);

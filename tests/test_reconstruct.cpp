@@ -1255,7 +1255,7 @@ TEST_CASE("NaN and infinite points: invalid_point with the first index, or skipp
 
 // Stray points around a shape: `far` single ones at 1 to 3 bounding-box diagonals from its
 // centre, and a speck of `speck` points within a tenth of the spacing of one another, two
-// diagonals away; appended after the shape's own points.
+// diagonals off the centre along each axis; appended after the shape's own points.
 std::vector<double> with_strays(const Shape& s, size_t far, size_t speck, uint64_t seed) {
     double low[3] = {1e300, 1e300, 1e300}, high[3] = {-1e300, -1e300, -1e300};
     for (size_t i = 0; i < s.size(); ++i)

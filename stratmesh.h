@@ -2433,7 +2433,8 @@ inline size_t drop_outliers_of(CloudReader& reader, size_t count, unsigned char*
             ++n;
         }
         if (n < 2 * kOutlierNeighbours) break;
-        // Halved before squaring, so that no finite box overflows.
+        // A box wider than the double range (points near +-1e308) gives an infinite side,
+        // which the loop below refuses: such a cloud loses no point.
         const Vec3 half = scaled(high - low, 0.5);
         double side = 4 * std::sqrt(dot(half, half)) / std::sqrt(static_cast<double>(n));
         double nearest = 0;

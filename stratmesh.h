@@ -159,7 +159,10 @@
 //   grows with its lexicographic (x, y) rank), so the set of triangles depends only on
 //   the coordinates: not on the input order, not on the architecture. Exact duplicates
 //   are not triangulated twice: each is mapped to the lowest index with the same
-//   coordinates. Every other point is a vertex of the output.
+//   coordinates. Every other point is a vertex of the output. Beyond the predicates' exact
+//   range the signs can contradict each other: delaunay_2d then still writes at most
+//   delaunay_2d_max_triangles() triangles of valid indices, or returns internal_error,
+//   but the triangles need not be Delaunay.
 // - NaN or infinite coordinates are refused (Status::invalid_point, with the index), or
 //   skipped and counted with the skip_invalid_points flag of reconstruct.
 // - reconstruct keeps its own predicate calls inside that exact range, whatever the cloud:
@@ -278,8 +281,9 @@ size_t delaunay_2d_max_triangles(size_t point_count);
 // or any two of the span of xy's points, the workspace, the triangle array, duplicate_of
 // and *info sharing a byte: then nothing at all is written); too_many_points;
 // invalid_point; too_few_points (fewer than 3 distinct points); collinear (no triangle
-// exists); out_of_memory; triangle_capacity. On every status but ok, triangle_count is 0
-// (except triangle_capacity) and no triangle is written.
+// exists); out_of_memory; triangle_capacity; internal_error (only for coordinates beyond
+// the predicates' exact range: see Robustness contract). On every status but ok,
+// triangle_count is 0 (except triangle_capacity) and no triangle is written.
 Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
                    void* workspace, size_t workspace_bytes,
                    uint32_t* triangles, size_t triangle_capacity,
@@ -2165,6 +2169,9 @@ Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
 
     size_t ghosts = 0;
     for (uint32_t t = 0; t < m.tr.triangle_count; ++t) ghosts += m.tr.is_ghost(t);
+    // A triangulation's hull has 3 edges or more; fewer means contradictory predicate
+    // signs (coordinates beyond the exact range), and then 2n - 5 would not bound `real`.
+    if (ghosts < 3) return Status::internal_error;
     size_t real = m.tr.triangle_count - ghosts;
     out.hull_vertex_count = ghosts;
     out.duplicate_count = point_count - inserted;

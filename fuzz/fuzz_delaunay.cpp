@@ -7,7 +7,6 @@
 // result, a second run gives the same bits, and the output array ends where its
 // allocation ends (an overrun trips AddressSanitizer).
 #include "fuzz_common.h"
-#include "known_bugs.h"
 
 #include "stratmesh.h"
 #include "support/delaunay_check.h"
@@ -136,8 +135,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     case Status::internal_error:
         if (out_of_contract) break;
         stratmesh_fuzz::fail("delaunay_2d returned internal_error");
-    case Status::triangle_capacity:  // known bug F (fuzz/known_bugs.h)
-        if (out_of_contract && !stratmesh_fuzz::strict()) break;
+    case Status::triangle_capacity:
         stratmesh_fuzz::fail("triangle_capacity with delaunay_2d_max_triangles() triangles");
     default:
         stratmesh_fuzz::fail("delaunay_2d returned an unexpected status", stratmesh::status_string(s));

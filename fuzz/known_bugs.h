@@ -1,10 +1,10 @@
-// Library bugs the harnesses found and that are not fixed yet (stratmesh.h is not changed by
-// the fuzzing work). By default each harness steers around the exact input class of each
-// bug, so that fuzzing keeps looking for new ones and CI stays meaningful; with the
-// environment variable STRATMESH_FUZZ_STRICT=1 the filters are off and the reproducers in
-// fuzz/corpus/<harness>/bug-* fail (fuzz/replay registers them as expected-to-fail tests,
-// fuzz_replay_<harness>_bug-..., which start "passing" - and so fail - once a bug is fixed:
-// then delete the filter here and move the reproducer into the regular corpus).
+// Library bugs the harnesses found and that are not fixed yet. By default each harness
+// steers around the exact input class of each bug, so that fuzzing keeps looking for new
+// ones and CI stays meaningful; with the environment variable STRATMESH_FUZZ_STRICT=1 the
+// filters are off and the reproducers in fuzz/corpus/<harness>/bug-* fail (fuzz/replay
+// registers them as expected-to-fail tests, fuzz_replay_<harness>_bug-..., which start
+// "passing" - and so fail - once a bug is fixed: then delete the filter here and move the
+// reproducer into the regular corpus).
 //
 // Fixed, kept as regression corpus files: A (NaN from the predicates on all-subnormal
 // points), C (undefined behaviour in reconstruct for coordinates beyond 2^511 or
@@ -13,18 +13,15 @@
 // made a repeated point a vertex instead of its lowest twin for a cloud with one far
 // outlier: the annulus coordinates spread beyond the predicates' exact range), H (undefined
 // behaviour, a NaN cast to an integer, for a cloud whose coordinates span more than the
-// largest double: the frame's extent and the centroid's sum overflowed).
+// largest double: the frame's extent and the centroid's sum overflowed), F (delaunay_2d
+// returned triangle_capacity with delaunay_2d_max_triangles() triangles of room, for 4
+// points spanning about 2^1029, outside the exactness contract: the contradictory signs
+// left a hull of fewer than 3 edges; now internal_error).
 // B: incircle has the wrong sign when the coordinates and their differences spread over
 //    more than 2^320 in magnitude: outside the documented contract (products of four terms
 //    cannot all be represented); the filter skips spreads above 300.
 //    Reproducer: bug-B-incircle-wrong-sign-span-618-bits (fuzz_predicates); the 434-bit one
 //    passes since the rescaling limits changed, but is equally outside the contract.
-// F: delaunay_2d returns triangle_capacity although the triangle array holds
-//    delaunay_2d_max_triangles(n) triangles (documented to always suffice), for 4 finite
-//    points whose coordinates span about 2^1029 (0, 3.4e-21, 9.5e139, 1.5e289): outside the
-//    exactness contract, but the bound (or at worst internal_error) should still hold.
-//    The harness tolerates it only for inputs outside the contract.
-//    Reproducer: bug-F-delaunay-triangle-capacity-wide-span (fuzz_delaunay).
 #ifndef STRATMESH_FUZZ_KNOWN_BUGS_H
 #define STRATMESH_FUZZ_KNOWN_BUGS_H
 

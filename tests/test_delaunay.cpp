@@ -833,6 +833,22 @@ TEST_CASE("triangle capacity too small: triangle_capacity, the count needed, not
     CHECK(exact.triangles == std::vector<uint32_t>(full.triangles.begin(), full.triangles.begin() + static_cast<std::ptrdiff_t>(3 * needed)));
 }
 
+TEST_CASE("coordinates spanning 2^1029, beyond the exact range: internal_error or at most 2n - 5 triangles") {
+    // The fuzzer's reproducer of known bug F: contradictory signs left a hull of 2 edges,
+    // and delaunay_2d returned triangle_capacity with delaunay_2d_max_triangles() of room.
+    const std::vector<double> xy = {0x1p+465, 0, -0x1.3e8p+641, -0x1.8000000000003p+960,
+                                    0, 0x1.ff8p-69, 0, 0};
+    Run r = triangulate(xy);
+    CHECK((r.status == Status::ok || r.status == Status::internal_error));
+    if (r.status == Status::ok) {
+        CHECK(r.count() <= stratmesh::delaunay_2d_max_triangles(4));
+        for (size_t k = 0; k < 3 * r.count(); ++k) CHECK(r.triangles[k] < 4);
+    } else {
+        CHECK(r.count() == 0);
+        CHECK(untouched_after(r.triangles, 0) == 0);
+    }
+}
+
 namespace {
 // Runs delaunay_2d with a fresh heap buffer of exactly `bytes` bytes (at `offset` into its
 // allocation, which still ends where the workspace ends).

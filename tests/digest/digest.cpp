@@ -1,7 +1,12 @@
-// Cross-architecture determinism check: reconstructs a fixed set of generated clouds and
-// triangulates a few 2D point sets, and prints one FNV-1a 64-bit digest of every status,
-// triangle count and triangle array. The same digest must come out of every platform
-// (.ci/arm.sh compares x86-64, aarch64 and 32-bit ARM).
+// Cross-architecture determinism check: reconstructs a fixed set of generated clouds (with
+// reconstruct() and with the stream), triangulates a few 2D point sets, and prints one
+// FNV-1a 64-bit digest of every status, triangle count and triangle array. The same digest
+// must come out of every platform (.ci/arm.sh compares x86-64, aarch64 and 32-bit ARM,
+// the last built with STRATMESH_SMALL_CODE).
+//
+// A second digest, "full", covers what STRATMESH_SMALL_CODE leaves out or meshes
+// differently (closed ends, the crescent rule, caps, drop_outliers, cap_ends): it is
+// printed by builds without the macro (x86-64 and aarch64 in .ci/arm.sh), which must agree.
 //
 // The clouds come from tests/support/shapes.h, whose coordinates go through sin, cos and
 // log: C libraries may differ there in the last bit. To test the library and not the C
@@ -13,6 +18,7 @@
 #include "stratmesh.h"
 #include "support/shapes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -49,11 +55,12 @@ std::vector<double> quantized(const std::vector<double>& v) {
     return out;
 }
 
-Fnv1a64 g_input, g_output;
+Fnv1a64 g_input, g_output, g_full_input, g_full;
 
-void reconstruct_case(const char* name, const std::vector<double>& raw, stratmesh::Options o) {
+void reconstruct_case(const char* name, const std::vector<double>& raw, stratmesh::Options o,
+                      Fnv1a64& input = g_input, Fnv1a64& output = g_output) {
     std::vector<double> xyz = quantized(raw);
-    for (double d : xyz) g_input.f64(d);
+    for (double d : xyz) input.f64(d);
     size_t n = xyz.size() / 3;
     std::vector<unsigned char> work(stratmesh::reconstruct_workspace_size(n, o));
     std::vector<uint32_t> tris(3 * stratmesh::reconstruct_max_triangles(n, o) + 3);
@@ -62,13 +69,88 @@ void reconstruct_case(const char* name, const std::vector<double>& raw, stratmes
     stratmesh::Cloud cloud = {xyz.data(), n, 0, stratmesh::Scalar::float64};
     stratmesh::Status s = stratmesh::reconstruct(cloud, o, work.data(), work.size(), tris.data(),
                                                  tris.size() / 3, &count, &report);
-    g_output.u32(static_cast<uint32_t>(s));
-    g_output.u64(count);
-    g_output.u64(report.layer_count);
-    for (size_t i = 0; i < 3 * count; ++i) g_output.u32(tris[i]);
+    output.u32(static_cast<uint32_t>(s));
+    output.u64(count);
+    output.u64(report.layer_count);
+    output.u64(report.rejected);
+    output.u64(report.caps_closed);
+    for (size_t i = 0; i < 3 * count; ++i) output.u32(tris[i]);
     std::printf("reconstruct %-34s %5zu points: %-12s %5zu triangles, %3zu layers\n", name, n,
                 s == stratmesh::Status::ok ? "ok" : "NOT OK", count, report.layer_count);
 }
+
+void collect_triangles(void* user, const uint32_t* triangles, size_t count) {
+    std::vector<uint32_t>& out = *static_cast<std::vector<uint32_t>*>(user);
+    out.insert(out.end(), triangles, triangles + 3 * count);
+}
+
+// The cloud pushed to a stream in `pushes` layers of equal height along z (its points are
+// generated in no order: each push takes the points of its height range); returns the
+// emitted triangles, and the pushed points in push order in `pushed`.
+std::vector<uint32_t> stream_case(const char* name, const std::vector<double>& raw, int pushes,
+                                  std::vector<double>& pushed) {
+    std::vector<double> xyz = quantized(raw);
+    for (double d : xyz) g_input.f64(d);
+    const size_t n = xyz.size() / 3;
+    double low = xyz[2], high = xyz[2];
+    for (size_t i = 0; i < n; ++i) {
+        low = std::min(low, xyz[3 * i + 2]);
+        high = std::max(high, xyz[3 * i + 2]);
+    }
+    stratmesh::Options o = {};
+    o.axis = stratmesh::Axis::z;
+    o.flags = stratmesh::origin_given;
+    std::vector<unsigned char> work(stratmesh::stream_workspace_size(n, o));
+    std::vector<uint32_t> tris;
+    stratmesh::Report report = {};
+    stratmesh::Stream* stream = nullptr;
+    stratmesh::Status s = stratmesh::stream_open(o, work.data(), work.size(), collect_triangles,
+                                                 &tris, &report, &stream);
+    pushed.clear();
+    for (int k = 0; s == stratmesh::Status::ok && k < pushes; ++k) {
+        const double bottom = low + (high - low) * k / pushes;
+        const double top = k + 1 == pushes ? high : low + (high - low) * (k + 1) / pushes;
+        const size_t first = pushed.size() / 3;
+        for (size_t i = 0; i < n; ++i) {
+            const double z = xyz[3 * i + 2];
+            if ((z >= bottom || k == 0) && (z < top || k + 1 == pushes))
+                pushed.insert(pushed.end(), {xyz[3 * i], xyz[3 * i + 1], z});
+        }
+        stratmesh::Cloud layer = {pushed.data() + 3 * first, pushed.size() / 3 - first, 0,
+                                  stratmesh::Scalar::float64};
+        s = stratmesh::stream_push(stream, layer, top);
+    }
+    if (s == stratmesh::Status::ok) s = stratmesh::stream_close(stream);
+    g_output.u32(static_cast<uint32_t>(s));
+    g_output.u64(tris.size() / 3);
+    g_output.u64(report.layer_count);
+    for (uint32_t t : tris) g_output.u32(t);
+    std::printf("stream      %-34s %5zu points: %-12s %5zu triangles, %3zu layers\n", name, n,
+                s == stratmesh::Status::ok ? "ok" : "NOT OK", tris.size() / 3, report.layer_count);
+    return tris;
+}
+
+#if !defined(STRATMESH_SMALL_CODE)
+// cap_ends() over a stream's triangles (see stream_case).
+void cap_ends_case(const char* name, const std::vector<double>& pushed, std::vector<uint32_t> tris) {
+    const size_t n = pushed.size() / 3;
+    stratmesh::Options o = {};
+    o.axis = stratmesh::Axis::z;
+    std::vector<unsigned char> work(stratmesh::cap_ends_workspace_size(n, tris.size() / 3));
+    size_t count = tris.size() / 3;
+    tris.resize(3 * stratmesh::reconstruct_max_triangles(n, o));
+    stratmesh::Report report = {};
+    stratmesh::Cloud cloud = {pushed.data(), n, 0, stratmesh::Scalar::float64};
+    stratmesh::Status s = stratmesh::cap_ends(cloud, o, work.data(), work.size(), tris.data(),
+                                              tris.size() / 3, &count, &report);
+    g_full.u32(static_cast<uint32_t>(s));
+    g_full.u64(count);
+    g_full.u64(report.caps_closed);
+    for (size_t i = 0; i < 3 * count; ++i) g_full.u32(tris[i]);
+    std::printf("cap_ends    %-34s %5zu points: %-12s %5zu triangles, %3zu caps\n", name, n,
+                s == stratmesh::Status::ok ? "ok" : "NOT OK", count, report.caps_closed);
+}
+#endif
 
 void delaunay_case(const char* name, const std::vector<double>& raw) {
     std::vector<double> xy = quantized(raw);
@@ -136,6 +218,32 @@ int main() {
     }
     reconstruct_case("disc and lobe, 1 layer", lobe, axis_z(1));
     reconstruct_case("disc and lobe, 2 layers", lobe, axis_z(2));
+    std::vector<double> pushed;
+    const std::vector<uint32_t> streamed = stream_case("bumpy tube, 5 pushes", bumpy, 5, pushed);
+
+#if !defined(STRATMESH_SMALL_CODE)
+    reconstruct_case("capsule (closed ends), automatic", shapes::capsule(3000, Pose::z).xyz,
+                     axis_z(), g_full_input, g_full);
+    reconstruct_case("slanted tube (crescent), 6 layers", shapes::slanted_tube(3000, Pose::z).xyz,
+                     axis_z(6), g_full_input, g_full);
+    stratmesh::Options capped = axis_z(4);
+    capped.flags = stratmesh::close_ends;
+    reconstruct_case("vase, 4 layers, close_ends", vase, capped, g_full_input, g_full);
+    // The bumpy tube with 12 far strays and a speck of 5, each a whole multiple of 2^-4
+    // away: drop_outliers must leave out the same 17 points everywhere.
+    std::vector<double> strays = bumpy;
+    for (int i = 0; i < 12; ++i) {
+        const double reach = 8 + i;
+        strays.insert(strays.end(), {i % 3 == 0 ? reach : 0.0625 * i, i % 3 == 1 ? -reach : 0.5,
+                                     i % 3 == 2 ? reach : 1.0});
+    }
+    for (int i = 0; i < 5; ++i) strays.insert(strays.end(), {20.0 + 0.0625 * i, 20.0, 20.0});
+    stratmesh::Options outliers = axis_z(4);
+    outliers.flags = stratmesh::drop_outliers;
+    reconstruct_case("bumpy tube + strays, drop_outliers", strays, outliers, g_full_input,
+                     g_full);
+    cap_ends_case("bumpy tube, 5 pushes, capped", pushed, streamed);
+#endif
 
     shapes::Rng rng(2024);
     std::vector<double> random;
@@ -158,5 +266,11 @@ int main() {
 
     std::printf("input  %016llx\n", static_cast<unsigned long long>(g_input.h));
     std::printf("digest %016llx\n", static_cast<unsigned long long>(g_output.h));
+#if !defined(STRATMESH_SMALL_CODE)
+    std::printf("full   %016llx   (input %016llx)\n", static_cast<unsigned long long>(g_full.h),
+                static_cast<unsigned long long>(g_full_input.h));
+#else
+    std::printf("full   not built (STRATMESH_SMALL_CODE)\n");
+#endif
     return 0;
 }

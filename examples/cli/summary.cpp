@@ -52,6 +52,32 @@ void print_ends(std::FILE* out, const RunRecord& r) {
                  top ? "closed" : "open");
 }
 
+// Where the surface folds (triangles facing the axis): the layers, bottom up from 1, with
+// their fold counts, so that a user can move the cuts or the axis there. Known only when
+// every layer was recorded.
+void print_folds(std::FILE* out, const RunRecord& r) {
+    if (r.report.folds == 0 || r.layers.empty() || r.layers.size() != r.report.layer_count)
+        return;
+    const size_t kListed = 6;
+    std::string list;
+    size_t listed = 0, folding = 0;
+    for (size_t k = 0; k < r.layers.size(); ++k) {
+        if (r.layers[k].fold_count == 0) continue;
+        ++folding;
+        if (listed == kListed) continue;
+        ++listed;
+        const uint32_t folds = r.layers[k].fold_count;
+        list += (list.empty() ? "" : ", ") + std::to_string(k + 1) + " (" +
+                std::to_string(folds) + (folds == 1 ? " fold)" : " folds)");
+    }
+    if (folding > listed) list += ", ...";
+    std::fprintf(out, "  folds      in layer%s %s of %zu, bottom up:\n"
+                      "             not star-shaped around any centre tried (a branch, an "
+                      "overhang):\n             the surface may bridge gaps or cross itself "
+                      "there\n",
+                 folding > 1 ? "s" : "", list.c_str(), r.layers.size());
+}
+
 void print_counts(std::FILE* out, const RunRecord& r) {
     const stratmesh::Report& rep = r.report;
     std::fprintf(out, "  points     %zu read: %zu used, %zu duplicates, %zu rejected%s, %zu unused\n",
@@ -63,6 +89,7 @@ void print_counts(std::FILE* out, const RunRecord& r) {
     print_ends(out, r);
     std::fprintf(out, "  triangles  %zu (%zu illegal removed, %zu folds)\n", rep.triangle_count,
                  rep.illegal_removed, rep.folds);
+    print_folds(out, r);
     if (rep.caps_closed + rep.caps_left_open > 0)
         std::fprintf(out, "  caps       %zu closed (%zu triangles), %zu left open\n",
                      rep.caps_closed, rep.cap_triangles, rep.caps_left_open);

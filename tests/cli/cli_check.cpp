@@ -58,6 +58,19 @@ std::vector<double> cylinder_points(size_t count) {
     return xyz;
 }
 
+// Two parallel cylinders of radius 10, 50 apart, height 100: one tube around both folds
+// wherever it is centred.
+std::vector<double> twin_tube_points(size_t count) {
+    std::vector<double> xyz = cylinder_points(count);
+    for (size_t i = 0; i < count; ++i) {
+        const double r = std::hypot(xyz[3 * i], xyz[3 * i + 1]);
+        const double side = i % 2 ? 25 : -25;
+        xyz[3 * i] = side + 10 * xyz[3 * i] / r;
+        xyz[3 * i + 1] = 10 * xyz[3 * i + 1] / r;
+    }
+    return xyz;
+}
+
 // The cylinder and 9 stray points: 6 single ones 3 to 10 heights away, and a speck of 3
 // points 0.1 apart above it.
 std::vector<double> with_strays(std::vector<double> xyz) {
@@ -66,8 +79,9 @@ std::vector<double> with_strays(std::vector<double> xyz) {
     return xyz;
 }
 
-std::string as_xyz(const std::vector<double>& xyz, size_t nan_every) {
-    std::string text = "# a wavy cylinder\n";
+std::string as_xyz(const std::vector<double>& xyz, size_t nan_every,
+                   const char* title = "a wavy cylinder") {
+    std::string text = std::string("# ") + title + "\n";
     for (size_t i = 0; i < xyz.size() / 3; ++i) {
         if (nan_every && i % nan_every == nan_every / 2) text += "nan nan nan\n";
         text += number_text(xyz[3 * i]) + " " + number_text(xyz[3 * i + 1]) + " " +
@@ -124,6 +138,7 @@ int make_inputs(const std::string& dir) {
               write_file(dir + "/empty.xyz", "") &&
               write_file(dir + "/two_points.xyz", "0 0 0\n1 1 1\n") &&
               write_file(dir + "/cylinder.xyz", as_xyz(cylinder, 0)) &&
+              write_file(dir + "/twin_tubes.xyz", as_xyz(twin_tube_points(3000), 0, "two cylinders")) &&
               write_file(dir + "/cylinder_nan.xyz", as_xyz(cylinder, 500)) &&
               write_file(dir + "/cylinder_strays.xyz", as_xyz(with_strays(cylinder), 0)) &&
               write_file(dir + "/cylinder_obj.ply", as_obj(cylinder)) &&

@@ -113,7 +113,7 @@ std::vector<uint32_t> stream_case(const char* name, const std::vector<double>& r
         const size_t first = pushed.size() / 3;
         for (size_t i = 0; i < n; ++i) {
             const double z = xyz[3 * i + 2];
-            if ((z >= bottom || k == 0) && (z < top || k + 1 == pushes))
+            if (z >= bottom && (z < top || k + 1 == pushes))
                 pushed.insert(pushed.end(), {xyz[3 * i], xyz[3 * i + 1], z});
         }
         stratmesh::Cloud layer = {pushed.data() + 3 * first, pushed.size() / 3 - first, 0,

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """error_by_layer.py - where a mesh's distance to a reference surface lies, layer by layer.
 
-    bench/error_by_layer.py MESH REPORT.json REFERENCE
+    bench/error_by_layer.py MESH REPORT.json REFERENCE [--box X0,Y0,Z0,X1,Y1,Z1]...
 
 MESH is the stratmesh tool's output as ascii PLY (`--ascii`) or OFF, REPORT.json its
 `--report` (the axis and the layers' ranges), REFERENCE an OFF, ascii PLY or OBJ mesh of the
@@ -12,7 +12,9 @@ vertices, or in the band between layers when they lie in more than one. Prints, 
 for the bands: triangles, share of the mesh's area, share of the area-weighted distance, and
 the mean distance (area-weighted, relative to the reference's diagonal, as meshq's
 mean_out_to_ref); then the share of area and of distance that the triangles farther than
-0.5% and 1% of the diagonal carry. For example (bench/README.md):
+0.5% and 1% of the diagonal carry; with --box (repeatable), the same for the triangles
+whose centroid lies in one of the boxes (corners in the mesh's coordinates) and for the
+rest. For example (bench/README.md):
 
     stratmesh femur.ply -o femur_out.ply --ascii --report femur.json
     bench/error_by_layer.py femur_out.ply femur.json femur_reference.off
@@ -169,13 +171,37 @@ class NearestSurface:
                    for t in candidates)
 
 
+def parse_boxes(args):
+    """Removes each `--box X0,Y0,Z0,X1,Y1,Z1` from args; returns the boxes."""
+    boxes = []
+    while "--box" in args:
+        at = args.index("--box")
+        if at + 1 >= len(args):
+            sys.exit(__doc__)
+        try:
+            numbers = [float(x) for x in args[at + 1].split(",")]
+        except ValueError:
+            numbers = []
+        if len(numbers) != 6:
+            sys.exit("--box takes six numbers: X0,Y0,Z0,X1,Y1,Z1")
+        boxes.append((numbers[:3], numbers[3:]))
+        del args[at:at + 2]
+    return boxes
+
+
+def in_boxes(p, boxes):
+    return any(all(low[k] <= p[k] <= high[k] for k in range(3)) for low, high in boxes)
+
+
 def main():
-    if len(sys.argv) != 4:
+    args = sys.argv[1:]
+    boxes = parse_boxes(args)
+    if len(args) != 3:
         sys.exit(__doc__)
-    vertices, triangles = read_mesh(sys.argv[1])
-    with open(sys.argv[2]) as f:
+    vertices, triangles = read_mesh(args[0])
+    with open(args[1]) as f:
         report = json.load(f)
-    ref_vertices, ref_triangles = read_mesh(sys.argv[3])
+    ref_vertices, ref_triangles = read_mesh(args[2])
     diag = diagonal(ref_vertices)
     surface = NearestSurface(ref_vertices, ref_triangles, diag / 400)
 
@@ -192,6 +218,7 @@ def main():
     layer = [layer_of(v) for v in vertices]
     groups = {}  # layer index, or "bands": [triangles, area, area * distance]
     tails = {0.005: [0.0, 0.0], 0.01: [0.0, 0.0]}
+    boxed = [0, 0.0, 0.0]  # triangles whose centroid lies in a --box, their area, area * distance
     total_area = total_error = 0.0
     for t in triangles:
         a, b, c = (vertices[i] for i in t)
@@ -206,6 +233,10 @@ def main():
         g[2] += s * d
         total_area += s
         total_error += s * d
+        if boxes and in_boxes(probes[0], boxes):
+            boxed[0] += 1
+            boxed[1] += s
+            boxed[2] += s * d
         for limit, sums in tails.items():
             if d > limit:
                 sums[0] += s
@@ -220,6 +251,14 @@ def main():
         label = "bands between layers" if name == "bands" else \
             f"layer {name} [{cuts[name]:.4g}, {cuts[name + 1]:.4g}]"
         print(f"{label:<26} {n:9d} {s / total_area:5.3f} {e / total_error:9.3f}  {e / s:.6f}")
+    if boxes:
+        n, s, e = boxed
+        mean = f"{e / s:.6f}" if s > 0 else "-"
+        print(f"{'in the boxes':<26} {n:9d} {s / total_area:5.3f} {e / total_error:9.3f}  {mean}")
+        rest = total_area - s
+        mean = f"{(total_error - e) / rest:.6f}" if rest > 0 else "-"
+        print(f"{'outside them':<26} {len(triangles) - n:9d} {rest / total_area:5.3f} "
+              f"{(total_error - e) / total_error:9.3f}  {mean}")
     for limit, (s, e) in tails.items():
         print(f"triangles farther than {limit:.3f}: {s / total_area:.3f} of the area, "
               f"{e / total_error:.3f} of the distance")

@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <initializer_list>
 #include <vector>
 
 namespace {
@@ -57,6 +58,19 @@ std::vector<double> quantized(const std::vector<double>& v) {
 
 Fnv1a64 g_input, g_output, g_full_input, g_full;
 
+// Adds one call's outcome to `output` (its status, triangle count, `counts` and triangles)
+// and prints a line: what ran, on what, and `shown` with its label.
+void record(Fnv1a64& output, const char* call, const char* name, size_t points,
+            stratmesh::Status s, const uint32_t* tris, size_t count,
+            std::initializer_list<uint64_t> counts, size_t shown, const char* label) {
+    output.u32(static_cast<uint32_t>(s));
+    output.u64(count);
+    for (uint64_t c : counts) output.u64(c);
+    for (size_t i = 0; i < 3 * count; ++i) output.u32(tris[i]);
+    std::printf("%-11s %-34s %5zu points: %-12s %5zu triangles, %3zu %s\n", call, name, points,
+                s == stratmesh::Status::ok ? "ok" : "NOT OK", count, shown, label);
+}
+
 void reconstruct_case(const char* name, const std::vector<double>& raw, stratmesh::Options o,
                       Fnv1a64& input = g_input, Fnv1a64& output = g_output) {
     std::vector<double> xyz = quantized(raw);
@@ -69,14 +83,8 @@ void reconstruct_case(const char* name, const std::vector<double>& raw, stratmes
     stratmesh::Cloud cloud = {xyz.data(), n, 0, stratmesh::Scalar::float64};
     stratmesh::Status s = stratmesh::reconstruct(cloud, o, work.data(), work.size(), tris.data(),
                                                  tris.size() / 3, &count, &report);
-    output.u32(static_cast<uint32_t>(s));
-    output.u64(count);
-    output.u64(report.layer_count);
-    output.u64(report.rejected);
-    output.u64(report.caps_closed);
-    for (size_t i = 0; i < 3 * count; ++i) output.u32(tris[i]);
-    std::printf("reconstruct %-34s %5zu points: %-12s %5zu triangles, %3zu layers\n", name, n,
-                s == stratmesh::Status::ok ? "ok" : "NOT OK", count, report.layer_count);
+    record(output, "reconstruct", name, n, s, tris.data(), count,
+           {report.layer_count, report.rejected, report.caps_closed}, report.layer_count, "layers");
 }
 
 void collect_triangles(void* user, const uint32_t* triangles, size_t count) {
@@ -121,12 +129,8 @@ std::vector<uint32_t> stream_case(const char* name, const std::vector<double>& r
         s = stratmesh::stream_push(stream, layer, top);
     }
     if (s == stratmesh::Status::ok) s = stratmesh::stream_close(stream);
-    g_output.u32(static_cast<uint32_t>(s));
-    g_output.u64(tris.size() / 3);
-    g_output.u64(report.layer_count);
-    for (uint32_t t : tris) g_output.u32(t);
-    std::printf("stream      %-34s %5zu points: %-12s %5zu triangles, %3zu layers\n", name, n,
-                s == stratmesh::Status::ok ? "ok" : "NOT OK", tris.size() / 3, report.layer_count);
+    record(g_output, "stream", name, n, s, tris.data(), tris.size() / 3, {report.layer_count},
+           report.layer_count, "layers");
     return tris;
 }
 
@@ -143,12 +147,8 @@ void cap_ends_case(const char* name, const std::vector<double>& pushed, std::vec
     stratmesh::Cloud cloud = {pushed.data(), n, 0, stratmesh::Scalar::float64};
     stratmesh::Status s = stratmesh::cap_ends(cloud, o, work.data(), work.size(), tris.data(),
                                               tris.size() / 3, &count, &report);
-    g_full.u32(static_cast<uint32_t>(s));
-    g_full.u64(count);
-    g_full.u64(report.caps_closed);
-    for (size_t i = 0; i < 3 * count; ++i) g_full.u32(tris[i]);
-    std::printf("cap_ends    %-34s %5zu points: %-12s %5zu triangles, %3zu caps\n", name, n,
-                s == stratmesh::Status::ok ? "ok" : "NOT OK", count, report.caps_closed);
+    record(g_full, "cap_ends", name, n, s, tris.data(), count, {report.caps_closed},
+           report.caps_closed, "caps");
 }
 #endif
 

@@ -114,10 +114,13 @@ TEST_CASE("parallel layers: the same bytes as in order, whatever the runner, on 
         shapes::closed_cylinder(3000, Pose::x), shapes::capsule(3000, Pose::tilted)};
     unsigned two = 2, eight = 8;
     for (const Shape& s : shapes_list) {
-        for (const Layout& layout : kLayouts) {
-            INFO(s.name << " (" << shapes::pose_name(s.pose) << "), " << layout.name);
+        for (const Layout& layout : kLayouts)
+        for (uint32_t flags : {0u, uint32_t(stratmesh::surface_flips)}) {
+            INFO(s.name << " (" << shapes::pose_name(s.pose) << "), " << layout.name
+                        << (flags ? ", surface_flips" : ""));
             std::vector<double> cuts;
             Options o = axis_options(s);
+            o.flags |= flags;
             layout.apply(o, cuts, s);
             const Result sequential = run(s, o);
             REQUIRE(sequential.status == Status::ok);

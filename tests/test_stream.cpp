@@ -198,6 +198,13 @@ TEST_CASE("stream: the same triangles as reconstruct() on the same layers, every
     });
 }
 
+TEST_CASE("stream: with surface_flips, the same triangles as reconstruct() with it") {
+    for_every_shape({equal_fractions(6), {0.03, 0.06, 0.85, 0.97}}, [](const Layered& l, Options o) {
+        o.flags |= stratmesh::surface_flips;
+        check_same(run_batch(l, o), run_stream(l, o, l.size()));
+    });
+}
+
 TEST_CASE("stream: pushes of one contour each (CT slices) merge into layers as reconstruct() does") {
     for (Pose pose : {Pose::z, Pose::x}) {
         const Shape s = shapes::ct_slices(2000, pose);

@@ -78,6 +78,7 @@ void record_command_line(const CommandLine& line, RunRecord& record) {
     record.skip_invalid = line.skip_invalid;
     record.cap = line.cap;
     record.drop_outliers = line.drop_outliers;
+    record.surface_flips = line.surface_flips;
     record.threads = line.threads;
     record.origin_given = line.origin_given || line.stream;
     for (size_t k = 0; k < 3; ++k) record.origin[k] = line.origin[k];
@@ -94,7 +95,8 @@ stratmesh::Options make_options(const CommandLine& line, ProgressMonitor& monito
     options.layer_height = line.layer_height;
     options.flags = (line.skip_invalid ? stratmesh::skip_invalid_points : 0u) |
                     (line.cap ? stratmesh::close_ends : 0u) |
-                    (line.drop_outliers ? stratmesh::drop_outliers : 0u);
+                    (line.drop_outliers ? stratmesh::drop_outliers : 0u) |
+                    (line.surface_flips ? stratmesh::surface_flips : 0u);
     options.progress = &ProgressMonitor::callback;
     options.progress_user = &monitor;
     if (line.origin_given) {

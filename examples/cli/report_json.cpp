@@ -198,6 +198,7 @@ void write_options(JsonWriter& j, const RunRecord& r) {
     j.flag_field("skip_invalid", r.skip_invalid);
     j.flag_field("cap", r.cap);
     j.flag_field("drop_outliers", r.drop_outliers);
+    j.flag_field("surface_flips", r.surface_flips);
     j.count_field("threads", r.threads);
     j.flag_field("stream", r.stream);
     j.key("stream_points");

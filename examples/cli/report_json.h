@@ -33,6 +33,7 @@ struct RunRecord {
     bool skip_invalid = false;
     bool cap = false;
     bool drop_outliers = false;
+    bool surface_flips = false;
     uint32_t threads = 1;
     bool origin_given = false;
     double origin[3] = {0, 0, 0};

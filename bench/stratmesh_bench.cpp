@@ -138,12 +138,14 @@ struct Layering {
     uint32_t layer_count;  // 0 and no cuts: the library's automatic layers
     const double* cuts;    // coordinates along the axis
     size_t cut_count;
+    uint32_t flags = 0;    // stratmesh::Options::flags
 };
 
 constexpr Layering kNoLayering = {stratmesh::Axis::automatic, 0, nullptr, 0};
 
 // Eight equal layers along z; one layer; automatic layers.
 constexpr Layering kTubeLayers = {stratmesh::Axis::z, 8, nullptr, 0};
+constexpr Layering kTubeLayersFlipped = {stratmesh::Axis::z, 8, nullptr, 0, stratmesh::surface_flips};
 constexpr Layering kOneLayerAlongZ = {stratmesh::Axis::z, 1, nullptr, 0};
 constexpr Layering kAutomaticAlongZ = {stratmesh::Axis::z, 0, nullptr, 0};
 // A hundred equal layers along z (the stream case cuts them itself, between the extremes).
@@ -182,6 +184,9 @@ const CaseSpec kCases[] = {
      kTubeLayers},
     {"tube-4e6", "tube", Kind::reconstruct, 4000000, 0x5EED0103u, 3, bench::generate_tube,
      kTubeLayers},
+    // The cloud of tube-1e6 (same seed) with the surface_flips flag.
+    {"tube-1e6-flips", "tube", Kind::reconstruct, 1000000, 0x5EED0102u, 5,
+     bench::generate_tube, kTubeLayersFlipped},
     // The cloud of tube-1e6 (same seed) in a single layer.
     {"tube-1e6-1layer", "tube", Kind::reconstruct, 1000000, 0x5EED0102u, 5,
      bench::generate_tube, kOneLayerAlongZ},
@@ -597,6 +602,7 @@ stratmesh::Options reconstruct_options(const Layering& layering, PhaseClock* clo
     options.cuts = layering.cuts;
     options.cut_count = layering.cut_count;
     options.layer_count = layering.layer_count;
+    options.flags = layering.flags;
     options.progress = note_phase;
     options.progress_user = clock;
     return options;

@@ -125,7 +125,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const size_t capacity = small_capacity ? std::min<size_t>(max_tris, in.below(64)) : max_tris;
     const size_t layer_capacity = in.below(8);
     // Read last, so that the corpus's older inputs keep their meaning.
-    if (in.u8() & 1) options.flags |= stratmesh::drop_outliers;
+    const uint8_t last = in.u8();
+    if (last & 1) options.flags |= stratmesh::drop_outliers;
+    if (last & 2) options.flags |= stratmesh::surface_flips;
     const bool dropping = (options.flags & stratmesh::drop_outliers) != 0;
 
     Run first = run(cloud, options, capacity, layer_capacity, 0xA5);

@@ -5,8 +5,9 @@
 // the last built with STRATMESH_SMALL_CODE).
 //
 // A second digest, "full", covers what STRATMESH_SMALL_CODE leaves out or meshes
-// differently (closed ends, the crescent rule, caps, drop_outliers, cap_ends): it is
-// printed by builds without the macro (x86-64 and aarch64 in .ci/arm.sh), which must agree.
+// differently (closed ends, the crescent rule, caps, drop_outliers, cap_ends, the
+// surface_flips flag): it is printed by builds without the macro (x86-64 and aarch64 in
+// .ci/arm.sh), which must agree.
 //
 // The clouds come from tests/support/shapes.h, whose coordinates go through sin, cos and
 // log: C libraries may differ there in the last bit. To test the library and not the C
@@ -243,6 +244,12 @@ int main() {
     reconstruct_case("bumpy tube + strays, drop_outliers", strays, outliers, g_full_input,
                      g_full);
     cap_ends_case("bumpy tube, 5 pushes, capped", pushed, streamed);
+    stratmesh::Options flipped = axis_z(3);
+    flipped.flags = stratmesh::surface_flips;
+    reconstruct_case("bumpy tube, 3 layers, surface_flips", bumpy, flipped, g_full_input, g_full);
+    flipped.layer_count = 2;
+    reconstruct_case("head, 2 layers, surface_flips", shapes::head(3000, Pose::z).xyz, flipped,
+                     g_full_input, g_full);
 #endif
 
     shapes::Rng rng(2024);

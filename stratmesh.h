@@ -91,7 +91,9 @@
 //                            kPoleDepth), which it unrolls on the cylinder like the rest:
 //                            a flat base folds and its loop runs through its points.
 //                            The drop_outliers flag is refused (invalid_argument):
-//                            filter the cloud before it reaches the device.
+//                            filter the cloud before it reaches the device. The
+//                            surface_flips flag is ignored (about 4 KiB): the layers
+//                            stay Delaunay on their annulus, as in the paper.
 //
 // ==== Memory ===============================================================================
 //
@@ -1965,9 +1967,10 @@ inline bool must_flip(const Triangulation& tr, uint32_t e) {
     return orient2d_robust(tr.point(q), tr.point(b), tr.point(p)) > 0;
 }
 
-// Flips e = a->b of (a, b, p) with its twin in (b, a, q) into (p, a, q) and (q, b, p): the
-// new triangles keep e's two triangle slots, and the new edge q->p is the last of the first.
-inline void relink_flip(Triangulation& tr, uint32_t e) {
+// Flips e = a->b of (a, b, p) with its twin in (b, a, q) into (p, a, q) and (q, b, p) (the
+// new triangles keep e's two triangle slots), and with kQueue queues the two edges that may
+// now fail the Delaunay test.
+template <bool kQueue> inline void flip_edge(Triangulation& tr, uint32_t e, uint32_t* top) {
     uint32_t f = tr.twin[e];
     uint32_t t = e / 3, u = f / 3;
     uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)], p = tr.vertex[prev_edge(e)];
@@ -1983,14 +1986,9 @@ inline void relink_flip(Triangulation& tr, uint32_t e) {
     tr.link(3 * u, xd);
     tr.link(3 * u + 1, xa);
     tr.link(3 * t + 2, 3 * u + 2);
-}
-
-// Flips e (see relink_flip) and queues the two edges that may now fail the Delaunay test.
-inline void flip_edge(Triangulation& tr, uint32_t e, uint32_t& top) {
-    const uint32_t t = e / 3, u = tr.twin[e] / 3;
-    relink_flip(tr, e);
-    push_edge(tr, top, 3 * t + 1);
-    push_edge(tr, top, 3 * u);
+    if (!kQueue) return;
+    push_edge(tr, *top, 3 * t + 1);
+    push_edge(tr, *top, 3 * u);
 }
 
 // Inserts vertex p. Returns the vertex it duplicates, p itself if it was inserted, or
@@ -2011,7 +2009,7 @@ inline uint32_t insert_vertex(Triangulation& tr, uint32_t p) {
         uint32_t e = tr.stack[--top];
         if (!must_flip(tr, e)) continue;
         if (top + 2 > tr.stack_capacity || ++flips > tr.triangle_capacity) return kNoIndex;
-        flip_edge(tr, e, top);
+        flip_edge<true>(tr, e, &top);
     }
     return p;
 }
@@ -3799,11 +3797,8 @@ inline bool flip_on_surface(Triangulation& tr, const Local* points, const Cylind
     const Vec3 other_normal = normal_of(lb, la, lq);
     mean = Vec3{mean.x + other_normal.x, mean.y + other_normal.y, mean.z + other_normal.z};
     const Vec3 n1 = normal_of(lp, la, lq), n2 = normal_of(lq, lb, lp);
-    if (dot(n1, mean) > kGentleFlip * std::sqrt(dot(n1, n1) * dot(mean, mean)) &&
-        dot(n2, mean) > kGentleFlip * std::sqrt(dot(n2, n2) * dot(mean, mean))) {
-        relink_flip(tr, e);
-        return true;
-    }
+    const bool gentle = dot(n1, mean) > kGentleFlip * std::sqrt(dot(n1, n1) * dot(mean, mean)) &&
+                        dot(n2, mean) > kGentleFlip * std::sqrt(dot(n2, n2) * dot(mean, mean));
     const Box3 quad = box_of(first[0], first[1], first[2], second[1]);
     auto clear_of = [&](uint32_t g) {
         const uint32_t s = g / 3;
@@ -3817,8 +3812,8 @@ inline bool flip_on_surface(Triangulation& tr, const Local* points, const Cylind
     // The triangles around the quad's corners.
     const uint32_t corners[4] = {e, f, prev_edge(e), prev_edge(f)};
     for (uint32_t corner : corners)
-        if (!around_vertex(tr, corner, clear_of)) return false;
-    relink_flip(tr, e);
+        if (!gentle && !around_vertex(tr, corner, clear_of)) return false;
+    flip_edge<false>(tr, e, nullptr);
     return true;
 }
 

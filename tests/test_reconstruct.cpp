@@ -2530,7 +2530,7 @@ TEST_CASE("close_ends: a triangle array too small for the caps gives triangle_ca
 // nearer the truth (measured: 11% at 1 layer, 10% at 6). The smooth surfaces of revolution
 // come out farther (vase 9%, cone 7% at 1 layer; README, "Flips on the surface"), within
 // the bound below; the grid and the CT slices have nothing to flip.
-TEST_CASE("surface_flips: the same guarantees, the bumpy tube nearer the true surface") {
+TEST_CASE("surface_flips: the same guarantees, the bumpy tube nearer the true surface, no shape farther") {
     const std::vector<Shape> list = {
         shapes::bumpy_tube(kLarge, Pose::tilted), shapes::head(kLarge, Pose::x),
         shapes::vase(kLarge, Pose::z),            shapes::cone(kLarge, Pose::tilted),
@@ -2567,7 +2567,8 @@ TEST_CASE("surface_flips: the same guarantees, the bumpy tube nearer the true su
             const double before = mean_centroid_deviation(s, plain.triangles);
             const double after = mean_centroid_deviation(s, flipped.triangles);
             MESSAGE(s.name << ", " << layers << " layers: mean distance " << before << " -> " << after);
-            CHECK(after <= 1.15 * before);
+            // Without the bend veto the vase came out 9% and the cone 7% farther.
+            CHECK(after <= 1.04 * before);
             if (s.name.rfind("bumpy tube", 0) == 0) {
                 CHECK(flipped.triangles != plain.triangles);
                 CHECK(after <= 0.95 * before);

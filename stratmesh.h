@@ -3659,35 +3659,47 @@ inline void choose_centre(LoadedLayer& layer, Arena& arena) {
 // the crease: on a synthetic bust with ears (bench/horned_bust.py --no-horns) the ears had
 // 14% of the area and 57% of the distance to the true surface, 2.7 times the distance of
 // CGAL's advancing front there, as close as it elsewhere. So once a layer is triangulated
-// and its loops are settled, its surface edges are flipped by the empty-circle rule on the
-// surface itself: an edge ab between triangles abp and baq is flipped to pq where the
-// angles at p and q, measured in 3D, sum to more than 180 degrees (in a plane: q inside the
-// circle through a, b, p). A flip is kept only if neither new triangle faces the axis (no
-// new fold) nor is degenerate, pq is not already an edge, and, unless both new normals are
-// within 26 degrees of the old pair's (kGentleFlip: the new triangles cover about the same
-// place as the old), neither new triangle meets a surface triangle around the quad's
-// corners (the test is in floating point, on triangles shrunk by a millionth about their
-// centroids, so that shared corners and edges do not count; testing the triangles around
-// the corners' neighbours too changed nothing on the synthetic bust). Nor is a flip kept
-// whose new edge bends the surface more than kBendVeto times the old one did: the bend of an
-// edge ab is |(b - a) . (n_b - n_a)| with n the vertex normals (the mean of the unit normals
-// of the triangles around), 8 times the sag at the middle of a curve through a and b
-// normal to n_a and n_b. Without that, the rule made smooth surfaces of revolution farther
-// from their true surface: their annulus triangles run along the direction that curves
-// least, and the flips turned them across it (one layer, mean distance to the analytic
-// surface: vase 13% and cone 27% farther than without flips; with the veto 0.5% farther
-// and 7% closer, and a bumpy tube 13% closer instead of 10%). Loop edges are never
-// flipped, so the loops, the bands and the peeled triangles that add_group may put back are
-// the same as without the flips. Only an edge facing an obtuse angle can qualify, so the
-// first sweep reads the twins of few triangles, and later sweeps visit only the triangles
-// the sweep before changed. On a curved surface the rule need not settle, so the sweeps are
-// bounded (kSurfaceFlipSweeps; the clouds measured settle in 4 to 6).
+// and its loops are settled, its surface edges are flipped on the surface itself, by two
+// rules. An edge ab between triangles abp and baq is flipped to pq
+//  - by the empty-circle rule, where the angles at p and q, measured in 3D, sum to more
+//    than 180 degrees (in a plane: q inside the circle through a, b, p), unless pq bends
+//    the surface more than kBendVeto times what ab did;
+//  - for the bend alone, where pq bends it kBendGain times less than ab.
+// The bend of an edge ab is |(b - a) . (n_b - n_a)| with n the vertex normals (the mean of
+// the unit normals of the triangles around): 8 times the sag at the middle of a curve
+// through a and b normal to n_a and n_b. An edge along the direction in which the surface
+// curves least bends least, and triangles along it lie nearest the surface: on a cone,
+// along its generatrices. The empty-circle rule alone, which wants fat triangles, turned
+// the annulus's triangles across that direction on smooth surfaces of revolution (one
+// layer, mean distance to the analytic surface: vase 13% and cone 27% farther than
+// without flips); with both rules the vase is 3% and the cone 47% closer, the bumpy tube
+// 44% (10% with the empty-circle rule alone), the bust with ears 25% (18%). Since
+// kBendVeto <= kBendGain, the two rules never flip one quad back and forth with the same
+// normals; the normals are estimated anew at the start of each of the first
+// kNormalSweeps sweeps and then kept, so that the flips settle (the clouds measured: at
+// most 2 flips in the last sweep).
+// A flip is kept only if neither new triangle faces the axis (no new fold) nor is
+// degenerate, the new triangles' widest angle is at most 150 degrees (kWidestAngle) or
+// less wide than the old ones' (the bend alone makes needles: without that limit 17% of
+// the bust's triangles had an angle under 5 degrees, with it 2%, as without flips), pq is not already an edge nor a chord of a loop
+// (where close_ends puts its cap), and, unless both new normals are within 26 degrees of
+// the old pair's (kGentleFlip: the new triangles cover about the same place as the old),
+// neither new triangle meets a surface triangle around the quad's corners (the test is in
+// floating point, on triangles shrunk by a millionth about their centroids, so that
+// shared corners and edges do not count; testing the triangles around the corners'
+// neighbours too changed nothing on the synthetic bust). Loop edges are never flipped, so
+// the loops, the bands and the peeled triangles that add_group may put back are the same
+// as without the flips. The first sweep visits every edge; later sweeps only the
+// triangles the sweep before changed. The sweeps are bounded (kSurfaceFlipSweeps).
 const uint32_t kSurfaceFlipSweeps = 8;
+const uint32_t kNormalSweeps = 4;  // the sweeps that start with the normals estimated anew
 const uint32_t kFanLimit = 64;  // a vertex with more neighbours keeps its edges
 const double kFlipMargin = 1e-9;
 const double kGentleFlip = 0.9;  // cosine of the largest angle between a new and the mean normal
 const double kShrink = 1e-6;
-const double kBendVeto = 3;
+const double kBendVeto = 3;  // a flip by the empty-circle rule may bend at most 3 times more
+const double kBendGain = 3;  // a flip for the bend alone must bend 3 times less
+const double kWidestAngle = -0.86602540378443865;  // cosine of 150 degrees
 
 inline Vec3 vec_of(const Local& p) { return Vec3{p.x, p.y, p.h}; }
 
@@ -3780,56 +3792,95 @@ inline bool around_vertex(const Triangulation& tr, uint32_t from, Visit visit) {
     return false;
 }
 
-// The normal of the surface at the start of half-edge `from`: the sum of the unit normals
-// of the surface triangles around it, made unit. Zero if the vertex has more than
-// kFanLimit neighbours (it keeps its edges) or no surface triangle of nonzero area.
-inline Vec3 vertex_normal(const Triangulation& tr, const Local* points, uint32_t from) {
-    Vec3 sum{0, 0, 0};
-    const bool whole = around_vertex(tr, from, [&](uint32_t g) {
-        const uint32_t s = g / 3;
-        if (!on_surface(tr, s)) return true;
-        const uint32_t* v = tr.vertex + 3 * s;
-        const Vec3 n = normal_of(points[v[0] - 1], points[v[1] - 1], points[v[2] - 1]);
-        const double length = std::sqrt(dot(n, n));
-        if (length > 0) sum = Vec3{sum.x + n.x / length, sum.y + n.y / length, sum.z + n.z / length};
-        return true;
-    });
-    const double length = std::sqrt(dot(sum, sum));
-    return whole && length > 0 ? scaled(sum, 1 / length) : Vec3{0, 0, 0};
-}
+// The vertex normals, kept in the room of the annulus coordinates (two doubles a vertex,
+// free once the loops are settled) as three floats, copied in and out so that no type is
+// read through another: the sum of the unit normals of the surface triangles around the
+// vertex.
+struct VertexNormals {
+    double* room;
+    // The unit normal at vertex v; zero if it has no surface triangle of nonzero area.
+    Vec3 at(uint32_t v) const {
+        float n[3];
+        std::memcpy(n, room + 2 * static_cast<size_t>(v), sizeof n);
+        const Vec3 sum = {n[0], n[1], n[2]};
+        const double length = std::sqrt(dot(sum, sum));
+        return length > 0 ? scaled(sum, 1 / length) : sum;
+    }
+    void estimate(const Triangulation& tr, const Local* points, size_t vertices) {
+        std::memset(room, 0, 2 * vertices * sizeof(double));
+        for (uint32_t t = 0; t < tr.triangle_count; ++t) {
+            if (!on_surface(tr, t)) continue;
+            const uint32_t* v = tr.vertex + 3 * t;
+            Vec3 n = normal_of(points[v[0] - 1], points[v[1] - 1], points[v[2] - 1]);
+            const double length = std::sqrt(dot(n, n));
+            if (length == 0) continue;
+            n = scaled(n, 1 / length);
+            for (uint32_t k = 0; k < 3; ++k) {
+                float sum[3];
+                std::memcpy(sum, room + 2 * static_cast<size_t>(v[k]), sizeof sum);
+                sum[0] += static_cast<float>(n.x);
+                sum[1] += static_cast<float>(n.y);
+                sum[2] += static_cast<float>(n.z);
+                std::memcpy(room + 2 * static_cast<size_t>(v[k]), sum, sizeof sum);
+            }
+        }
+    }
+};
 
-// How much the surface bends along edge ab, with normals na and nb at its ends (see above).
+// How much the surface bends along edge ab, with unit normals na and nb at its ends (see
+// above).
 inline double bend_along(Vec3 a, Vec3 b, Vec3 na, Vec3 nb) {
     return std::fabs(dot(b - a, nb - na));
 }
 
+// The cosine of the widest angle of triangle abc.
+inline double widest_angle_cosine(Vec3 a, Vec3 b, Vec3 c) {
+    const Vec3 corner[3] = {a, b, c};
+    double widest = 1;
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 u = corner[(k + 1) % 3] - corner[k], v = corner[(k + 2) % 3] - corner[k];
+        const double lengths = std::sqrt(dot(u, u) * dot(v, v));
+        const double cosine = lengths > 0 ? dot(u, v) / lengths : -1;
+        widest = cosine < widest ? cosine : widest;
+    }
+    return widest;
+}
+
 // Flips half-edge e of a layer's triangulation on the surface if that helps (see above).
-inline bool flip_on_surface(Triangulation& tr, const Local* points, const Cylinder& cyl,
-                            uint32_t e) {
+inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32_t* flags,
+                            VertexNormals& normals, const Cylinder& cyl, uint32_t e) {
     const uint32_t f = tr.twin[e];
     const uint32_t t = e / 3, u = f / 3;
     if (!on_surface(tr, u)) return false;
     const uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)], p = tr.vertex[prev_edge(e)];
     const uint32_t q = tr.vertex[prev_edge(f)];
+    // A chord of a loop would stand where close_ends puts its cap.
+    if (p == q || (flags[p] & flags[q] & (kOnBottomLoop | kOnTopLoop))) return false;
     const Local &la = points[a - 1], &lb = points[b - 1], &lp = points[p - 1], &lq = points[q - 1];
-    if (p == q || !flip_helps(vec_of(la), vec_of(lb), vec_of(lp), vec_of(lq))) return false;
+    const Vec3 na = normals.at(a), nb = normals.at(b), np = normals.at(p), nq = normals.at(q);
+    if (dot(na, na) == 0 || dot(nb, nb) == 0 || dot(np, np) == 0 || dot(nq, nq) == 0)
+        return false;
+    const double bend_before = bend_along(vec_of(la), vec_of(lb), na, nb);
+    const double bend_after = bend_along(vec_of(lp), vec_of(lq), np, nq);
+    if (flip_helps(vec_of(la), vec_of(lb), vec_of(lp), vec_of(lq))
+            ? bend_after > kBendVeto * bend_before
+            : !(kBendGain * bend_after < bend_before))
+        return false;
+    const double widest_after =
+        std::fmin(widest_angle_cosine(vec_of(lp), vec_of(la), vec_of(lq)),
+                  widest_angle_cosine(vec_of(lq), vec_of(lb), vec_of(lp)));
+    if (widest_after < kWidestAngle &&
+        widest_after < std::fmin(widest_angle_cosine(vec_of(la), vec_of(lb), vec_of(lp)),
+                                 widest_angle_cosine(vec_of(lb), vec_of(la), vec_of(lq))))
+        return false;
     // The new triangles (p, a, q) and (q, b, p), counter-clockwise on the annulus.
     if (faces_axis(lq, la, lp, cyl) || faces_axis(lp, lb, lq, cyl) ||
         doubled_area(lp, la, lq) == 0 || doubled_area(lq, lb, lp) == 0)
-        return false;
-    const Vec3 na = vertex_normal(tr, points, e), nb = vertex_normal(tr, points, f);
-    const Vec3 np = vertex_normal(tr, points, prev_edge(e));
-    const Vec3 nq = vertex_normal(tr, points, prev_edge(f));
-    if (dot(na, na) == 0 || dot(nb, nb) == 0 || dot(np, np) == 0 || dot(nq, nq) == 0 ||
-        bend_along(vec_of(lp), vec_of(lq), np, nq) >
-            kBendVeto * bend_along(vec_of(la), vec_of(lb), na, nb))
         return false;
     if (!around_vertex(tr, prev_edge(e), [&tr, q](uint32_t g) {
             return tr.vertex[next_edge(g)] != q;
         }))
         return false;
-    const Vec3 first[3] = {vec_of(lp), vec_of(la), vec_of(lq)};
-    const Vec3 second[3] = {vec_of(lq), vec_of(lb), vec_of(lp)};
     // A flip in a gently curved quad, convex seen along its normal, covers about the
     // same place as before: nothing else to check.
     Vec3 mean = normal_of(la, lb, lp);
@@ -3838,46 +3889,40 @@ inline bool flip_on_surface(Triangulation& tr, const Local* points, const Cylind
     const Vec3 n1 = normal_of(lp, la, lq), n2 = normal_of(lq, lb, lp);
     const bool gentle = dot(n1, mean) > kGentleFlip * std::sqrt(dot(n1, n1) * dot(mean, mean)) &&
                         dot(n2, mean) > kGentleFlip * std::sqrt(dot(n2, n2) * dot(mean, mean));
-    const Box3 quad = box_of(first[0], first[1], first[2], second[1]);
-    auto clear_of = [&](uint32_t g) {
-        const uint32_t s = g / 3;
-        if (s == t || s == u || !on_surface(tr, s)) return true;
-        const uint32_t* v = tr.vertex + 3 * s;
-        const Vec3 other[3] = {vec_of(points[v[0] - 1]), vec_of(points[v[1] - 1]),
-                               vec_of(points[v[2] - 1])};
-        return !quad.meets(box_of(other[0], other[1], other[2], other[2])) ||
-               (!triangles_meet(first, other) && !triangles_meet(second, other));
-    };
-    // The triangles around the quad's corners.
-    const uint32_t corners[4] = {e, f, prev_edge(e), prev_edge(f)};
-    for (uint32_t corner : corners)
-        if (!gentle && !around_vertex(tr, corner, clear_of)) return false;
+    if (!gentle) {
+        const Vec3 first[3] = {vec_of(lp), vec_of(la), vec_of(lq)};
+        const Vec3 second[3] = {vec_of(lq), vec_of(lb), vec_of(lp)};
+        const Box3 quad = box_of(first[0], first[1], first[2], second[1]);
+        auto clear_of = [&](uint32_t g) {
+            const uint32_t s = g / 3;
+            if (s == t || s == u || !on_surface(tr, s)) return true;
+            const uint32_t* v = tr.vertex + 3 * s;
+            const Vec3 other[3] = {vec_of(points[v[0] - 1]), vec_of(points[v[1] - 1]),
+                                   vec_of(points[v[2] - 1])};
+            return !quad.meets(box_of(other[0], other[1], other[2], other[2])) ||
+                   (!triangles_meet(first, other) && !triangles_meet(second, other));
+        };
+        // The triangles around the quad's corners.
+        const uint32_t corners[4] = {e, f, prev_edge(e), prev_edge(f)};
+        for (uint32_t corner : corners)
+            if (!around_vertex(tr, corner, clear_of)) return false;
+    }
     flip_edge<false>(tr, e, nullptr);
     return true;
-}
-
-// The half-edge of surface triangle t that faces its obtuse angle, if it has one: only such
-// an edge can have angles summing to more than 180 degrees across it, and most triangles
-// have none, so that most twins are never read.
-inline uint32_t edge_facing_obtuse_angle(const Triangulation& tr, const Local* points, uint32_t t) {
-    const uint32_t* v = tr.vertex + 3 * t;
-    const Vec3 c[3] = {vec_of(points[v[0] - 1]), vec_of(points[v[1] - 1]),
-                       vec_of(points[v[2] - 1])};
-    for (uint32_t k = 0; k < 3; ++k)
-        if (dot(c[(k + 1) % 3] - c[k], c[(k + 2) % 3] - c[k]) < 0)
-            return 3 * t + (k + 1) % 3;
-    return kNoIndex;
 }
 
 // Flips the surface edges of a layer's triangulation, sweep after sweep, until a sweep
 // flips none or kSurfaceFlipSweeps have run; after the first sweep, only edges between
 // two corners of quads flipped in the sweep before (the edges whose triangles changed).
 // `flags` holds a word per vertex (see triangulate_layer); the bits kFlippedBefore and
-// kFlippedNow are used here and cleared. Returns the number of flips.
+// kFlippedNow are used here and cleared. `room` is the annulus coordinates, two doubles a
+// vertex, overwritten. Returns the number of flips.
 inline size_t flip_layer_on_surface(Triangulation& tr, const Local* points, const Cylinder& cyl,
-                                    uint32_t* flags, size_t vertices) {
+                                    uint32_t* flags, double* room, size_t vertices) {
+    VertexNormals normals = {room};
     size_t flips = 0;
     for (uint32_t sweep = 0; sweep < kSurfaceFlipSweeps; ++sweep) {
+        if (sweep < kNormalSweeps) normals.estimate(tr, points, vertices);
         size_t flipped = 0;
         for (uint32_t t = 0; t < tr.triangle_count; ++t) {
             if (!on_surface(tr, t)) continue;
@@ -3886,18 +3931,20 @@ inline size_t flip_layer_on_surface(Triangulation& tr, const Local* points, cons
             if (sweep > 0 && ((flags[v[0]] & kFlippedBefore) + (flags[v[1]] & kFlippedBefore) +
                               (flags[v[2]] & kFlippedBefore)) < 2 * kFlippedBefore)
                 continue;
-            const uint32_t e = edge_facing_obtuse_angle(tr, points, t);
-            if (e == kNoIndex) continue;
-            const uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)];
-            if ((sweep > 0 && !(flags[a] & flags[b] & kFlippedBefore)) ||
-                !flip_on_surface(tr, points, cyl, e))
-                continue;
-            ++flipped;
-            // t is (p, a, q) after the flip, and the twin's triangle (q, b, p).
-            flags[tr.vertex[3 * t]] |= kFlippedNow;
-            flags[tr.vertex[3 * t + 1]] |= kFlippedNow;
-            flags[tr.vertex[3 * t + 2]] |= kFlippedNow;
-            flags[b] |= kFlippedNow;
+            for (uint32_t e = 3 * t; e < 3 * t + 3; ++e) {
+                // Each edge once a sweep, from the side of its larger half-edge.
+                const uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)];
+                if (tr.twin[e] > e || (sweep > 0 && !(flags[a] & flags[b] & kFlippedBefore)) ||
+                    !flip_on_surface(tr, points, flags, normals, cyl, e))
+                    continue;
+                ++flipped;
+                // t is (p, a, q) after the flip, and the twin's triangle (q, b, p).
+                flags[tr.vertex[3 * t]] |= kFlippedNow;
+                flags[tr.vertex[3 * t + 1]] |= kFlippedNow;
+                flags[tr.vertex[3 * t + 2]] |= kFlippedNow;
+                flags[b] |= kFlippedNow;
+                break;
+            }
         }
         for (size_t v = 0; v < vertices; ++v)
             flags[v] = (flags[v] & ~(kFlippedBefore | kFlippedNow)) |
@@ -3983,7 +4030,7 @@ inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Ar
     name_loop(tr, order, flags, loops.bottom, loops.bottom_count, loops.bottom_flags, false);
     name_loop(tr, order, flags, loops.top, loops.top_count, loops.top_flags, true);
     if (kSurfaceFlips && layer.surface_flips &&
-        flip_layer_on_surface(tr, points, cyl, flags, total) && folds)
+        flip_layer_on_surface(tr, points, cyl, flags, xy, total) && folds)
         folds = count_folds(tr, points, 1, cyl, nullptr);
     // The triangles at the bottom loop (the border) go last, so that a chunk's triangles at
     // its loop vertices are one stretch of the sink with the band (see chunk_is_sound).

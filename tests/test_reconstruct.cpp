@@ -635,6 +635,30 @@ double mean_centroid_deviation(const Shape& s, const std::vector<uint32_t>& tria
                                    [&s](const double* p) { return s.deviation(p); });
 }
 
+// The triangles of a mesh with an angle wider than `degrees`.
+size_t triangles_wider_than(const Shape& s, const std::vector<uint32_t>& triangles,
+                            double degrees) {
+    const double limit = std::cos(degrees * 3.14159265358979323846 / 180);
+    size_t wide = 0;
+    for (size_t t = 0; t + 2 < triangles.size(); t += 3) {
+        bool any = false;
+        for (size_t k = 0; k < 3 && !any; ++k) {
+            const double* o = s.xyz.data() + 3 * size_t(triangles[t + k]);
+            const double* a = s.xyz.data() + 3 * size_t(triangles[t + (k + 1) % 3]);
+            const double* b = s.xyz.data() + 3 * size_t(triangles[t + (k + 2) % 3]);
+            double dot = 0, aa = 0, bb = 0;
+            for (int i = 0; i < 3; ++i) {
+                dot += (a[i] - o[i]) * (b[i] - o[i]);
+                aa += (a[i] - o[i]) * (a[i] - o[i]);
+                bb += (b[i] - o[i]) * (b[i] - o[i]);
+            }
+            any = dot < limit * std::sqrt(aa * bb);
+        }
+        wide += any;
+    }
+    return wide;
+}
+
 // A band between two layers used to join loops that skip the points next to the cut (the
 // lower layer's hull, the upper layer's centre link), so its triangles spanned chords
 // several spacings long and cut through the surface. This test's figure at 20,000 points, 24
@@ -2566,12 +2590,19 @@ TEST_CASE("surface_flips: the same guarantees, the bumpy tube nearer the true su
             }
             const double before = mean_centroid_deviation(s, plain.triangles);
             const double after = mean_centroid_deviation(s, flipped.triangles);
-            MESSAGE(s.name << ", " << layers << " layers: mean distance " << before << " -> " << after);
-            // Without the bend veto the vase came out 9% and the cone 7% farther.
-            CHECK(after <= 1.04 * before);
-            if (s.name.rfind("bumpy tube", 0) == 0) {
+            MESSAGE(s.name << ", " << layers << " layers: mean distance " << before << " -> " << after
+                           << ", triangles wider than 150 degrees "
+                           << triangles_wider_than(s, plain.triangles, 150) << " -> "
+                           << triangles_wider_than(s, flipped.triangles, 150));
+            // With the empty-circle rule alone the vase came out 9% and the cone 7% farther.
+            CHECK(after <= before);
+            CHECK(triangles_wider_than(s, flipped.triangles, 150) <=
+                  triangles_wider_than(s, plain.triangles, 150));
+            // These two curve much less along one direction than across it, which the bend
+            // finds: 10% closer with the empty-circle rule alone, 35 to 50% with both.
+            if (s.name.rfind("bumpy tube", 0) == 0 || s.name.rfind("cone", 0) == 0) {
                 CHECK(flipped.triangles != plain.triangles);
-                CHECK(after <= 0.95 * before);
+                CHECK(after <= 0.75 * before);
             }
         }
 }

@@ -352,18 +352,20 @@ enum Flags : uint32_t {
     // it (invalid_argument), and so does a build with STRATMESH_SMALL_CODE.
     drop_outliers = 1u << 3,
     // After each layer is triangulated on its unrolled annulus (the paper's method), its
-    // edges are flipped by the empty-circle rule on the surface itself, with angles
-    // measured in 3D: the unrolling squeezes whatever lies almost across the axis (the
-    // underside of an ear, a chin, a crease) and bumps that turn the surface steeply
-    // around the axis, and there the flips join the points that are near on the surface.
-    // No vertex, loop or band changes; a flip never makes a fold and is checked against
-    // crossing the nearby triangles; the stream gives the same triangles as reconstruct()
-    // with it. Measured (README, "Flips on the surface"), mean distance to the true
-    // surface: 17% smaller on a synthetic bust with ears, 12% with horns, 9% on a hand,
-    // 6% on a femur, 11% on the bumpy tube, the same on the bundled bust, but 9% larger on
-    // a vase and 7% on a cone (smooth surfaces of revolution); 1.7 times the time on the
-    // 1e6-point tube. Off by default, for that time (the command-line tool turns it on).
-    // A build with STRATMESH_SMALL_CODE ignores it.
+    // edges are flipped on the surface itself: by the empty-circle rule with angles
+    // measured in 3D, and toward the direction in which the surface curves least. The
+    // unrolling squeezes whatever lies almost across the axis (the underside of an ear, a
+    // chin, a crease) and bumps that turn the surface steeply around the axis; there the
+    // flips join the points that are near on the surface, and everywhere they lay edges
+    // along the surface's flattest direction. No vertex, loop or band changes; a flip
+    // never makes a fold nor an angle over 150 degrees (unless it narrows one), and is
+    // checked against crossing the nearby triangles; the stream gives the same triangles
+    // as reconstruct() with it. Measured (README, "Flips on the surface"), mean distance
+    // to the true surface: 25% smaller on a synthetic bust with ears, 11% with horns, 11%
+    // on a hand, 9% on a femur, 30 to 44% on analytic tubes, 34 to 47% on a cone, 3% on a
+    // vase, the same on the bundled bust; 2.4 times the time on the 1e6-point tube. Off
+    // by default, for that time (the command-line tool turns it on). A build with
+    // STRATMESH_SMALL_CODE ignores it.
     surface_flips = 1u << 4,
 };
 
@@ -3802,7 +3804,8 @@ struct VertexNormals {
     Vec3 at(uint32_t v) const {
         float n[3];
         std::memcpy(n, room + 2 * static_cast<size_t>(v), sizeof n);
-        const Vec3 sum = {n[0], n[1], n[2]};
+        const Vec3 sum = {static_cast<double>(n[0]), static_cast<double>(n[1]),
+                          static_cast<double>(n[2])};
         const double length = std::sqrt(dot(sum, sum));
         return length > 0 ? scaled(sum, 1 / length) : sum;
     }

@@ -363,9 +363,9 @@ enum Flags : uint32_t {
     // as reconstruct() with it. Measured (README, "Flips on the surface"), mean distance
     // to the true surface: 25% smaller on a synthetic bust with ears, 11% with horns, 11%
     // on a hand, 9% on a femur, 30 to 44% on analytic tubes, 34 to 47% on a cone, 3% on a
-    // vase, the same on the bundled bust; 2.4 times the time on the 1e6-point tube. Off
-    // by default, for that time (the command-line tool turns it on). A build with
-    // STRATMESH_SMALL_CODE ignores it.
+    // vase, the same on the bundled bust; 2.4 to 2.8 times the time on the 1e6-point
+    // tube. Off by default, for that time (the command-line tool turns it on). A build
+    // with STRATMESH_SMALL_CODE ignores it.
     surface_flips = 1u << 4,
 };
 
@@ -3683,13 +3683,14 @@ inline void choose_centre(LoadedLayer& layer, Arena& arena) {
 // A flip is kept only if neither new triangle faces the axis (no new fold) nor is
 // degenerate, the new triangles' widest angle is at most 150 degrees (kWidestAngle) or
 // less wide than the old ones' (the bend alone makes needles: without that limit 17% of
-// the bust's triangles had an angle under 5 degrees, with it 2%, as without flips), pq is not already an edge nor a chord of a loop
-// (where close_ends puts its cap), and, unless both new normals are within 26 degrees of
-// the old pair's (kGentleFlip: the new triangles cover about the same place as the old),
-// neither new triangle meets a surface triangle around the quad's corners (the test is in
-// floating point, on triangles shrunk by a millionth about their centroids, so that
-// shared corners and edges do not count; testing the triangles around the corners'
-// neighbours too changed nothing on the synthetic bust). Loop edges are never flipped, so
+// the bust's triangles had an angle under 5 degrees, with it 2%, as without flips), pq is
+// not already an edge nor a chord of a loop (where close_ends puts its cap), and, unless
+// both new normals are within 26 degrees of the old pair's (kGentleFlip: the new
+// triangles cover about the same place as the old), neither new triangle meets a surface
+// triangle around the quad's corners (the test is in floating point, on triangles shrunk
+// by a millionth about their centroids, so that shared corners and edges do not count;
+// testing the triangles around the corners' neighbours too changed nothing on the
+// synthetic bust). Loop edges are never flipped, so
 // the loops, the bands and the peeled triangles that add_group may put back are the same
 // as without the flips. The first sweep visits every edge; later sweeps only the
 // triangles the sweep before changed. The sweeps are bounded (kSurfaceFlipSweeps).
@@ -3797,17 +3798,15 @@ inline bool around_vertex(const Triangulation& tr, uint32_t from, Visit visit) {
 // The vertex normals, kept in the room of the annulus coordinates (two doubles a vertex,
 // free once the loops are settled) as three floats, copied in and out so that no type is
 // read through another: the sum of the unit normals of the surface triangles around the
-// vertex.
+// vertex, made unit.
 struct VertexNormals {
     double* room;
     // The unit normal at vertex v; zero if it has no surface triangle of nonzero area.
     Vec3 at(uint32_t v) const {
         float n[3];
         std::memcpy(n, room + 2 * static_cast<size_t>(v), sizeof n);
-        const Vec3 sum = {static_cast<double>(n[0]), static_cast<double>(n[1]),
-                          static_cast<double>(n[2])};
-        const double length = std::sqrt(dot(sum, sum));
-        return length > 0 ? scaled(sum, 1 / length) : sum;
+        return Vec3{static_cast<double>(n[0]), static_cast<double>(n[1]),
+                    static_cast<double>(n[2])};
     }
     void estimate(const Triangulation& tr, const Local* points, size_t vertices) {
         std::memset(room, 0, 2 * vertices * sizeof(double));
@@ -3826,6 +3825,15 @@ struct VertexNormals {
                 sum[2] += static_cast<float>(n.z);
                 std::memcpy(room + 2 * static_cast<size_t>(v[k]), sum, sizeof sum);
             }
+        }
+        for (size_t v = 0; v < vertices; ++v) {
+            const Vec3 sum = at(static_cast<uint32_t>(v));
+            const double length = std::sqrt(dot(sum, sum));
+            if (length == 0) continue;
+            const float unit[3] = {static_cast<float>(sum.x / length),
+                                   static_cast<float>(sum.y / length),
+                                   static_cast<float>(sum.z / length)};
+            std::memcpy(room + 2 * v, unit, sizeof unit);
         }
     }
 };

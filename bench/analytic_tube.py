@@ -7,6 +7,8 @@ SHAPE is the radius around the z axis, z in [0, 6]:
     bumpy  r = 1 + 0.25 sin(5 t) cos(z)          (the test suite's bumpy tube)
     wavy   r = 1 + 0.3 sin(3 t) sin(2 z) + 0.2 cos(7 t)
     cyl    r = 1
+    vase   r = 1 + 0.6 sin(1.2 z)                   (smooth, of revolution)
+    cone   r = 2 - 0.3 z                            (ruled: straight generatrices)
 The cloud is POINTS points spread evenly over the surface's area (rejection on the area
 element), each moved radially by Gaussian noise of standard deviation NOISE; ascii PLY with
 float x, y, z. The reference is the surface on a 720 x 600 grid of (t, z), closed around
@@ -24,6 +26,8 @@ RADII = {
     "bumpy": lambda t, z: 1 + 0.25 * math.sin(5 * t) * math.cos(z),
     "wavy": lambda t, z: 1 + 0.3 * math.sin(3 * t) * math.sin(2 * z) + 0.2 * math.cos(7 * t),
     "cyl": lambda t, z: 1.0,
+    "vase": lambda t, z: 1 + 0.6 * math.sin(1.2 * z),
+    "cone": lambda t, z: 2 - 0.3 * z,
 }
 
 

@@ -3690,10 +3690,10 @@ inline void choose_centre(LoadedLayer& layer, Arena& arena) {
 // triangle around the quad's corners (the test is in floating point, on triangles shrunk
 // by a millionth about their centroids, so that shared corners and edges do not count;
 // testing the triangles around the corners' neighbours too changed nothing on the
-// synthetic bust). Loop edges are never flipped, so
-// the loops, the bands and the peeled triangles that add_group may put back are the same
-// as without the flips. The first sweep visits every edge; later sweeps only the
-// triangles the sweep before changed. The sweeps are bounded (kSurfaceFlipSweeps).
+// synthetic bust). Loop edges are never flipped, so the loops, the bands and the peeled
+// triangles that add_group may put back are the same as without the flips. The first
+// sweep visits every edge; later sweeps only the triangles the sweep before changed. The
+// sweeps are bounded (kSurfaceFlipSweeps).
 const uint32_t kSurfaceFlipSweeps = 8;
 const uint32_t kNormalSweeps = 4;  // the sweeps that start with the normals estimated anew
 const uint32_t kFanLimit = 64;  // a vertex with more neighbours keeps its edges

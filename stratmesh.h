@@ -93,7 +93,11 @@
 //                            The drop_outliers flag is refused (invalid_argument):
 //                            filter the cloud before it reaches the device. The
 //                            surface_flips flag is ignored (about 4 KiB): the layers
-//                            stay Delaunay on their annulus, as in the paper.
+//                            stay Delaunay on their annulus, as in the paper. A band
+//                            that folds between peeled loops gets all the peeled
+//                            triangles of both loops back, not only those around its
+//                            folds (kLocalUnpeel, 0.4 KiB): a little farther from the
+//                            surface at such seams.
 //
 // ==== Memory ===============================================================================
 //
@@ -745,6 +749,7 @@ const bool kClosedEnds = false;
 const uint32_t kCapEarStarts = 1;
 const bool kDropOutliers = false;
 const bool kSurfaceFlips = false;
+const bool kLocalUnpeel = false;
 #else
 const bool kNetShortcut = true;  // a chunk whose loop fans are whole skips the net
 const bool kStagePoints = true;  // reconstruct() keeps the grouped points in spare workspace
@@ -764,6 +769,9 @@ const uint32_t kCapEarStarts = 8;
 const bool kDropOutliers = true;
 // Layers are flipped on the surface (see "flips on the surface" in >>layer triangulation).
 const bool kSurfaceFlips = true;
+// A band that folds between peeled loops gets back only the peeled triangles around its
+// folds (see add_group); without it, all of them.
+const bool kLocalUnpeel = true;
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 
@@ -3324,6 +3332,7 @@ const uint32_t kFlippedBefore = 8, kFlippedNow = 16;  // see flip_layer_on_surfa
 const uint32_t kPassShift = 8;  // above it: the peeling pass that put a vertex on its loop
 const uint32_t kPassBit = 3;    // where LayerLoops::bottom_flags and top_flags keep that pass
 const unsigned char kPassBits = static_cast<unsigned char>(0xF << kPassBit);
+const unsigned char kUnpeeled = 0x80;  // in those flags: the band puts the peeled triangle back
 
 // Collects the link of the centre (vertex 0) counter-clockwise into loop, one entry per link
 // edge u -> w: the half-edge w -> u of the triangle beyond it. Flags its vertices
@@ -3387,6 +3396,9 @@ inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* count, 
 // other cannot follow), add_group stitches it again between the loops as they were, with
 // the triangles peeled off both put back (put_back_peeled): the seam as without peeling.
 const uint32_t kPeelPasses = 8;
+// Stitches of a band that folds (see add_group): with kLocalUnpeel, three with the peel
+// groups around its folds put back, then all; without, one and then all.
+const uint32_t kUnpeelRounds = kLocalUnpeel ? 4 : 2;
 const double kPeelSlope = 1.0;
 
 // Whether the triangle of loop entry g (see centre_link and hull_loop) is peeled.
@@ -4366,16 +4378,46 @@ inline void settle_band(Band& band, size_t* swaps) {
     if (!band_is_proper(band) && restart_half_way(band)) *swaps += untangle_runs(band);
 }
 
-// Emits the triangles peeled off a loop (see "peeling" in >>layer triangulation): vertex x,
-// peeled in pass k, came off the edge between the nearest loop vertices before and after it
-// from earlier passes (entry 0 is on the hull or the link). id(i) is entry i's band index,
-// point(id) its point.
+// Marks kUnpeeled the peeled entries of a loop's flags[0..n) in the peel groups around entry
+// k: the entries between the nearest ones before and after k that were on the loop before
+// peeling (pass 0; entry 0 is one). A peeled vertex came off an edge between entries of
+// earlier passes in its group, so the group put back whole leaves the loop as it was
+// there, and the other groups' peeling as it is.
+inline void unpeel_around(unsigned char* flags, uint32_t n, uint32_t k) {
+    auto unpeel = [flags](uint32_t i) {
+        if (!(flags[i] & kPassBits)) return false;
+        flags[i] |= kUnpeeled;
+        return true;
+    };
+    unpeel(k);
+    for (uint32_t i = k; i > 0 && unpeel(i - 1); --i) {}
+    for (uint32_t i = (k + 1) % n; i != k && unpeel(i); i = (i + 1) % n) {}
+}
+
+// Marks every peeled entry of flags[0..n) kUnpeeled or, with !on, none.
+inline void mark_unpeeled(unsigned char* flags, uint32_t n, bool on) {
+    for (uint32_t i = 0; i < n; ++i)
+        flags[i] = static_cast<unsigned char>(on && (flags[i] & kPassBits) ? flags[i] | kUnpeeled
+                                                                           : flags[i] & ~kUnpeeled);
+}
+
+inline size_t count_unpeeled(const unsigned char* flags, uint32_t n) {
+    size_t marked = 0;
+    for (uint32_t i = 0; i < n; ++i) marked += (flags[i] & kUnpeeled) != 0;
+    return marked;
+}
+
+// Emits the triangles peeled off a loop (see "peeling" in >>layer triangulation), with
+// kLocalUnpeel those whose vertex is marked kUnpeeled, else all: vertex x, peeled in pass
+// k, came off the edge between the nearest loop vertices before and after it from earlier
+// passes (entry 0 is on the hull or the link). id(i) is entry i's band index, point(id) its
+// point.
 template <class IdOf, class PointOf>
 inline void put_back_peeled(const unsigned char* flags, uint32_t n, bool top, const IdOf& id,
                             const PointOf& point, const Cylinder& cyl, TriangleSink& sink) {
     auto pass = [flags](uint32_t i) { return flags[i] & kPassBits; };
     for (uint32_t x = 0; x < n; ++x) {
-        if (!pass(x)) continue;
+        if (!pass(x) || (kLocalUnpeel && !(flags[x] & kUnpeeled))) continue;
         uint32_t before = x - 1, after = (x + 1) % n;
         while (pass(before) >= pass(x)) --before;
         while (pass(after) >= pass(x)) after = (after + 1) % n;
@@ -4389,10 +4431,14 @@ inline void put_back_peeled(const unsigned char* flags, uint32_t n, bool top, co
 // Stitches loop A (the lower layer's top loop: reader indices a_ids with their seam flags,
 // cylinder ca) to the loaded upper layer's bottom loop (loops.bottom, layer-local indices;
 // the layer's cylinder has the cut as h0). With `unpeel`, both loops as they were before
-// peeling, and the peeled triangles put back. The band's triangles name the upper layer's
-// points by layer-local index and the i-th point of A by layer.count + i.
+// peeling, and the peeled triangles put back (with kLocalUnpeel the caller marks them all
+// kUnpeeled first); else, with kLocalUnpeel, the entries marked kUnpeeled are left out and
+// their peeled triangles put back, and each band triangle that faces the axis marks the
+// peel groups around its corners kUnpeeled (unpeel_around) for a next attempt. The band's
+// triangles name the upper layer's points by layer-local index and the i-th point of A by
+// layer.count + i.
 inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cylinder& ca,
-                          const uint32_t* a_ids, const unsigned char* a_flags, uint32_t p,
+                          const uint32_t* a_ids, unsigned char* a_flags, uint32_t p,
                           const LoadedLayer& layer, const LayerLoops& loops, bool unpeel,
                           Arena& arena, TriangleSink& sink, size_t* swaps) {
     const Cylinder& cb = layer.cyl;
@@ -4408,14 +4454,17 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
     double* scratch = arena.alloc<double>(kIncircleScratch);
     if (arena.failed) return false;
     const uint32_t a_length = p;
+    auto left_out = [unpeel](unsigned char f) {
+        return (f & kPassBits) && (unpeel || (kLocalUnpeel && (f & kUnpeeled)));
+    };
     p = 0;
     for (uint32_t i = 0; i < a_length; ++i) {
-        if (!unpeel || !(a_flags[i] & kPassBits)) a[p++] = below + i;
+        if (!left_out(a_flags[i])) a[p++] = below + i;
         a_points[i] = frame.local(cloud.point(a_ids[i]));
     }
     q = 0;
     for (uint32_t j = 0; j < loops.bottom_count; ++j)
-        if (!unpeel || !(loops.bottom_flags[j] & kPassBits)) b[q++] = loops.bottom[j];
+        if (!left_out(loops.bottom_flags[j])) b[q++] = loops.bottom[j];
     // The layer's points are read again (the loaded ones are in triangulate_layer's order,
     // or were never loaded when a job triangulated the layer): only the loop's are read.
     auto point = [&](uint32_t id) -> Local {
@@ -4436,23 +4485,33 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
     const double two_pi = 6.28318530717958647693;
     Band band = {a, xa, p, b, xb, q, two_pi * unrolled_radius, steps, scratch, {}};
     // Walks the settled band: returns its folds, adds its doubled area to *area and, with
-    // `emit`, writes its triangles to the sink.
+    // `emit`, writes its triangles to the sink and (kLocalUnpeel) marks the peel groups
+    // around the folds: those around the state's a[i] and b[j], which hold the triangle's
+    // third corner too unless it is on the loop since before peeling. B's entry of b[j] is
+    // found walking loops.bottom along (b is in its order, rotated), once around at most.
     auto walk_band = [&](bool emit, double* area) {
         size_t folds = 0;
-        uint32_t i = 0, j = 0;
+        uint32_t i = 0, j = 0, entry = 0;
         for (uint32_t t = 0; t < p + q; ++t) {
             uint32_t x, y, z;  // counter-clockwise on the annulus
+            const uint32_t a0 = a[i % p], b0 = b[j % q];
             if (steps[t] == 0) {
-                x = a[(i + 1) % p], y = a[i % p], z = b[j % q];
+                x = a[(i + 1) % p], y = a0, z = b0;
                 ++i;
             } else {
-                x = b[j % q], y = b[(j + 1) % q], z = a[i % p];
+                x = b0, y = b[(j + 1) % q], z = a0;
                 ++j;
             }
             const Local px = point(x), py = point(y), pz = point(z);
-            folds += faces_axis(px, pz, py, shared);
+            const bool folded = faces_axis(px, pz, py, shared);
+            folds += folded;
             *area += doubled_area(px, py, pz);
             if (emit) sink.write(x, y, z);
+            if (!kLocalUnpeel || !emit || !folded) continue;
+            for (uint32_t k = 0; k < loops.bottom_count && loops.bottom[entry] != b0; ++k)
+                entry = (entry + 1) % loops.bottom_count;
+            unpeel_around(a_flags, a_length, a0 - below);
+            unpeel_around(loops.bottom_flags, loops.bottom_count, entry);
         }
         return folds;
     };
@@ -4486,7 +4545,7 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
         if (folds == 0 && trial == 0) break;
     }
     *swaps += best_swaps;
-    if (unpeel) {
+    if (kLocalUnpeel || unpeel) {
         put_back_peeled(a_flags, a_length, true, [below](uint32_t i) { return below + i; },
                         point, shared, sink);
         put_back_peeled(loops.bottom_flags, loops.bottom_count, false,
@@ -5842,9 +5901,11 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
             LayerLoops loops = {c.bottom, 0, c.next_top, 0, c.bottom_flags, c.next_unused,
                                 0, 0};
             // A band between peeled loops that folds (a peeled loop can dip where the other
-            // cannot follow) is stitched again between the loops as they were before peeling,
-            // with the triangles peeled off them put back (see "peeling" in >>layer
-            // triangulation).
+            // cannot follow) is stitched again with the peel groups around its folds put
+            // back (kLocalUnpeel; see "peeling" in >>layer triangulation), at most
+            // kUnpeelRounds times; where it still folds, or no peeled entry is near a fold,
+            // between the loops as they were before peeling, with all their peeled triangles
+            // put back.
             auto stitch = [&]() {
                 if (status != Status::ok || c.top_count == 0) return;
                 const size_t band_start = sink.count, band_folds = sink.folds;
@@ -5856,17 +5917,30 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
                         if (loops.bottom_flags[j] & kPassBits) return true;
                     return false;
                 };
-                for (int unpeel = 0; unpeel < 2; ++unpeel) {
+                auto unpeeled = [&]() {
+                    return count_unpeeled(c.top_unused, c.top_count) +
+                           count_unpeeled(loops.bottom_flags, loops.bottom_count);
+                };
+                // Rounds before the last put back the groups marked; the last, all.
+                for (uint32_t round = 0; round < kUnpeelRounds; ++round) {
+                    if (kLocalUnpeel && (round == 0 || round + 1 == kUnpeelRounds)) {
+                        mark_unpeeled(c.top_unused, c.top_count, round + 1 == kUnpeelRounds);
+                        mark_unpeeled(loops.bottom_flags, loops.bottom_count,
+                                      round + 1 == kUnpeelRounds);
+                    }
                     sink.count = band_start;
                     sink.folds = band_folds;
                     c.swaps = band_swaps;
+                    const size_t marked = kLocalUnpeel ? unpeeled() : 0;
                     if (!stitch_layers(c.reader, c.frame, c.top_cylinder, c.top, c.top_unused,
-                                       c.top_count, layer, loops, unpeel != 0, arena, sink,
-                                       &c.swaps)) {
+                                       c.top_count, layer, loops, round + 1 == kUnpeelRounds,
+                                       arena, sink, &c.swaps)) {
                         status = Status::out_of_memory;
                         return;
                     }
                     if (sink.folds == band_folds || !peeled()) return;
+                    if (kLocalUnpeel && unpeeled() == marked && round + 2 < kUnpeelRounds)
+                        round = kUnpeelRounds - 2;  // no group near a fold: the last round
                 }
             };
             // A job's result in reader indices goes in as it is when its chunk needs no

@@ -53,7 +53,8 @@ if [ "$n" != 1 ]; then
 fi
 echo "all three digests are identical"
 # What STRATMESH_SMALL_CODE leaves out (closed ends, crescents, caps, drop_outliers,
-# cap_ends) has its own digest, from the two builds without the macro.
+# cap_ends, surface flips, the local put-back of peeled triangles) has its own digest, from
+# the two builds without the macro.
 for a in native aarch64; do
   printf '%-8s full %s\n' "$a" "$(grep '^full ' "$out/digest-$a.txt" | cut -c8-)"
 done

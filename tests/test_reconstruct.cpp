@@ -663,12 +663,17 @@ size_t triangles_wider_than(const Shape& s, const std::vector<uint32_t>& triangl
 // lower layer's hull, the upper layer's centre link), so its triangles spanned chords
 // several spacings long and cut through the surface. This test's figure at 20,000 points, 24
 // layers over one layer, before the loops were peeled: cylinder 2.78, elliptic tube 3.35,
-// bumpy tube 3.02 (8 layers: 1.57, 1.70, 1.61); after: 1.54, 1.45, 1.26 (8 layers: 1.18,
-// 1.15, 1.12). The rest is the bands themselves: each seam still joins two fronts.
+// bumpy tube 3.02 (8 layers: 1.57, 1.70, 1.61); after: 1.54, 1.45, 1.26, cone 1.64, vase
+// 1.12 (8 layers: 1.18, 1.15, 1.12, 1.27, 1.03), most of it from bands whose peeled loops
+// were all put back for one fold; with only the peel groups around the folds put back
+// (see add_group): 1.19, 1.14, 1.12, 1.30, 1.12 (8 layers: 1.06, 1.06, 1.04, 1.12, 1.03).
+// The rest is the bands themselves: each seam still joins two fronts.
 TEST_CASE("seams: many layers stay about as close to the true surface as one layer") {
     const std::vector<Shape> tubes = {shapes::cylinder(kLarge, Pose::z),
                                       shapes::elliptic_tube(kLarge, Pose::tilted),
-                                      shapes::bumpy_tube(kLarge, Pose::x)};
+                                      shapes::bumpy_tube(kLarge, Pose::x),
+                                      shapes::cone(kLarge, Pose::z),
+                                      shapes::vase(kLarge, Pose::tilted)};
     for (const Shape& s : tubes) {
         CAPTURE(s.name);
         double one = 0;
@@ -682,7 +687,7 @@ TEST_CASE("seams: many layers stay about as close to the true surface as one lay
             double mean = mean_centroid_deviation(s, run.triangles);
             MESSAGE(s.name << ", " << layers << " layers: mean distance " << mean);
             if (layers == 1) one = mean;
-            CHECK(mean <= (layers == 8 ? 1.3 : 1.6) * one);
+            CHECK(mean <= (layers == 8 ? 1.15 : 1.35) * one);
         }
     }
 }

@@ -775,6 +775,14 @@ const bool kLocalUnpeel = true;
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 
+// Kept out of line in the small build: inlined at each caller, these few functions grow
+// the Cortex-M7 code past its 32 KiB (examples/firmware/build.sh).
+#if defined(STRATMESH_SMALL_CODE) && (defined(__GNUC__) || defined(__clang__))
+#define STRATMESH_SMALL_NOINLINE __attribute__((noinline))
+#else
+#define STRATMESH_SMALL_NOINLINE
+#endif
+
 #if defined(__GNUC__) || defined(__clang__)
 inline double abs_value(double x) { return __builtin_fabs(x); }
 #else
@@ -3047,7 +3055,7 @@ inline double exp_portable(double x) {
 }
 
 // A monotone stand-in for the polar angle of (dx, dy), in [0, 4): no trigonometry.
-inline double pseudo_angle(double dx, double dy) {
+STRATMESH_SMALL_NOINLINE inline double pseudo_angle(double dx, double dy) {
     double sum = abs_value(dx) + abs_value(dy);
     double t = sum > 0 ? dy / sum : 0;  // in [-1, 1]
     return dx >= 0 ? (t < 0 ? 4 + t : t) : 2 - t;
@@ -3375,35 +3383,43 @@ inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* count, 
     *count = n;
 }
 
-// Peeling. Both loops are convex hulls, each in its own picture: the top loop on the annulus,
-// the bottom loop on the annulus turned inside out (z -> 1/z maps the centre's link to the
-// hull). A hull's edges are chords over the points just inside it, several spacings long,
-// and the band to the next layer spanned them with long triangles that cut through the
-// surface: with 24 layers on a star-shaped tube the bands held 11% of the area, at 5 times
-// the mean distance from the true surface. The next layer's points lie beyond the chord, so
-// in one triangulation of both layers the chord's sliver would not be there. Hence a loop
-// triangle is peeled off the layer when its angle at the inner vertex x is obtuse on the
-// surface (in 3D), and x joins the loop, where the band's empty-circle swaps settle it with
-// the other layer's points. Only when x is on no loop (the loops stay simple and apart), lies
-// between the edge's ends in angle around the centre (the loop still turns monotonically),
-// and the two new loop edges rise at most kPeelSlope (45 degrees; steeper loops also made
-// the caps fail on ragged ends). And only in a layer without folds: where the layer is not
-// star-shaped around its centre the loops are not monotone around the band's centre either,
-// and longer loops gave the bands more self-intersections. The passes are bounded: each
-// peels every loop edge at most once. Each loop keeps, per vertex, the pass that put it
-// there (LayerLoops::bottom_flags, top_flags), so that the band can put the peeled
-// triangles back: where a band between peeled loops folds (a peeled loop can dip where the
-// other cannot follow), add_group stitches it again between the loops as they were, with
-// the triangles peeled off both put back (put_back_peeled): the seam as without peeling.
+// Peeling. Both loops are convex hulls, each in its own picture: the top loop on the
+// annulus, the bottom loop on the annulus turned inside out (z -> 1/z maps the centre's
+// link to the hull). A hull's edges are chords over the points just inside it, several
+// spacings long, and the band to the next layer spanned them with long triangles that cut
+// through the surface: with 24 layers on a star-shaped tube the bands held 11% of the
+// area, at 5 times the mean distance from the true surface. The next layer's points lie
+// beyond the chord, so in one triangulation of both layers the chord's sliver would not
+// be there. Hence a loop triangle is peeled off the layer when its angle at the inner
+// vertex x is obtuse on the surface (in 3D), and x joins the loop, where the band's
+// empty-circle swaps settle it with the other layer's points. Only when x is on no loop
+// (the loops stay simple and apart), lies between the edge's ends in angle around the
+// centre (the loop still turns monotonically), and the two new loop edges rise at most
+// kPeelSlope (45 degrees) on the surface's ends (the first layer's bottom loop, the last
+// one's top loop: steeper loops made the caps fail on ragged ends), kInnerPeelSlope (63
+// degrees) between layers, where the gentler limit left chords several spacings long: on
+// the test tubes with 24 layers 1.12 to 1.19 times the single layer's mean distance to
+// the true surface, 1.02 to 1.10 with it (72 degrees: 1.00 to 1.08, but more
+// self-intersections on the hand of ../shared/data; no limit: 0.98 to 1.05). And only in
+// a layer without folds: where the layer is not star-shaped around its centre the loops
+// are not monotone around the band's centre either, and longer loops gave the bands more
+// self-intersections. The passes are bounded: each peels every loop edge at most once.
+// Each loop keeps, per vertex, the pass that put it there (LayerLoops::bottom_flags,
+// top_flags), so that the band can put the peeled triangles back: where a band between
+// peeled loops folds (a peeled loop can dip where the other cannot follow), add_group
+// stitches it again with the peeled triangles around the folds put back
+// (put_back_peeled), and if it still folds, between the loops as they were, with all the
+// triangles peeled off both put back: the seam as without peeling.
 const uint32_t kPeelPasses = 8;
 // Stitches of a band that folds (see add_group): with kLocalUnpeel, three with the peel
 // groups around its folds put back, then all; without, one and then all.
 const uint32_t kUnpeelRounds = kLocalUnpeel ? 4 : 2;
 const double kPeelSlope = 1.0;
+const double kInnerPeelSlope = 2.0;
 
 // Whether the triangle of loop entry g (see centre_link and hull_loop) is peeled.
 inline bool peels(const Triangulation& tr, const Local* points, const uint32_t* flags,
-                  uint32_t g, bool top) {
+                  uint32_t g, bool top, double slope) {
     if (!on_surface(tr, g / 3)) return false;
     uint32_t from = tr.vertex[g], to = tr.vertex[next_edge(g)], x = tr.vertex[prev_edge(g)];
     if (flags[x] & (kOnBottomLoop | kOnTopLoop)) return false;
@@ -3413,9 +3429,9 @@ inline bool peels(const Triangulation& tr, const Local* points, const uint32_t* 
         to = t;
     }
     const Local &a = points[from - 1], &b = points[to - 1], &p = points[x - 1];
-    auto gentle = [&p](const Local& q) {
+    auto gentle = [&p, slope](const Local& q) {
         double dh = q.h - p.h, dx = q.x - p.x, dy = q.y - p.y;
-        return dh * dh <= kPeelSlope * kPeelSlope * (dx * dx + dy * dy);
+        return dh * dh <= slope * slope * (dx * dx + dy * dy);
     };
     double dot = (a.x - p.x) * (b.x - p.x) + (a.y - p.y) * (b.y - p.y) + (a.h - p.h) * (b.h - p.h);
     return dot < 0 && gentle(a) && gentle(b) &&
@@ -3428,14 +3444,14 @@ inline bool peels(const Triangulation& tr, const Local* points, const uint32_t* 
 // that it is no longer emitted. The pass reads the loop from the array's end, where it never
 // meets what it writes: both loops together hold each vertex at most once.
 inline uint32_t peel_loop(Triangulation& tr, const Local* points, uint32_t* flags, uint32_t* loop,
-                          uint32_t n, uint32_t capacity, bool top) {
+                          uint32_t n, uint32_t capacity, bool top, double slope) {
     for (uint32_t pass = 0; pass < kPeelPasses; ++pass) {
         std::memmove(loop + (capacity - n), loop, n * sizeof(uint32_t));
         const uint32_t* entries = loop + (capacity - n);
         uint32_t m = 0;
         for (uint32_t i = 0; i < n; ++i) {
             const uint32_t g = entries[i];
-            if (m + 2 > capacity - n + i + 1 || !peels(tr, points, flags, g, top)) {
+            if (m + 2 > capacity - n + i + 1 || !peels(tr, points, flags, g, top, slope)) {
                 loop[m++] = g;
                 continue;
             }
@@ -3473,6 +3489,7 @@ struct LoadedLayer {
     Local* points;        // ids' points, until triangulate_layer puts them in its own order
     Cylinder cyl;
     bool surface_flips;   // Frame::surface_flips
+    uint32_t ends;        // kLowPole, kHighPole: the surface's ends (see find_closed_ends)
 };
 
 // `staged` (optional): the same points in frame coordinates, in the arena's end room
@@ -3482,6 +3499,7 @@ inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint3
                        LoadedLayer& layer) {
     const bool intact = kStagePoints && staged && arena.untouched(staged);
     layer.ids = ids;
+    layer.ends = 0;
     layer.count = count;
     if (kSurfaceFlips) layer.surface_flips = frame.surface_flips;
     layer.points = arena.alloc<Local>(count);
@@ -3530,6 +3548,7 @@ const double kEndSlab = 0.5;
 const double kAcrossEnd = 0.5;
 
 inline void find_closed_ends(LoadedLayer& layer, uint32_t ends) {
+    layer.ends = ends;
     Cylinder& c = layer.cyl;
     const Local* points = layer.points;
     const size_t n = layer.count;
@@ -4045,10 +4064,13 @@ inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Ar
     size_t folds = count_folds(tr, points, 1, cyl, nullptr);
     if (folds == 0) {
         const uint32_t capacity = static_cast<uint32_t>(count);
+        auto slope = [&layer](uint32_t end) {
+            return (layer.ends & end) ? kPeelSlope : kInnerPeelSlope;
+        };
         loops.bottom_count = peel_loop(tr, points, flags, loops.bottom, loops.bottom_count,
-                                       capacity, false);
-        loops.top_count =
-            peel_loop(tr, points, flags, loops.top, loops.top_count, capacity, true);
+                                       capacity, false, slope(kLowPole));
+        loops.top_count = peel_loop(tr, points, flags, loops.top, loops.top_count, capacity,
+                                    true, slope(kHighPole));
     }
     name_loop(tr, order, flags, loops.bottom, loops.bottom_count, loops.bottom_flags, false);
     name_loop(tr, order, flags, loops.top, loops.top_count, loops.top_flags, true);
@@ -5869,7 +5891,7 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
         const bool triangulated = kParallelLayers && ahead && ahead->done && last == first &&
                                   ahead->ends == ends;
         LoadedLayer layer = {ids, n, nullptr, triangulated ? ahead->cylinder : Cylinder{},
-                             kSurfaceFlips && c.frame.surface_flips};
+                             kSurfaceFlips && c.frame.surface_flips, ends};
         const Local* staged = q.staged ? q.staged + q.start[first] : nullptr;
         if (!triangulated && !load_layer(c.reader, c.frame, ids, staged, n, h0, h1, arena, layer))
             return Status::out_of_memory;
@@ -6469,7 +6491,7 @@ inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& 
     }
 }
 
-inline void report_frame(const Frame& frame, Report& rep) {
+STRATMESH_SMALL_NOINLINE inline void report_frame(const Frame& frame, Report& rep) {
     rep.axis[0] = frame.axis.x;
     rep.axis[1] = frame.axis.y;
     rep.axis[2] = frame.axis.z;
@@ -7134,6 +7156,8 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
 #endif
 
 }  // namespace stratmesh
+
+#undef STRATMESH_SMALL_NOINLINE
 
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC pop_options

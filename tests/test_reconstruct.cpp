@@ -666,8 +666,10 @@ size_t triangles_wider_than(const Shape& s, const std::vector<uint32_t>& triangl
 // bumpy tube 3.02 (8 layers: 1.57, 1.70, 1.61); after: 1.54, 1.45, 1.26, cone 1.64, vase
 // 1.12 (8 layers: 1.18, 1.15, 1.12, 1.27, 1.03), most of it from bands whose peeled loops
 // were all put back for one fold; with only the peel groups around the folds put back
-// (see add_group): 1.19, 1.14, 1.12, 1.30, 1.12 (8 layers: 1.06, 1.06, 1.04, 1.12, 1.03).
-// The rest is the bands themselves: each seam still joins two fronts.
+// (see add_group): 1.19, 1.14, 1.12, 1.30, 1.12 (8 layers: 1.06, 1.06, 1.04, 1.12, 1.03);
+// with inner loops also peeled where they rise up to 63 degrees (kInnerPeelSlope, 45 at
+// the surface's ends): 1.05, 1.10, 1.02, 1.09, 1.07 (8 layers: 1.02, 0.99, 1.01, 1.07,
+// 1.01). The rest is the bands themselves: each seam still joins two fronts.
 TEST_CASE("seams: many layers stay about as close to the true surface as one layer") {
     const std::vector<Shape> tubes = {shapes::cylinder(kLarge, Pose::z),
                                       shapes::elliptic_tube(kLarge, Pose::tilted),
@@ -687,7 +689,7 @@ TEST_CASE("seams: many layers stay about as close to the true surface as one lay
             double mean = mean_centroid_deviation(s, run.triangles);
             MESSAGE(s.name << ", " << layers << " layers: mean distance " << mean);
             if (layers == 1) one = mean;
-            CHECK(mean <= (layers == 8 ? 1.15 : 1.35) * one);
+            CHECK(mean <= (layers == 8 ? 1.1 : 1.15) * one);
         }
     }
 }

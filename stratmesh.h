@@ -3411,8 +3411,9 @@ inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* count, 
 // (put_back_peeled), and if it still folds, between the loops as they were, with all the
 // triangles peeled off both put back: the seam as without peeling.
 const uint32_t kPeelPasses = 8;
-// Stitches of a band that folds (see add_group): with kLocalUnpeel, three with the peel
-// groups around its folds put back, then all; without, one and then all.
+// Stitches of a band (see add_group): the first between the peeled loops; where it folds,
+// with kLocalUnpeel, up to two more with the peel groups around the folds put back, then
+// one with all; without kLocalUnpeel, one with all.
 const uint32_t kUnpeelRounds = kLocalUnpeel ? 4 : 2;
 const double kPeelSlope = 1.0;
 const double kInnerPeelSlope = 2.0;
@@ -5924,10 +5925,9 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
                                 0, 0};
             // A band between peeled loops that folds (a peeled loop can dip where the other
             // cannot follow) is stitched again with the peel groups around its folds put
-            // back (kLocalUnpeel; see "peeling" in >>layer triangulation), at most
-            // kUnpeelRounds times; where it still folds, or no peeled entry is near a fold,
-            // between the loops as they were before peeling, with all their peeled triangles
-            // put back.
+            // back (kLocalUnpeel; see "peeling" in >>layer triangulation and kUnpeelRounds);
+            // where it still folds, or no peeled entry is near a fold, between the loops as
+            // they were before peeling, with all their peeled triangles put back.
             auto stitch = [&]() {
                 if (status != Status::ok || c.top_count == 0) return;
                 const size_t band_start = sink.count, band_folds = sink.folds;

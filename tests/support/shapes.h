@@ -360,6 +360,90 @@ inline Shape capsule(size_t n, Pose pose, uint64_t seed = 24) {
     return s;
 }
 
+// A tube that forks at its top end into two horns, as on a bust with horns: a trunk of
+// radius 1 around the axis from z = -3 (open there) up to the pole of its dome at z = 1.5,
+// and two horns rising outward from inside the dome, (+-0.45, 0, 0.6), to tips at
+// (+-1.1, 0, 3.5), their radius tapering from 0.3 to 0.03. Above the dome the cross-section
+// is two separate discs. n points spread evenly over the boundary of the union (the parts
+// of each piece outside the others); deviation() is the union's signed distance (a horn's
+// is measured across its centre line, within 1% of the true distance for its taper).
+struct RoundCone {  // a segment a -> b with radius ra at a and rb at b, rounded ends
+    double a[3], b[3], ra, rb;
+    double distance(const double* p) const {
+        double ab[3], ap[3], dot = 0, len2 = 0;
+        for (int k = 0; k < 3; ++k) {
+            ab[k] = b[k] - a[k];
+            ap[k] = p[k] - a[k];
+            dot += ab[k] * ap[k];
+            len2 += ab[k] * ab[k];
+        }
+        const double t = std::max(0.0, std::min(1.0, dot / len2));
+        return std::hypot(ap[0] - t * ab[0], ap[1] - t * ab[1], ap[2] - t * ab[2]) -
+               (ra + t * (rb - ra));
+    }
+};
+inline Shape forked_tube(size_t n, Pose pose, uint64_t seed = 25) {
+    static const RoundCone parts[3] = {{{0, 0, -4}, {0, 0, 0.5}, 1.0, 1.0},
+                                       {{0.45, 0, 0.6}, {1.1, 0, 3.5}, 0.3, 0.03},
+                                       {{-0.45, 0, 0.6}, {-1.1, 0, 3.5}, 0.3, 0.03}};
+    Shape s = detail::start("forked tube", pose, cylinder_radius, -3, 3.53);
+    s.closed_distance = [](const double* p) {
+        return std::min(parts[0].distance(p), std::min(parts[1].distance(p), parts[2].distance(p)));
+    };
+    // Each piece: its side (area about pi (ra + rb) times its length) and its two end caps
+    // (half spheres of radius ra and rb).
+    double side[3], area[3], total = 0;
+    for (int c = 0; c < 3; ++c) {
+        const RoundCone& q = parts[c];
+        side[c] = kPi * (q.ra + q.rb) * std::hypot(q.b[0] - q.a[0], q.b[1] - q.a[1], q.b[2] - q.a[2]);
+        area[c] = side[c] + 2 * kPi * (q.ra * q.ra + q.rb * q.rb);
+        total += area[c];
+    }
+    Rng rng(seed);
+    size_t tries = 0;
+    while (s.size() < n) {
+        ++tries;
+        double u = rng.uniform(0, total);
+        int c = 0;
+        while (c < 2 && u >= area[c]) u -= area[c++];
+        const RoundCone& q = parts[c];
+        double axis[3] = {q.b[0] - q.a[0], q.b[1] - q.a[1], q.b[2] - q.a[2]};
+        const double length = std::hypot(axis[0], axis[1], axis[2]);
+        for (double& x : axis) x /= length;
+        // Two unit vectors across the segment (no segment is along y).
+        double e1[3] = {axis[2], 0, -axis[0]};
+        const double l1 = std::hypot(e1[0], e1[1], e1[2]);
+        for (double& x : e1) x /= l1;
+        const double e2[3] = {axis[1] * e1[2] - axis[2] * e1[1], axis[2] * e1[0] - axis[0] * e1[2],
+                              axis[0] * e1[1] - axis[1] * e1[0]};
+        double p[3];
+        if (u < side[c]) {  // t drawn with density proportional to the radius
+            const double t = rng.uniform(), phi = rng.uniform(0, 2 * kPi);
+            const double r = q.ra + t * (q.rb - q.ra);
+            if (rng.uniform() * std::max(q.ra, q.rb) > r) continue;
+            for (int k = 0; k < 3; ++k)
+                p[k] = q.a[k] + t * length * axis[k] + r * (std::cos(phi) * e1[k] + std::sin(phi) * e2[k]);
+        } else {  // a half sphere at one end, chosen by its area
+            const bool at_b = rng.uniform() * (q.ra * q.ra + q.rb * q.rb) < q.rb * q.rb;
+            const double r = at_b ? q.rb : q.ra;
+            const double h = rng.uniform(0, 1) * (at_b ? 1 : -1), phi = rng.uniform(0, 2 * kPi);
+            const double w = std::sqrt(1 - h * h);
+            const double* end = at_b ? q.b : q.a;
+            for (int k = 0; k < 3; ++k)
+                p[k] = end[k] + r * (h * axis[k] + w * (std::cos(phi) * e1[k] + std::sin(phi) * e2[k]));
+        }
+        if (p[2] < -3) continue;  // the open end
+        bool inside = false;
+        for (int o = 0; o < 3; ++o)
+            if (o != c && parts[o].distance(p) < 0) inside = true;
+        if (inside) continue;
+        s.add_local(std::atan2(p[1], p[0]), p[2], std::hypot(p[0], p[1]));
+    }
+    // The boundary's area is about the share of samples kept.
+    s.spacing = std::sqrt(total / static_cast<double>(tries));
+    return s;
+}
+
 // A cylindrical range scan: a regular (theta, z) grid on the unit cylinder over
 // z in [-3, 3], with about n points in rows of equal angular and vertical spacing. Every
 // grid cell is a rectangle: four cocircular points, everywhere.

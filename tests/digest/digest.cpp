@@ -253,6 +253,9 @@ int main() {
     // Bands that fold between peeled loops: the peel groups around the folds put back.
     reconstruct_case("bumpy tube, layer height 0.5", bumpy, axis_z(0, 0.5), g_full_input, g_full);
     reconstruct_case("disc and lobe, 2 layers", lobe, axis_z(2), g_full_input, g_full);
+    // A last layer that folds: its end loop peeled all the same, 64 passes at most.
+    reconstruct_case("forked tube, 4 layers", shapes::forked_tube(3000, Pose::z).xyz, axis_z(4),
+                     g_full_input, g_full);
 #endif
 
     shapes::Rng rng(2024);

@@ -360,13 +360,6 @@ inline Shape capsule(size_t n, Pose pose, uint64_t seed = 24) {
     return s;
 }
 
-// A tube that forks at its top end into two horns, as on a bust with horns: a trunk of
-// radius 1 around the axis from z = -3 (open there) up to the pole of its dome at z = 1.5,
-// and two horns rising outward from inside the dome, (+-0.45, 0, 0.6), to tips at
-// (+-1.1, 0, 3.5), their radius tapering from 0.3 to 0.03. Above the dome the cross-section
-// is two separate discs. n points spread evenly over the boundary of the union (the parts
-// of each piece outside the others); deviation() is the union's signed distance (a horn's
-// is measured across its centre line, within 1% of the true distance for its taper).
 struct RoundCone {  // a segment a -> b with radius ra at a and rb at b, rounded ends
     double a[3], b[3], ra, rb;
     double distance(const double* p) const {
@@ -382,12 +375,17 @@ struct RoundCone {  // a segment a -> b with radius ra at a and rb at b, rounded
                (ra + t * (rb - ra));
     }
 };
-inline Shape forked_tube(size_t n, Pose pose, uint64_t seed = 25) {
-    static const RoundCone parts[3] = {{{0, 0, -4}, {0, 0, 0.5}, 1.0, 1.0},
-                                       {{0.45, 0, 0.6}, {1.1, 0, 3.5}, 0.3, 0.03},
-                                       {{-0.45, 0, 0.6}, {-1.1, 0, 3.5}, 0.3, 0.03}};
-    Shape s = detail::start("forked tube", pose, cylinder_radius, -3, 3.53);
-    s.closed_distance = [](const double* p) {
+
+namespace detail {
+
+// n points spread evenly over the boundary of the union of three round cones (the parts
+// of each piece outside the others), cut to heights [z0, z1] (open there); deviation() is
+// the union's signed distance (a piece's is measured across its centre line, within 1% of
+// the true distance for a taper like a horn's). No piece may lie along y.
+inline Shape union_of_round_cones(const char* name, Pose pose, const RoundCone* parts, double z0,
+                                  double z1, size_t n, uint64_t seed) {
+    Shape s = start(name, pose, cylinder_radius, z0, z1);
+    s.closed_distance = [parts](const double* p) {
         return std::min(parts[0].distance(p), std::min(parts[1].distance(p), parts[2].distance(p)));
     };
     // Each piece: its side (area about pi (ra + rb) times its length) and its two end caps
@@ -432,7 +430,7 @@ inline Shape forked_tube(size_t n, Pose pose, uint64_t seed = 25) {
             for (int k = 0; k < 3; ++k)
                 p[k] = end[k] + r * (h * axis[k] + w * (std::cos(phi) * e1[k] + std::sin(phi) * e2[k]));
         }
-        if (p[2] < -3) continue;  // the open end
+        if (p[2] < z0 || p[2] > z1) continue;  // the open ends
         bool inside = false;
         for (int o = 0; o < 3; ++o)
             if (o != c && parts[o].distance(p) < 0) inside = true;
@@ -442,6 +440,20 @@ inline Shape forked_tube(size_t n, Pose pose, uint64_t seed = 25) {
     // The boundary's area is about the share of samples kept.
     s.spacing = std::sqrt(total / static_cast<double>(tries));
     return s;
+}
+
+}  // namespace detail
+
+// A tube that forks at its top end into two horns, as on a bust with horns: a trunk of
+// radius 1 around the axis from z = -3 (open there) up to the pole of its dome at z = 1.5,
+// and two horns rising outward from inside the dome, (+-0.45, 0, 0.6), to tips at
+// (+-1.1, 0, 3.5), their radius tapering from 0.3 to 0.03. Above the dome the cross-section
+// is two separate discs.
+inline Shape forked_tube(size_t n, Pose pose, uint64_t seed = 25) {
+    static const RoundCone parts[3] = {{{0, 0, -4}, {0, 0, 0.5}, 1.0, 1.0},
+                                       {{0.45, 0, 0.6}, {1.1, 0, 3.5}, 0.3, 0.03},
+                                       {{-0.45, 0, 0.6}, {-1.1, 0, 3.5}, 0.3, 0.03}};
+    return detail::union_of_round_cones("forked tube", pose, parts, -3, 3.53, n, seed);
 }
 
 // A cylindrical range scan: a regular (theta, z) grid on the unit cylinder over

@@ -112,7 +112,7 @@ TEST_CASE("parallel layers: the same bytes as in order, whatever the runner, on 
         shapes::noisy_tube(3000, Pose::z),  shapes::head(3000, Pose::tilted),
         shapes::elliptic_tube(3000, Pose::x), shapes::slanted_tube(3000, Pose::tilted),
         shapes::closed_cylinder(3000, Pose::x), shapes::capsule(3000, Pose::tilted),
-        shapes::forked_tube(3000, Pose::z)};
+        shapes::forked_tube(3000, Pose::z),     shapes::knobbed_tube(3000, Pose::x)};
     unsigned two = 2, eight = 8;
     for (const Shape& s : shapes_list) {
         for (const Layout& layout : kLayouts)

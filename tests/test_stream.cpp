@@ -161,15 +161,17 @@ void check_same(const Output& batch, const Output& stream) {
 }
 
 // Runs check(layered cloud, options with a shared origin) on every test shape, the closed
-// ones (whose ends the first and the last layer close) and the forked tube (whose last layer
-// folds, and its end loop is peeled all the same), in 3 poses, at 400 and 3000 points, cut
-// by each plan of layer fractions.
+// ones (whose ends the first and the last layer close), the forked tube (whose last layer
+// folds, and its end loop is peeled all the same) and the knobbed tube (closed at a bottom
+// whose layer is not star-shaped), in 3 poses, at 400 and 3000 points, cut by each plan of
+// layer fractions.
 template <class Check>
 void for_every_shape(const std::vector<std::vector<double>>& plans, const Check& check) {
     std::vector<shapes::Kind> kinds = shapes::kinds();
     kinds.push_back({"closed cylinder", [](size_t n, Pose p) { return shapes::closed_cylinder(n, p); }});
     kinds.push_back({"capsule", [](size_t n, Pose p) { return shapes::capsule(n, p); }});
     kinds.push_back({"forked tube", [](size_t n, Pose p) { return shapes::forked_tube(n, p); }});
+    kinds.push_back({"knobbed tube", [](size_t n, Pose p) { return shapes::knobbed_tube(n, p); }});
     for (const shapes::Kind& kind : kinds) {
         for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
             for (size_t n : {size_t(400), size_t(3000)}) {

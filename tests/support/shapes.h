@@ -456,6 +456,18 @@ inline Shape forked_tube(size_t n, Pose pose, uint64_t seed = 25) {
     return detail::union_of_round_cones("forked tube", pose, parts, -3, 3.53, n, seed);
 }
 
+// A tube closed at its bottom by two knobs side by side, as a femur by its condyles: a
+// trunk of radius 1 around the axis, open at z = 3, its dome's pole at z = -1, and two
+// knobs of radius 0.5 along (+-0.65, 0, z) for z from -1.2 to -0.2, wider together than
+// the trunk, their lowest points at z = -1.7. Below the trunk's pole the cross-section is
+// two discs 0.3 apart, and the notch between them rises to the pole.
+inline Shape knobbed_tube(size_t n, Pose pose, uint64_t seed = 26) {
+    static const RoundCone parts[3] = {{{0, 0, 0}, {0, 0, 4}, 1.0, 1.0},
+                                       {{0.65, 0, -1.2}, {0.65, 0, -0.2}, 0.5, 0.5},
+                                       {{-0.65, 0, -1.2}, {-0.65, 0, -0.2}, 0.5, 0.5}};
+    return detail::union_of_round_cones("knobbed tube", pose, parts, -1.7, 3, n, seed);
+}
+
 // A cylindrical range scan: a regular (theta, z) grid on the unit cylinder over
 // z in [-3, 3], with about n points in rows of equal angular and vertical spacing. Every
 // grid cell is a rectangle: four cocircular points, everywhere.

@@ -256,6 +256,9 @@ int main() {
     // A last layer that folds: its end loop peeled all the same, 64 passes at most.
     reconstruct_case("forked tube, 4 layers", shapes::forked_tube(3000, Pose::z).xyz, axis_z(4),
                      g_full_input, g_full);
+    // A first layer closed by the outline rule: a knobbed end (find_closed_ends).
+    reconstruct_case("knobbed tube, 4 layers", shapes::knobbed_tube(3000, Pose::z).xyz, axis_z(4),
+                     g_full_input, g_full);
 #endif
 
     shapes::Rng rng(2024);

@@ -364,15 +364,18 @@ enum Flags : uint32_t {
     // unrolling squeezes whatever lies almost across the axis (the underside of an ear, a
     // chin, a crease) and bumps that turn the surface steeply around the axis; there the
     // flips join the points that are near on the surface, and everywhere they lay edges
-    // along the surface's flattest direction. No vertex, loop or band changes; a flip
-    // never makes a fold nor an angle over 150 degrees (unless it narrows one), and is
-    // checked against crossing the nearby triangles; the stream gives the same triangles
-    // as reconstruct() with it. Measured (README, "Flips on the surface"), mean distance
-    // to the true surface: 25% smaller on a synthetic bust with ears, 11% with horns, 11%
-    // on a hand, 9% on a femur, 30 to 44% on analytic tubes, 34 to 47% on a cone, 3% on a
-    // vase, the same on the bundled bust; 2.4 to 2.8 times the time on the 1e6-point
-    // tube. Off by default, for that time (the command-line tool turns it on). A build
-    // with STRATMESH_SMALL_CODE ignores it.
+    // along the surface's flattest direction. Once a layer is stitched to the one below,
+    // the band and the layer's triangles at that seam are flipped the same way, so a cut
+    // costs less (16 layers of a bumpy tube 12% farther from the true surface than one
+    // layer instead of 24%). No vertex or loop changes; a flip never makes a fold nor an
+    // angle over 150 degrees (unless it narrows one), and is checked against crossing the
+    // nearby triangles (at a seam only gentle flips are made, which need no check); the
+    // stream gives the same triangles as reconstruct() with it. Measured (README, "Flips
+    // on the surface"), mean distance to the true surface: 25% smaller on a synthetic
+    // bust with ears, 11% with horns, 11% on a hand, 9% on a femur, 30 to 44% on analytic
+    // tubes, 34 to 47% on a cone, 3% on a vase, the same on the bundled bust; 2.4 to 2.8
+    // times the time on the 1e6-point tube. Off by default, for that time (the
+    // command-line tool turns it on). A build with STRATMESH_SMALL_CODE ignores it.
     surface_flips = 1u << 4,
 };
 
@@ -3790,7 +3793,8 @@ inline void choose_centre(LoadedLayer& layer, Arena& arena) {
 // by a millionth about their centroids, so that shared corners and edges do not count;
 // testing the triangles around the corners' neighbours too changed nothing on the
 // synthetic bust). Loop edges are never flipped, so the loops, the bands and the peeled
-// triangles that add_group may put back are the same as without the flips. The first
+// triangles that add_group may put back are the same as without the flips (the band and
+// the triangles at its loops are flipped later, see "flips across the seam"). The first
 // sweep visits every edge; later sweeps only the triangles the sweep before changed. The
 // sweeps are bounded (kSurfaceFlipSweeps).
 const uint32_t kSurfaceFlipSweeps = 8;
@@ -5691,14 +5695,22 @@ inline bool loop_fans_are_one_piece(const uint32_t* tri, size_t count, size_t be
     return whole;
 }
 
-// Triangles of a chunk from layer-local and band indices to output indices.
+// Triangles of a chunk from layer-local and band indices to reader indices, and on to
+// output indices unless the seam's flips (see "flips across the seam"), which read the
+// points, come between: then name_output_points does that step.
 inline void name_chunk_points(const SurfaceChain& c, const LoadedLayer& layer, uint32_t* tri,
                               size_t count) {
     for (size_t k = 0; k < 3 * count; ++k) {
         uint32_t l = tri[k];
         uint32_t id = l < layer.count ? layer.ids[l] : c.top[l - layer.count];
-        tri[k] = c.output_id ? c.output_id[id] : id;
+        tri[k] = !kSurfaceFlips && c.output_id ? c.output_id[id] : id;
     }
+}
+
+// A final chunk's triangles from reader indices to output indices (with kSurfaceFlips).
+inline void name_output_points(const SurfaceChain& c, uint32_t* tri, size_t count) {
+    if (!kSurfaceFlips || !c.output_id) return;
+    for (size_t k = 0; k < 3 * count; ++k) tri[k] = c.output_id[tri[k]];
 }
 
 // Whether the safety net and seal_seam would leave a chunk as it is, judged from its
@@ -5942,6 +5954,318 @@ inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerL
     return sound;
 }
 
+// ---- flips across the seam ----
+//
+// With the surface_flips flag. A layer's flips on the surface (see "flips on the surface")
+// run before its band is stitched and never move a loop's edge, so the band and the layer's
+// triangles at its bottom loop keep the unrolled Delaunay's choice: 16 layers of a bumpy
+// tube came 24% farther from the true surface than one (README, "Flips on the surface";
+// 12% with the seam's flips). Once a chunk is
+// final, its seam (the triangles with a corner on the loop below or on the layer's bottom
+// loop) is flipped by the same rules, with three limits that keep everything outside the
+// seam as it is:
+//  - only edges between two seam triangles, so the loop below's edges, the edges to the
+//    rest of the chunk and the chunk before (which the stream has handed out) stay;
+//  - only flips where p or q is a loop point: a loop point's triangles in the chunk are all
+//    in the seam, so whether pq is an edge already is read from its fan (the loop below's
+//    other side, in the chunk before, has no point of this layer), and a chord between two
+//    points of one loop (the loop below, the layer's bottom or top loop) is refused, as it
+//    would stand where the next band or a cap goes; both new triangles keep that corner,
+//    so they stay in the seam;
+//  - only gentle flips (kGentleFlip), which need no crossing test, and none that makes or
+//    unmakes a fold (the layer's cylinder), so Report::folds keeps its count.
+// Vertex normals come from every triangle of the chunk. The seam's memory, at most about
+// 72 bytes per vertex of the chunk and 4 per point read, fits in the safety net's room
+// (reconstruct_scratch_size: 91 per point) because a seam of more triangles than three
+// quarters of the chunk's vertices is left as it is: a thin layer, mostly loop.
+
+const uint32_t kLoopBelow = 1, kBottomLoopPoint = 2, kTopLoopPoint = 4, kLoopBits = 3;
+
+struct Seam {
+    uint32_t* chunk;        // the chunk's triangles, reader indices
+    uint32_t* slot;         // seam triangle s is chunk triangle slot[s]
+    uint32_t* vertex;       // 3 per seam triangle: its seam points
+    uint32_t* twin;         // 3 per seam triangle: the opposite half-edge, or kNoIndex
+    uint32_t* degree;       // per seam point: its seam triangles
+    uint32_t* ids;          // per seam point: its reader index
+    unsigned char* loop;    // per seam point: kLoopBelow, kBottomLoopPoint, kTopLoopPoint
+    float* fixed_normal;    // 3 per seam point: the sum over its triangles off the seam
+    float* normal;          // 3 per seam point
+    // Per reader index of the chunk's points and loops (the rest unset): its loop bits,
+    // and above them (seam point + 1) << kLoopBits once it is one.
+    uint32_t* tag;
+    uint32_t triangles, points;
+
+    // The seam point of reader index id (one of the chunk's), or kNoIndex.
+    uint32_t point_of(uint32_t id) const {
+        return (tag[id] >> kLoopBits) == 0 ? kNoIndex : (tag[id] >> kLoopBits) - 1;
+    }
+};
+
+// The seam of a chunk (see above). False with seam.triangles = 0 when it is left as it is;
+// false with arena.failed when the arena is too small.
+inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
+                      uint32_t* chunk, size_t count, Arena& arena, Seam& seam) {
+    seam.chunk = chunk;
+    seam.triangles = 0;
+    // The tags, over reader indices up to the largest of the chunk's and the loops'.
+    uint32_t largest = 0;
+    for (size_t k = 0; k < 3 * count; ++k) largest = chunk[k] > largest ? chunk[k] : largest;
+    for (uint32_t i = 0; i < c.top_count; ++i) largest = c.top[i] > largest ? c.top[i] : largest;
+    for (uint32_t i = 0; i < layer.count; ++i)
+        largest = layer.ids[i] > largest ? layer.ids[i] : largest;
+    seam.tag = arena.alloc<uint32_t>(size_t{largest} + 1);
+    const size_t vertices = layer.count + c.top_count;
+    const size_t most = 3 * vertices / 4;  // more seam triangles: left as it is
+    seam.slot = arena.alloc<uint32_t>(most);
+    if (arena.failed) return false;
+    for (size_t k = 0; k < 3 * count; ++k) seam.tag[chunk[k]] = 0;
+    for (uint32_t i = 0; i < c.top_count; ++i) seam.tag[c.top[i]] = kLoopBelow;
+    for (uint32_t i = 0; i < loops.bottom_count; ++i) seam.tag[layer.ids[loops.bottom[i]]] = 0;
+    for (uint32_t i = 0; i < loops.top_count; ++i) seam.tag[layer.ids[loops.top[i]]] = 0;
+    for (uint32_t i = 0; i < loops.bottom_count; ++i)
+        seam.tag[layer.ids[loops.bottom[i]]] |= kBottomLoopPoint;
+    for (uint32_t i = 0; i < loops.top_count; ++i)
+        seam.tag[layer.ids[loops.top[i]]] |= kTopLoopPoint;
+    size_t triangles = 0;
+    for (size_t t = 0; t < count; ++t) {
+        const uint32_t* v = chunk + 3 * t;
+        if (!((seam.tag[v[0]] | seam.tag[v[1]] | seam.tag[v[2]]) & (kLoopBelow | kBottomLoopPoint)))
+            continue;
+        if (triangles == most) return false;
+        seam.slot[triangles++] = static_cast<uint32_t>(t);
+    }
+    if (triangles == 0) return false;
+    seam.triangles = static_cast<uint32_t>(triangles);
+    seam.vertex = arena.alloc<uint32_t>(3 * triangles);
+    seam.twin = arena.alloc<uint32_t>(3 * triangles);
+    seam.ids = arena.alloc<uint32_t>(3 * triangles);
+    if (arena.failed) return false;
+    uint32_t points = 0;
+    for (size_t s = 0; s < triangles; ++s)
+        for (uint32_t j = 0; j < 3; ++j) {
+            const uint32_t id = chunk[3 * size_t{seam.slot[s]} + j];
+            if ((seam.tag[id] >> kLoopBits) == 0) {
+                seam.ids[points] = id;
+                seam.tag[id] |= (points + 1) << kLoopBits;
+                ++points;
+            }
+            seam.vertex[3 * s + j] = (seam.tag[id] >> kLoopBits) - 1;
+        }
+    seam.points = points;
+    seam.degree = arena.alloc<uint32_t>(points);
+    seam.loop = arena.alloc<unsigned char>(points);
+    seam.fixed_normal = arena.alloc<float>(3 * size_t{points});
+    seam.normal = arena.alloc<float>(3 * size_t{points});
+    if (arena.failed) return false;
+    for (uint32_t v = 0; v < points; ++v) {
+        seam.loop[v] = static_cast<unsigned char>(seam.tag[seam.ids[v]] & 7u);
+        seam.degree[v] = 0;
+    }
+    for (size_t i = 0; i < 3 * triangles; ++i) ++seam.degree[seam.vertex[i]];
+    // Twins through each point's outgoing half-edges.
+    size_t mark = arena.mark();
+    uint32_t* first = arena.alloc<uint32_t>(size_t{points} + 1);
+    uint32_t* outgoing = arena.alloc<uint32_t>(3 * triangles);
+    if (arena.failed) return false;
+    std::memset(first, 0, (size_t{points} + 1) * sizeof(uint32_t));
+    for (size_t e = 0; e < 3 * triangles; ++e) ++first[seam.vertex[e] + 1];
+    for (uint32_t v = 0; v < points; ++v) first[v + 1] += first[v];
+    for (uint32_t e = 0; e < 3 * triangles; ++e) outgoing[first[seam.vertex[e]]++] = e;
+    for (uint32_t v = points; v > 0; --v) first[v] = first[v - 1];
+    first[0] = 0;
+    for (uint32_t e = 0; e < 3 * triangles; ++e) {
+        const uint32_t a = seam.vertex[e], b = seam.vertex[next_edge(e)];
+        seam.twin[e] = kNoIndex;
+        for (uint32_t i = first[b]; i < first[b + 1]; ++i)
+            if (seam.vertex[next_edge(outgoing[i])] == a) seam.twin[e] = outgoing[i];
+    }
+    arena.rewind(mark);
+    return true;
+}
+
+// Seam point v's normal.
+inline Vec3 seam_normal(const Seam& seam, uint32_t v) {
+    const float* n = seam.normal + 3 * size_t{v};
+    return Vec3{static_cast<double>(n[0]), static_cast<double>(n[1]),
+                static_cast<double>(n[2])};
+}
+
+// Adds triangle v's unit normal to sums[3 k] for each corner k of it that is a seam point.
+inline void add_seam_normal(const SurfaceChain& c, const Seam& seam, const uint32_t* v,
+                            float* sums) {
+    const uint32_t at[3] = {seam.point_of(v[0]), seam.point_of(v[1]), seam.point_of(v[2])};
+    if (at[0] == kNoIndex && at[1] == kNoIndex && at[2] == kNoIndex) return;
+    Vec3 n = normal_of(c.frame.local(c.reader.point(v[0])), c.frame.local(c.reader.point(v[1])),
+                       c.frame.local(c.reader.point(v[2])));
+    const double length = std::sqrt(dot(n, n));
+    if (length == 0) return;
+    n = scaled(n, 1 / length);
+    for (uint32_t k : at) {
+        if (k == kNoIndex) continue;
+        float* sum = sums + 3 * size_t{k};
+        sum[0] += static_cast<float>(n.x);
+        sum[1] += static_cast<float>(n.y);
+        sum[2] += static_cast<float>(n.z);
+    }
+}
+
+// The sums of the unit normals of the chunk's triangles off the seam, at the seam's points.
+inline void sum_fixed_normals(const SurfaceChain& c, const Seam& seam, size_t count) {
+    std::memset(seam.fixed_normal, 0, 3 * size_t{seam.points} * sizeof(float));
+    uint32_t next = 0;  // seam.slot is increasing
+    for (size_t t = 0; t < count; ++t) {
+        if (next < seam.triangles && seam.slot[next] == t) {
+            ++next;
+            continue;
+        }
+        add_seam_normal(c, seam, seam.chunk + 3 * t, seam.fixed_normal);
+    }
+}
+
+// The seam's vertex normals over every triangle of the chunk (see VertexNormals): the fixed
+// sums and the seam's own triangles, made unit.
+inline void estimate_seam_normals(const SurfaceChain& c, const Seam& seam) {
+    std::memcpy(seam.normal, seam.fixed_normal, 3 * size_t{seam.points} * sizeof(float));
+    for (uint32_t s = 0; s < seam.triangles; ++s)
+        add_seam_normal(c, seam, seam.chunk + 3 * size_t{seam.slot[s]}, seam.normal);
+    for (uint32_t k = 0; k < seam.points; ++k) {
+        float* sum = seam.normal + 3 * size_t{k};
+        const Vec3 n = seam_normal(seam, k);
+        const double length = std::sqrt(dot(n, n));
+        if (length == 0) continue;
+        sum[0] = static_cast<float>(n.x / length);
+        sum[1] = static_cast<float>(n.y / length);
+        sum[2] = static_cast<float>(n.z / length);
+    }
+}
+
+// Whether seam point x's triangles, walked around it from half-edge `from` (leaving x) both
+// ways, are all of its seam triangles and none has an edge to y.
+inline bool fan_misses(const Seam& seam, uint32_t from, uint32_t x, uint32_t y) {
+    uint32_t seen = 0;
+    auto clear = [&seam, y](uint32_t g) {
+        return seam.vertex[next_edge(g)] != y && seam.vertex[prev_edge(g)] != y;
+    };
+    uint32_t g = from;
+    for (uint32_t steps = 0;; ++steps) {
+        if (steps == kFanLimit || !clear(g)) return false;
+        ++seen;
+        const uint32_t h = seam.twin[prev_edge(g)];
+        if (h == from) return seen == seam.degree[x];
+        if (h == kNoIndex) break;
+        g = h;
+    }
+    g = from;
+    for (uint32_t steps = 0;; ++steps) {
+        const uint32_t back = seam.twin[g];
+        if (back == kNoIndex) break;
+        g = next_edge(back);
+        if (steps == kFanLimit || !clear(g)) return false;
+        ++seen;
+    }
+    return seen == seam.degree[x];
+}
+
+// Flips half-edge e of the seam if that helps (see above and flip_on_surface).
+inline bool flip_seam_edge(const SurfaceChain& c, Seam& seam, const Cylinder& cyl, uint32_t e) {
+    const uint32_t f = seam.twin[e];
+    if (f == kNoIndex) return false;
+    const uint32_t a = seam.vertex[e], b = seam.vertex[next_edge(e)];
+    const uint32_t p = seam.vertex[prev_edge(e)], q = seam.vertex[prev_edge(f)];
+    if (p == q || (seam.loop[p] & seam.loop[q]) ||
+        !((seam.loop[p] | seam.loop[q]) & (kLoopBelow | kBottomLoopPoint)))
+        return false;
+    const bool p_anchors = (seam.loop[p] & (kLoopBelow | kBottomLoopPoint)) != 0;
+    if (p_anchors ? !fan_misses(seam, prev_edge(e), p, q) : !fan_misses(seam, prev_edge(f), q, p))
+        return false;
+    const Vec3 na = seam_normal(seam, a), nb = seam_normal(seam, b);
+    const Vec3 np = seam_normal(seam, p), nq = seam_normal(seam, q);
+    if (dot(na, na) == 0 || dot(nb, nb) == 0 || dot(np, np) == 0 || dot(nq, nq) == 0)
+        return false;
+    const Local la = c.frame.local(c.reader.point(seam.ids[a]));
+    const Local lb = c.frame.local(c.reader.point(seam.ids[b]));
+    const Local lp = c.frame.local(c.reader.point(seam.ids[p]));
+    const Local lq = c.frame.local(c.reader.point(seam.ids[q]));
+    const double bend_before = bend_along(vec_of(la), vec_of(lb), na, nb);
+    const double bend_after = bend_along(vec_of(lp), vec_of(lq), np, nq);
+    if (flip_helps(vec_of(la), vec_of(lb), vec_of(lp), vec_of(lq))
+            ? bend_after > kBendVeto * bend_before
+            : !(kBendGain * bend_after < bend_before))
+        return false;
+    const double widest_after =
+        std::fmin(widest_angle_cosine(vec_of(lp), vec_of(la), vec_of(lq)),
+                  widest_angle_cosine(vec_of(lq), vec_of(lb), vec_of(lp)));
+    if (widest_after < kWidestAngle &&
+        widest_after < std::fmin(widest_angle_cosine(vec_of(la), vec_of(lb), vec_of(lp)),
+                                 widest_angle_cosine(vec_of(lb), vec_of(la), vec_of(lq))))
+        return false;
+    // The chunk's triangles face outwards counter-clockwise, as do the new (p, a, q) and
+    // (q, b, p).
+    if (faces_axis(la, lb, lp, cyl) || faces_axis(lb, la, lq, cyl) ||
+        faces_axis(lp, la, lq, cyl) || faces_axis(lq, lb, lp, cyl) ||
+        doubled_area(lp, la, lq) == 0 || doubled_area(lq, lb, lp) == 0)
+        return false;
+    Vec3 mean = normal_of(la, lb, lp);
+    const Vec3 other_normal = normal_of(lb, la, lq);
+    mean = Vec3{mean.x + other_normal.x, mean.y + other_normal.y, mean.z + other_normal.z};
+    const Vec3 n1 = normal_of(lp, la, lq), n2 = normal_of(lq, lb, lp);
+    if (!(dot(n1, mean) > kGentleFlip * std::sqrt(dot(n1, n1) * dot(mean, mean)) &&
+          dot(n2, mean) > kGentleFlip * std::sqrt(dot(n2, n2) * dot(mean, mean))))
+        return false;
+    const uint32_t t = e / 3, u = f / 3;
+    const uint32_t xa = seam.twin[next_edge(e)], xb = seam.twin[prev_edge(e)];
+    const uint32_t xc = seam.twin[next_edge(f)], xd = seam.twin[prev_edge(f)];
+    const uint32_t corners[6] = {p, a, q, q, b, p};
+    for (uint32_t j = 0; j < 3; ++j) {
+        seam.vertex[3 * t + j] = corners[j];
+        seam.vertex[3 * u + j] = corners[3 + j];
+        seam.chunk[3 * size_t{seam.slot[t]} + j] = seam.ids[corners[j]];
+        seam.chunk[3 * size_t{seam.slot[u]} + j] = seam.ids[corners[3 + j]];
+    }
+    auto link = [&seam](uint32_t g, uint32_t h) {
+        seam.twin[g] = h;
+        if (h != kNoIndex) seam.twin[h] = g;
+    };
+    link(3 * t, xb);
+    link(3 * t + 1, xc);
+    link(3 * u, xd);
+    link(3 * u + 1, xa);
+    link(3 * t + 2, 3 * u + 2);
+    --seam.degree[a];
+    --seam.degree[b];
+    ++seam.degree[p];
+    ++seam.degree[q];
+    return true;
+}
+
+// Flips a final chunk's seam (reader indices) on the surface, sweep after sweep as
+// flip_layer_on_surface does. Returns false if the arena is too small.
+inline bool flip_seam(const SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
+                      uint32_t* chunk, size_t count, Arena& arena) {
+    size_t mark = arena.mark();
+    Seam seam;
+    if (!find_seam(c, layer, loops, chunk, count, arena, seam)) {
+        arena.rewind(mark);
+        return !arena.failed;
+    }
+    sum_fixed_normals(c, seam, count);
+    for (uint32_t sweep = 0; sweep < kSurfaceFlipSweeps; ++sweep) {
+        if (sweep < kNormalSweeps) estimate_seam_normals(c, seam);
+        size_t flipped = 0;
+        for (uint32_t s = 0; s < seam.triangles; ++s)
+            for (uint32_t e = 3 * s; e < 3 * s + 3; ++e) {
+                const uint32_t f = seam.twin[e];
+                if (f == kNoIndex || f > e || !flip_seam_edge(c, seam, layer.cyl, e)) continue;
+                ++flipped;
+                break;
+            }
+        if (flipped == 0) break;
+    }
+    arena.rewind(mark);
+    return true;
+}
+
 // Forms the group starting at planned layer `first`, triangulates it, stitches it to the
 // chain's top loop and finishes the chunk. `ahead` (optional) is planned layer `first`
 // triangulated ahead: used when the group is that layer alone. Returns ok (also when
@@ -6078,6 +6402,14 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
                     name_chunk_points(c, layer, chunk, sink.count - chunk_start);
                 else
                     status = finish_chunk(c, layer, loops, chunk_start, arena, sink);
+            }
+            if (status == Status::ok && sink.count <= sink.capacity) {
+                uint32_t* chunk = sink.triangles + 3 * chunk_start;
+                const size_t in_chunk = sink.count - chunk_start;
+                if (kSurfaceFlips && layer.surface_flips && c.top_count > 0 &&
+                    !flip_seam(c, layer, loops, chunk, in_chunk, arena))
+                    return Status::out_of_memory;
+                name_output_points(c, chunk, in_chunk);
             }
             if (status == Status::ok) {
                 for (uint32_t i = 0; i < loops.top_count; ++i) loops.top[i] = ids[loops.top[i]];

@@ -6016,7 +6016,9 @@ inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
         largest = layer.ids[i] > largest ? layer.ids[i] : largest;
     seam.tag = arena.alloc<uint32_t>(size_t{largest} + 1);
     const size_t vertices = layer.count + c.top_count;
-    const size_t most = 3 * vertices / 4;  // more seam triangles: left as it is
+    // More seam triangles: left as it is (and the tags' seam points fit above the bits).
+    size_t most = 3 * vertices / 4;
+    if (most > (kNoIndex >> kLoopBits) / 3) most = (kNoIndex >> kLoopBits) / 3;
     seam.slot = arena.alloc<uint32_t>(most);
     if (arena.failed) return false;
     for (size_t k = 0; k < 3 * count; ++k) seam.tag[chunk[k]] = 0;

@@ -3960,18 +3960,11 @@ inline double widest_angle_cosine(Vec3 a, Vec3 b, Vec3 c) {
     return widest;
 }
 
-// Flips half-edge e of a layer's triangulation on the surface if that helps (see above).
-inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32_t* flags,
-                            VertexNormals& normals, const Cylinder& cyl, uint32_t e) {
-    const uint32_t f = tr.twin[e];
-    const uint32_t t = e / 3, u = f / 3;
-    if (!on_surface(tr, u)) return false;
-    const uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)], p = tr.vertex[prev_edge(e)];
-    const uint32_t q = tr.vertex[prev_edge(f)];
-    // A chord of a loop would stand where close_ends puts its cap.
-    if (p == q || (flags[p] & flags[q] & (kOnBottomLoop | kOnTopLoop))) return false;
-    const Local &la = points[a - 1], &lb = points[b - 1], &lp = points[p - 1], &lq = points[q - 1];
-    const Vec3 na = normals.at(a), nb = normals.at(b), np = normals.at(p), nq = normals.at(q);
+// Whether the surface wants ab of triangles abp and baq turned into pq, by the two rules
+// (see above; na .. nq the corners' unit normals, none zero) without an angle wider than
+// kWidestAngle (unless the old pair had a wider one).
+inline bool flip_wanted(const Local& la, const Local& lb, const Local& lp, const Local& lq,
+                        Vec3 na, Vec3 nb, Vec3 np, Vec3 nq) {
     if (dot(na, na) == 0 || dot(nb, nb) == 0 || dot(np, np) == 0 || dot(nq, nq) == 0)
         return false;
     const double bend_before = bend_along(vec_of(la), vec_of(lb), na, nb);
@@ -3983,9 +3976,34 @@ inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32
     const double widest_after =
         std::fmin(widest_angle_cosine(vec_of(lp), vec_of(la), vec_of(lq)),
                   widest_angle_cosine(vec_of(lq), vec_of(lb), vec_of(lp)));
-    if (widest_after < kWidestAngle &&
-        widest_after < std::fmin(widest_angle_cosine(vec_of(la), vec_of(lb), vec_of(lp)),
-                                 widest_angle_cosine(vec_of(lb), vec_of(la), vec_of(lq))))
+    return !(widest_after < kWidestAngle &&
+             widest_after < std::fmin(widest_angle_cosine(vec_of(la), vec_of(lb), vec_of(lp)),
+                                      widest_angle_cosine(vec_of(lb), vec_of(la), vec_of(lq))));
+}
+
+// Whether both new triangles (p, a, q) and (q, b, p) of that flip have normals within
+// kGentleFlip of the old pair's mean.
+inline bool gentle_flip(const Local& la, const Local& lb, const Local& lp, const Local& lq) {
+    Vec3 mean = normal_of(la, lb, lp);
+    const Vec3 other_normal = normal_of(lb, la, lq);
+    mean = Vec3{mean.x + other_normal.x, mean.y + other_normal.y, mean.z + other_normal.z};
+    const Vec3 n1 = normal_of(lp, la, lq), n2 = normal_of(lq, lb, lp);
+    return dot(n1, mean) > kGentleFlip * std::sqrt(dot(n1, n1) * dot(mean, mean)) &&
+           dot(n2, mean) > kGentleFlip * std::sqrt(dot(n2, n2) * dot(mean, mean));
+}
+
+// Flips half-edge e of a layer's triangulation on the surface if that helps (see above).
+inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32_t* flags,
+                            VertexNormals& normals, const Cylinder& cyl, uint32_t e) {
+    const uint32_t f = tr.twin[e];
+    const uint32_t t = e / 3, u = f / 3;
+    if (!on_surface(tr, u)) return false;
+    const uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)], p = tr.vertex[prev_edge(e)];
+    const uint32_t q = tr.vertex[prev_edge(f)];
+    // A chord of a loop would stand where close_ends puts its cap.
+    if (p == q || (flags[p] & flags[q] & (kOnBottomLoop | kOnTopLoop))) return false;
+    const Local &la = points[a - 1], &lb = points[b - 1], &lp = points[p - 1], &lq = points[q - 1];
+    if (!flip_wanted(la, lb, lp, lq, normals.at(a), normals.at(b), normals.at(p), normals.at(q)))
         return false;
     // The new triangles (p, a, q) and (q, b, p), counter-clockwise on the annulus.
     if (faces_axis(lq, la, lp, cyl) || faces_axis(lp, lb, lq, cyl) ||
@@ -3997,13 +4015,7 @@ inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32
         return false;
     // A flip in a gently curved quad, convex seen along its normal, covers about the
     // same place as before: nothing else to check.
-    Vec3 mean = normal_of(la, lb, lp);
-    const Vec3 other_normal = normal_of(lb, la, lq);
-    mean = Vec3{mean.x + other_normal.x, mean.y + other_normal.y, mean.z + other_normal.z};
-    const Vec3 n1 = normal_of(lp, la, lq), n2 = normal_of(lq, lb, lp);
-    const bool gentle = dot(n1, mean) > kGentleFlip * std::sqrt(dot(n1, n1) * dot(mean, mean)) &&
-                        dot(n2, mean) > kGentleFlip * std::sqrt(dot(n2, n2) * dot(mean, mean));
-    if (!gentle) {
+    if (!gentle_flip(la, lb, lp, lq)) {
         const Vec3 first[3] = {vec_of(lp), vec_of(la), vec_of(lq)};
         const Vec3 second[3] = {vec_of(lq), vec_of(lb), vec_of(lp)};
         const Box3 quad = box_of(first[0], first[1], first[2], second[1]);
@@ -6181,26 +6193,12 @@ inline bool flip_seam_edge(const SurfaceChain& c, Seam& seam, const Cylinder& cy
     const bool p_anchors = (seam.loop[p] & (kLoopBelow | kBottomLoopPoint)) != 0;
     if (p_anchors ? !fan_misses(seam, prev_edge(e), p, q) : !fan_misses(seam, prev_edge(f), q, p))
         return false;
-    const Vec3 na = seam_normal(seam, a), nb = seam_normal(seam, b);
-    const Vec3 np = seam_normal(seam, p), nq = seam_normal(seam, q);
-    if (dot(na, na) == 0 || dot(nb, nb) == 0 || dot(np, np) == 0 || dot(nq, nq) == 0)
-        return false;
     const Local la = c.frame.local(c.reader.point(seam.ids[a]));
     const Local lb = c.frame.local(c.reader.point(seam.ids[b]));
     const Local lp = c.frame.local(c.reader.point(seam.ids[p]));
     const Local lq = c.frame.local(c.reader.point(seam.ids[q]));
-    const double bend_before = bend_along(vec_of(la), vec_of(lb), na, nb);
-    const double bend_after = bend_along(vec_of(lp), vec_of(lq), np, nq);
-    if (flip_helps(vec_of(la), vec_of(lb), vec_of(lp), vec_of(lq))
-            ? bend_after > kBendVeto * bend_before
-            : !(kBendGain * bend_after < bend_before))
-        return false;
-    const double widest_after =
-        std::fmin(widest_angle_cosine(vec_of(lp), vec_of(la), vec_of(lq)),
-                  widest_angle_cosine(vec_of(lq), vec_of(lb), vec_of(lp)));
-    if (widest_after < kWidestAngle &&
-        widest_after < std::fmin(widest_angle_cosine(vec_of(la), vec_of(lb), vec_of(lp)),
-                                 widest_angle_cosine(vec_of(lb), vec_of(la), vec_of(lq))))
+    if (!flip_wanted(la, lb, lp, lq, seam_normal(seam, a), seam_normal(seam, b),
+                     seam_normal(seam, p), seam_normal(seam, q)))
         return false;
     // The chunk's triangles face outwards counter-clockwise, as do the new (p, a, q) and
     // (q, b, p).
@@ -6208,13 +6206,7 @@ inline bool flip_seam_edge(const SurfaceChain& c, Seam& seam, const Cylinder& cy
         faces_axis(lp, la, lq, cyl) || faces_axis(lq, lb, lp, cyl) ||
         doubled_area(lp, la, lq) == 0 || doubled_area(lq, lb, lp) == 0)
         return false;
-    Vec3 mean = normal_of(la, lb, lp);
-    const Vec3 other_normal = normal_of(lb, la, lq);
-    mean = Vec3{mean.x + other_normal.x, mean.y + other_normal.y, mean.z + other_normal.z};
-    const Vec3 n1 = normal_of(lp, la, lq), n2 = normal_of(lq, lb, lp);
-    if (!(dot(n1, mean) > kGentleFlip * std::sqrt(dot(n1, n1) * dot(mean, mean)) &&
-          dot(n2, mean) > kGentleFlip * std::sqrt(dot(n2, n2) * dot(mean, mean))))
-        return false;
+    if (!gentle_flip(la, lb, lp, lq)) return false;
     const uint32_t t = e / 3, u = f / 3;
     const uint32_t xa = seam.twin[next_edge(e)], xb = seam.twin[prev_edge(e)];
     const uint32_t xc = seam.twin[next_edge(f)], xd = seam.twin[prev_edge(f)];

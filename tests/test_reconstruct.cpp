@@ -205,8 +205,33 @@ struct Case {
     Run run;
     mesh_check::Result mesh;
     bool checked_intersections = false;
+    size_t layer_count_mismatches = 0;  // see count_layer_mismatches
     double ms_reconstruct = 0, ms_check = 0;
 };
+
+// Layers whose point count disagrees with the points found in their range along the
+// reported axis, counted here from the input: at least those more than a hair inside it,
+// at most those within a hair of it (a point on a cut may go either way).
+size_t count_layer_mismatches(const Shape& s, const Run& run) {
+    const double* axis = run.report.axis;
+    std::vector<double> heights(s.size());
+    for (size_t i = 0; i < s.size(); ++i) {
+        const double* p = &s.xyz[3 * i];
+        heights[i] = p[0] * axis[0] + p[1] * axis[1] + p[2] * axis[2];
+    }
+    if (heights.empty() || run.layers.empty()) return 0;
+    const double hair = 1e-9 * (run.layers.back().top - run.layers.front().bottom);
+    size_t mismatches = 0;
+    for (const LayerInfo& layer : run.layers) {
+        size_t inside = 0, around = 0;
+        for (double h : heights) {
+            inside += h > layer.bottom + hair && h < layer.top - hair;
+            around += h >= layer.bottom - hair && h <= layer.top + hair;
+        }
+        mismatches += layer.point_count < inside || layer.point_count > around;
+    }
+    return mismatches;
+}
 
 double elapsed_ms(std::chrono::steady_clock::time_point since) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
@@ -224,6 +249,7 @@ Case run_case(const Shape& s, Layering layering, bool self_intersections) {
     auto t0 = std::chrono::steady_clock::now();
     c.run = reconstruct_guarded(cloud_of(s), o);
     c.ms_reconstruct = elapsed_ms(t0);
+    c.layer_count_mismatches = count_layer_mismatches(s, c.run);
     auto t1 = std::chrono::steady_clock::now();
     c.mesh = check_mesh(s, c.run.triangles.data(), c.run.count, self_intersections);
     c.ms_check = elapsed_ms(t1);
@@ -261,6 +287,7 @@ void check_report(const Case& c) {
         CHECK(info.closed_ends == 0);  // these shapes are open tubes: both ends are rims
     }
     CHECK(points == r.points_used + r.unused);
+    CHECK(c.layer_count_mismatches == 0);
     CHECK(triangles == run.count + r.illegal_removed);
     CHECK(folds == r.folds);
 }

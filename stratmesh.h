@@ -2990,17 +2990,19 @@ inline void plan_automatic_layers(const CloudReader& cloud, size_t count, size_t
 }
 
 // The layer of height h: the last k with h >= bounds[k] - tolerance, or 0. `per_height` is
-// count / (bounds[count] - bounds[0]): the layer h would be in if the layers were equal,
-// which they are unless cuts or the automatic plan set them, is tried first, and the
-// search that follows narrows from there (one dependent comparison per halving is what a
-// million points wait on).
+// count / (bounds[count] - bounds[0]). The layer h would be in if the layers were equal,
+// which they are unless cuts or the automatic plan set them, is tried first, with one
+// branch that a million points in no order still predict (a binary search's would not);
+// the search is for the rest.
 inline uint32_t layer_of(const LayerPlan& plan, double h, double per_height) {
-    const double guess = (h - plan.bounds[0]) * per_height;
+    const double* bounds = plan.bounds;
+    const double tolerance = plan.tolerance;
     const uint32_t last = plan.count - 1;
+    const double guess = (h - bounds[0]) * per_height;
     const uint32_t k = guess > 0 ? (guess < last ? static_cast<uint32_t>(guess) : last) : 0;
-    const bool in_or_above = k == 0 || h >= plan.bounds[k] - plan.tolerance;
-    uint32_t lo = in_or_above ? k : 0, hi = in_or_above ? plan.count : k;  // answer in [lo, hi)
-    if (in_or_above && k < last && h < plan.bounds[k + 1] - plan.tolerance) hi = k + 1;
+    if (((k == 0) | (h >= bounds[k] - tolerance)) & ((k == last) | (h < bounds[k + 1] - tolerance)))
+        return k;
+    uint32_t lo = 0, hi = plan.count;  // answer in [lo, hi)
     while (hi - lo > 1) {
         uint32_t mid = lo + (hi - lo) / 2;
         if (h >= plan.bounds[mid] - plan.tolerance)
@@ -6892,8 +6894,9 @@ inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& 
     for (size_t i = 0; i < count; ++i) {
         layer[i] = cloud.valid(i) ? layer_of(plan, frame.height(cloud.point(i)), per_height)
                                   : kNoIndex;
-        if (layer[i] != kNoIndex) ++m.layer_start[layer[i] + 2];
     }
+    for (size_t i = 0; i < count; ++i)
+        if (layer[i] != kNoIndex) ++m.layer_start[layer[i] + 2];
     for (uint32_t k = 0; k < plan.count; ++k) m.layer_start[k + 2] += m.layer_start[k + 1];
     for (size_t i = 0; i < count; ++i) {
         if (layer[i] == kNoIndex) continue;

@@ -757,6 +757,7 @@ const bool kDropOutliers = false;
 const bool kSurfaceFlips = false;
 const bool kLocalUnpeel = false;
 const bool kPeelFoldedEnds = false;
+const bool kFastLoops = false;
 #else
 const bool kNetShortcut = true;  // a chunk whose loop fans are whole skips the net
 const bool kStagePoints = true;  // reconstruct() keeps the grouped points in spare workspace
@@ -782,6 +783,10 @@ const bool kLocalUnpeel = true;
 // The surface's end loops are peeled in layers that fold too (see "peeling" in >>layer
 // triangulation).
 const bool kPeelFoldedEnds = true;
+// Per-point loops in forms that cost code for speed, the same bits either way: the equal-
+// layer guess in layer_of, pseudo_angle without branches, floor by truncation in
+// exp_portable.
+const bool kFastLoops = true;
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 
@@ -2990,17 +2995,18 @@ inline void plan_automatic_layers(const CloudReader& cloud, size_t count, size_t
 }
 
 // The layer of height h: the last k with h >= bounds[k] - tolerance, or 0. `per_height` is
-// count / (bounds[count] - bounds[0]). The layer h would be in if the layers were equal,
-// which they are unless cuts or the automatic plan set them, is tried first, with one
-// branch that a million points in no order still predict (a binary search's would not);
-// the search is for the rest.
+// count / (bounds[count] - bounds[0]). With kFastLoops, the layer h would be in if the
+// layers were equal, which they are unless cuts or the automatic plan set them, is tried
+// first, with one branch that a million points in no order still predict (a binary
+// search's would not); the search is for the rest.
 inline uint32_t layer_of(const LayerPlan& plan, double h, double per_height) {
     const double* bounds = plan.bounds;
     const double tolerance = plan.tolerance;
     const uint32_t last = plan.count - 1;
     const double guess = (h - bounds[0]) * per_height;
     const uint32_t k = guess > 0 ? (guess < last ? static_cast<uint32_t>(guess) : last) : 0;
-    if (((k == 0) | (h >= bounds[k] - tolerance)) & ((k == last) | (h < bounds[k + 1] - tolerance)))
+    if (kFastLoops && ((k == 0) | (h >= bounds[k] - tolerance)) &
+                          ((k == last) | (h < bounds[k + 1] - tolerance)))
         return k;
     uint32_t lo = 0, hi = plan.count;  // answer in [lo, hi)
     while (hi - lo > 1) {
@@ -3059,7 +3065,11 @@ inline double exp_portable(double x) {
     if (x > 64) x = 64;
     const double ln2_hi = 6.93147180369123816490e-01;
     const double ln2_lo = 1.90821492927058770002e-10;
-    double k = std::floor(x * 1.44269504088896338700 + 0.5);
+    // floor(y) by truncation (|y| < 93 here): std::floor is a library call per point on
+    // x86-64's baseline, which has no rounding instruction (one instruction on ARM).
+    const double y = x * 1.44269504088896338700 + 0.5;
+    double k = kFastLoops ? static_cast<double>(static_cast<int32_t>(y)) : std::floor(y);
+    if (kFastLoops && k > y) k -= 1;
     double r = (x - k * ln2_hi) - k * ln2_lo;  // |r| <= 0.35
     double p = 1.0 / 6227020800.0;             // 1/13!
     static constexpr double inverse_factorials[13] = {1.0 / 479001600.0, 1.0 / 39916800.0,
@@ -3076,11 +3086,16 @@ inline double exp_portable(double x) {
     return p * two_k;
 }
 
-// A monotone stand-in for the polar angle of (dx, dy), in [0, 4): no trigonometry.
+// A monotone stand-in for the polar angle of (dx, dy), in [0, 4): no trigonometry. The
+// quadrant picks one of three values by index, not by branch: points in no angular order
+// (a layer as the scanner wrote it) would mispredict half of the branches.
 STRATMESH_SMALL_NOINLINE inline double pseudo_angle(double dx, double dy) {
     double sum = abs_value(dx) + abs_value(dy);
     double t = sum > 0 ? dy / sum : 0;  // in [-1, 1]
-    return dx >= 0 ? (t < 0 ? 4 + t : t) : 2 - t;
+    if (!kFastLoops) return dx >= 0 ? (t < 0 ? 4 + t : t) : 2 - t;
+    const double angles[3] = {t, 4 + t, 2 - t};
+    const bool left = !(dx >= 0);
+    return angles[2 * static_cast<int>(left) + static_cast<int>(!left & (t < 0))];
 }
 
 // The polar angle of (dx, dy) in [0, 2 pi), with + - * / only (the same bits everywhere):
@@ -6890,13 +6905,13 @@ inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& 
                            const LayerPlan& plan, uint32_t* layer, Local* staged,
                            ReconstructMemory& m) {
     std::memset(m.layer_start, 0, sizeof(uint32_t) * (plan.count + 2));
-    const double per_height = plan.count / (plan.bounds[plan.count] - plan.bounds[0]);
+    const double per_height =
+        kFastLoops ? plan.count / (plan.bounds[plan.count] - plan.bounds[0]) : 0;
     for (size_t i = 0; i < count; ++i) {
         layer[i] = cloud.valid(i) ? layer_of(plan, frame.height(cloud.point(i)), per_height)
                                   : kNoIndex;
-    }
-    for (size_t i = 0; i < count; ++i)
         if (layer[i] != kNoIndex) ++m.layer_start[layer[i] + 2];
+    }
     for (uint32_t k = 0; k < plan.count; ++k) m.layer_start[k + 2] += m.layer_start[k + 1];
     for (size_t i = 0; i < count; ++i) {
         if (layer[i] == kNoIndex) continue;

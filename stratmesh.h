@@ -2551,6 +2551,7 @@ struct Frame {
     // Layers are flipped on the surface (the surface_flips flag; see "flips on the surface"
     // in >>layer triangulation).
     bool surface_flips;
+    Vec3 low, high;  // the valid points' lowest and highest coordinates (choose_frame)
     // (p - origin) * scale, without overflow.
     Vec3 offset(Vec3 p) const {
         if (halved) return scaled(scaled(p, 0.5) - half_origin, 2 * scale);
@@ -2629,6 +2630,10 @@ inline Status choose_frame(const CloudReader& cloud, size_t count, const Options
     const Vec3 sum = {total[0], total[1], total[2]};
     const Vec3 small_sum = {small_total[0], small_total[1], small_total[2]};
     const Vec3 low = {lowest[0], lowest[1], lowest[2]}, high = {highest[0], highest[1], highest[2]};
+    if (kFastLoops) {
+        frame.low = low;
+        frame.high = high;
+    }
     if (!(is_finite(sum.x) && is_finite(sum.y) && is_finite(sum.z)))
         frame.origin = scaled(scaled(small_sum, 1.0 / static_cast<double>(valid)), 0x1p40);
     else
@@ -6901,6 +6906,36 @@ inline Status reject_invalid_points(const CloudReader& reader, size_t count,
 // point's layer kept in `layer` (count entries of scratch) between its two passes. With
 // `staged` (optional, as many entries as valid points), the points in frame coordinates
 // go there in the same order.
+// The lowest and highest frame height of the valid points.
+inline void height_range(const CloudReader& cloud, size_t count, const Frame& frame, double* lo,
+                         double* hi) {
+    for (size_t i = 0; i < count; ++i) {
+        if (!cloud.valid(i)) continue;
+        const double h = frame.height(cloud.point(i));
+        if (h < *lo) *lo = h;
+        if (h > *hi) *hi = h;
+    }
+}
+
+// height_range without a pass over the cloud, where the axis is a coordinate axis (and
+// the frame not halved): a height is then (p_k - origin_k) * scale plus zeros, exactly
+// that value, and rounding keeps the order, so the lowest and highest coordinates along
+// the axis give the same two heights, bit for bit. False otherwise.
+inline bool height_range_from_extremes(const Frame& frame, double* lo, double* hi) {
+    const double axis[3] = {frame.axis.x, frame.axis.y, frame.axis.z};
+    const double low[3] = {frame.low.x, frame.low.y, frame.low.z};
+    const double high[3] = {frame.high.x, frame.high.y, frame.high.z};
+    const double origin[3] = {frame.origin.x, frame.origin.y, frame.origin.z};
+    for (int k = 0; k < 3; ++k) {
+        if (frame.halved || axis[k] != 1 || axis[(k + 1) % 3] != 0 || axis[(k + 2) % 3] != 0)
+            continue;
+        *lo = (low[k] - origin[k]) * frame.scale;
+        *hi = (high[k] - origin[k]) * frame.scale;
+        return true;
+    }
+    return false;
+}
+
 inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& frame,
                            const LayerPlan& plan, uint32_t* layer, Local* staged,
                            ReconstructMemory& m) {
@@ -7041,12 +7076,8 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     }
 
     double lo = DBL_MAX, hi = -DBL_MAX;
-    for (size_t i = 0; i < cloud.count; ++i) {
-        if (!reader.valid(i)) continue;
-        const double h = frame.height(reader.point(i));
-        if (h < lo) lo = h;
-        if (h > hi) hi = h;
-    }
+    if (!kFastLoops || !height_range_from_extremes(frame, &lo, &hi))
+        height_range(reader, cloud.count, frame, &lo, &hi);
     if (!(hi > lo)) {
         rep.detail = "every point has the same height along the axis";
         return Status::flat_cloud;

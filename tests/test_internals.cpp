@@ -1,0 +1,101 @@
+// Internal functions whose fast paths must answer as the plain way does, bit for bit:
+// the frame's height range from the extremes, the layer of a height. This suite compiles
+// the implementation itself, to reach them.
+#define STRATMESH_IMPLEMENTATION
+#include "stratmesh.h"
+
+#include <doctest/doctest.h>
+
+#include <cfloat>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
+using stratmesh::Axis;
+using stratmesh::Cloud;
+using stratmesh::Options;
+using stratmesh::Scalar;
+using stratmesh::Status;
+
+#if !defined(STRATMESH_SMALL_CODE)  // which keeps no extremes in the frame (kFastLoops)
+TEST_CASE("internals: the height range from a coordinate axis's extremes equals the pass") {
+    std::mt19937_64 random(20261202);
+    std::uniform_real_distribution<double> unit(-1, 1);
+    for (int trial = 0; trial < 200; ++trial) {
+        // Offsets and sizes from tiny to huge, float and double, some invalid points, and
+        // now and then a given origin far away.
+        const double offset = std::ldexp(unit(random), static_cast<int>(random() % 200) - 100);
+        const double size = std::ldexp(1.0, static_cast<int>(random() % 120) - 60);
+        const bool as_float = trial % 3 == 0;
+        const size_t count = 3 + random() % 300;
+        std::vector<double> xyz(3 * count);
+        std::vector<float> xyz_float(3 * count);
+        for (size_t i = 0; i < 3 * count; ++i) {
+            xyz[i] = offset + size * unit(random);
+            if (random() % 50 == 0) xyz[i] = std::numeric_limits<double>::quiet_NaN();
+            xyz_float[i] = static_cast<float>(xyz[i]);
+        }
+        const Cloud cloud = {as_float ? static_cast<const void*>(xyz_float.data()) : xyz.data(),
+                             count, 0, as_float ? Scalar::float32 : Scalar::float64};
+        const stratmesh::detail::CloudReader reader = stratmesh::detail::reader_of(cloud);
+        for (Axis axis : {Axis::x, Axis::y, Axis::z, Axis::direction}) {
+            Options options = {};
+            options.axis = axis;
+            options.direction[0] = 0;
+            options.direction[1] = -0.0;
+            options.direction[2] = 3;  // normalised to exactly (0, 0, 1) or (0, -0, 1)
+            if (trial % 7 == 0) {
+                options.flags |= stratmesh::origin_given;
+                for (double& o : options.origin) o = offset + 1e6 * size * unit(random);
+            }
+            stratmesh::detail::Frame frame;
+            REQUIRE(stratmesh::detail::choose_frame(reader, count, options, frame) == Status::ok);
+            double lo = DBL_MAX, hi = -DBL_MAX, pass_lo = DBL_MAX, pass_hi = -DBL_MAX;
+            stratmesh::detail::height_range(reader, count, frame, &pass_lo, &pass_hi);
+            INFO("trial " << trial << ", offset " << offset << ", size " << size);
+            if (stratmesh::detail::height_range_from_extremes(frame, &lo, &hi)) {
+                CHECK(!frame.halved);
+                CHECK(std::memcmp(&lo, &pass_lo, sizeof lo) == 0);
+                CHECK(std::memcmp(&hi, &pass_hi, sizeof hi) == 0);
+            } else {
+                CHECK(frame.halved);  // every axis here is a coordinate axis
+            }
+        }
+    }
+}
+
+#endif
+
+TEST_CASE("internals: layer_of finds the same layer as a scan of the bounds") {
+    std::mt19937_64 random(7);
+    std::uniform_real_distribution<double> unit(0, 1);
+    for (int trial = 0; trial < 300; ++trial) {
+        // Equal layers (the guess's case), uneven ones, and one layer.
+        const uint32_t count = 1 + static_cast<uint32_t>(random() % (trial % 5 == 0 ? 1 : 40));
+        std::vector<double> bounds(count + 1);
+        const double lo = 1000 * (unit(random) - 0.5), height = std::ldexp(unit(random) + 0.1, trial % 9 - 4);
+        for (uint32_t k = 0; k <= count; ++k) bounds[k] = lo + height * k / count;
+        if (trial % 2 == 1)
+            for (uint32_t k = 1; k < count; ++k)
+                bounds[k] = bounds[k - 1] + (bounds[count] - bounds[k - 1]) * unit(random) / 2;
+        const stratmesh::detail::LayerPlan plan = {bounds.data(), count, height * 0x1p-40};
+        const double per_height = count / (bounds[count] - bounds[0]);
+        for (int probe = 0; probe < 400; ++probe) {
+            double h = bounds[0] + (bounds[count] - bounds[0]) * (1.2 * unit(random) - 0.1);
+            if (probe % 4 == 0) {  // on a bound, or a hair either side of its tolerance
+                const double b = bounds[random() % (count + 1)];
+                const double steps[] = {0, -plan.tolerance, -plan.tolerance * 1.0000001,
+                                        -plan.tolerance * 0.9999999};
+                h = b + steps[random() % 4];
+            }
+            uint32_t expected = 0;
+            for (uint32_t k = 1; k < count; ++k)
+                if (h >= bounds[k] - plan.tolerance) expected = k;
+            INFO("trial " << trial << ", " << count << " layers, h " << h);
+            CHECK(stratmesh::detail::layer_of(plan, h, per_height) == expected);
+        }
+    }
+}

@@ -3294,12 +3294,30 @@ inline bool on_surface(const Triangulation& tr, uint32_t t) {
     return !tr.is_ghost(t) && v[0] != 0 && v[1] != 0 && v[2] != 0;
 }
 
+// Asks for the cache line holding p ahead of its use, where the compiler offers a way
+// (GCC, Clang): a hint, which changes nothing but the time.
+inline void prefetch(const void* p) {
+#if defined(__GNUC__) || defined(__clang__)
+    __builtin_prefetch(p);
+#else
+    (void)p;
+#endif
+}
+
 // The surface triangles of a layer's triangulation that face its axis; vertex v is
-// points[(v - 1) * stride]. Adds their doubled areas to *area if given.
+// points[(v - 1) * stride]. Adds their doubled areas to *area if given. The triangles'
+// slots are not in the points' order: with kFastLoops the corners a few triangles ahead
+// are prefetched, as the loop otherwise waits on the cache for most of them.
 inline size_t count_folds(const Triangulation& tr, const Local* points, size_t stride,
                           const Cylinder& cyl, double* area) {
     size_t folds = 0;
+    const uint32_t ahead = 12;
     for (uint32_t t = 0; t < tr.triangle_count; ++t) {
+        if (kFastLoops && t + ahead < tr.triangle_count) {
+            const uint32_t* w = tr.vertex + 3 * (t + ahead);
+            for (uint32_t i = 0; i < 3; ++i)
+                if (w[i] != 0 && w[i] != kGhost) prefetch(points + (w[i] - 1) * stride);
+        }
         const uint32_t* v = tr.vertex + 3 * t;
         if (!on_surface(tr, t)) continue;
         const Local &a = points[(v[2] - 1) * stride], &b = points[(v[1] - 1) * stride],

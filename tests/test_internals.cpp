@@ -99,3 +99,16 @@ TEST_CASE("internals: layer_of finds the same layer as a scan of the bounds") {
         }
     }
 }
+
+TEST_CASE("internals: trailing_zeros counts as the loop over the bits does") {
+    std::mt19937 random(11);
+    for (int trial = 0; trial < 100000; ++trial) {
+        // Random words with from 0 to 31 low bits cleared, and 0 itself.
+        const uint32_t h = trial == 0 ? 0 : static_cast<uint32_t>(random()) << (trial % 32);
+        const uint32_t limit = static_cast<uint32_t>(random() % 32);
+        uint32_t expected = 0;
+        while (expected < limit && (h & (1u << expected)) == 0) ++expected;
+        INFO("h " << h << ", limit " << limit);
+        CHECK(stratmesh::detail::trailing_zeros(h, limit) == expected);
+    }
+}

@@ -790,12 +790,30 @@ const bool kFastLoops = true;
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 
-// Kept out of line in the small build: inlined at each caller, these few functions grow
-// the Cortex-M7 code past its 32 KiB (examples/firmware/build.sh).
-#if defined(STRATMESH_SMALL_CODE) && (defined(__GNUC__) || defined(__clang__))
-#define STRATMESH_SMALL_NOINLINE __attribute__((noinline))
+// Kept out of line: STRATMESH_NOINLINE always, the predicates' exact stages, so that the
+// filtered call, which settles nearly all, keeps its registers (inlined, the exact stage
+// made it spill: 125 instructions a filtered incircle instead of about 60);
+// STRATMESH_FAST_NOINLINE in the full build, for the same reason (the small build inlines
+// it into its one caller, where a call costs more code); STRATMESH_SMALL_NOINLINE in the
+// small build: inlined at each caller, these few functions grow the Cortex-M7 code past
+// its 32 KiB (examples/firmware/build.sh).
+#if defined(__GNUC__) || defined(__clang__)
+#define STRATMESH_NOINLINE __attribute__((noinline))
+#elif defined(_MSC_VER)
+#define STRATMESH_NOINLINE __declspec(noinline)
+#else
+#define STRATMESH_NOINLINE
+#endif
+#if defined(STRATMESH_SMALL_CODE)
+#define STRATMESH_SMALL_NOINLINE STRATMESH_NOINLINE
+#if defined(__GNUC__) || defined(__clang__)
+#define STRATMESH_FAST_NOINLINE __attribute__((always_inline))
+#else
+#define STRATMESH_FAST_NOINLINE
+#endif
 #else
 #define STRATMESH_SMALL_NOINLINE
+#define STRATMESH_FAST_NOINLINE STRATMESH_NOINLINE
 #endif
 
 #if defined(__GNUC__) || defined(__clang__)
@@ -1361,7 +1379,7 @@ inline bool incircle_from_integer_differences(const double rows[3][2], double* d
 // integer stage, then with rescaling in expansions), then the raw coordinates are used
 // (with STRATMESH_SMALL_CODE at once, after the rescaling: kFastExactStages). Kept apart
 // from the filter so that the common, filtered call stays small.
-inline double orient2d_beyond_filter(const double* a, const double* b, const double* c) {
+STRATMESH_NOINLINE inline double orient2d_beyond_filter(const double* a, const double* b, const double* c) {
     double differences[4], tails[4], det = 0;
     two_diff(a[0], c[0], differences[0], tails[0]);
     two_diff(a[1], c[1], differences[1], tails[1]);
@@ -1539,7 +1557,7 @@ inline bool differences_to(const double* a, const double* b, const double* c, co
 // (there is no underflow to avoid); then the differences after rescaling; then the raw
 // coordinates (with STRATMESH_SMALL_CODE only these: kFastExactStages). Kept apart from
 // the filter so that the common, filtered call stays small.
-inline double incircle_beyond_filter(const double* a, const double* b, const double* c,
+STRATMESH_NOINLINE inline double incircle_beyond_filter(const double* a, const double* b, const double* c,
                                      const double* d, double* scratch) {
     double rows[3][2], det = 0;
     const bool exact = differences_to(a, b, c, d, rows);
@@ -1591,12 +1609,10 @@ inline bool lex_less(const double* p, const double* q) {
 // symbolic perturbation: point i is lifted by eps^(4 - rank(i)), the lexicographically
 // largest point the most. A tie is settled by the largest point whose cofactor (the
 // orientation of the other three) is non-zero; d's cofactor is -orient(a, b, c) < 0, so
-// the loop always ends. Never returns 0 for four distinct points.
-inline int incircle_perturbed(const double* a, const double* b, const double* c,
-                              const double* d, double* scratch) {
-    double det = incircle_robust(a, b, c, d, scratch);
-    if (det > 0) return 1;
-    if (det < 0) return -1;
+// the loop always ends. Never returns 0 for four distinct points. The tie is settled out of
+// line (STRATMESH_FAST_NOINLINE), so that the filtered test inlines into its callers.
+STRATMESH_FAST_NOINLINE inline int incircle_tie(const double* a, const double* b, const double* c,
+                                           const double* d) {
     const double* p[4] = {a, b, c, d};
     // Sort the four points by decreasing lexicographic rank (insertion sort, 4 items).
     int order[4] = {0, 1, 2, 3};
@@ -1618,6 +1634,15 @@ inline int incircle_perturbed(const double* a, const double* b, const double* c,
         if (o < 0) return -1;
     }
     return -1;
+}
+
+STRATMESH_SMALL_NOINLINE inline int incircle_perturbed(const double* a, const double* b,
+                                                       const double* c, const double* d,
+                                                       double* scratch) {
+    const double det = incircle_robust(a, b, c, d, scratch);
+    if (det > 0) return 1;
+    if (det < 0) return -1;
+    return incircle_tie(a, b, c, d);
 }
 
 }  // namespace detail
@@ -7650,6 +7675,8 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
 }  // namespace stratmesh
 
 #undef STRATMESH_SMALL_NOINLINE
+#undef STRATMESH_FAST_NOINLINE
+#undef STRATMESH_NOINLINE
 
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC pop_options

@@ -785,14 +785,14 @@ const bool kLocalUnpeel = true;
 const bool kPeelFoldedEnds = true;
 // Per-point loops in forms that cost code for speed, the same bits either way: the equal-
 // layer guess in layer_of, pseudo_angle without branches, floor by truncation in
-// exp_portable.
+// exp_portable, the height range from choose_frame's extremes, count_folds' prefetching.
 const bool kFastLoops = true;
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 
 // Kept out of line: STRATMESH_NOINLINE always, the predicates' exact stages, so that the
 // filtered call, which settles nearly all, keeps its registers (inlined, the exact stage
-// made it spill: 125 instructions a filtered incircle instead of about 60);
+// made it spill: 125 instructions a filtered incircle instead of about 70);
 // STRATMESH_FAST_NOINLINE in the full build, for the same reason (the small build inlines
 // it into its one caller, where a call costs more code); STRATMESH_SMALL_NOINLINE in the
 // small build: inlined at each caller, these few functions grow the Cortex-M7 code past
@@ -1379,7 +1379,8 @@ inline bool incircle_from_integer_differences(const double rows[3][2], double* d
 // integer stage, then with rescaling in expansions), then the raw coordinates are used
 // (with STRATMESH_SMALL_CODE at once, after the rescaling: kFastExactStages). Kept apart
 // from the filter so that the common, filtered call stays small.
-STRATMESH_NOINLINE inline double orient2d_beyond_filter(const double* a, const double* b, const double* c) {
+STRATMESH_NOINLINE inline double orient2d_beyond_filter(const double* a, const double* b,
+                                                         const double* c) {
     double differences[4], tails[4], det = 0;
     two_diff(a[0], c[0], differences[0], tails[0]);
     two_diff(a[1], c[1], differences[1], tails[1]);
@@ -1557,8 +1558,9 @@ inline bool differences_to(const double* a, const double* b, const double* c, co
 // (there is no underflow to avoid); then the differences after rescaling; then the raw
 // coordinates (with STRATMESH_SMALL_CODE only these: kFastExactStages). Kept apart from
 // the filter so that the common, filtered call stays small.
-STRATMESH_NOINLINE inline double incircle_beyond_filter(const double* a, const double* b, const double* c,
-                                     const double* d, double* scratch) {
+STRATMESH_NOINLINE inline double incircle_beyond_filter(const double* a, const double* b,
+                                                         const double* c, const double* d,
+                                                         double* scratch) {
     double rows[3][2], det = 0;
     const bool exact = differences_to(a, b, c, d, rows);
     if (kFastExactStages && exact && incircle_from_integer_differences(rows, &det))
@@ -1611,8 +1613,8 @@ inline bool lex_less(const double* p, const double* q) {
 // orientation of the other three) is non-zero; d's cofactor is -orient(a, b, c) < 0, so
 // the loop always ends. Never returns 0 for four distinct points. The tie is settled out of
 // line (STRATMESH_FAST_NOINLINE), so that the filtered test inlines into its callers.
-STRATMESH_FAST_NOINLINE inline int incircle_tie(const double* a, const double* b, const double* c,
-                                           const double* d) {
+STRATMESH_FAST_NOINLINE inline int incircle_tie(const double* a, const double* b,
+                                                const double* c, const double* d) {
     const double* p[4] = {a, b, c, d};
     // Sort the four points by decreasing lexicographic rank (insertion sort, 4 items).
     int order[4] = {0, 1, 2, 3};
@@ -1774,8 +1776,6 @@ struct BoundingBox2d {
     double min[2], max[2];
 };
 
-// Fills order[0..count) with the indices of the points (x, y doubles, stride bytes apart)
-// in BRIO order over `box`; scratch from the arena.
 // The number of trailing zero bits of h, at most `limit` (< 32). The loop over the bits,
 // whose length is random, mispredicts its exit on about every other point; GCC and Clang
 // count them in an instruction or two (2.5% of delaunay_2d's time on 1e6 points).
@@ -1790,6 +1790,8 @@ inline uint32_t trailing_zeros(uint32_t h, uint32_t limit) {
 #endif
 }
 
+// Fills order[0..count) with the indices of the points (x, y doubles, stride bytes apart)
+// in BRIO order over `box`; scratch from the arena.
 inline bool spatial_order(const unsigned char* xy, size_t stride, size_t count,
                           const BoundingBox2d& box, uint32_t* order, Arena& arena) {
     size_t mark = arena.mark();
@@ -6958,10 +6960,6 @@ inline Status reject_invalid_points(const CloudReader& reader, size_t count,
     return Status::ok;
 }
 
-// Groups the valid points by layer (input order within a layer): a counting sort, with each
-// point's layer kept in `layer` (count entries of scratch) between its two passes. With
-// `staged` (optional, as many entries as valid points), the points in frame coordinates
-// go there in the same order.
 // The lowest and highest frame height of the valid points.
 inline void height_range(const CloudReader& cloud, size_t count, const Frame& frame, double* lo,
                          double* hi) {
@@ -6992,6 +6990,10 @@ inline bool height_range_from_extremes(const Frame& frame, double* lo, double* h
     return false;
 }
 
+// Groups the valid points by layer (input order within a layer): a counting sort, with each
+// point's layer kept in `layer` (count entries of scratch) between its two passes. With
+// `staged` (optional, as many entries as valid points), the points in frame coordinates
+// go there in the same order.
 inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& frame,
                            const LayerPlan& plan, uint32_t* layer, Local* staged,
                            ReconstructMemory& m) {

@@ -2591,7 +2591,8 @@ struct Frame {
     // Layers are flipped on the surface (the surface_flips flag; see "flips on the surface"
     // in >>layer triangulation).
     bool surface_flips;
-    Vec3 low, high;  // the valid points' lowest and highest coordinates (choose_frame)
+    // The valid points' lowest and highest coordinates (set by choose_frame with kFastLoops).
+    Vec3 low, high;
     // (p - origin) * scale, without overflow.
     Vec3 offset(Vec3 p) const {
         if (halved) return scaled(scaled(p, 0.5) - half_origin, 2 * scale);

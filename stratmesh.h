@@ -2648,29 +2648,52 @@ inline Vec3 principal_direction(const double m[3][3]) {
     return big < 0 ? scaled(v, -1.0) : v;
 }
 
-// The frame: centroid origin, axis from the options (or PCA), e1/e2 completing it.
-inline Status choose_frame(const CloudReader& cloud, size_t count, const Options& options,
-                           Frame& frame) {
-    // Coordinates near the top of the double range overflow the sum: then the sum of the
-    // points scaled down by 2^-40 (exactly), which leaves room for 2^32 points, is used.
-    double total[3] = {0, 0, 0}, small_total[3] = {0, 0, 0};
-    double lowest[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, highest[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
-    size_t valid = 0;
+// What one pass over the cloud learns, for reject_invalid_points and choose_frame: how many
+// points are valid, how many distinct positions they take (counted up to 3), and their sums
+// and extremes. Coordinates near the top of the double range overflow the sum: then the
+// sum of the points scaled down by 2^-40 (exactly), which leaves room for 2^32 points, is
+// used.
+struct CloudSums {
+    size_t valid;
+    uint32_t distinct;
+    double total[3], small_total[3], lowest[3], highest[3];
+};
+
+inline CloudSums sum_cloud(const CloudReader& cloud, size_t count) {
+    CloudSums s = {0, 0, {0, 0, 0}, {0, 0, 0}, {DBL_MAX, DBL_MAX, DBL_MAX},
+                   {-DBL_MAX, -DBL_MAX, -DBL_MAX}};
+    Vec3 seen[2];
     for (size_t i = 0; i < count; ++i) {
         if (!cloud.valid(i)) continue;
         const Vec3 p = cloud.point(i);
+        if (s.distinct < 3) {
+            bool repeat = false;
+            for (uint32_t k = 0; k < s.distinct; ++k)
+                repeat = repeat || (p.x == seen[k].x && p.y == seen[k].y && p.z == seen[k].z);
+            if (!repeat && s.distinct < 2) seen[s.distinct] = p;
+            s.distinct += !repeat;
+        }
         const double c[3] = {p.x, p.y, p.z};
         for (int k = 0; k < 3; ++k) {
-            total[k] += c[k];
-            small_total[k] += c[k] * 0x1p-40;
-            if (c[k] < lowest[k]) lowest[k] = c[k];
-            if (c[k] > highest[k]) highest[k] = c[k];
+            s.total[k] += c[k];
+            s.small_total[k] += c[k] * 0x1p-40;
+            if (c[k] < s.lowest[k]) s.lowest[k] = c[k];
+            if (c[k] > s.highest[k]) s.highest[k] = c[k];
         }
-        ++valid;
+        ++s.valid;
     }
-    const Vec3 sum = {total[0], total[1], total[2]};
-    const Vec3 small_sum = {small_total[0], small_total[1], small_total[2]};
-    const Vec3 low = {lowest[0], lowest[1], lowest[2]}, high = {highest[0], highest[1], highest[2]};
+    return s;
+}
+
+// The frame: centroid origin, axis from the options (or PCA), e1/e2 completing it; `sums`
+// is sum_cloud(cloud, count).
+inline Status choose_frame(const CloudReader& cloud, size_t count, const CloudSums& sums,
+                           const Options& options, Frame& frame) {
+    const size_t valid = sums.valid;
+    const Vec3 sum = {sums.total[0], sums.total[1], sums.total[2]};
+    const Vec3 small_sum = {sums.small_total[0], sums.small_total[1], sums.small_total[2]};
+    const Vec3 low = {sums.lowest[0], sums.lowest[1], sums.lowest[2]};
+    const Vec3 high = {sums.highest[0], sums.highest[1], sums.highest[2]};
     if (kFastLoops) {
         frame.low = low;
         frame.high = high;
@@ -2736,21 +2759,9 @@ inline Status choose_frame(const CloudReader& cloud, size_t count, const Options
     return Status::ok;
 }
 
-// Whether the valid points take at least three distinct positions; stops at the third.
-inline bool has_three_distinct_points(const CloudReader& cloud, size_t count) {
-    Vec3 seen[2];
-    size_t distinct = 0;
-    for (size_t i = 0; i < count; ++i) {
-        if (!cloud.valid(i)) continue;
-        Vec3 p = cloud.point(i);
-        bool repeat = false;
-        for (size_t k = 0; k < distinct; ++k)
-            repeat = repeat || (p.x == seen[k].x && p.y == seen[k].y && p.z == seen[k].z);
-        if (repeat) continue;
-        if (distinct == 2) return true;
-        seen[distinct++] = p;
-    }
-    return false;
+inline Status choose_frame(const CloudReader& cloud, size_t count, const Options& options,
+                           Frame& frame) {
+    return choose_frame(cloud, count, sum_cloud(cloud, count), options, frame);
 }
 
 // Layer boundaries: bounds[0] = lowest height, bounds[count] = highest, layer i holds the
@@ -6943,21 +6954,21 @@ inline CloudReader reader_of(const Cloud& cloud) {
             cloud.stride_bytes ? cloud.stride_bytes : 3 * scalar, cloud.scalar == Scalar::float32, nullptr};
 }
 
-// Counts the points with a NaN or infinite coordinate in rep.rejected, or stops at the
-// first one with invalid_point unless the skip_invalid_points flag is given.
+// Counts the points with a NaN or infinite coordinate in rep.rejected, or refuses the
+// cloud at the first one with invalid_point unless the skip_invalid_points flag is given;
+// `sums` is sum_cloud of the cloud's `count` points.
 inline Status reject_invalid_points(const CloudReader& reader, size_t count,
-                                    const Options& options, Report& rep) {
-    for (size_t i = 0; i < count; ++i) {
-        if (reader.valid(i)) continue;
-        if (!(options.flags & skip_invalid_points)) {
-            rep.first_invalid_point = i;
-            rep.rejected = count;
-            rep.detail = "a point has a NaN or infinite coordinate (see first_invalid_point; "
-                         "the skip_invalid_points flag skips such points instead)";
-            return Status::invalid_point;
-        }
-        ++rep.rejected;
+                                    const CloudSums& sums, const Options& options, Report& rep) {
+    if (sums.valid < count && !(options.flags & skip_invalid_points)) {
+        size_t first = 0;
+        while (reader.valid(first)) ++first;
+        rep.first_invalid_point = first;
+        rep.rejected = count;
+        rep.detail = "a point has a NaN or infinite coordinate (see first_invalid_point; "
+                     "the skip_invalid_points flag skips such points instead)";
+        return Status::invalid_point;
     }
+    rep.rejected += count - sums.valid;
     return Status::ok;
 }
 
@@ -7110,7 +7121,9 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     if (status != Status::ok) return status;
     notify(options, Phase::validate, 0);
     CloudReader reader = reader_of(cloud);
-    status = reject_invalid_points(reader, cloud.count, options, rep);
+    // One pass serves both the check for invalid points and the frame.
+    CloudSums sums = sum_cloud(reader, cloud.count);
+    status = reject_invalid_points(reader, cloud.count, sums, options, rep);
     if (status != Status::ok) return status;
     status = validate_layer_options(options);
     if (status != Status::ok) return status;
@@ -7123,13 +7136,14 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     if (options.flags & drop_outliers) {
         if (!kDropOutliers) return Status::invalid_argument;
         if (!find_outliers(reader, cloud.count, arena, rep)) return finish(Status::out_of_memory);
+        sums = sum_cloud(reader, cloud.count);  // without the outliers
     }
     size_t valid = cloud.count - rep.rejected;
     Frame frame;
-    status = choose_frame(reader, cloud.count, options, frame);
+    status = choose_frame(reader, cloud.count, sums, options, frame);
     if (status != Status::ok) return status;
     report_frame(frame, rep);
-    if (valid < 3 || !has_three_distinct_points(reader, cloud.count)) {
+    if (sums.distinct < 3) {
         rep.detail = "fewer than 3 distinct valid points";
         return Status::too_few_points;
     }
@@ -7653,7 +7667,8 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
         return finish(Status::invalid_argument);
     }
     const detail::CloudReader reader = detail::reader_of(cloud);
-    status = detail::reject_invalid_points(reader, cloud.count, options, checks);
+    const detail::CloudSums sums = detail::sum_cloud(reader, cloud.count);
+    status = detail::reject_invalid_points(reader, cloud.count, sums, options, checks);
     if (status != Status::ok) return finish(status);
     for (size_t k = 0; k < 3 * given; ++k)
         if (triangles[k] >= cloud.count || !reader.valid(triangles[k])) {
@@ -7661,7 +7676,7 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
             return finish(Status::invalid_argument);
         }
     detail::Frame frame;
-    status = detail::choose_frame(reader, cloud.count, options, frame);
+    status = detail::choose_frame(reader, cloud.count, sums, options, frame);
     if (status != Status::ok) return finish(status);
     status = detail::cap_boundary_loops(triangles, count, triangle_capacity, reader,
                                         cloud.count, frame, arena, caps, &needed);

@@ -2164,6 +2164,30 @@ TEST_CASE("malformed clouds: the documented status, counts that add up, nothing 
         check_refused(run, Status::too_few_points);
         CHECK(run.report.duplicates + run.report.unused == 5);
     }
+    SUBCASE("two positions repeated among skipped NaNs: too_few_points until a third comes") {
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        const double a[3] = {1, 2, 3}, b[3] = {1, 2, 4}, c[3] = {2, 2, 3.5};
+        std::vector<double> xyz;
+        for (const double* p : {a, b, a, b, a}) {
+            xyz.insert(xyz.end(), {nan, nan, nan});
+            xyz.insert(xyz.end(), p, p + 3);
+        }
+        Options skipping = along_z;
+        skipping.flags = stratmesh::skip_invalid_points;
+        const char* few = "fewer than 3 distinct valid points";
+        Run two = reconstruct_guarded(Cloud{xyz.data(), 10, 0, Scalar::float64}, skipping);
+        check_refused(two, Status::too_few_points);
+        CHECK(two.report.rejected == 5);
+        REQUIRE(two.report.detail != nullptr);
+        CHECK(std::string(two.report.detail) == few);
+        // A third position as the very last point passes that check (what follows refuses
+        // three points for its own reason, or meshes them).
+        xyz.insert(xyz.end(), c, c + 3);
+        Run three = reconstruct_guarded(Cloud{xyz.data(), 11, 0, Scalar::float64}, skipping);
+        CHECK(three.report.rejected == 5);
+        CHECK(counts_add_up(three.report));
+        CHECK((three.report.detail == nullptr || std::string(three.report.detail) != few));
+    }
     SUBCASE("all points on one line beside the axis, or across it: no surface") {
         // Small integers times powers of two: exactly on their lines whatever the compiler
         // contracts (a fused multiply-add would move 0.01 * i - 1 off the line).

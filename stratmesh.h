@@ -7123,7 +7123,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     if (status != Status::ok) return status;
     notify(options, Phase::validate, 0);
     CloudReader reader = reader_of(cloud);
-    // One pass serves both the check for invalid points and the frame.
+    // One pass serves the check for invalid points, the frame and the distinct points.
     CloudSums sums = sum_cloud(reader, cloud.count);
     status = reject_invalid_points(reader, cloud.count, sums, options, rep);
     if (status != Status::ok) return status;

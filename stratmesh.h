@@ -617,8 +617,9 @@ Status stream_open(const Options& options, void* workspace, size_t workspace_byt
 // Pushes the next layer: its points (any stride and scalar, as for reconstruct) and its top,
 // the height (dot(point, axis)) where the next layer begins. Every point must lie between
 // the previous push's top and this one's (up to 2^-40 of their size; the first push has no
-// lower limit), and top must not be below the previous top; the top of the last push only
-// bounds its points (the last layer ends at its highest point). May call emit.
+// lower limit; a push without valid points has a top all the same), and top must not be
+// below the previous top; the top of the last push only bounds its points (the last layer
+// ends at its highest point). May call emit.
 // Returns ok; invalid_argument (null stream, points in the workspace, a null pointer with a
 // non-zero count, a bad stride or scalar); invalid_point (NaN/Inf without
 // skip_invalid_points, or a point more than 2^60 times the first layer's size away);
@@ -2661,20 +2662,28 @@ struct CloudSums {
     double total[3], small_total[3], lowest[3], highest[3];
 };
 
+// Counts the distinct positions among points given one by one, up to 3 (two are kept: the
+// third ends the count).
+struct DistinctPoints {
+    uint32_t count;
+    Vec3 seen[2];
+    void add(Vec3 p) {
+        if (count >= 3) return;
+        for (uint32_t k = 0; k < count; ++k)
+            if (p.x == seen[k].x && p.y == seen[k].y && p.z == seen[k].z) return;
+        if (count < 2) seen[count] = p;
+        ++count;
+    }
+};
+
 inline CloudSums sum_cloud(const CloudReader& cloud, size_t count) {
     CloudSums s = {0, 0, {0, 0, 0}, {0, 0, 0}, {DBL_MAX, DBL_MAX, DBL_MAX},
                    {-DBL_MAX, -DBL_MAX, -DBL_MAX}};
-    Vec3 seen[2];
+    DistinctPoints distinct = {0, {}};
     for (size_t i = 0; i < count; ++i) {
         if (!cloud.valid(i)) continue;
         const Vec3 p = cloud.point(i);
-        if (s.distinct < 3) {
-            bool repeat = false;
-            for (uint32_t k = 0; k < s.distinct; ++k)
-                repeat = repeat || (p.x == seen[k].x && p.y == seen[k].y && p.z == seen[k].z);
-            if (!repeat && s.distinct < 2) seen[s.distinct] = p;
-            s.distinct += !repeat;
-        }
+        distinct.add(p);
         const double c[3] = {p.x, p.y, p.z};
         for (int k = 0; k < 3; ++k) {
             s.total[k] += c[k];
@@ -2684,6 +2693,7 @@ inline CloudSums sum_cloud(const CloudReader& cloud, size_t count) {
         }
         ++s.valid;
     }
+    s.distinct = distinct.count;
     return s;
 }
 
@@ -2759,11 +2769,6 @@ inline Status choose_frame(const CloudReader& cloud, size_t count, const CloudSu
     frame.e1 = e1;
     frame.e2 = cross(axis, e1);
     return Status::ok;
-}
-
-inline Status choose_frame(const CloudReader& cloud, size_t count, const Options& options,
-                           Frame& frame) {
-    return choose_frame(cloud, count, sum_cloud(cloud, count), options, frame);
 }
 
 // Layer boundaries: bounds[0] = lowest height, bounds[count] = highest, layer i holds the
@@ -7314,9 +7319,11 @@ struct Stream {
     detail::SurfaceChain chain;
     bool has_frame;
     double last_top;              // the previous push's top, as a frame height
+    // Before the first valid point there is no frame: the top of the pushes until then, as
+    // given (a lower limit for the points after them all the same); -DBL_MAX before any.
+    double early_top;
     double lowest, highest;       // the points' frame heights so far
-    size_t distinct;              // distinct points seen, up to 3
-    detail::Vec3 seen[2];
+    detail::DistinctPoints distinct;  // among the points so far
     Status failure;               // sticky: a triangulation error
     bool closed;
 };
@@ -7416,13 +7423,6 @@ inline Status advance(Stream& s, bool complete) {
     return Status::ok;
 }
 
-inline bool tracks_new_distinct_point(Stream& s, Vec3 p) {
-    for (size_t k = 0; k < s.distinct && k < 2; ++k)
-        if (p.x == s.seen[k].x && p.y == s.seen[k].y && p.z == s.seen[k].z) return false;
-    if (s.distinct < 2) s.seen[s.distinct] = p;
-    return true;
-}
-
 }  // namespace detail
 
 size_t stream_workspace_size(size_t max_points_held, const Options& options) {
@@ -7468,11 +7468,12 @@ Status stream_open(const Options& options, void* workspace, size_t workspace_byt
     s->rep.layers = report ? report->layers : nullptr;
     s->rep.layer_capacity = s->rep.layers ? report->layer_capacity : 0;
     s->failure = Status::ok;
+    s->early_top = -DBL_MAX;
     for (size_t i = 0; i < low; ++i) s->positions[i] = static_cast<uint32_t>(i);
     // The frame's axis is checked now, on no points.
     detail::Frame frame;
     detail::CloudReader none = {nullptr, 0, false, nullptr};
-    Status status = detail::choose_frame(none, 0, options, frame);
+    Status status = detail::choose_frame(none, 0, detail::sum_cloud(none, 0), options, frame);
     if (status != Status::ok) return status;
     detail::publish(*s);
     *stream = s;
@@ -7496,34 +7497,40 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     const detail::CloudReader reader = {static_cast<const unsigned char*>(points.xyz), stride,
                                         points.scalar == Scalar::float32, nullptr};
     // Check everything before anything changes.
-    size_t valid = 0;
-    for (size_t i = 0; i < points.count; ++i) {
-        if (reader.valid(i)) {
-            ++valid;
-        } else if (!(s.options.flags & skip_invalid_points)) {
-            s.rep.first_invalid_point = s.rep.points_in + i;
-            return detail::refuse_push(s, Status::invalid_point,
-                                       "a point has a NaN or infinite coordinate (see "
-                                       "first_invalid_point; the skip_invalid_points flag skips "
-                                       "such points instead)");
-        }
+    const detail::CloudSums sums = detail::sum_cloud(reader, points.count);
+    const size_t valid = sums.valid;
+    if (valid < points.count && !(s.options.flags & skip_invalid_points)) {
+        size_t first = 0;
+        while (reader.valid(first)) ++first;
+        s.rep.first_invalid_point = s.rep.points_in + first;
+        return detail::refuse_push(s, Status::invalid_point,
+                                   "a point has a NaN or infinite coordinate (see "
+                                   "first_invalid_point; the skip_invalid_points flag skips "
+                                   "such points instead)");
     }
+    const char* const top_below = "a pushed layer's top is below the previous layer's top";
+    if (!s.has_frame && top < s.early_top)
+        return detail::refuse_push(s, Status::out_of_order, top_below);
     if (!s.has_frame && valid == 0) {  // nothing to place yet: pushes before the first point
         s.rep.points_in += points.count;
         s.rep.rejected += points.count;
+        s.early_top = top;
         detail::publish(s);
         return Status::ok;
     }
     detail::Frame frame = s.chain.frame;
     if (!s.has_frame) {
-        Status status = detail::choose_frame(reader, points.count, s.options, frame);
+        Status status = detail::choose_frame(reader, points.count, sums, s.options, frame);
         if (status != Status::ok) return status;
     }
-    const double top_height = (top - detail::dot(frame.origin, frame.axis)) * frame.scale;
+    const double axis_origin = detail::dot(frame.origin, frame.axis);
+    const double top_height = (top - axis_origin) * frame.scale;
+    // The previous top, which the points must not lie below: the last push's, or before the
+    // first point that of the pushes without points (far below all, or -infinity, if none).
+    const double lower_limit =
+        s.has_frame ? s.last_top : (s.early_top - axis_origin) * frame.scale;
     auto slack = [](double h) { return 0x1p-40 * (1 + detail::abs_value(h)); };
-    if (s.has_frame && top_height < s.last_top)
-        return detail::refuse_push(s, Status::out_of_order,
-                                   "a pushed layer's top is below the previous layer's top");
+    if (top_height < lower_limit) return detail::refuse_push(s, Status::out_of_order, top_below);
     double low = DBL_MAX, high = -DBL_MAX;
     for (size_t i = 0; i < points.count; ++i) {
         if (!reader.valid(i)) continue;
@@ -7536,8 +7543,7 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
                                        "a pushed point lies more than 2^60 times the first "
                                        "layer's size away from it");
         }
-        if (p.h > top_height + slack(top_height) ||
-            (s.has_frame && p.h < s.last_top - slack(s.last_top)))
+        if (p.h > top_height + slack(top_height) || p.h < lower_limit - slack(lower_limit))
             return detail::refuse_push(s, Status::out_of_order,
                                        "a pushed point lies outside its layer: below the previous "
                                        "layer's top or above its own");
@@ -7569,7 +7575,7 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
             continue;
         }
         detail::Vec3 p = reader.point(i);
-        if (s.distinct < 3 && detail::tracks_new_distinct_point(s, p)) ++s.distinct;
+        s.distinct.add(p);
         s.points[s.fill] = p;
         s.global[s.fill] = static_cast<uint32_t>(s.rep.points_in + i);
         ++s.fill;
@@ -7597,7 +7603,7 @@ Status stream_close(Stream* stream) {
     s.closed = true;
     Status status = s.failure;
     const size_t valid = s.rep.points_in - s.rep.rejected;
-    if (status == Status::ok && (valid < 3 || s.distinct < 3)) {
+    if (status == Status::ok && (valid < 3 || s.distinct.count < 3)) {
         s.rep.detail = "fewer than 3 distinct valid points";
         status = Status::too_few_points;
     } else if (status == Status::ok && !(s.highest > s.lowest)) {

@@ -16,7 +16,10 @@
 // largest double: the frame's extent and the centroid's sum overflowed), F (delaunay_2d
 // returned triangle_capacity with delaunay_2d_max_triangles() triangles of room, for 4
 // points spanning about 2^1029, outside the exactness contract: the contradictory signs
-// left a hull of fewer than 3 edges; now internal_error).
+// left a hull of fewer than 3 edges; now internal_error), I (the stream forgot the top of
+// a push without valid points before the first point: the next push's points below it
+// were accepted, and its triangles differed from reconstruct()'s with that top as a cut;
+// now out_of_order, as documented).
 // B: incircle has the wrong sign when the coordinates and their differences spread over
 //    more than 2^320 in magnitude: outside the documented contract (products of four terms
 //    cannot all be represented); the filter skips spreads above 300.

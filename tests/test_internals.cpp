@@ -52,7 +52,8 @@ TEST_CASE("internals: the height range from a coordinate axis's extremes equals 
                 for (double& o : options.origin) o = offset + 1e6 * size * unit(random);
             }
             stratmesh::detail::Frame frame;
-            REQUIRE(stratmesh::detail::choose_frame(reader, count, options, frame) == Status::ok);
+            const stratmesh::detail::CloudSums sums = stratmesh::detail::sum_cloud(reader, count);
+            REQUIRE(stratmesh::detail::choose_frame(reader, count, sums, options, frame) == Status::ok);
             double lo = DBL_MAX, hi = -DBL_MAX, pass_lo = DBL_MAX, pass_hi = -DBL_MAX;
             stratmesh::detail::height_range(reader, count, frame, &pass_lo, &pass_hi);
             INFO("trial " << trial << ", offset " << offset << ", size " << size);

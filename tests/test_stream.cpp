@@ -281,6 +281,58 @@ TEST_CASE("stream: the output is a manifold tube through every point") {
     CHECK(out.report.layer_count == 10);
 }
 
+TEST_CASE("stream: malformed pushes are refused with their status and change nothing") {
+    const Shape s = shapes::cylinder(2000, Pose::z);
+    double axis[3];
+    s.axis_direction(axis);
+    const Layered l = layer_cloud(s.xyz, axis, equal_fractions(4));
+    REQUIRE(l.cuts.size() == 3);
+    const Options o = shared_origin(s);
+    std::vector<unsigned char> work(stratmesh::stream_workspace_size(l.size(), o));
+    std::vector<uint32_t> triangles;
+    Report report{};
+    stratmesh::Stream* stream = nullptr;
+    REQUIRE(stratmesh::stream_open(o, work.data(), work.size(), collect, &triangles, &report,
+                                   &stream) == Status::ok);
+    auto layer = [&l](size_t k) {
+        return Cloud{l.xyz.data() + 3 * l.start[k], l.start[k + 1] - l.start[k], 0, Scalar::float64};
+    };
+    const Cloud none = {nullptr, 0, 0, Scalar::float64};
+    auto refused = [&](const Cloud& c, double top, Status expected) {
+        const size_t in = report.points_in, emitted = triangles.size();
+        CHECK(stratmesh::stream_push(stream, c, top) == expected);
+        CHECK(report.points_in == in);
+        CHECK(triangles.size() == emitted);
+        CHECK(report.detail != nullptr);
+    };
+    // Before the first point a push without points has a top all the same: what follows
+    // keeps to it (layer 0 lies below the first cut).
+    REQUIRE(stratmesh::stream_push(stream, none, l.cuts[0]) == Status::ok);
+    refused(none, l.cuts[0] - 1, Status::out_of_order);
+    refused(layer(0), l.cuts[0], Status::out_of_order);
+    REQUIRE(stratmesh::stream_push(stream, layer(1), l.cuts[1]) == Status::ok);
+    refused(layer(0), l.cuts[1], Status::out_of_order);     // below the previous top
+    refused(layer(2), l.cuts[0], Status::out_of_order);     // a top below the previous one
+    refused(layer(3), l.cuts[2], Status::out_of_order);     // above its own top
+    refused(layer(2), std::nan(""), Status::invalid_layers);
+    std::vector<double> with_nan(l.xyz.begin() + 3 * static_cast<std::ptrdiff_t>(l.start[2]),
+                                 l.xyz.begin() + 3 * static_cast<std::ptrdiff_t>(l.start[3]));
+    with_nan[3 * 5 + 1] = std::nan("");
+    const size_t before = report.points_in;
+    refused(Cloud{with_nan.data(), with_nan.size() / 3, 0, Scalar::float64}, l.cuts[2],
+            Status::invalid_point);
+    CHECK(report.first_invalid_point == before + 5);
+    REQUIRE(stratmesh::stream_push(stream, layer(2), l.cuts[2]) == Status::ok);
+    REQUIRE(stratmesh::stream_push(stream, layer(3), l.top) == Status::ok);
+    REQUIRE(stratmesh::stream_close(stream) == Status::ok);
+    const size_t accepted = l.size() - (l.start[1] - l.start[0]);
+    CHECK(report.points_in == accepted);
+    CHECK(report.points_used == accepted);
+    // The accepted points' global indices: layers 1 to 3 in push order.
+    REQUIRE(!triangles.empty());
+    CHECK(*std::max_element(triangles.begin(), triangles.end()) < accepted);
+}
+
 #if !defined(STRATMESH_SMALL_CODE)  // cap_ends() is left out there (see the header's Config)
 namespace {
 

@@ -6961,18 +6961,30 @@ inline CloudReader reader_of(const Cloud& cloud) {
             cloud.stride_bytes ? cloud.stride_bytes : 3 * scalar, cloud.scalar == Scalar::float32, nullptr};
 }
 
+const char* const kInvalidPointDetail =
+    "a point has a NaN or infinite coordinate (see first_invalid_point; the "
+    "skip_invalid_points flag skips such points instead)";
+
+// Where a cloud of `count` points (`sums` is its sum_cloud) is refused with invalid_point:
+// at its first point with a NaN or infinite coordinate, unless the skip_invalid_points flag
+// is given. `count` if it is not refused.
+inline size_t refused_at(const CloudReader& reader, size_t count, const CloudSums& sums,
+                         const Options& options) {
+    if (sums.valid == count || (options.flags & skip_invalid_points)) return count;
+    size_t first = 0;
+    while (reader.valid(first)) ++first;
+    return first;
+}
+
 // Counts the points with a NaN or infinite coordinate in rep.rejected, or refuses the
-// cloud at the first one with invalid_point unless the skip_invalid_points flag is given;
-// `sums` is sum_cloud of the cloud's `count` points.
+// cloud (see refused_at).
 inline Status reject_invalid_points(const CloudReader& reader, size_t count,
                                     const CloudSums& sums, const Options& options, Report& rep) {
-    if (sums.valid < count && !(options.flags & skip_invalid_points)) {
-        size_t first = 0;
-        while (reader.valid(first)) ++first;
+    const size_t first = refused_at(reader, count, sums, options);
+    if (first < count) {
         rep.first_invalid_point = first;
         rep.rejected = count;
-        rep.detail = "a point has a NaN or infinite coordinate (see first_invalid_point; "
-                     "the skip_invalid_points flag skips such points instead)";
+        rep.detail = kInvalidPointDetail;
         return Status::invalid_point;
     }
     rep.rejected += count - sums.valid;
@@ -7499,14 +7511,10 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     // Check everything before anything changes.
     const detail::CloudSums sums = detail::sum_cloud(reader, points.count);
     const size_t valid = sums.valid;
-    if (valid < points.count && !(s.options.flags & skip_invalid_points)) {
-        size_t first = 0;
-        while (reader.valid(first)) ++first;
-        s.rep.first_invalid_point = s.rep.points_in + first;
-        return detail::refuse_push(s, Status::invalid_point,
-                                   "a point has a NaN or infinite coordinate (see "
-                                   "first_invalid_point; the skip_invalid_points flag skips "
-                                   "such points instead)");
+    const size_t first_invalid = detail::refused_at(reader, points.count, sums, s.options);
+    if (first_invalid < points.count) {
+        s.rep.first_invalid_point = s.rep.points_in + first_invalid;
+        return detail::refuse_push(s, Status::invalid_point, detail::kInvalidPointDetail);
     }
     const char* const top_below = "a pushed layer's top is below the previous layer's top";
     if (!s.has_frame && top < s.early_top)

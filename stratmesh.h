@@ -129,10 +129,10 @@
 //
 // Stack: no recursion anywhere. The exact incircle's expansions (about 8 KiB) live in the
 // workspace when called from the triangulation, and on the stack only when you call
-// incircle() yourself. Measured worst cases (CI checks them): reconstruct 2.7 KiB,
-// stream_push 2.2 KiB and delaunay_2d 1.5 KiB on a Cortex-M7 (GCC -Os, call graph of
+// incircle() yourself. Measured worst cases (CI checks them): reconstruct 3.0 KiB,
+// stream_push 2.4 KiB and delaunay_2d 1.4 KiB on a Cortex-M7 (GCC -Os, call graph of
 // -fstack-usage, libm and your progress callback not included); painted-stack high-water
-// marks on x86-64 with g++ 12 -O3 of 7.1 KiB for reconstruct and 3.6 KiB for delaunay_2d
+// marks on x86-64 with g++ 12 -O3 of 6.6 KiB for reconstruct and 2.5 KiB for delaunay_2d
 // (inlining makes frames bigger than at -Os); incircle() called directly 9.1 KiB.
 //
 // ==== Errors ===============================================================================

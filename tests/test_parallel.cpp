@@ -190,3 +190,71 @@ TEST_CASE("parallel layers: a workspace too small for the jobs falls back to wor
     CHECK(tris == sequential.triangles);
     CHECK(report.parallel_layers == 0);
 }
+
+TEST_CASE("parallel layers: any workspace below the bound gives out_of_memory or the same triangles") {
+    // The jobs take their room in steps (the layers done ahead, then each group, its band,
+    // the flips across its seam, the safety net, the caps): a workspace that runs out at any
+    // of them must end in out_of_memory with nothing counted, or, where the runner falls
+    // back to working in order, in the triangles of the sequential run, never in others;
+    // and nothing is written past the workspace or the triangle capacity.
+    struct Case {
+        Shape shape;
+        uint32_t layers;
+        uint32_t flags;
+    };
+    const Case cases[] = {
+        {shapes::bumpy_tube(2000, Pose::tilted), 6, 0},
+        {shapes::bumpy_tube(2000, Pose::tilted), 6, uint32_t(stratmesh::surface_flips)},
+        {shapes::capsule(2000, Pose::x), 5, uint32_t(stratmesh::close_ends)},
+        {shapes::cylinder(2000, Pose::z), 30, 0},  // thin layers: the safety net repairs
+    };
+    unsigned two = 2;
+    for (const Case& c : cases) {
+        INFO(c.shape.name << ", " << c.layers << " layers, flags " << c.flags);
+        Options o = axis_options(c.shape);
+        o.layer_count = c.layers;
+        o.flags |= c.flags;
+        const Result sequential = run(c.shape, o);
+        REQUIRE(sequential.status == Status::ok);
+        Options p = o;
+        p.run_jobs = run_on_threads;
+        p.jobs_user = &two;
+        const stratmesh::Cloud cloud = cloud_of(c.shape);
+        const size_t bound = stratmesh::reconstruct_workspace_size(cloud.count, p);
+        const size_t capacity = stratmesh::reconstruct_max_triangles(cloud.count, p);
+        size_t failures = 0, successes = 0, smallest_success = bound;
+        auto attempt = [&](size_t bytes) {
+            CAPTURE(bytes);
+            std::vector<unsigned char> work(bytes + 64, 0xA5);
+            std::vector<uint32_t> tris(3 * capacity + 1, 0xFEFEFEFEu);
+            Report report = {};
+            size_t count = 12345;
+            const Status status = stratmesh::reconstruct(cloud, p, work.data(), bytes, tris.data(),
+                                                         capacity, &count, &report);
+            CHECK(tris.back() == 0xFEFEFEFEu);
+            CHECK(std::all_of(work.end() - 64, work.end(), [](unsigned char b) { return b == 0xA5; }));
+            if (status == Status::ok) {
+                ++successes;
+                smallest_success = std::min(smallest_success, bytes);
+                tris.resize(3 * count);
+                CHECK(tris == sequential.triangles);
+                CHECK(report.points_used == sequential.report.points_used);
+            } else {
+                ++failures;
+                CHECK(status == Status::out_of_memory);
+                CHECK(count == 0);
+            }
+        };
+        // A coarse ladder up to the bound, then a fine one across the coarse step where the
+        // sizes began to work: there the room runs out late in the run.
+        for (size_t bytes : {size_t{0}, size_t{1}, size_t{100}, size_t{4096}, bound - 1}) attempt(bytes);
+        for (size_t k = 1; k < 64; ++k) attempt(bound * k / 64);
+        const size_t coarse = smallest_success;
+        for (size_t k = 1; k < 64; ++k) attempt(coarse - bound / 64 * k / 64);
+        MESSAGE(c.shape.name << ": " << failures << " sizes out_of_memory, " << successes
+                             << " the same triangles; smallest that worked " << smallest_success
+                             << " of a bound of " << bound);
+        CHECK(failures >= 4);
+        CHECK(successes >= 1);
+    }
+}

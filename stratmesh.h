@@ -214,7 +214,7 @@ namespace stratmesh {
     X(invalid_point, "a coordinate is NaN or infinite")                                   \
     X(too_few_points, "fewer than 3 distinct points")                                     \
     X(collinear, "all points lie on one line")                                            \
-    X(invalid_axis, "the axis direction is zero, NaN or infinite")                        \
+    X(invalid_axis, "the axis direction is zero, NaN, infinite, or too long or short to square") \
     X(invalid_layers, "a cut, the layer count or the layer height is NaN, infinite or negative") \
     X(flat_cloud, "the cloud has no extent along the axis")                               \
     X(not_columnar, "the points do not surround the axis in any layer")                   \
@@ -396,7 +396,7 @@ typedef void (*JobRunner)(void* user, uint32_t count, JobFunction job, void* con
 // All zero means defaults: `Options options = {};` is always valid.
 struct Options {
     Axis axis;
-    double direction[3];     // for Axis::direction; any non-zero length
+    double direction[3];     // for Axis::direction; any length from 1.5e-154 to 1.3e154
     // Layers, first match wins: explicit cut positions along the axis, as the coordinate
     // dot(point, axis) (with Axis::z, a cut at 68 is the plane z = 68; a point on a cut,
     // up to 2^-40 of the cloud's height, belongs to the layer above); any order,
@@ -535,12 +535,14 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 //                 when buffers overlap: see invalid_argument below).
 //
 // Returns ok; invalid_argument (a null pointer with a non-zero count, a stride smaller than
-// one point, an unknown Scalar, cut_count without cuts, a null triangle_count,
+// one point, an unknown Scalar, cut_count without cuts, a null triangle_count, a NaN or
+// infinite origin with origin_given,
 // drop_outliers in a build with STRATMESH_SMALL_CODE, or any two of the span of the cloud's
 // points, the workspace, the triangle array, *triangle_count, *report and the report's
 // layer array sharing a byte: then nothing at all is written, not even the report);
 // too_many_points; invalid_point (Report::first_invalid_point, unless
-// skip_invalid_points); invalid_axis (Axis::direction of zero length, NaN or infinite);
+// skip_invalid_points); invalid_axis (an unknown Axis, or Axis::direction zero, NaN,
+// infinite, or of a length outside 1.5e-154 to 1.3e154);
 // invalid_layers (a NaN or infinite cut, more than 2^32 - 2 cuts, a negative or
 // non-finite layer_height);
 // too_few_points (fewer than 3 valid points, or no surface spans them); flat_cloud (no
@@ -626,7 +628,8 @@ Status stream_open(const Options& options, void* workspace, size_t workspace_byt
 // invalid_layers (a NaN or infinite top); out_of_order; too_many_points (2^32 - 3 points in
 // all); out_of_memory (more than the workspace can hold: the push is refused and the stream
 // unchanged); and, from triangulating, the errors of reconstruct(), after which the stream
-// only returns that status. A refused push changes nothing.
+// only returns that status. A refused push changes nothing but Report::detail, which says
+// why.
 Status stream_push(Stream* stream, const Cloud& points, double top);
 
 // Forms and emits the last layers and completes the report. Returns ok or the status of
@@ -2621,9 +2624,12 @@ inline double scale_for_extent(double extent) {
     return std::ldexp(1.0, -exponent);
 }
 
+// False unless v's squared length is a normal double (v's length between about 1.5e-154
+// and 1.3e154): a subnormal square has lost the bits that make the result unit.
 inline bool normalize(Vec3& v) {
-    double len = std::sqrt(dot(v, v));
-    if (!(len > 0) || !is_finite(len)) return false;
+    const double square = dot(v, v);
+    if (!(square >= DBL_MIN) || !is_finite(square)) return false;
+    const double len = std::sqrt(square);
     v = scaled(v, 1.0 / len);
     return true;
 }
@@ -7499,13 +7505,23 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     size_t scalar = points.scalar == Scalar::float32 ? sizeof(float)
                   : points.scalar == Scalar::float64 ? sizeof(double) : 0;
     size_t stride = points.stride_bytes ? points.stride_bytes : 3 * scalar;
-    if (scalar == 0 || stride < 3 * scalar || (points.count > 0 && !points.xyz))
-        return Status::invalid_argument;
-    if (detail::ranges_overlap(detail::strided_range(points.xyz, points.count, stride, 3 * scalar),
-                               s.workspace))
-        return Status::invalid_argument;
-    if (!detail::is_finite(top)) return Status::invalid_layers;
-    if (points.count > detail::kMaxPoints - 1 - s.rep.points_in) return Status::too_many_points;
+    // A refusal names its own reason, never the one of a push refused before.
+    Status refusal = Status::ok;
+    const char* why = nullptr;
+    if (scalar == 0 || stride < 3 * scalar || (points.count > 0 && !points.xyz) ||
+        detail::ranges_overlap(detail::strided_range(points.xyz, points.count, stride, 3 * scalar),
+                               s.workspace)) {
+        refusal = Status::invalid_argument;
+        why = "a pushed cloud has a null pointer with a non-zero count, a stride smaller than "
+              "one point, an unknown scalar type, or points in the stream's workspace";
+    } else if (!detail::is_finite(top)) {
+        refusal = Status::invalid_layers;
+        why = "a pushed layer's top is NaN or infinite";
+    } else if (points.count > detail::kMaxPoints - 1 - s.rep.points_in) {
+        refusal = Status::too_many_points;
+        why = "more points pushed than 32-bit triangle indices can address";
+    }
+    if (refusal != Status::ok) return detail::refuse_push(s, refusal, why);
     const detail::CloudReader reader = {static_cast<const unsigned char*>(points.xyz), stride,
                                         points.scalar == Scalar::float32, nullptr};
     // Check everything before anything changes.

@@ -1769,6 +1769,34 @@ TEST_CASE("statuses for bad arguments and options") {
         CHECK(reconstruct_guarded(cloud, o).status == Status::invalid_axis);
         o.direction[2] = std::numeric_limits<double>::quiet_NaN();
         CHECK(reconstruct_guarded(cloud, o).status == Status::invalid_axis);
+        Options unknown = axis_options(s);
+        unknown.axis = static_cast<Axis>(17);
+        CHECK(reconstruct_guarded(cloud, unknown).status == Status::invalid_axis);
+    }
+    SUBCASE("a direction whose square is not a normal double: invalid_axis; any other length: the same triangles") {
+        // Scaling by a power of two is exact, so every length whose square is a normal
+        // double gives the unit direction's bits; a subnormal square has lost some (from
+        // 2^-515 to 2^-535 the call returned ok with other triangles before the check) and
+        // an infinite one has no length.
+        double unit[3];
+        s.axis_direction(unit);
+        Options o = {};
+        o.axis = Axis::direction;
+        for (int k = 0; k < 3; ++k) o.direction[k] = unit[k];
+        const Run reference = reconstruct_guarded(cloud, o);
+        REQUIRE(reference.status == Status::ok);
+        for (int exponent : {-500, -20, 20, 500}) {
+            CAPTURE(exponent);
+            for (int k = 0; k < 3; ++k) o.direction[k] = std::ldexp(unit[k], exponent);
+            const Run run = reconstruct_guarded(cloud, o);
+            REQUIRE(run.status == Status::ok);
+            CHECK(run.triangles == reference.triangles);
+        }
+        for (int exponent : {-520, -540, 520, 1000}) {
+            CAPTURE(exponent);
+            for (int k = 0; k < 3; ++k) o.direction[k] = std::ldexp(unit[k], exponent);
+            CHECK(reconstruct_guarded(cloud, o).status == Status::invalid_axis);
+        }
     }
     SUBCASE("NaN cut, negative layer height: invalid_layers") {
         Options o = axis_options(s);
@@ -1789,6 +1817,21 @@ TEST_CASE("statuses for bad arguments and options") {
         std::vector<uint32_t> tris(3 * stratmesh::reconstruct_max_triangles(s.size(), o));
         CHECK(stratmesh::reconstruct(cloud, o, work.data(), work.size(), tris.data(), tris.size() / 3, nullptr, nullptr) ==
               Status::invalid_argument);
+    }
+    SUBCASE("cut_count without cuts, a NaN or infinite origin: invalid_argument") {
+        Options o = axis_options(s);
+        o.cut_count = 2;
+        CHECK(reconstruct_guarded(cloud, o).status == Status::invalid_argument);
+        for (double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+            Options p = axis_options(s);
+            p.flags |= stratmesh::origin_given;
+            p.origin[1] = bad;
+            const Run run = reconstruct_guarded(cloud, p);
+            CHECK(run.status == Status::invalid_argument);
+            CHECK(run.count == 0);
+            p.flags &= ~uint32_t(stratmesh::origin_given);  // without the flag the origin is not read
+            CHECK(reconstruct_guarded(cloud, p).status == Status::ok);
+        }
     }
     SUBCASE("fewer than 3 points: too_few_points") {
         Options o = axis_options(s);

@@ -298,12 +298,19 @@ TEST_CASE("stream: malformed pushes are refused with their status and change not
         return Cloud{l.xyz.data() + 3 * l.start[k], l.start[k + 1] - l.start[k], 0, Scalar::float64};
     };
     const Cloud none = {nullptr, 0, 0, Scalar::float64};
+    // Each refusal says why in the report, in its own words: not those of the refusal before
+    // when its status differs.
+    Status last_status = Status::ok;
+    const char* last_detail = nullptr;
     auto refused = [&](const Cloud& c, double top, Status expected) {
         const size_t in = report.points_in, emitted = triangles.size();
         CHECK(stratmesh::stream_push(stream, c, top) == expected);
         CHECK(report.points_in == in);
         CHECK(triangles.size() == emitted);
         CHECK(report.detail != nullptr);
+        if (expected != last_status) CHECK(report.detail != last_detail);
+        last_status = expected;
+        last_detail = report.detail;
     };
     // Before the first point a push without points has a top all the same: what follows
     // keeps to it (layer 0 lies below the first cut).
@@ -315,6 +322,15 @@ TEST_CASE("stream: malformed pushes are refused with their status and change not
     refused(layer(2), l.cuts[0], Status::out_of_order);     // a top below the previous one
     refused(layer(3), l.cuts[2], Status::out_of_order);     // above its own top
     refused(layer(2), std::nan(""), Status::invalid_layers);
+    const Cloud third = layer(2);
+    refused(Cloud{third.xyz, third.count, 2 * sizeof(double), Scalar::float64}, l.cuts[2],
+            Status::invalid_argument);  // a stride smaller than one point
+    refused(layer(2), std::numeric_limits<double>::infinity(), Status::invalid_layers);
+    refused(Cloud{third.xyz, third.count, 0, static_cast<Scalar>(7)}, l.cuts[2],
+            Status::invalid_argument);  // an unknown scalar type
+    refused(Cloud{nullptr, 5, 0, Scalar::float64}, l.cuts[2], Status::invalid_argument);
+    refused(Cloud{work.data() + 64, 10, 0, Scalar::float32}, l.cuts[2],
+            Status::invalid_argument);  // points in the stream's workspace
     std::vector<double> with_nan(l.xyz.begin() + 3 * static_cast<std::ptrdiff_t>(l.start[2]),
                                  l.xyz.begin() + 3 * static_cast<std::ptrdiff_t>(l.start[3]));
     with_nan[3 * 5 + 1] = std::nan("");

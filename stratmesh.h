@@ -390,7 +390,10 @@ typedef void (*JobFunction)(void* context, uint32_t index);
 
 // Runs job(context, i) once for every i in [0, count), in any order, on any threads (the
 // caller's pool, RTOS tasks, std::thread, or a plain loop), and returns when all have
-// finished. Jobs are independent: each writes only its own part of the workspace.
+// finished. Jobs are independent: each writes only its own part of the workspace. A
+// runner that skips a job only loses time (its layers are done in order afterwards), one
+// that runs a job again after it finished changes nothing, and an index outside
+// [0, count) is ignored; the same job on two threads at once is a data race.
 typedef void (*JobRunner)(void* user, uint32_t count, JobFunction job, void* context);
 
 // All zero means defaults: `Options options = {};` is always valid.
@@ -424,8 +427,8 @@ struct Options {
     // Optional, reconstruct() only: with a runner, the layers are triangulated as
     // independent jobs (at most kMaxJobs of them, each over a run of consecutive layers with
     // its own scratch in the workspace); grouping layers, stitching them and the safety net
-    // stay in order. The triangles and the report are the same bytes whatever the runner does,
-    // as long as it runs every job once.
+    // stay in order. The triangles and the report are the same bytes whatever the runner
+    // does (see JobRunner), Report::parallel_layers aside.
     // reconstruct_workspace_size() grows with a runner (see there); a workspace too small
     // for the jobs' scratch runs them in order instead (Report::parallel_layers says how
     // many layers were triangulated by jobs). Jobs call no user code, not even progress.
@@ -6733,6 +6736,7 @@ inline void keep_border(LayerAhead& a, const uint32_t* ids, size_t n, Arena& are
 
 inline void run_layer_job(void* context, uint32_t index) {
     const ParallelLayers& p = *static_cast<const ParallelLayers*>(context);
+    if (index >= p.job_count) return;  // a runner's mistake: no job of ours
     const LayerQueue& q = *p.queue;
     Arena arena = Arena::over(p.scratch[index], p.scratch_bytes[index]);
     for (uint32_t slot = p.first_slot[index]; slot < p.first_slot[index + 1]; ++slot) {

@@ -258,3 +258,58 @@ TEST_CASE("parallel layers: any workspace below the bound gives out_of_memory or
         CHECK(successes >= 1);
     }
 }
+
+namespace {
+
+// Runners that break the contract in the ways JobRunner allows for.
+void run_even_only(void*, uint32_t count, JobFunction job, void* context) {
+    for (uint32_t i = 0; i < count; i += 2) job(context, i);
+}
+
+void run_twice(void*, uint32_t count, JobFunction job, void* context) {
+    for (uint32_t round = 0; round < 2; ++round)
+        for (uint32_t i = 0; i < count; ++i) job(context, i);
+}
+
+void run_with_strangers(void*, uint32_t count, JobFunction job, void* context) {
+    job(context, count);
+    job(context, 0xFFFFFFFFu);
+    for (uint32_t i = 0; i < count; ++i) job(context, i);
+    job(context, count + 1);
+}
+
+void run_none(void*, uint32_t, JobFunction, void*) {}
+
+}  // namespace
+
+TEST_CASE("parallel layers: a runner that skips jobs, repeats them or names others gives the same bytes") {
+    const Shape s = shapes::bumpy_tube(4000, Pose::tilted);
+    Options o = axis_options(s);
+    o.layer_count = 8;
+    const Result sequential = run(s, o);
+    REQUIRE(sequential.status == Status::ok);
+    Options all = o;
+    all.run_jobs = run_in_order;
+    const size_t every_layer = run(s, all).report.parallel_layers;
+    REQUIRE(every_layer > 2);
+    struct Runner {
+        const char* name;
+        stratmesh::JobRunner run;
+    };
+    for (Runner runner : {Runner{"every other job", run_even_only}, Runner{"every job twice", run_twice},
+                          Runner{"indices past the count", run_with_strangers}, Runner{"no job", run_none}}) {
+        INFO(runner.name);
+        Options p = o;
+        p.run_jobs = runner.run;
+        const Result parallel = run(s, p);
+        check_same(sequential, parallel);
+        if (runner.run == run_even_only) {
+            CHECK(parallel.report.parallel_layers > 0);
+            CHECK(parallel.report.parallel_layers < every_layer);
+        } else if (runner.run == run_none) {
+            CHECK(parallel.report.parallel_layers == 0);
+        } else {
+            CHECK(parallel.report.parallel_layers == every_layer);
+        }
+    }
+}

@@ -599,7 +599,8 @@ struct Stream;  // lives in the caller's workspace
 
 // Receives final triangles: 3 * count global indices (the position of the point among all
 // points pushed so far, invalid ones included), counter-clockwise seen from outside. The
-// array is only valid during the call.
+// array is only valid during the call. Must not call back into the stream it came from
+// (it is mid-push); any other stream, or reconstruct() with another workspace, is fine.
 typedef void (*TriangleCallback)(void* user, const uint32_t* triangles, size_t count);
 
 // Bytes for a stream that holds at most max_points_held points at once; 0 if that is

@@ -1994,6 +1994,64 @@ TEST_CASE("a too-small triangle array gives triangle_capacity with the needed co
 // sees any overrun), and the bound stays within a small factor of the peak. Adversarial
 // layouts included: every point in one layer, (almost) one point per layer, heavy
 // duplication.
+namespace {
+void run_jobs_in_order(void*, uint32_t count, stratmesh::JobFunction job, void* context) {
+    for (uint32_t i = 0; i < count; ++i) job(context, i);
+}
+}  // namespace
+
+TEST_CASE("workspace sizes: never wrap around, 0 beyond what can be served") {
+    // A size computed in overflowing arithmetic would come back small: a caller would
+    // allocate it and be refused, or worse trust it. Every bound must grow with the count,
+    // at least 16 bytes a point, until it is 0 (no workspace can serve that many), and stay
+    // 0 above. On 64-bit targets the 32-bit indices end it (about 4.3e9 points); on 32-bit
+    // ones the address space.
+    Options plain = {};
+    Options capped = {};
+    capped.flags = stratmesh::close_ends;
+    Options jobs = {};
+    jobs.run_jobs = run_jobs_in_order;
+    struct Bound {
+        const char* name;
+        std::function<size_t(size_t)> size;
+    };
+    const Bound bounds[] = {
+        {"reconstruct", [&](size_t n) { return stratmesh::reconstruct_workspace_size(n, plain); }},
+        {"reconstruct with close_ends", [&](size_t n) { return stratmesh::reconstruct_workspace_size(n, capped); }},
+        {"reconstruct with a runner", [&](size_t n) { return stratmesh::reconstruct_workspace_size(n, jobs); }},
+        {"stream", [&](size_t n) { return stratmesh::stream_workspace_size(n, plain); }},
+#if !defined(STRATMESH_SMALL_CODE)
+        {"cap_ends", [](size_t n) { return stratmesh::cap_ends_workspace_size(n, n <= SIZE_MAX / 2 ? 2 * n : n); }},
+#endif
+        {"delaunay_2d", [](size_t n) { return stratmesh::delaunay_2d_workspace_size(n); }},
+    };
+    const size_t m = SIZE_MAX;
+    const size_t counts[] = {0, 1, 3, 1000, size_t{1} << 20, size_t{1} << 26, m / 1024, m / 200,
+                             m / 64, m / 24, m / 16, m / 2, m - 1, m};
+    for (const Bound& b : bounds) {
+        INFO(b.name);
+        size_t previous = 0;
+        bool ended = false;
+        for (size_t n : counts) {
+            CAPTURE(n);
+            const size_t bytes = b.size(n);
+            if (ended) {
+                CHECK(bytes == 0);
+                continue;
+            }
+            if (bytes == 0) {
+                CHECK(n > 1000);  // every small cloud can be served
+                ended = true;
+                continue;
+            }
+            CHECK(bytes >= previous);
+            CHECK(bytes / 16 >= n);
+            previous = bytes;
+        }
+        CHECK(ended);
+    }
+}
+
 TEST_CASE("workspace: the bound suffices, the reported peak is exact, one byte short is out_of_memory") {
     struct Setup {
         const char* name;

@@ -553,6 +553,32 @@ TEST_CASE("point by point reading gives the points of the whole-file readers") {
         CHECK(streamed.size() == xyz.size());
         CHECK(streamed_info.format == whole_info.format);
         CHECK(streamed_info.encoding == whole_info.encoding);
+        // The most points the file can hold (it sizes the stream's workspace): the PLY
+        // header's count, or for text at least the points there are.
+        if (streamed_info.format == CloudFormat::ply)
+            CHECK(streamed_info.point_limit == xyz.size() / 3);
+        else
+            CHECK(streamed_info.point_limit >= xyz.size() / 3);
+        CHECK(streamed_info.point_limit < UINT64_MAX);
+    }
+}
+
+TEST_CASE("point by point reading: the most points a text file can hold bounds the shortest lines") {
+    TempDir dir;
+    // The shortest lines a point can take, with and without a line end on the last one.
+    const std::pair<const char*, std::string> files[] = {
+        {"short.xyz", "1 2 3\n4 5 6\n7 8 9\n"}, {"no_end.xyz", "1 2 3\n4 5 6\n7,8,9"},
+        {"short.obj", "v 1 2 3\nv 4 5 6\nv 7 8 9"}};
+    for (const auto& file : files) {
+        CAPTURE(file.first);
+        save(dir.file(file.first), file.second);
+        std::vector<double> streamed;
+        std::string error;
+        CloudInfo info;
+        REQUIRE_MESSAGE(read_streamed(dir.file(file.first), streamed, error, info), error);
+        CHECK(streamed.size() == 9);
+        CHECK(info.point_limit >= 3);
+        CHECK(info.point_limit <= 4);
     }
 }
 

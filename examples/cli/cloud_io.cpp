@@ -159,9 +159,18 @@ std::unique_ptr<PointReader> open_point_reader(const std::string& path, CloudInf
         error = "OFF files cannot be read point by point (--stream): convert the file to PLY "
                 "or XYZ";
     else if (info.format == CloudFormat::ply)
-        reader = open_ply_points(std::move(file), error, info.encoding);
-    else
+        reader = open_ply_points(std::move(file), error, info.encoding, info.point_limit);
+    else {
+        // A point takes a line of at least three one-character numbers and two separators
+        // ("1 2 3"), an OBJ vertex two characters more ("v 1 2 3"), and a line end but on
+        // the last line.
+        std::error_code failed;
+        const bool regular = std::filesystem::is_regular_file(path, failed);
+        const uintmax_t bytes = regular ? std::filesystem::file_size(path, failed) : 0;
+        if (regular && !failed)
+            info.point_limit = bytes / (info.format == CloudFormat::obj ? 8 : 6) + 1;
         reader = open_text_points(std::move(file), info.format == CloudFormat::obj);
+    }
     if (!reader) error = path + ": " + error;
     return reader;
 }

@@ -12,6 +12,7 @@
 #define STRATMESH_CLI_CLOUD_IO_H
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,6 +35,10 @@ CloudFormat detect_cloud_format(const char* data, size_t size);
 struct CloudInfo {
     CloudFormat format = CloudFormat::automatic; // the format actually read
     std::string encoding; // PLY: "ascii", "binary_little_endian", "binary_big_endian"
+    // open_point_reader: the most points the file can hold (a PLY header's vertex count; a
+    // text file's size over the shortest line a point can take); UINT64_MAX if unknown (a
+    // pipe).
+    uint64_t point_limit = UINT64_MAX;
 };
 
 // Parses a whole file image. `format` automatic detects it from the content; any other

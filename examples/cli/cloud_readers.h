@@ -20,8 +20,9 @@ bool read_off(std::string_view data, std::vector<double>& xyz, std::string& erro
 bool read_obj(std::string_view data, std::vector<double>& xyz, std::string& error);
 
 // Point-by-point readers over a file window positioned at the start of the file.
+// open_ply_points also gives the header's encoding and vertex count.
 std::unique_ptr<PointReader> open_ply_points(std::unique_ptr<FileWindow> file, std::string& error,
-                                             std::string& encoding);
+                                             std::string& encoding, uint64_t& vertex_count);
 std::unique_ptr<PointReader> open_text_points(std::unique_ptr<FileWindow> file, bool obj);
 
 // True for OFF header keywords: OFF with the optional prefixes ST, C, N, 4, n.

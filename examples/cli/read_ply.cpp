@@ -601,7 +601,7 @@ private:
 } // namespace
 
 std::unique_ptr<PointReader> open_ply_points(std::unique_ptr<FileWindow> file, std::string& error,
-                                             std::string& encoding) {
+                                             std::string& encoding, uint64_t& vertex_count) {
     // The header must lie within the first block: headers are a few hundred bytes.
     const size_t kMaxHeader = 1 << 20;
     PlyHeader header;
@@ -615,6 +615,7 @@ std::unique_ptr<PointReader> open_ply_points(std::unique_ptr<FileWindow> file, s
         return nullptr;
     }
     encoding = encoding_name(header.encoding);
+    vertex_count = vertex.count;
     file->skip(header.data_offset);
     file->set_first_line(header.data_line);
     auto points =

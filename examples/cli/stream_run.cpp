@@ -81,6 +81,10 @@ public:
         CloudInfo info;
         std::unique_ptr<PointReader> reader = open_point_reader(line_.input, info, error);
         if (!reader) return StreamOutcome::file_error;
+        // The stream never holds more points than the file has: a small file gets a small
+        // workspace, whatever --stream-points allows (the library needs room for 16).
+        const uint64_t most = std::max<uint64_t>(info.point_limit, 16);
+        if (record_.stream_points > most) record_.stream_points = most;
         record_.input_format = cloud_format_name(info.format);
         record_.input_encoding = info.encoding;
         if (!writer_.open(line_.output, mesh_format_from_extension(line_.output), line_.ascii,
@@ -126,7 +130,8 @@ private:
         options_.flags |= stratmesh::origin_given;
         for (size_t k = 0; k < 3; ++k) record_.origin[k] = options_.origin[k];
         tops_.start(first[0] * axis_[0] + first[1] * axis_[1] + first[2] * axis_[2]);
-        record_.workspace_bytes = stratmesh::stream_workspace_size(line_.stream_points, options_);
+        record_.workspace_bytes = stratmesh::stream_workspace_size(
+            static_cast<size_t>(std::min<uint64_t>(record_.stream_points, SIZE_MAX)), options_);
         workspace_.reset(new (std::nothrow) unsigned char[record_.workspace_bytes]);
         record_.reconstructed = true;
         if (!workspace_ || record_.workspace_bytes == 0) {

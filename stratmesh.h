@@ -79,8 +79,9 @@
 //                            along the axis (see >>caps; 0.3 KiB), so its caps are the Delaunay
 //                            triangulation of each loop's projection, which crosses a
 //                            wall leaning over a ragged loop more often, and their ear
-//                            clipping's restarts (kCapEarStarts), so a few more loops
-//                            are left open. It leaves out cap_ends() too (not
+//                            clipping's restarts (kCapEarStarts) and the exhaustive
+//                            search that follows (kCapSearchCorners), so a few more
+//                            loops are left open. It leaves out cap_ends() too (not
 //                            declared: 0.6 KiB on the Cortex-M7); reconstruct()'s
 //                            close_ends stays. And it leaves out the
 //                            crescent rule (a layer next to a slanted end of the tube
@@ -114,11 +115,12 @@
 // delaunay_2d needs 72 bytes per point plus about 10 KiB; its output is at most
 // 2n - 5 triangles (24 bytes per point). reconstruct needs about 115 bytes per point
 // (the triangulation of its largest possible layer with the layer's coordinates, plus the
-// layer grouping and boundary loops), about 121 with the close_ends flag, about 166 with a
+// layer grouping and boundary loops), about 121 with the close_ends flag (plus up to
+// 32 KiB for the search of a cap: n (n - 1) / 2 bytes below 256 points), about 166 with a
 // jobs runner (Options::run_jobs); its output is at most 2n triangles. A stream needs about
 // 190 bytes per point it holds at once, whatever the size of the whole cloud; cap_ends()
 // 78 bytes per point of the whole cloud (its loops may pass through every point) plus 12
-// per triangle: about 102 per point for a tube.
+// per triangle, plus the same 32 KiB: about 102 per point for a tube.
 //
 // The whole workspace belongs to the call while it runs, including what it does not need:
 // without a runner, reconstruct keeps the points grouped by layer (24 bytes each) at the
@@ -341,11 +343,12 @@ enum Flags : uint32_t {
     // high along the axis as the loop allows (so that a wall leaning over a ragged loop
     // stays clear of it), constrained Delaunay where the loop is planar, avoiding any
     // diagonal that is already an edge of the surface. A loop whose projection is not a
-    // simple polygon, or that no ear clipping tried closes without repeating such an edge,
-    // stays open: the call still returns ok, Report::caps_left_open counts it and
-    // Report::detail says so. Caps do not cross one another; like the rest of the
-    // surface, they are not checked against the tube. The workspace bound grows by about 6
-    // bytes per point with this flag; reconstruct_max_triangles() still suffices (a closed
+    // simple polygon, or that neither ear clipping nor (for loops of at most 256 corners)
+    // an exhaustive search closes without repeating such an edge, stays open: the call
+    // still returns ok, Report::caps_left_open counts it and Report::detail says so. Caps
+    // do not cross one another; like the rest of the surface, they are not checked against
+    // the tube. The workspace bound grows by about 6 bytes per point with this flag, plus
+    // up to 32 KiB for that search; reconstruct_max_triangles() still suffices (a closed
     // surface through V vertices has 2V - 4 triangles). The stream refuses the flag: its
     // surface is capped afterwards by cap_ends().
     close_ends = 1u << 1,
@@ -493,8 +496,8 @@ struct Report {
     size_t workspace_used;
     size_t diagonal_swaps;   // band diagonals swapped when stitching layers (paper's step 4)
     // With close_ends: boundary loops closed by a cap, loops left open (their projection
-    // across the axis is not a simple polygon, or its ears would repeat edges of the
-    // surface), and the cap triangles, which are the last
+    // across the axis is not a simple polygon, or every cap found for them would repeat
+    // edges of the surface), and the cap triangles, which are the last
     // cap_triangles of the output (included in triangle_count). All 0 without the flag.
     size_t caps_closed;
     size_t caps_left_open;
@@ -769,6 +772,7 @@ const bool kLiftedCaps = false;
 const bool kCrescentLayers = false;
 const bool kClosedEnds = false;
 const uint32_t kCapEarStarts = 1;
+const uint32_t kCapSearchCorners = 0;
 const bool kDropOutliers = false;
 const bool kSurfaceFlips = false;
 const bool kLocalUnpeel = false;
@@ -789,6 +793,9 @@ const bool kCrescentLayers = true;
 const bool kClosedEnds = true;
 // A cap whose ear clipping gets stuck is clipped again from other corners (see >>caps).
 const uint32_t kCapEarStarts = 8;
+// A loop of at most this many corners that no clipping closes is searched exhaustively for
+// a cap (see >>caps; its table takes a byte per pair of corners: 32 KiB).
+const uint32_t kCapSearchCorners = 256;
 // The drop_outliers flag (see "outliers" in >>layers); without it, the flag is refused.
 const bool kDropOutliers = true;
 // Layers are flipped on the surface (see "flips on the surface" in >>layer triangulation).
@@ -5119,8 +5126,12 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
 // Each cap triangle runs the loop's edges against the surface's direction, so the closed
 // surface stays consistently oriented (the bottom cap faces -axis, the top one +axis). A
 // diagonal that is already an edge of the surface would join three triangles: ears and
-// flips that would make one are skipped. A loop whose projection is not simple, or whose
-// remaining ears all make such a diagonal, stays open.
+// flips that would make one are skipped. Where the wall has fins (triangles with two edges
+// on the loop: a scan rounded to a grid makes them), the fin's middle corner has no way
+// into the cap but a diagonal to a corner it sees across the loop, which ear clipping
+// never makes; so a loop that no clipping closes, of at most kCapSearchCorners corners, is
+// searched exhaustively (search_cap). A loop whose projection is not simple, or that
+// neither closes, stays open.
 //
 // The loops of a star-shaped layer run monotonically in angle around its centre (see the
 // unroll section), so their projections are simple but for rounding or the safety net's
@@ -5178,6 +5189,8 @@ struct CapLoop {
     uint32_t* corners;        // per cap triangle: 3 positions, counter-clockwise
     uint32_t* across;         // per cap triangle edge k (corner k to k + 1): the edge beyond
     uint32_t* stack;          // cap triangles whose edges are to be checked
+    uint8_t* search;          // per pair of positions i < j: the cap search's choice, k - i
+                              // (allocated, and read, only where kCapSearchCorners > 0)
 };
 
 const unsigned char kLoopStart = 1, kLoopBroken = 2;
@@ -5213,6 +5226,10 @@ inline bool allocate_cap_loop(CapLoop& c, size_t length, Arena& arena) {
     c.corners = arena.alloc<uint32_t>(3 * length);
     c.across = arena.alloc<uint32_t>(3 * length);
     c.stack = arena.alloc<uint32_t>(length);
+    if (kCapSearchCorners > 0) {
+        const size_t searched = length < kCapSearchCorners ? length : kCapSearchCorners;
+        c.search = arena.alloc<uint8_t>(searched * (searched - 1) / 2);
+    }
     return !arena.failed;
 }
 
@@ -5480,6 +5497,91 @@ public:
         }
     }
 
+    // Triangulates the loop by searching all its triangulations for one whose diagonals
+    // are no edges of the surface (dynamic programming over the pairs of corners: the
+    // polygon i, i + 1, ..., j closed by diagonal i - j has one if some corner k between
+    // makes a triangle i, k, j with both sides closable): what ear clipping misses where
+    // fins of the wall leave a corner nothing to join but a corner across the loop. For
+    // loops of at most kCapSearchCorners corners (cubic time: about 0.1 s for 256);
+    // false if there are more, or none is found.
+    bool search_cap() {
+        const uint32_t m = length_;
+        if (m > kCapSearchCorners || m < 3) return false;
+        // choice(i, j): the corner k, stored as k - i, of a triangle i, k, j from which the
+        // polygon i .. j closes; 0 if it does not (i - j no diagonal, or no such k).
+        auto choice = [this](uint32_t i, uint32_t j) -> uint8_t& {
+            return c_.search[static_cast<size_t>(j) * (j - 1) / 2 + i];
+        };
+        auto closes = [&choice](uint32_t i, uint32_t j) { return j == i + 1 || choice(i, j) != 0; };
+        for (uint32_t span = 2; span < m; ++span)
+            for (uint32_t i = 0; i + span < m; ++i) {
+                const uint32_t j = i + span;
+                uint8_t& best = choice(i, j);
+                best = 0;
+                // i - j must be a diagonal (the loop edge m - 1 -> 0 closes the whole).
+                if ((j != m - 1 || i != 0) &&
+                    (g_.has_edge(ids_[i], ids_[j]) || !diagonal_inside(i, j)))
+                    continue;
+                for (uint32_t k = i + 1; k < j && best == 0; ++k)
+                    if (closes(i, k) && closes(k, j)) best = static_cast<uint8_t>(k - i);
+            }
+        if (choice(0, m - 1) == 0) return false;
+        // The triangles, from the outermost in: each job is a pair (i, j) and the edge of
+        // the triangle already made beyond its side j -> i (kNoIndex for the loop edge).
+        triangles_ = 0;
+        uint32_t depth = 0;
+        auto push = [this, &depth](uint32_t i, uint32_t j, uint32_t beyond) {
+            c_.prev[depth] = i;
+            c_.next[depth] = j;
+            c_.owner[depth++] = beyond;
+        };
+        push(0, m - 1, kNoIndex);
+        while (depth > 0) {
+            --depth;
+            const uint32_t i = c_.prev[depth], j = c_.next[depth], beyond = c_.owner[depth];
+            const uint32_t k = i + choice(i, j);
+            const uint32_t t = triangles_++;
+            uint32_t* corner = c_.corners + 3 * static_cast<size_t>(t);
+            corner[0] = i;
+            corner[1] = k;
+            corner[2] = j;
+            for (uint32_t e = 0; e < 3; ++e) c_.across[3 * static_cast<size_t>(t) + e] = kNoIndex;
+            link(3 * t + 2, beyond);
+            if (k > i + 1) push(i, k, 3 * t);
+            if (j > k + 1) push(k, j, 3 * t + 1);
+        }
+        return true;
+    }
+
+    // Whether i - j (positions on the loop) runs inside the polygon: within the corners at
+    // both ends and clear of every loop edge that does not end at i or j.
+    bool diagonal_inside(uint32_t i, uint32_t j) const {
+        auto within_corner = [this](uint32_t a, uint32_t b) {
+            const double* pa = point(a);
+            const double* pb = point(b);
+            const double* before = point(a == 0 ? length_ - 1 : a - 1);
+            const double* after = point(a + 1 == length_ ? 0 : a + 1);
+            if (orient2d_robust(before, pa, after) > 0)
+                return orient2d_robust(pa, pb, before) > 0 && orient2d_robust(pb, pa, after) > 0;
+            return !(orient2d_robust(pa, pb, after) >= 0 && orient2d_robust(pb, pa, before) >= 0);
+        };
+        if (!within_corner(i, j) || !within_corner(j, i)) return false;
+        const double* pi = point(i);
+        const double* pj = point(j);
+        for (uint32_t a = 0; a < length_; ++a) {
+            const uint32_t b = a + 1 == length_ ? 0 : a + 1;
+            if (a == i || a == j || b == i || b == j) continue;
+            const double oa = orient2d_robust(pi, pj, point(a));
+            const double ob = orient2d_robust(pi, pj, point(b));
+            if ((oa > 0 && ob > 0) || (oa < 0 && ob < 0)) continue;
+            const double oi = orient2d_robust(point(a), point(b), pi);
+            const double oj = orient2d_robust(point(a), point(b), pj);
+            if ((oi > 0 && oj > 0) || (oi < 0 && oj < 0)) continue;
+            return false;  // the segments cross or touch
+        }
+        return true;
+    }
+
     uint32_t triangles() const { return triangles_; }
 
 private:
@@ -5594,8 +5696,8 @@ struct CapCounts {
 const char* const kCapsTooLargeDetail =
     "the triangle array is too small for the caps; triangle_count says how many are needed";
 const char* const kLoopLeftOpenDetail =
-    "a boundary loop's projection across the axis is not a simple polygon (or each of its "
-    "ears would repeat an edge of the surface): it is left open";
+    "a boundary loop's projection across the axis is not a simple polygon (or every cap "
+    "found for it would repeat an edge of the surface): it is left open";
 
 // Caps every boundary loop of the surface tri[0 .. 3 count) over the cloud's points,
 // appending the cap triangles (count grows); each loop is projected across the frame's
@@ -5662,6 +5764,7 @@ inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
         bool clipped = false;
         for (uint32_t k = 0; turn != 0 && !clipped && k < kCapEarStarts; ++k)
             clipped = cap.clip_ears(static_cast<uint32_t>(uint64_t{k} * length / kCapEarStarts));
+        if (kCapSearchCorners > 0 && turn != 0 && !clipped) clipped = cap.search_cap();
         if (!clipped) {
             ++caps.left_open;
             continue;

@@ -441,6 +441,71 @@ TEST_CASE("cap_ends: the capped stream output is a closed manifold through every
     CHECK(r.intersecting_pairs == 0);
 }
 
+TEST_CASE("cap_ends: a loop whose every ear would repeat an edge of the wall (fins) is still capped") {
+    // An open tube of `around` x `rows` quads; under every sixth bottom edge a fin: a point
+    // below and outside it, with one triangle on that edge. The bottom loop then runs
+    // through the fins, whose corners poke outwards across the axis: their neighbours are
+    // reflex, and each fin's ear would join its edge's ends, an edge of the wall, so a cap
+    // must join each fin to a corner it sees across the loop. Ear clipping never does
+    // (stuck from each of its starting corners, it left this loop open); the search does.
+    // (With a fin under every other edge no cap exists: the fins' diagonals would cross.)
+    const uint32_t around = 24, rows = 4;
+    const double pi = 3.14159265358979323846;
+    std::vector<double> xyz;
+    auto add_point = [&](double r, double angle, double z) {
+        xyz.push_back(r * std::cos(angle));
+        xyz.push_back(r * std::sin(angle));
+        xyz.push_back(z);
+        return static_cast<uint32_t>(xyz.size() / 3 - 1);
+    };
+    for (uint32_t row = 0; row < rows; ++row)
+        for (uint32_t k = 0; k < around; ++k) add_point(1.0, 2 * pi * k / around, row);
+    auto ring = [&](uint32_t row, uint32_t k) { return row * around + k % around; };
+    std::vector<uint32_t> tris;
+    for (uint32_t row = 0; row + 1 < rows; ++row)
+        for (uint32_t k = 0; k < around; ++k) {
+            const uint32_t a = ring(row, k), b = ring(row, k + 1), c = ring(row + 1, k + 1),
+                           d = ring(row + 1, k);
+            tris.insert(tris.end(), {a, b, c, a, c, d});
+        }
+    for (uint32_t k = 0; k < around; k += 6) {
+        const uint32_t fin = add_point(1.08, 2 * pi * (k + 0.5) / around, -0.2);
+        tris.insert(tris.end(), {ring(0, k + 1), ring(0, k), fin});
+    }
+    const size_t n = xyz.size() / 3, surface = tris.size() / 3;
+    const Cloud cloud = {xyz.data(), n, 0, Scalar::float64};
+    Options o = {};
+    o.axis = stratmesh::Axis::z;
+    std::vector<uint32_t> capped(tris);
+    capped.resize(3 * stratmesh::reconstruct_max_triangles(n, o));
+    std::vector<unsigned char> work(stratmesh::cap_ends_workspace_size(n, surface));
+    size_t count = surface;
+    Report report;
+    REQUIRE(stratmesh::cap_ends(cloud, o, work.data(), work.size(), capped.data(),
+                                capped.size() / 3, &count, &report) == Status::ok);
+    CHECK(report.caps_left_open == 0);
+    CHECK(report.caps_closed == 2);
+    CHECK(report.workspace_used <= work.size());
+    // The wall comes first, unchanged; then the caps make a closed, consistently oriented
+    // manifold through every point.
+    CHECK(std::equal(tris.begin(), tris.end(), capped.begin()));
+    mesh_check::Input in;
+    in.points = xyz.data();
+    in.point_count = n;
+    in.triangles = capped.data();
+    in.triangle_count = count;
+    in.self_intersections = false;
+    const mesh_check::Result r = mesh_check::check(in);
+    INFO(r.summary());
+    CHECK(r.nonmanifold_edges == 0);
+    CHECK(r.nonmanifold_vertices == 0);
+    CHECK(r.inconsistent_edges == 0);
+    CHECK(r.boundary_loops == 0);
+    CHECK(r.components == 1);
+    CHECK(r.euler == 2);
+    CHECK(r.vertices_used == n);
+}
+
 TEST_CASE("cap_ends: bad arguments get their status and leave the triangles as they were") {
     const Shape s = shapes::cylinder(600, Pose::z);
     double axis[3];

@@ -80,8 +80,8 @@
 //                            triangulation of each loop's projection, which crosses a
 //                            wall leaning over a ragged loop more often, and their ear
 //                            clipping's restarts (kCapEarStarts) and the exhaustive
-//                            search that follows (kCapSearchCorners), so a few more
-//                            loops are left open. It leaves out cap_ends() too (not
+//                            search that follows (kCapSearchCorners) and the flips of
+//                            fins (kCapFinFlips), so a few more loops are left open. It leaves out cap_ends() too (not
 //                            declared: 0.6 KiB on the Cortex-M7); reconstruct()'s
 //                            close_ends stays. And it leaves out the
 //                            crescent rule (a layer next to a slanted end of the tube
@@ -342,9 +342,13 @@ enum Flags : uint32_t {
     // projection across the axis (Report::axis), the bottom cap as low and the top cap as
     // high along the axis as the loop allows (so that a wall leaning over a ragged loop
     // stays clear of it), constrained Delaunay where the loop is planar, avoiding any
-    // diagonal that is already an edge of the surface. A loop whose projection is not a
-    // simple polygon, or that neither ear clipping nor (for loops of at most 256 corners)
-    // an exhaustive search closes without repeating such an edge, stays open: the call
+    // diagonal that is already an edge of the surface. Where the surface's fins (triangles
+    // with two edges on the loop) leave no such cap, the edge under a fin may be flipped
+    // (the fin and the triangle beyond it become two others: same corners, same count; the
+    // loop unchanged), which frees its chord for the cap; only flips the cap then uses are
+    // made. A loop whose projection is not a simple polygon, or that neither ear clipping
+    // nor (for loops of at most 256 corners) an exhaustive search closes, with or without
+    // those flips, stays open: the call
     // still returns ok, Report::caps_left_open counts it and Report::detail says so. Caps
     // do not cross one another; like the rest of the surface, they are not checked against
     // the tube. The workspace bound grows by about 6 bytes per point with this flag, plus
@@ -681,7 +685,9 @@ Status stream_close(Stream* stream);
 size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count);
 
 // Appends caps to triangles[0 .. 3 * *triangle_count) (global indices into `cloud`) and
-// sets *triangle_count to the new total. options: axis, direction, origin (with
+// sets *triangle_count to the new total. Where a loop can be capped only so, the edge under
+// a fin of the surface is flipped (see close_ends): two of the given triangles then
+// change, in place. options: axis, direction, origin (with
 // origin_given) and skip_invalid_points as given to the stream or reconstruct(); the rest
 // is not used. report (optional): only caps_closed, caps_left_open, cap_triangles,
 // workspace_used (this call's) and detail are set, the rest left as it is: the stream's
@@ -773,6 +779,7 @@ const bool kCrescentLayers = false;
 const bool kClosedEnds = false;
 const uint32_t kCapEarStarts = 1;
 const uint32_t kCapSearchCorners = 0;
+const bool kCapFinFlips = false;
 const bool kDropOutliers = false;
 const bool kSurfaceFlips = false;
 const bool kLocalUnpeel = false;
@@ -796,6 +803,9 @@ const uint32_t kCapEarStarts = 8;
 // A loop of at most this many corners that no clipping closes is searched exhaustively for
 // a cap (see >>caps; its table takes a byte per pair of corners: 32 KiB).
 const uint32_t kCapSearchCorners = 256;
+// A loop that no cap closes as the wall stands may have the wall's edges under its fins
+// flipped, where its cap needs their chords (see >>caps).
+const bool kCapFinFlips = true;
 // The drop_outliers flag (see "outliers" in >>layers); without it, the flag is refused.
 const bool kDropOutliers = true;
 // Layers are flipped on the surface (see "flips on the surface" in >>layer triangulation).
@@ -5130,8 +5140,9 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
 // on the loop: a scan rounded to a grid makes them), the fin's middle corner has no way
 // into the cap but a diagonal to a corner it sees across the loop, which ear clipping
 // never makes; so a loop that no clipping closes, of at most kCapSearchCorners corners, is
-// searched exhaustively (search_cap). A loop whose projection is not simple, or that
-// neither closes, stays open.
+// searched exhaustively (search_cap). Where fins leave no cap at all, the wall's edges under
+// them may be flipped (see "fins flipped out of the way" below). A loop whose projection
+// is not simple, or that none of these closes, stays open.
 //
 // The loops of a star-shaped layer run monotonically in angle around its centre (see the
 // unroll section), so their projections are simple but for rounding or the safety net's
@@ -5195,6 +5206,7 @@ struct CapLoop {
 
 const unsigned char kLoopStart = 1, kLoopBroken = 2;
 const unsigned char kRemoved = 1, kReflex = 2, kQueued = 4;
+const unsigned char kFinSeen = 1, kFinFlippable = 2, kFinWaived = 4, kFinUsed = 8;
 
 // The allocation sequences of the cap phase: the call runs them with its real sizes,
 // reconstruct_workspace_size with the largest possible ones, so the two cannot disagree.
@@ -5433,6 +5445,28 @@ public:
                      bool lower)
         : c_(c), ids_(ids), length_(length), g_(g), lower_(lower) {}
 
+    // Ear clipping from kCapEarStarts corners, then the search; false if neither closes.
+    bool triangulate() {
+        for (uint32_t k = 0; k < kCapEarStarts; ++k)
+            if (clip_ears(static_cast<uint32_t>(uint64_t{k} * length_ / kCapEarStarts))) return true;
+        return kCapSearchCorners > 0 && search_cap();
+    }
+
+    // From now on the chords of the fins marked in `fins` (per position, kFinWaived) are
+    // allowed as diagonals: the wall's edge there is to be flipped away (see flip_used_fins).
+    void waive(const unsigned char* fins) { waived_ = fins; }
+
+    // The fin whose chord is a - b (positions): the position between them, if it is a
+    // waived fin; else kNoIndex.
+    uint32_t waived_fin(uint32_t a, uint32_t b) const {
+        if (!kCapFinFlips || waived_ == nullptr) return kNoIndex;
+        const uint32_t after_a = a + 1 == length_ ? 0 : a + 1, after_b = b + 1 == length_ ? 0 : b + 1;
+        const uint32_t mid = (after_a + 1 == length_ ? 0 : after_a + 1) == b ? after_a
+                           : (after_b + 1 == length_ ? 0 : after_b + 1) == a ? after_b
+                                                                             : kNoIndex;
+        return mid != kNoIndex && (waived_[mid] & kFinWaived) ? mid : kNoIndex;
+    }
+
     bool clip_ears(uint32_t start) {
         uint32_t reflex_count = 0;
         for (uint32_t i = 0; i < length_; ++i) {
@@ -5520,7 +5554,7 @@ public:
                 best = 0;
                 // i - j must be a diagonal (the loop edge m - 1 -> 0 closes the whole).
                 if ((j != m - 1 || i != 0) &&
-                    (g_.has_edge(ids_[i], ids_[j]) || !diagonal_inside(i, j)))
+                    (joined(i, j) || !diagonal_inside(i, j)))
                     continue;
                 for (uint32_t k = i + 1; k < j && best == 0; ++k)
                     if (closes(i, k) && closes(k, j)) best = static_cast<uint8_t>(k - i);
@@ -5587,6 +5621,11 @@ public:
 private:
     const double* point(uint32_t i) const { return c_.xy + 2 * static_cast<size_t>(i); }
 
+    // Whether positions a and b are joined by an edge of the surface that stays there.
+    bool joined(uint32_t a, uint32_t b) const {
+        return g_.has_edge(ids_[a], ids_[b]) && waived_fin(a, b) == kNoIndex;
+    }
+
     bool convex(uint32_t i) const {
         return orient2d_robust(point(c_.prev[i]), point(i), point(c_.next[i])) > 0;
     }
@@ -5607,7 +5646,7 @@ private:
     bool is_ear(uint32_t v, uint32_t& reflex_count) {
         if (c_.flags[v] & kReflex) return false;
         uint32_t p = c_.prev[v], n = c_.next[v];
-        if (g_.has_edge(ids_[p], ids_[n])) return false;
+        if (joined(p, n)) return false;
         bool empty = true;
         uint32_t kept = 0;
         for (uint32_t k = 0; k < reflex_count; ++k) {
@@ -5661,7 +5700,7 @@ private:
                incircle_perturbed(point(a), point(b), point(w), point(d), c_.scratch) > 0)))
             return kNoIndex;
         if (orient2d_robust(point(a), point(d), point(w)) <= 0 ||
-            orient2d_robust(point(d), point(b), point(w)) <= 0 || g_.has_edge(ids_[w], ids_[d]))
+            orient2d_robust(point(d), point(b), point(w)) <= 0 || joined(w, d))
             return kNoIndex;
         uint32_t beyond_bw = c_.across[3 * t + (k + 1) % 3], beyond_wa = c_.across[3 * t + (k + 2) % 3];
         uint32_t beyond_ad = c_.across[3 * u + (j + 1) % 3], beyond_db = c_.across[3 * u + (j + 2) % 3];
@@ -5686,6 +5725,7 @@ private:
     const CapGraph& g_;
     bool lower_;
     uint32_t triangles_ = 0;
+    const unsigned char* waived_ = nullptr;
 };
 
 struct CapCounts {
@@ -5698,6 +5738,119 @@ const char* const kCapsTooLargeDetail =
 const char* const kLoopLeftOpenDetail =
     "a boundary loop's projection across the axis is not a simple polygon (or every cap "
     "found for it would repeat an edge of the surface): it is left open";
+
+// ---- fins flipped out of the way
+//
+// A loop with fins can have no cap at all: each fin's middle corner needs a diagonal to a
+// corner it sees across the loop, and with fins close together those diagonals cross or
+// see nothing (a fin under every other edge; 35 of the 43 loops the search left open on
+// sparse crops of the bundled bust, README). Then the wall gives way: the fin (u, v, m)
+// and the wall triangle beyond its chord, (v, u, x), become (u, x, m) and (x, v, m) (m,
+// the fin's middle corner, has no other triangle, so m - x is a new edge and the surface
+// stays a manifold), and the chord u - v is free for the cap. Only fins whose x is on no
+// loop (no new chord) and whose two new triangles face the way the old pair does are
+// offered, and only those whose chord the cap then takes are flipped: a loop that closed
+// before closes as before, and one that stays open leaves the wall as it was.
+
+// The per point key of a loop's fin chords: at the chord's first corner (position i - 1),
+// the fin's position i. `key` is all kNoIndex outside these calls.
+inline void key_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length,
+                           const unsigned char* fins, unsigned char wanted, bool set) {
+    for (uint32_t i = 0; i < length; ++i)
+        if (fins[i] & wanted) key[ids[i == 0 ? length - 1 : i - 1]] = set ? i : kNoIndex;
+}
+
+// The fin position whose chord is a - b (either way round), or kNoIndex.
+inline uint32_t keyed_fin(const uint32_t* key, const uint32_t* ids, uint32_t length,
+                          uint32_t a, uint32_t b) {
+    for (int side = 0; side < 2; ++side) {
+        const uint32_t i = key[side == 0 ? a : b];
+        if (i != kNoIndex && ids[i + 1 == length ? 0 : i + 1] == (side == 0 ? b : a)) return i;
+    }
+    return kNoIndex;
+}
+
+// Whether (u, x, m) and (x, v, m) face the way (u, v, m) and (v, u, x) do together.
+inline bool fin_flip_keeps_facing(const CloudReader& cloud, const Frame& frame, uint32_t u,
+                                  uint32_t v, uint32_t m, uint32_t x) {
+    const Vec3 pu = frame.offset(cloud.point(u)), pv = frame.offset(cloud.point(v));
+    const Vec3 pm = frame.offset(cloud.point(m)), px = frame.offset(cloud.point(x));
+    const Vec3 fin = cross(pv - pu, pm - pu), beyond = cross(pu - pv, px - pv);
+    const Vec3 first = cross(px - pu, pm - pu), second = cross(pv - px, pm - px);
+    return dot(first, fin) + dot(first, beyond) > 0 && dot(second, fin) + dot(second, beyond) > 0;
+}
+
+// Marks kFinWaived the fins of the loop ids[0 .. length) that may be flipped (above),
+// scanning the wall tri[0 .. 3 wall); returns how many.
+inline uint32_t mark_flippable_fins(const uint32_t* tri, size_t wall, const CloudReader& cloud,
+                                    const Frame& frame, const CapGraph& g, uint32_t* key,
+                                    const uint32_t* ids, uint32_t length, unsigned char* fins) {
+    if (length <= 4) return 0;  // a chord two corners apart either way: no single fin
+    for (uint32_t i = 0; i < length; ++i)
+        fins[i] = g.has_edge(ids[i == 0 ? length - 1 : i - 1], ids[i + 1 == length ? 0 : i + 1])
+                      ? kFinSeen | kFinFlippable : 0;
+    key_fin_chords(key, ids, length, fins, kFinSeen, true);
+    for (uint32_t i = 0; i < length; ++i) fins[i] = 0;
+    for (size_t t = 0; t < wall; ++t) {
+        const uint32_t* c = tri + 3 * t;
+        for (uint32_t k = 0; k < 3; ++k) {
+            const uint32_t a = c[k], b = c[(k + 1) % 3], o = c[(k + 2) % 3];
+            const uint32_t i = keyed_fin(key, ids, length, a, b);
+            if (i == kNoIndex) continue;
+            if (o == ids[i]) {
+                fins[i] |= kFinSeen;
+            } else if (g.offsets[o + 1] == g.offsets[o] &&  // o is on no loop
+                       fin_flip_keeps_facing(cloud, frame, b, a, ids[i], o)) {
+                fins[i] |= kFinFlippable;  // beyond a -> b: the fin runs b -> a -> ids[i]
+            }
+        }
+    }
+    key_fin_chords(key, ids, length, fins, kFinSeen | kFinFlippable, false);
+    uint32_t marked = 0;
+    for (uint32_t i = 0; i < length; ++i) {
+        const bool both = fins[i] == (kFinSeen | kFinFlippable);
+        fins[i] = both ? kFinWaived : 0;
+        marked += both;
+    }
+    return marked;
+}
+
+// Flips the wall's edge under each fin marked kFinUsed. slots: two size_t per position (in
+// the memory of the loop's projection, free once its cap is made).
+inline void flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const uint32_t* ids,
+                           uint32_t length, const unsigned char* fins, double* slots) {
+    auto slot = [slots](uint32_t i, uint32_t which) { return slots + 2 * static_cast<size_t>(i) + which; };
+    static_assert(sizeof(size_t) <= sizeof(double), "a slot holds a triangle index");
+    const size_t unset = ~size_t{0};
+    for (uint32_t i = 0; i < length; ++i) {
+        std::memcpy(slot(i, 0), &unset, sizeof unset);
+        std::memcpy(slot(i, 1), &unset, sizeof unset);
+    }
+    key_fin_chords(key, ids, length, fins, kFinUsed, true);
+    for (size_t t = 0; t < wall; ++t) {
+        const uint32_t* c = tri + 3 * t;
+        for (uint32_t k = 0; k < 3; ++k) {
+            const uint32_t i = keyed_fin(key, ids, length, c[k], c[(k + 1) % 3]);
+            if (i != kNoIndex) std::memcpy(slot(i, c[(k + 2) % 3] == ids[i] ? 0 : 1), &t, sizeof t);
+        }
+    }
+    for (uint32_t i = 0; i < length; ++i) {
+        if (!(fins[i] & kFinUsed)) continue;
+        size_t fin = 0, beyond = 0;
+        std::memcpy(&fin, slot(i, 0), sizeof fin);
+        std::memcpy(&beyond, slot(i, 1), sizeof beyond);
+        if (fin == unset || beyond == unset) continue;  // a soup given to cap_ends() only
+        uint32_t* f = tri + 3 * fin;
+        uint32_t* w = tri + 3 * beyond;
+        uint32_t k = 0;  // w's edge k -> k + 1 is the chord, v -> u
+        while (k < 2 && keyed_fin(key, ids, length, w[k], w[(k + 1) % 3]) != i) ++k;
+        const uint32_t v = w[k], u = w[(k + 1) % 3], x = w[(k + 2) % 3], m = ids[i];
+        const uint32_t flipped[6] = {u, x, m, x, v, m};
+        std::memcpy(f, flipped, 3 * sizeof(uint32_t));
+        std::memcpy(w, flipped + 3, 3 * sizeof(uint32_t));
+    }
+    key_fin_chords(key, ids, length, fins, kFinUsed, false);
+}
 
 // Caps every boundary loop of the surface tri[0 .. 3 count) over the cloud's points,
 // appending the cap triangles (count grows); each loop is projected across the frame's
@@ -5714,6 +5867,7 @@ inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
         *height = p.h;
     };
     caps = {0, 0, 0};
+    const size_t wall = count;
     size_t mark = arena.mark();
     CapGraph g;
     if (!allocate_cap_graph(g, point_count, count, arena)) return Status::out_of_memory;
@@ -5761,10 +5915,16 @@ inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
             for (uint32_t i = 0; i < length; ++i) c.xy[2 * static_cast<size_t>(i)] = -c.xy[2 * static_cast<size_t>(i)];
         // A loop turning clockwise seen from +axis is capped facing -axis: a bottom cap.
         CapTriangulation cap(c, ids, length, g, turn < 0);
-        bool clipped = false;
-        for (uint32_t k = 0; turn != 0 && !clipped && k < kCapEarStarts; ++k)
-            clipped = cap.clip_ears(static_cast<uint32_t>(uint64_t{k} * length / kCapEarStarts));
-        if (kCapSearchCorners > 0 && turn != 0 && !clipped) clipped = cap.search_cap();
+        bool clipped = turn != 0 && cap.triangulate();
+        // The loop's start markers are read no more: its fins' flags take their place.
+        unsigned char* fins = c.starts + (ids - c.ids);
+        bool waived = false;
+        if (kCapFinFlips && turn != 0 && !clipped &&
+            mark_flippable_fins(tri, wall, cloud, frame, g, g.boundary_next, ids, length, fins) > 0) {
+            cap.waive(fins);
+            waived = true;
+            clipped = cap.triangulate();
+        }
         if (!clipped) {
             ++caps.left_open;
             continue;
@@ -5772,8 +5932,16 @@ inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
         double xy[2];  // c.xy holds them, mirrored
         for (uint32_t i = 0; kLiftedCaps && i < length; ++i) project(ids[i], xy, c.height + i);
         cap.settle_diagonals();
-        for (size_t k = 0; k < 3 * static_cast<size_t>(cap.triangles()); ++k)
+        bool flips = false;
+        for (size_t k = 0; k < 3 * static_cast<size_t>(cap.triangles()); ++k) {
             tri[3 * count + k] = ids[c.corners[k]];
+            const uint32_t fin = waived ? cap.waived_fin(c.corners[k], c.corners[k - k % 3 + (k + 1) % 3]) : kNoIndex;
+            if (fin != kNoIndex) {
+                fins[fin] |= kFinUsed;
+                flips = true;
+            }
+        }
+        if (flips) flip_used_fins(tri, wall, g.boundary_next, ids, length, fins, c.xy);
         count += cap.triangles();
         caps.triangles += cap.triangles();
         ++caps.closed;

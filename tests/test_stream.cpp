@@ -8,10 +8,14 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <limits>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -441,59 +445,65 @@ TEST_CASE("cap_ends: the capped stream output is a closed manifold through every
     CHECK(r.intersecting_pairs == 0);
 }
 
-TEST_CASE("cap_ends: a loop whose every ear would repeat an edge of the wall (fins) is still capped") {
-    // An open tube of `around` x `rows` quads; under every sixth bottom edge a fin: a point
-    // below and outside it, with one triangle on that edge. The bottom loop then runs
-    // through the fins, whose corners poke outwards across the axis: their neighbours are
-    // reflex, and each fin's ear would join its edge's ends, an edge of the wall, so a cap
-    // must join each fin to a corner it sees across the loop. Ear clipping never does
-    // (stuck from each of its starting corners, it left this loop open); the search does.
-    // (With a fin under every other edge no cap exists: the fins' diagonals would cross.)
-    const uint32_t around = 24, rows = 4;
-    const double pi = 3.14159265358979323846;
+// An open tube of `around` x 4 quads about the z axis; under every `fin_step`-th bottom
+// edge a fin: a point below and outside it, with one triangle on that edge. The bottom
+// loop then runs through the fins, whose corners poke outwards across the axis: their
+// neighbours are reflex, and each fin's ear would join its edge's ends, an edge of the
+// wall, so a cap must join each fin to a corner it sees across the loop.
+struct FinnedTube {
     std::vector<double> xyz;
+    std::vector<uint32_t> wall, capped;  // capped: cap_ends()'s triangles
+    size_t count = 0;
+    Report report = {};
+    Status status = Status::ok;
+    std::vector<uint32_t> fins;  // the fins' points
+};
+
+FinnedTube cap_finned_tube(uint32_t around, uint32_t fin_step) {
+    const uint32_t rows = 4;
+    const double pi = 3.14159265358979323846;
+    FinnedTube f;
     auto add_point = [&](double r, double angle, double z) {
-        xyz.push_back(r * std::cos(angle));
-        xyz.push_back(r * std::sin(angle));
-        xyz.push_back(z);
-        return static_cast<uint32_t>(xyz.size() / 3 - 1);
+        f.xyz.push_back(r * std::cos(angle));
+        f.xyz.push_back(r * std::sin(angle));
+        f.xyz.push_back(z);
+        return static_cast<uint32_t>(f.xyz.size() / 3 - 1);
     };
     for (uint32_t row = 0; row < rows; ++row)
         for (uint32_t k = 0; k < around; ++k) add_point(1.0, 2 * pi * k / around, row);
     auto ring = [&](uint32_t row, uint32_t k) { return row * around + k % around; };
-    std::vector<uint32_t> tris;
     for (uint32_t row = 0; row + 1 < rows; ++row)
         for (uint32_t k = 0; k < around; ++k) {
             const uint32_t a = ring(row, k), b = ring(row, k + 1), c = ring(row + 1, k + 1),
                            d = ring(row + 1, k);
-            tris.insert(tris.end(), {a, b, c, a, c, d});
+            f.wall.insert(f.wall.end(), {a, b, c, a, c, d});
         }
-    for (uint32_t k = 0; k < around; k += 6) {
+    for (uint32_t k = 0; k < around; k += fin_step) {
         const uint32_t fin = add_point(1.08, 2 * pi * (k + 0.5) / around, -0.2);
-        tris.insert(tris.end(), {ring(0, k + 1), ring(0, k), fin});
+        f.wall.insert(f.wall.end(), {ring(0, k + 1), ring(0, k), fin});
+        f.fins.push_back(fin);
     }
-    const size_t n = xyz.size() / 3, surface = tris.size() / 3;
-    const Cloud cloud = {xyz.data(), n, 0, Scalar::float64};
+    const size_t n = f.xyz.size() / 3, surface = f.wall.size() / 3;
+    const Cloud cloud = {f.xyz.data(), n, 0, Scalar::float64};
     Options o = {};
     o.axis = stratmesh::Axis::z;
-    std::vector<uint32_t> capped(tris);
-    capped.resize(3 * stratmesh::reconstruct_max_triangles(n, o));
+    f.capped = f.wall;
+    f.capped.resize(3 * stratmesh::reconstruct_max_triangles(n, o));
     std::vector<unsigned char> work(stratmesh::cap_ends_workspace_size(n, surface));
-    size_t count = surface;
-    Report report;
-    REQUIRE(stratmesh::cap_ends(cloud, o, work.data(), work.size(), capped.data(),
-                                capped.size() / 3, &count, &report) == Status::ok);
-    CHECK(report.caps_left_open == 0);
-    CHECK(report.caps_closed == 2);
-    CHECK(report.workspace_used <= work.size());
-    // The wall comes first, unchanged; then the caps make a closed, consistently oriented
-    // manifold through every point.
-    CHECK(std::equal(tris.begin(), tris.end(), capped.begin()));
+    f.count = surface;
+    f.status = stratmesh::cap_ends(cloud, o, work.data(), work.size(), f.capped.data(),
+                                   f.capped.size() / 3, &f.count, &f.report);
+    CHECK(f.report.workspace_used <= work.size());
+    return f;
+}
+
+// A closed, consistently oriented manifold through every point.
+void check_closed(const FinnedTube& f) {
     mesh_check::Input in;
-    in.points = xyz.data();
-    in.point_count = n;
-    in.triangles = capped.data();
-    in.triangle_count = count;
+    in.points = f.xyz.data();
+    in.point_count = f.xyz.size() / 3;
+    in.triangles = f.capped.data();
+    in.triangle_count = f.count;
     in.self_intersections = false;
     const mesh_check::Result r = mesh_check::check(in);
     INFO(r.summary());
@@ -503,7 +513,68 @@ TEST_CASE("cap_ends: a loop whose every ear would repeat an edge of the wall (fi
     CHECK(r.boundary_loops == 0);
     CHECK(r.components == 1);
     CHECK(r.euler == 2);
-    CHECK(r.vertices_used == n);
+    CHECK(r.vertices_used == in.point_count);
+}
+
+TEST_CASE("cap_ends: a loop whose every ear would repeat an edge of the wall (fins) is still capped") {
+    // A fin under every sixth edge: ear clipping is stuck from each of its starting
+    // corners (it left this loop open); the search finds a cap, the wall as it was.
+    const FinnedTube f = cap_finned_tube(24, 6);
+    REQUIRE(f.status == Status::ok);
+    CHECK(f.report.caps_left_open == 0);
+    CHECK(f.report.caps_closed == 2);
+    CHECK(std::equal(f.wall.begin(), f.wall.end(), f.capped.begin()));
+    check_closed(f);
+}
+
+TEST_CASE("cap_ends: where fins leave no cap, the wall's edges under them are flipped") {
+    // A fin under every other edge: the fins' diagonals across the loop would cross, so no
+    // cap over the loop's corners avoids the wall's edges (the search left it open). The
+    // edge under a fin is flipped where the cap needs its chord.
+    const FinnedTube f = cap_finned_tube(24, 2);
+    REQUIRE(f.status == Status::ok);
+    CHECK(f.report.caps_left_open == 0);
+    CHECK(f.report.caps_closed == 2);
+    check_closed(f);
+    // The wall keeps its count and its boundary; what changed are pairs of triangles, each
+    // a fin's and the one beyond its chord, now both at the fin's point.
+    const size_t surface = f.wall.size() / 3;
+    auto sorted_triangles = [](const uint32_t* t, size_t count) {
+        std::vector<std::array<uint32_t, 3>> out(count);
+        for (size_t i = 0; i < count; ++i) {
+            std::array<uint32_t, 3> c = {t[3 * i], t[3 * i + 1], t[3 * i + 2]};
+            std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
+            out[i] = c;
+        }
+        std::sort(out.begin(), out.end());
+        return out;
+    };
+    const auto before = sorted_triangles(f.wall.data(), surface);
+    const auto after = sorted_triangles(f.capped.data(), surface);
+    std::vector<std::array<uint32_t, 3>> gone, made;
+    std::set_difference(before.begin(), before.end(), after.begin(), after.end(), std::back_inserter(gone));
+    std::set_difference(after.begin(), after.end(), before.begin(), before.end(), std::back_inserter(made));
+    CHECK(!made.empty());
+    CHECK(made.size() == gone.size());
+    CHECK(made.size() % 2 == 0);
+    auto has_fin = [&f](const std::array<uint32_t, 3>& t) {
+        return std::any_of(t.begin(), t.end(), [&f](uint32_t v) {
+            return std::find(f.fins.begin(), f.fins.end(), v) != f.fins.end();
+        });
+    };
+    CHECK(std::all_of(made.begin(), made.end(), has_fin));
+    size_t fins_gone = 0;
+    for (const auto& t : gone) fins_gone += has_fin(t);
+    CHECK(fins_gone == gone.size() / 2);
+    auto boundary = [](const uint32_t* t, size_t count) {
+        std::set<std::pair<uint32_t, uint32_t>> edges, open;
+        for (size_t i = 0; i < count; ++i)
+            for (size_t k = 0; k < 3; ++k) edges.insert({t[3 * i + k], t[3 * i + (k + 1) % 3]});
+        for (const auto& e : edges)
+            if (!edges.count({e.second, e.first})) open.insert(e);
+        return open;
+    };
+    CHECK(boundary(f.wall.data(), surface) == boundary(f.capped.data(), surface));
 }
 
 TEST_CASE("cap_ends: bad arguments get their status and leave the triangles as they were") {

@@ -144,11 +144,14 @@ private:
         return record_.status == stratmesh::Status::ok;
     }
 
-    // Writes the triangles as they come; with --cap, keeps them for the caps too.
+    // Writes the triangles as they come; with --cap, keeps them instead, to write them with
+    // the caps: cap_ends() may flip the edge under a fin of the surface in place.
     static void take_triangles(void* user, const uint32_t* triangles, size_t count) {
         StreamRunner& runner = *static_cast<StreamRunner*>(user);
-        runner.writer_.add_triangles(triangles, count);
-        if (runner.line_.cap) runner.kept_.insert(runner.kept_.end(), triangles, triangles + 3 * count);
+        if (runner.line_.cap)
+            runner.kept_.insert(runner.kept_.end(), triangles, triangles + 3 * count);
+        else
+            runner.writer_.add_triangles(triangles, count);
     }
 
     // Writes the layer's vertices (before any triangle can use them) and pushes it.
@@ -189,7 +192,8 @@ private:
     }
 
     // --cap: closes the kept surface over every point read, as the run without --stream
-    // does (the same frame: the cloud's, with the stream's origin), and writes the caps.
+    // does (the same frame: the cloud's, with the stream's origin), and writes the surface
+    // and its caps.
     stratmesh::Status close_with_caps() {
         Clock::time_point start = Clock::now();
         const size_t n = all_points_.size() / 3, surface = kept_.size() / 3;
@@ -206,7 +210,7 @@ private:
         stream_seconds_ += seconds_since(start);
         if (caps.detail) report_.detail = caps.detail;
         if (status != stratmesh::Status::ok) return status;
-        writer_.add_triangles(kept_.data() + 3 * surface, count - surface);
+        writer_.add_triangles(kept_.data(), count);
         report_.caps_closed = caps.caps_closed;
         report_.caps_left_open = caps.caps_left_open;
         report_.cap_triangles = caps.cap_triangles;

@@ -5753,11 +5753,16 @@ const char* const kLoopLeftOpenDetail =
 // before closes as before, and one that stays open leaves the wall as it was.
 
 // The per point key of a loop's fin chords: at the chord's first corner (position i - 1),
-// the fin's position i. `key` is all kNoIndex outside these calls.
+// the fin's position i, for the fins with a flag in `wanted`. `key` is all kNoIndex outside
+// these calls: clear_fin_chords puts it back.
 inline void key_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length,
-                           const unsigned char* fins, unsigned char wanted, bool set) {
+                           const unsigned char* fins, unsigned char wanted) {
     for (uint32_t i = 0; i < length; ++i)
-        if (fins[i] & wanted) key[ids[i == 0 ? length - 1 : i - 1]] = set ? i : kNoIndex;
+        if (fins[i] & wanted) key[ids[i == 0 ? length - 1 : i - 1]] = i;
+}
+
+inline void clear_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length) {
+    for (uint32_t i = 0; i < length; ++i) key[ids[i]] = kNoIndex;
 }
 
 // The fin position whose chord is a - b (either way round), or kNoIndex.
@@ -5789,7 +5794,7 @@ inline uint32_t mark_flippable_fins(const uint32_t* tri, size_t wall, const Clou
     for (uint32_t i = 0; i < length; ++i)
         fins[i] = g.has_edge(ids[i == 0 ? length - 1 : i - 1], ids[i + 1 == length ? 0 : i + 1])
                       ? kFinSeen | kFinFlippable : 0;
-    key_fin_chords(key, ids, length, fins, kFinSeen, true);
+    key_fin_chords(key, ids, length, fins, kFinSeen);
     for (uint32_t i = 0; i < length; ++i) fins[i] = 0;
     for (size_t t = 0; t < wall; ++t) {
         const uint32_t* c = tri + 3 * t;
@@ -5805,7 +5810,7 @@ inline uint32_t mark_flippable_fins(const uint32_t* tri, size_t wall, const Clou
             }
         }
     }
-    key_fin_chords(key, ids, length, fins, kFinSeen | kFinFlippable, false);
+    clear_fin_chords(key, ids, length);
     uint32_t marked = 0;
     for (uint32_t i = 0; i < length; ++i) {
         const bool both = fins[i] == (kFinSeen | kFinFlippable);
@@ -5826,7 +5831,7 @@ inline void flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const uint
         std::memcpy(slot(i, 0), &unset, sizeof unset);
         std::memcpy(slot(i, 1), &unset, sizeof unset);
     }
-    key_fin_chords(key, ids, length, fins, kFinUsed, true);
+    key_fin_chords(key, ids, length, fins, kFinUsed);
     for (size_t t = 0; t < wall; ++t) {
         const uint32_t* c = tri + 3 * t;
         for (uint32_t k = 0; k < 3; ++k) {
@@ -5849,7 +5854,7 @@ inline void flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const uint
         std::memcpy(f, flipped, 3 * sizeof(uint32_t));
         std::memcpy(w, flipped + 3, 3 * sizeof(uint32_t));
     }
-    key_fin_chords(key, ids, length, fins, kFinUsed, false);
+    clear_fin_chords(key, ids, length);
 }
 
 // Caps every boundary loop of the surface tri[0 .. 3 count) over the cloud's points,

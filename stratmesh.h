@@ -346,7 +346,7 @@ enum Flags : uint32_t {
     // with two edges on the loop) leave no such cap, the edge under a fin may be flipped
     // (the fin and the triangle beyond it become two others: same corners, same count; the
     // loop unchanged), which frees its chord for the cap; only flips the cap then uses are
-    // made. A loop whose projection is not a simple polygon, or that neither ear clipping
+    // made (Report::cap_wall_flips counts them). A loop whose projection is not a simple polygon, or that neither ear clipping
     // nor (for loops of at most 256 corners) an exhaustive search closes, with or without
     // those flips, stays open: the call
     // still returns ok, Report::caps_left_open counts it and Report::detail says so. Caps
@@ -506,6 +506,10 @@ struct Report {
     size_t caps_closed;
     size_t caps_left_open;
     size_t cap_triangles;
+    // With close_ends (and from cap_ends()): the surface's edges flipped under fins so that
+    // a loop could be capped; each changed two triangles of the surface in place (see
+    // close_ends). 0 where every loop closed without them, and in STRATMESH_SMALL_CODE.
+    size_t cap_wall_flips;
     // The stream only: the most points it held at once (compare with the max_points_held
     // given to stream_workspace_size()).
     size_t points_held;
@@ -690,7 +694,7 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count);
 // change, in place. options: axis, direction, origin (with
 // origin_given) and skip_invalid_points as given to the stream or reconstruct(); the rest
 // is not used. report (optional): only caps_closed, caps_left_open, cap_triangles,
-// workspace_used (this call's) and detail are set, the rest left as it is: the stream's
+// cap_wall_flips, workspace_used (this call's) and detail are set, the rest left as it is: the stream's
 // report can be passed, its counts kept (its workspace_used replaced).
 // Returns ok (loops whose projection is not simple stay open: caps_left_open);
 // invalid_argument (a null triangle_count, triangles or workspace where needed, a bad
@@ -5729,7 +5733,7 @@ private:
 };
 
 struct CapCounts {
-    size_t closed, left_open, triangles;
+    size_t closed, left_open, triangles, wall_flips;
 };
 
 // Report::detail for the caps, from reconstruct() and cap_ends() alike.
@@ -5820,9 +5824,9 @@ inline uint32_t mark_flippable_fins(const uint32_t* tri, size_t wall, const Clou
     return marked;
 }
 
-// Flips the wall's edge under each fin marked kFinUsed. slots: two size_t per position (in
-// the memory of the loop's projection, free once its cap is made).
-inline void flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const uint32_t* ids,
+// Flips the wall's edge under each fin marked kFinUsed; returns how many it flipped. slots:
+// two size_t per position (in the memory of the loop's projection, free once its cap is made).
+inline size_t flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const uint32_t* ids,
                            uint32_t length, const unsigned char* fins, double* slots) {
     auto slot = [slots](uint32_t i, uint32_t which) { return slots + 2 * static_cast<size_t>(i) + which; };
     static_assert(sizeof(size_t) <= sizeof(double), "a slot holds a triangle index");
@@ -5832,6 +5836,7 @@ inline void flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const uint
         std::memcpy(slot(i, 1), &unset, sizeof unset);
     }
     key_fin_chords(key, ids, length, fins, kFinUsed);
+    size_t flipped_count = 0;
     for (size_t t = 0; t < wall; ++t) {
         const uint32_t* c = tri + 3 * t;
         for (uint32_t k = 0; k < 3; ++k) {
@@ -5853,13 +5858,15 @@ inline void flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const uint
         const uint32_t flipped[6] = {u, x, m, x, v, m};
         std::memcpy(f, flipped, 3 * sizeof(uint32_t));
         std::memcpy(w, flipped + 3, 3 * sizeof(uint32_t));
+        ++flipped_count;
     }
     clear_fin_chords(key, ids, length);
+    return flipped_count;
 }
 
 // Caps every boundary loop of the surface tri[0 .. 3 count) over the cloud's points,
-// appending the cap triangles (count grows); each loop is projected across the frame's
-// axis. Returns ok; out_of_memory; or triangle_capacity with *needed the triangles every
+// appending the cap triangles (count grows) and counting into caps (zeroed by the caller);
+// each loop is projected across the frame's axis. Returns ok; out_of_memory; or triangle_capacity with *needed the triangles every
 // cap closing would take, and nothing written.
 inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
                                  const CloudReader& cloud, size_t point_count,
@@ -5871,7 +5878,6 @@ inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
         xy[1] = p.y;
         *height = p.h;
     };
-    caps = {0, 0, 0};
     const size_t wall = count;
     size_t mark = arena.mark();
     CapGraph g;
@@ -5946,7 +5952,8 @@ inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
                 flips = true;
             }
         }
-        if (flips) flip_used_fins(tri, wall, g.boundary_next, ids, length, fins, c.xy);
+        if (flips)
+            caps.wall_flips += flip_used_fins(tri, wall, g.boundary_next, ids, length, fins, c.xy);
         count += cap.triangles();
         caps.triangles += cap.triangles();
         ++caps.closed;
@@ -7550,7 +7557,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
 
     notify(options, Phase::manifold, 0);
     size_t count = sink.count;
-    CapCounts caps = {0, 0, 0};
+    CapCounts caps = {0, 0, 0, 0};
     if (options.flags & close_ends) {
         size_t needed = 0;
         status = cap_boundary_loops(triangles, count, triangle_capacity, reader, cloud.count,
@@ -7565,6 +7572,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     rep.caps_closed = caps.closed;
     rep.caps_left_open = caps.left_open;
     rep.cap_triangles = caps.triangles;
+    rep.cap_wall_flips = caps.wall_flips;
     *triangle_count = count;
     rep.triangle_count = count;
     rep.folds = sink.folds;
@@ -7964,7 +7972,7 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
                                             triangle_capacity, triangle_count, report))
         return Status::invalid_argument;
     Report checks = {};  // what the shared checks write, copied out in part
-    detail::CapCounts caps = {0, 0, 0};
+    detail::CapCounts caps = {0, 0, 0, 0};
     detail::Arena arena = detail::Arena::over(workspace, workspace_bytes);
     const size_t given = triangle_count ? *triangle_count : 0;
     size_t count = given, needed = 0;
@@ -7973,6 +7981,7 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
             report->caps_closed = caps.closed;
             report->caps_left_open = caps.left_open;
             report->cap_triangles = caps.triangles;
+            report->cap_wall_flips = caps.wall_flips;
             report->workspace_used = arena.peak_from_buffer();
             report->detail = checks.detail;
         }

@@ -275,6 +275,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                              "caps: not an oriented edge-manifold");
         STRATMESH_FUZZ_CHECK(c.nonmanifold_vertices == 0, "caps: not vertex-manifold");
         STRATMESH_FUZZ_CHECK(c.boundary_loops == cap_report.caps_left_open, "caps: loops neither closed nor counted");
+        // Each flip under a fin rewrites two triangles of the surface, in place.
+        size_t rewritten = 0;
+        for (size_t k = 0; k < 3 * surface; k += 3)
+            rewritten += given[k] != capped[k] || given[k + 1] != capped[k + 1] || given[k + 2] != capped[k + 2];
+        STRATMESH_FUZZ_CHECK(rewritten == 2 * cap_report.cap_wall_flips, "wall flips miscounted");
     }
 
     // ---- the same as reconstruct() on the same layers (with close_ends: the caps too)

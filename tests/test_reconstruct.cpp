@@ -2691,6 +2691,7 @@ TEST_CASE("close_ends: cylinder, vase, bumpy tube, head and CT slices become clo
                     CHECK(tube.report.cap_triangles == 0);
                     REQUIRE(run.count == tube.count + run.report.cap_triangles);
                     CHECK(std::equal(tube.triangles.begin(), tube.triangles.end(), run.triangles.begin()));
+                    CHECK(run.report.cap_wall_flips == 0);
                     CHECK(run.report.caps_closed == 2);
                     CHECK(run.report.caps_left_open == 0);
                     CHECK(run.report.triangle_count == run.count);

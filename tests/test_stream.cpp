@@ -396,6 +396,7 @@ TEST_CASE("cap_ends: the stream's surface capped is reconstruct()'s with close_e
         CHECK(capped.report.caps_closed == batch.report.caps_closed);
         CHECK(capped.report.caps_left_open == batch.report.caps_left_open);
         CHECK(capped.report.cap_triangles == batch.report.cap_triangles);
+        CHECK(capped.report.cap_wall_flips == batch.report.cap_wall_flips);
         // Only the cap fields are set: the stream's counts stay.
         CHECK(capped.report.points_in == 0);
         ++compared;
@@ -523,6 +524,7 @@ TEST_CASE("cap_ends: a loop whose every ear would repeat an edge of the wall (fi
     REQUIRE(f.status == Status::ok);
     CHECK(f.report.caps_left_open == 0);
     CHECK(f.report.caps_closed == 2);
+    CHECK(f.report.cap_wall_flips == 0);
     CHECK(std::equal(f.wall.begin(), f.wall.end(), f.capped.begin()));
     check_closed(f);
 }
@@ -557,6 +559,7 @@ TEST_CASE("cap_ends: where fins leave no cap, the wall's edges under them are fl
     CHECK(!made.empty());
     CHECK(made.size() == gone.size());
     CHECK(made.size() % 2 == 0);
+    CHECK(f.report.cap_wall_flips == made.size() / 2);
     auto has_fin = [&f](const std::array<uint32_t, 3>& t) {
         return std::any_of(t.begin(), t.end(), [&f](uint32_t v) {
             return std::find(f.fins.begin(), f.fins.end(), v) != f.fins.end();

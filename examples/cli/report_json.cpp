@@ -250,6 +250,7 @@ void write_counts(JsonWriter& j, const stratmesh::Report& rep, stratmesh::Status
     j.count_field("closed", rep.caps_closed);
     j.count_field("left_open", rep.caps_left_open);
     j.count_field("triangles", rep.cap_triangles);
+    j.count_field("wall_flips", rep.cap_wall_flips);
     j.end_object();
     j.key("axis");
     j.begin_object();

@@ -214,6 +214,7 @@ private:
         report_.caps_closed = caps.caps_closed;
         report_.caps_left_open = caps.caps_left_open;
         report_.cap_triangles = caps.cap_triangles;
+        report_.cap_wall_flips = caps.cap_wall_flips;
         report_.triangle_count = count;
         return status;
     }

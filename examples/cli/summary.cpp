@@ -91,8 +91,11 @@ void print_counts(std::FILE* out, const RunRecord& r) {
                  rep.illegal_removed, rep.folds);
     print_folds(out, r);
     if (rep.caps_closed + rep.caps_left_open > 0)
-        std::fprintf(out, "  caps       %zu closed (%zu triangles), %zu left open\n",
-                     rep.caps_closed, rep.cap_triangles, rep.caps_left_open);
+        std::fprintf(out, "  caps       %zu closed (%zu triangles), %zu left open%s\n",
+                     rep.caps_closed, rep.cap_triangles, rep.caps_left_open,
+                     rep.cap_wall_flips ? (", " + std::to_string(rep.cap_wall_flips) +
+                                           " wall edges flipped under fins").c_str()
+                                        : "");
 }
 
 void print_costs(std::FILE* out, const RunRecord& r) {

@@ -11,7 +11,8 @@ a crop with fewer points is taken whole), each as read and rounded to a multiple
 values, and runs the tool with `--axis z --cap` and 1 and 3 layers on each: 360 runs on
 which each surface has a loop at the crop's bottom and a ragged one where it was cut.
 Prints one line per run that leaves a loop open, then one JSON line: the runs, the loops
-closed and left open, and the runs whose status was not ok. --quick runs the first seed
+closed and left open, the runs whose caps flipped wall edges under fins and those edges,
+and the runs whose status was not ok. --quick runs the first seed
 only (60 runs). README.md ("Known limitations", caps over wall fins) quotes it on the
 bundled bust:
 
@@ -55,7 +56,8 @@ def main(argv):
         return 2
     points, _ = read_ply(argv[0])
     z0, z1 = min(p[2] for p in points), max(p[2] for p in points)
-    totals = {"runs": 0, "closed": 0, "left_open": 0, "failed": 0}
+    totals = {"runs": 0, "closed": 0, "left_open": 0, "runs_with_wall_flips": 0,
+              "wall_flips": 0, "failed": 0}
     with tempfile.TemporaryDirectory() as work:
         cloud_path = os.path.join(work, "crop.ply")
         mesh_path = os.path.join(work, "mesh.ply")
@@ -84,6 +86,9 @@ def main(argv):
                             caps = report["caps"]
                             totals["closed"] += caps["closed"]
                             totals["left_open"] += caps["left_open"]
+                            flips = caps.get("wall_flips", 0)  # older tools lack it
+                            totals["wall_flips"] += flips
+                            totals["runs_with_wall_flips"] += flips > 0
                             if caps["left_open"]:
                                 print("round %s, %d points, seed %d, below %.0f%%, %d layers: "
                                       "%d loop(s) left open" % (step, len(crop), seed,

@@ -346,9 +346,9 @@ enum Flags : uint32_t {
     // with two edges on the loop) leave no such cap, the edge under a fin may be flipped
     // (the fin and the triangle beyond it become two others: same corners, same count; the
     // loop unchanged), which frees its chord for the cap; only flips the cap then uses are
-    // made (Report::cap_wall_flips counts them). A loop whose projection is not a simple polygon, or that neither ear clipping
-    // nor (for loops of at most 256 corners) an exhaustive search closes, with or without
-    // those flips, stays open: the call
+    // made (Report::cap_wall_flips counts them). A loop whose projection is not a simple
+    // polygon, or that neither ear clipping nor (for loops of at most 256 corners) an
+    // exhaustive search closes, with or without those flips, stays open: the call
     // still returns ok, Report::caps_left_open counts it and Report::detail says so. Caps
     // do not cross one another; like the rest of the surface, they are not checked against
     // the tube. The workspace bound grows by about 6 bytes per point with this flag, plus
@@ -694,8 +694,8 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count);
 // change, in place. options: axis, direction, origin (with
 // origin_given) and skip_invalid_points as given to the stream or reconstruct(); the rest
 // is not used. report (optional): only caps_closed, caps_left_open, cap_triangles,
-// cap_wall_flips, workspace_used (this call's) and detail are set, the rest left as it is: the stream's
-// report can be passed, its counts kept (its workspace_used replaced).
+// cap_wall_flips, workspace_used (this call's) and detail are set, the rest left as it
+// is: the stream's report can be passed, its counts kept (its workspace_used replaced).
 // Returns ok (loops whose projection is not simple stay open: caps_left_open);
 // invalid_argument (a null triangle_count, triangles or workspace where needed, a bad
 // stride or scalar, *triangle_count above triangle_capacity, an index outside the cloud or
@@ -5827,7 +5827,7 @@ inline uint32_t mark_flippable_fins(const uint32_t* tri, size_t wall, const Clou
 // Flips the wall's edge under each fin marked kFinUsed; returns how many it flipped. slots:
 // two size_t per position (in the memory of the loop's projection, free once its cap is made).
 inline size_t flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const uint32_t* ids,
-                           uint32_t length, const unsigned char* fins, double* slots) {
+                             uint32_t length, const unsigned char* fins, double* slots) {
     auto slot = [slots](uint32_t i, uint32_t which) { return slots + 2 * static_cast<size_t>(i) + which; };
     static_assert(sizeof(size_t) <= sizeof(double), "a slot holds a triangle index");
     const size_t unset = ~size_t{0};
@@ -5866,8 +5866,9 @@ inline size_t flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const ui
 
 // Caps every boundary loop of the surface tri[0 .. 3 count) over the cloud's points,
 // appending the cap triangles (count grows) and counting into caps (zeroed by the caller);
-// each loop is projected across the frame's axis. Returns ok; out_of_memory; or triangle_capacity with *needed the triangles every
-// cap closing would take, and nothing written.
+// each loop is projected across the frame's axis. Returns ok; out_of_memory; or
+// triangle_capacity with *needed the triangles every cap closing would take, and nothing
+// written.
 inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
                                  const CloudReader& cloud, size_t point_count,
                                  const Frame& frame, Arena& arena, CapCounts& caps,

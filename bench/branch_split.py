@@ -1,0 +1,158 @@
+#!/usr/bin/env python3
+"""branch_split.py - how close separate tubes per branch come, before any junction.
+
+    bench/branch_split.py CLOUD.ply HEIGHT OUT.ply [--gap D] [--stratmesh PATH]
+                          [-- TRUNK_OPTIONS...]
+
+An experiment for the branching that stratmesh does not do yet (README, "Known
+limitations"): splits the cloud (x, y, z of the vertex element) at HEIGHT along z into the
+trunk below and the pieces above it, pieces being the connected parts of the points above
+when points closer than D join (single linkage; D defaults to 4 times the median distance
+from a point to its nearest neighbour, over a sample of 200 points); runs the stratmesh tool
+on the trunk with TRUNK_OPTIONS (for example --axis z --layers 8) and on each piece of at
+least 20 points with the tool's automatic axis and layers; and writes OUT.ply, one mesh
+over every point of the cloud in its order, with the triangles of all those runs: the
+branches as tubes of their own, not joined to the trunk (each junction leaves a gap and
+two loops). Prints one JSON line: the pieces' point counts, each run's status, layers and
+folds. Measure it with the checker of ../shared/tools/meshq, against a reference made as
+bench/README.md describes, e.g. on the horned bust (horned_bust.py; its horns leave the
+skull's section at z = 2.85):
+
+    bench/branch_split.py horned.ply 2.85 split.ply -- --axis z --layers 8
+    meshq --mesh split.ply --ref horned_reference.off --cloud horned.ply
+
+The tool is build/examples/cli/stratmesh (relative to the source tree) unless --stratmesh
+or the environment variable STRATMESH says otherwise. Needs python3 only.
+"""
+import json
+import math
+import os
+import random
+import subprocess
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from order_probe import read_ply, write_cloud  # noqa: E402
+
+SMALLEST_PIECE = 20
+
+
+def median_spacing(points):
+    sample = random.Random(1).sample(points, min(200, len(points)))
+    nearest = []
+    for p in sample:
+        best = math.inf
+        for q in points:
+            d = (p[0] - q[0]) ** 2 + (p[1] - q[1]) ** 2 + (p[2] - q[2]) ** 2
+            if 0 < d < best:
+                best = d
+        nearest.append(math.sqrt(best))
+    nearest.sort()
+    return nearest[len(nearest) // 2]
+
+
+def pieces_of(points, gap):
+    """Single-linkage pieces of the points at distance gap: lists of indices."""
+    parent = list(range(len(points)))
+
+    def root(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    cells = {}
+    for i, p in enumerate(points):
+        cells.setdefault(tuple(int(math.floor(c / gap)) for c in p), []).append(i)
+    for (cx, cy, cz), members in cells.items():
+        for dx in (-1, 0, 1):
+            for dy in (-1, 0, 1):
+                for dz in (-1, 0, 1):
+                    for j in cells.get((cx + dx, cy + dy, cz + dz), ()):
+                        for i in members:
+                            if i < j and math.dist(points[i], points[j]) < gap:
+                                parent[root(i)] = root(j)
+    groups = {}
+    for i in range(len(points)):
+        groups.setdefault(root(i), []).append(i)
+    return sorted(groups.values(), key=len, reverse=True)
+
+
+def write_mesh(path, points, faces):
+    with open(path, "w") as f:
+        f.write("ply\nformat ascii 1.0\nelement vertex %d\nproperty double x\n"
+                "property double y\nproperty double z\nelement face %d\n"
+                "property list uchar int vertex_indices\nend_header\n"
+                % (len(points), len(faces)))
+        for p in points:
+            f.write("%.17g %.17g %.17g\n" % p)
+        for t in faces:
+            f.write("3 %d %d %d\n" % t)
+
+
+def main(argv):
+    tool = os.environ.get("STRATMESH") or os.path.join(
+        os.path.dirname(os.path.abspath(__file__)), "..", "build", "examples", "cli", "stratmesh")
+    trunk_options = []
+    if "--" in argv:
+        trunk_options = argv[argv.index("--") + 1:]
+        argv = argv[:argv.index("--")]
+    gap = None
+    for flag in ("--gap", "--stratmesh"):
+        if flag in argv:
+            i = argv.index(flag)
+            if i + 1 >= len(argv):
+                print(__doc__.split("\n\n")[1], file=sys.stderr)
+                return 2
+            if flag == "--gap":
+                gap = float(argv[i + 1])
+            else:
+                tool = argv[i + 1]
+            argv = argv[:i] + argv[i + 2:]
+    if len(argv) != 3:
+        print(__doc__.split("\n\n")[1], file=sys.stderr)
+        return 2
+    points, _ = read_ply(argv[0])
+    height, out_path = float(argv[1]), argv[2]
+    if gap is None:
+        gap = 4 * median_spacing(points)
+    below = [i for i, p in enumerate(points) if p[2] < height]
+    above = [i for i, p in enumerate(points) if p[2] >= height]
+    parts = [("trunk", below, trunk_options)]
+    small = 0
+    for k, piece in enumerate(pieces_of([points[i] for i in above], gap)):
+        if len(piece) < SMALLEST_PIECE:
+            small += len(piece)
+            continue
+        parts.append(("piece %d" % k, [above[i] for i in piece], []))
+    summary = {"gap": gap, "points": len(points), "left_out_in_small_pieces": small, "runs": []}
+    faces = []
+    with tempfile.TemporaryDirectory() as work:
+        for name, indices, options in parts:
+            cloud_path = os.path.join(work, "part.ply")
+            mesh_path = os.path.join(work, "part_mesh.ply")
+            report_path = os.path.join(work, "report.json")
+            write_cloud(cloud_path, [points[i] for i in indices])
+            run = subprocess.run([tool, cloud_path, "-o", mesh_path, "--ascii", "--report",
+                                  report_path, "-q"] + options,
+                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            report = json.load(open(report_path)) if run.returncode == 0 else {}
+            summary["runs"].append({"part": name, "points": len(indices),
+                                    "status": report.get("status", "failed"),
+                                    "layers": report.get("layer_count"),
+                                    "folds": report.get("folds")})
+            if run.returncode != 0:
+                continue
+            vertices, part_faces = read_ply(mesh_path)
+            if len(vertices) != len(indices):
+                raise SystemExit("the tool wrote %d vertices for %d points"
+                                 % (len(vertices), len(indices)))
+            faces.extend(tuple(indices[c] for c in face) for face in part_faces)
+    write_mesh(out_path, points, faces)
+    print(json.dumps(summary))
+    return 0 if all(r["status"] == "ok" for r in summary["runs"]) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,13 +1,13 @@
 #!/usr/bin/env python3
 """branch_split.py - how close separate tubes per branch come, before any junction.
 
-    bench/branch_split.py CLOUD.ply HEIGHT OUT.ply [--gap D] [--stratmesh PATH]
+    bench/branch_split.py CLOUD.ply HEIGHT OUT.ply [--below] [--gap D] [--stratmesh PATH]
                           [-- TRUNK_OPTIONS...]
 
 An experiment for the branching that stratmesh does not do yet (README, "Known
 limitations"): splits the cloud (x, y, z of the vertex element) at HEIGHT along z into the
-trunk below and the pieces above it, pieces being the connected parts of the points above
-when points closer than D join (single linkage; D defaults to 4 times the median distance
+trunk below and the pieces above it (with --below: the trunk above and the pieces below),
+pieces being the connected parts of those points when points closer than D join (single linkage; D defaults to 4 times the median distance
 from a point to its nearest neighbour, over a sample of 200 points); runs the stratmesh tool
 on the trunk with TRUNK_OPTIONS (for example --axis z --layers 8) and on each piece of at
 least 20 points with the tool's automatic axis and layers; and writes OUT.ply, one mesh
@@ -99,6 +99,9 @@ def main(argv):
         trunk_options = argv[argv.index("--") + 1:]
         argv = argv[:argv.index("--")]
     gap = None
+    below_first = "--below" in argv
+    if below_first:
+        argv.remove("--below")
     for flag in ("--gap", "--stratmesh"):
         if flag in argv:
             i = argv.index(flag)
@@ -117,15 +120,15 @@ def main(argv):
     height, out_path = float(argv[1]), argv[2]
     if gap is None:
         gap = 4 * median_spacing(points)
-    below = [i for i, p in enumerate(points) if p[2] < height]
-    above = [i for i, p in enumerate(points) if p[2] >= height]
-    parts = [("trunk", below, trunk_options)]
+    trunk = [i for i, p in enumerate(points) if (p[2] >= height) == below_first]
+    branches = [i for i, p in enumerate(points) if (p[2] >= height) != below_first]
+    parts = [("trunk", trunk, trunk_options)]
     small = 0
-    for k, piece in enumerate(pieces_of([points[i] for i in above], gap)):
+    for k, piece in enumerate(pieces_of([points[i] for i in branches], gap)):
         if len(piece) < SMALLEST_PIECE:
             small += len(piece)
             continue
-        parts.append(("piece %d" % k, [above[i] for i in piece], []))
+        parts.append(("piece %d" % k, [branches[i] for i in piece], []))
     summary = {"gap": gap, "points": len(points), "left_out_in_small_pieces": small, "runs": []}
     faces = []
     with tempfile.TemporaryDirectory() as work:

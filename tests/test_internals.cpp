@@ -113,3 +113,29 @@ TEST_CASE("internals: trailing_zeros counts as the loop over the bits does") {
         CHECK(stratmesh::detail::trailing_zeros(h, limit) == expected);
     }
 }
+
+TEST_CASE("internals: exp_portable is within two ulp of exp, monotone, and clamped") {
+    // Every 1e-4 over the range the unrolling uses, and the points of the table's steps
+    // (k ln2 / 32), where the reduction changes j.
+    double previous = 0;
+    double worst = 0;
+    for (long i = -640000; i <= 640000; ++i) {
+        const double x = static_cast<double>(i) * 1e-4;
+        const double e = stratmesh::detail::exp_portable(x);
+        worst = std::fmax(worst, std::fabs(e - std::exp(x)) / std::exp(x));
+        CHECK_MESSAGE(e >= previous, "x " << x);
+        previous = e;
+    }
+    for (int k = -2954; k <= 2954; ++k) {
+        const double x = k * 0.693147180559945309417 / 32;
+        worst = std::fmax(worst, std::fabs(stratmesh::detail::exp_portable(x) - std::exp(x)) /
+                                     std::exp(x));
+    }
+    INFO("worst relative error " << worst);
+    CHECK(worst < 2 * DBL_EPSILON);
+    // Beyond [-64, 64] and for NaN, the clamp's values.
+    CHECK(stratmesh::detail::exp_portable(1e300) == stratmesh::detail::exp_portable(64));
+    CHECK(stratmesh::detail::exp_portable(-1e300) == stratmesh::detail::exp_portable(-64));
+    CHECK(stratmesh::detail::exp_portable(std::nan("")) == stratmesh::detail::exp_portable(-64));
+    CHECK(stratmesh::detail::exp_portable(0) == 1);
+}

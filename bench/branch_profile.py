@@ -8,12 +8,12 @@ limitations"): cuts the cloud (x, y, z of the vertex element) into slabs T high 
 and counts each slab's pieces: the connected parts of its points when points closer than
 D join (single linkage, as branch_split.py; D defaults to 4 times the median distance from
 a point to its nearest neighbour, T to 2 D). A piece counts when it holds at least 20
-points and a twentieth of its slab's: a few stray points do not make a branch. Prints the
-profile, one line per run of slabs with the same count, bottom up, and the heights where
-the cloud parts: the lowest slab boundary above which the points make two pieces or more
-(the branches above: branch_split.py HEIGHT), and the highest below which they do
-(branch_split.py HEIGHT --below); every boundary is tried. With --json, one JSON line
-instead. E.g. on the horned bust (horned_bust.py), whose horns leave the skull at
+points and a twentieth of its slab's (of its side's, below): a few stray points do not
+make a branch. Prints the profile, one line per run of slabs with the same count, bottom
+up, and the heights where the cloud parts: the lowest slab boundary above which the points
+make two pieces or more (the branches above: branch_split.py HEIGHT), and the highest
+below which they do (branch_split.py HEIGHT --below); every boundary is tried. With
+--json, one JSON line instead. E.g. on the horned bust (horned_bust.py), whose horns leave the skull at
 z = 2.85 (bench/README.md has what it finds on the other clouds):
 
     bench/branch_profile.py horned.ply
@@ -48,7 +48,8 @@ def slab_pieces(points, gap, slab):
 
 
 def counted_pieces(points, gap):
-    """The pieces of the points that count (see above), largest first."""
+    """The pieces of the points that count (at least 20 points and a twentieth of them),
+    largest first."""
     least = max(SMALLEST_PIECE, len(points) / 20)
     return [piece for piece in pieces_of(points, gap) if len(piece) >= least]
 

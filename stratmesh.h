@@ -3165,8 +3165,9 @@ const uint32_t kSectors = 32;
 // float-to-integer conversion below with an out-of-range value. x = k ln2 / 32 + r with
 // |r| <= ln2 / 64 and k = 32 q + j, so e^x = 2^q 2^(j / 32) e^r: the table's 2^(j / 32)
 // are correctly rounded, and e^r's series to r^6 / 6! is within 4e-18 of it; within two
-// ulp of glibc's exp over [-64, 64] (tests; one measured). The series to r^13 / 13! that a reduction to
-// |r| <= ln2 / 2 needs took a fifth of triangulate_layer's own time on a tube.
+// ulp of glibc's exp over [-64, 64] (tests; one measured). The series to r^13 / 13! that
+// a reduction to |r| <= ln2 / 2 needs took a fifth of triangulate_layer's own time on a
+// tube.
 inline double exp_portable(double x) {
     if (!(x > -64)) x = -64;
     if (x > 64) x = 64;

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """branch_profile.py - where a cloud parts into branches along z.
 
-    bench/branch_profile.py CLOUD.ply [--gap D] [--slab T] [--json]
+    bench/branch_profile.py CLOUD.ply [--gap D] [--slab T] [--step S] [--json]
 
 The other half of the branching experiment of branch_split.py (README, "Known
 limitations"): cuts the cloud (x, y, z of the vertex element) into slabs T high along z
@@ -10,10 +10,11 @@ D join (single linkage, as branch_split.py; D defaults to 4 times the median dis
 a point to its nearest neighbour, T to 2 D). A piece counts when it holds at least 20
 points and a twentieth of its slab's (of its side's, below): a few stray points do not
 make a branch. Prints the profile, one line per run of slabs with the same count, bottom
-up, and the heights where the cloud parts: the lowest slab boundary above which the points
-make two pieces or more (the branches above: branch_split.py HEIGHT), and the highest
-below which they do (branch_split.py HEIGHT --below); every boundary is tried. With
---json, one JSON line instead. E.g. on the horned bust (horned_bust.py), whose horns leave the skull at
+up, and the heights where the cloud parts, tried every S (default D / 2): the lowest
+above which the points make two branches or more (branch_split.py HEIGHT), and the
+highest below which they do (branch_split.py HEIGHT --below), where a branch is a piece
+that starts at the cut and goes on from it (see parting_heights). With --json, one JSON
+line instead. E.g. on the horned bust (horned_bust.py), whose horns leave the skull at
 z = 2.85 (bench/README.md has what it finds on the other clouds):
 
     bench/branch_profile.py horned.ply
@@ -54,18 +55,36 @@ def counted_pieces(points, gap):
     return [piece for piece in pieces_of(points, gap) if len(piece) >= least]
 
 
-def parting_heights(points, gap, profile):
-    """The lowest slab boundary such that the points above it make two pieces or more, and
-    the highest such that the points below it do (None where there is none), each with
-    the pieces' point counts. Every boundary is tried: the lowest points may be one
-    branch alone (a condyle that reaches lower than the other)."""
+def is_branch(heights, cut, gap):
+    """Whether a piece with these heights starts at the cut (its nearest point within a gap
+    of it) and goes on from it (its farthest a gap or more away)."""
+    distances = [abs(h - cut) for h in heights]
+    return min(distances) <= gap and max(distances) >= gap
+
+
+def parting_heights(points, gap, step):
+    """The lowest height, of those `step` apart from the lowest point up, such that the
+    points above it make two pieces or more that reach down to it (their lowest point
+    within `gap` of it) and go on from it (a gap or more), and the highest such that the
+    points below it make two or more such pieces (None where there is none), each with the
+    pieces' point counts; cuts within two gaps of the cloud's end are not tried. A branch
+    parts at the cut and goes on: a piece that begins farther away is a patch that a hole
+    in the scan cut off (the top of the femur's head), one that ends within a gap a bump
+    (63 points of the kitten within a third of a gap above z = 0.15); and a side thinner
+    than two gaps is the rim at the cloud's end, which falls apart into arcs. The steps are
+    finer than the slabs: the femur's condyles part only between slab boundaries."""
+    low = min(p[2] for p in points)
+    high = max(p[2] for p in points)
+    heights = [low + k * step for k in range(1, int((high - low) / step) + 1)]
     found = []
-    boundaries = [bottom for bottom, _, _ in profile[1:]]
-    for side, order in (("above", boundaries), ("below", list(reversed(boundaries)))):
+    for side, order in (("above", heights), ("below", list(reversed(heights)))):
         best = None
         for height in order:
             part = [p for p in points if (p[2] >= height) == (side == "above")]
-            pieces = counted_pieces(part, gap)
+            if max(abs(p[2] - height) for p in part) < 2 * gap:
+                continue
+            pieces = [piece for piece in counted_pieces(part, gap)
+                      if is_branch([part[i][2] for i in piece], height, gap)]
             if len(pieces) >= 2:
                 best = (height, [len(piece) for piece in pieces])
                 break
@@ -74,7 +93,7 @@ def parting_heights(points, gap, profile):
 
 
 def main(argv):
-    options = {"--gap": None, "--slab": None}
+    options = {"--gap": None, "--slab": None, "--step": None}
     as_json = "--json" in argv
     if as_json:
         argv.remove("--json")
@@ -92,13 +111,14 @@ def main(argv):
     points, _ = read_ply(argv[0])
     gap = options["--gap"] or 4 * median_spacing(points)
     slab = options["--slab"] or 2 * gap
+    step = options["--step"] or gap / 2
     profile = slab_pieces(points, gap, slab)
-    above, below = parting_heights(points, gap, profile)
+    above, below = parting_heights(points, gap, step)
     if as_json:
-        print(json.dumps({"gap": gap, "slab": slab, "parts_above": above, "parts_below": below,
+        print(json.dumps({"gap": gap, "slab": slab, "step": step, "parts_above": above, "parts_below": below,
                           "profile": [[b, t, n] for b, t, n in profile]}))
         return 0
-    print("gap %.4g, slabs %.4g high" % (gap, slab))
+    print("gap %.4g, slabs %.4g high, cuts tried %.4g apart" % (gap, slab, step))
     run_start = 0
     for k in range(1, len(profile) + 1):
         if k == len(profile) or profile[k][2] != profile[run_start][2]:

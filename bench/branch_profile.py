@@ -12,10 +12,10 @@ points and a twentieth of its slab's (of its side's, below): a few stray points 
 make a branch. Prints the profile, one line per run of slabs with the same count, bottom
 up, and the heights where the cloud parts, tried every S (default D / 2): the lowest
 above which the points make two branches or more (branch_split.py HEIGHT), and the
-highest below which they do (branch_split.py HEIGHT --below), where a branch is a piece
-that starts at the cut and goes on from it (see parting_heights). With --json, one JSON
-line instead. E.g. on the horned bust (horned_bust.py), whose horns leave the skull at
-z = 2.85 (bench/README.md has what it finds on the other clouds):
+highest below which they do (branch_split.py HEIGHT --below), every piece there a branch:
+one that starts at the cut and goes on from it, its section too (see is_branch). With
+--json, one JSON line instead. E.g. on the horned bust (horned_bust.py), whose horns
+leave the skull at z = 2.85 (bench/README.md has what it finds on the other clouds):
 
     bench/branch_profile.py horned.ply
     bench/branch_split.py horned.ply HEIGHT split.ply -- --axis z --layers 8
@@ -55,24 +55,36 @@ def counted_pieces(points, gap):
     return [piece for piece in pieces_of(points, gap) if len(piece) >= least]
 
 
-def is_branch(heights, cut, gap):
-    """Whether a piece with these heights starts at the cut (its nearest point within a gap
-    of it) and goes on from it (its farthest a gap or more away)."""
-    distances = [abs(h - cut) for h in heights]
-    return min(distances) <= gap and max(distances) >= gap
+def is_branch(points, cut, gap):
+    """Whether a piece of these points starts at the cut (its nearest point within a gap of
+    it), goes on from it (its farthest a gap or more away) and its section goes on too: the
+    centroids of its points within a gap of the cut and within the next gap are less than
+    two gaps apart (across z)."""
+    distances = [abs(p[2] - cut) for p in points]
+    if not (min(distances) <= gap and max(distances) >= gap):
+        return False
+    slices = [[p for p, d in zip(points, distances) if k * gap <= d < (k + 1) * gap]
+              for k in range(2)]
+    if not slices[1]:
+        return True
+    centroids = [[sum(p[c] for p in slice_) / len(slice_) for c in range(2)]
+                 for slice_ in slices]
+    return math.dist(*centroids) < 2 * gap
 
 
 def parting_heights(points, gap, step):
     """The lowest height, of those `step` apart from the lowest point up, such that the
-    points above it make two pieces or more that reach down to it (their lowest point
-    within `gap` of it) and go on from it (a gap or more), and the highest such that the
-    points below it make two or more such pieces (None where there is none), each with the
-    pieces' point counts; cuts within two gaps of the cloud's end are not tried. A branch
-    parts at the cut and goes on: a piece that begins farther away is a patch that a hole
-    in the scan cut off (the top of the femur's head), one that ends within a gap a bump
-    (63 points of the kitten within a third of a gap above z = 0.15); and a side thinner
-    than two gaps is the rim at the cloud's end, which falls apart into arcs. The steps are
-    finer than the slabs: the femur's condyles part only between slab boundaries."""
+    points above it make two pieces or more and every one a branch (see is_branch), and the
+    highest such that the points below it do (None where there is none), each with the
+    pieces' point counts; cuts within two gaps of the cloud's end are not tried. Each of
+    is_branch's rules answers a false parting: a piece that begins farther away is a patch
+    that a hole in the scan cut off (the top of the femur's head), one that ends within a
+    gap a bump (63 points of the kitten within a third of a gap above z = 0.15), one whose
+    section jumps a cap joined to a branch (the crown of the horned bust, above z = 2.787,
+    with its left horn; above 2.814 the crown is a piece of its own, a patch, and that cut
+    is not taken either: its tube would be the crown's); and a side thinner than two gaps
+    is the rim at the cloud's end, which falls apart into arcs. The steps are finer than
+    the slabs: the femur's condyles part only between slab boundaries."""
     low = min(p[2] for p in points)
     high = max(p[2] for p in points)
     heights = [low + k * step for k in range(1, int((high - low) / step) + 1)]
@@ -83,9 +95,9 @@ def parting_heights(points, gap, step):
             part = [p for p in points if (p[2] >= height) == (side == "above")]
             if max(abs(p[2] - height) for p in part) < 2 * gap:
                 continue
-            pieces = [piece for piece in counted_pieces(part, gap)
-                      if is_branch([part[i][2] for i in piece], height, gap)]
-            if len(pieces) >= 2:
+            pieces = counted_pieces(part, gap)
+            if len(pieces) >= 2 and all(is_branch([part[i] for i in piece], height, gap)
+                                        for piece in pieces):
                 best = (height, [len(piece) for piece in pieces])
                 break
         found.append(best)

@@ -2,21 +2,24 @@
 """branch_split.py - how close separate tubes per branch come, before any junction.
 
     bench/branch_split.py CLOUD.ply HEIGHT OUT.ply [--below] [--gap D] [--stratmesh PATH]
-                          [-- TRUNK_OPTIONS...]
+                          [--piece-options "OPTIONS"] [-- TRUNK_OPTIONS...]
 
 An experiment for the branching that stratmesh does not do yet (README, "Known
 limitations"): splits the cloud (x, y, z of the vertex element) at HEIGHT along z into the
 trunk below and the pieces above it (with --below: the trunk above and the pieces below),
-pieces being the connected parts of those points when points closer than D join (single linkage; D defaults to 4 times the median distance
-from a point to its nearest neighbour, over a sample of 200 points); runs the stratmesh tool
-on the trunk with TRUNK_OPTIONS (for example --axis z --layers 8) and on each piece of at
-least 20 points with the tool's automatic axis and layers; and writes OUT.ply, one mesh
-over every point of the cloud in its order, with the triangles of all those runs: the
-branches as tubes of their own, not joined to the trunk (each junction leaves a gap and
-two loops). Prints one JSON line: the pieces' point counts, each run's status, layers and
-folds. Measure it with the checker of ../shared/tools/meshq, against a reference made as
-bench/README.md describes, e.g. on the horned bust (horned_bust.py; its horns leave the
-skull's section at z = 2.85):
+pieces being the connected parts of those points when points closer than D join (single
+linkage; D defaults to 4 times the median distance from a point to its nearest
+neighbour, over a sample of 200 points); runs the stratmesh tool on the trunk with
+TRUNK_OPTIONS (for example --axis z --layers 8) and on each piece of at least 20 points
+with the tool's automatic axis and layers, or with OPTIONS (split at spaces:
+--piece-options "--axis z" meshes the pieces along the trunk's axis, which suits short
+pieces such as the femur's condyles, where a long horn wants its own); and writes
+OUT.ply, one mesh over every point of the cloud in its order, with the triangles of all
+those runs: the branches as tubes of their own, not joined to the trunk (each junction
+leaves a gap and two loops). Prints one JSON line: the pieces' point counts, each run's
+status, layers and folds. Measure it with the checker of ../shared/tools/meshq, against a
+reference made as bench/README.md describes, e.g. on the horned bust (horned_bust.py; its
+horns leave the skull's section at z = 2.85):
 
     bench/branch_split.py horned.ply 2.85 split.ply -- --axis z --layers 8
     meshq --mesh split.ply --ref horned_reference.off --cloud horned.ply
@@ -102,7 +105,8 @@ def main(argv):
     below_first = "--below" in argv
     if below_first:
         argv.remove("--below")
-    for flag in ("--gap", "--stratmesh"):
+    piece_options = []
+    for flag in ("--gap", "--stratmesh", "--piece-options"):
         if flag in argv:
             i = argv.index(flag)
             if i + 1 >= len(argv):
@@ -110,6 +114,8 @@ def main(argv):
                 return 2
             if flag == "--gap":
                 gap = float(argv[i + 1])
+            elif flag == "--piece-options":
+                piece_options = argv[i + 1].split()
             else:
                 tool = argv[i + 1]
             argv = argv[:i] + argv[i + 2:]
@@ -128,7 +134,7 @@ def main(argv):
         if len(piece) < SMALLEST_PIECE:
             small += len(piece)
             continue
-        parts.append(("piece %d" % k, [branches[i] for i in piece], []))
+        parts.append(("piece %d" % k, [branches[i] for i in piece], piece_options))
     summary = {"gap": gap, "points": len(points), "left_out_in_small_pieces": small, "runs": []}
     faces = []
     with tempfile.TemporaryDirectory() as work:

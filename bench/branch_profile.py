@@ -127,7 +127,8 @@ def main(argv):
     profile = slab_pieces(points, gap, slab)
     above, below = parting_heights(points, gap, step)
     if as_json:
-        print(json.dumps({"gap": gap, "slab": slab, "step": step, "parts_above": above, "parts_below": below,
+        print(json.dumps({"gap": gap, "slab": slab, "step": step, "parts_above": above,
+                          "parts_below": below,
                           "profile": [[b, t, n] for b, t, n in profile]}))
         return 0
     print("gap %.4g, slabs %.4g high, cuts tried %.4g apart" % (gap, slab, step))

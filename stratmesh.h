@@ -392,6 +392,16 @@ enum Flags : uint32_t {
     // times the time on the 1e6-point tube. Off by default, for that time (the
     // command-line tool turns it on). A build with STRATMESH_SMALL_CODE ignores it.
     surface_flips = 1u << 4,
+    // No end of the surface is taken for a closed one (see ClosedEnd): the end layers are
+    // unrolled on the cylinder like the others, never around a pole, so the surface's loops
+    // lie where the cylinder's picture puts them (a flat end's points on its rim, a dome
+    // up to its highest points). For a cloud cut out of a larger object (a region of
+    // interest, a branch meshed on its own), whose ends are cuts however many points lie
+    // across them: a cut through the notch between the femur's condyles leaves points
+    // inside the shaft's outline, which the detection takes for a closed end and meshes
+    // across (README, Known limitations). A build with STRATMESH_SMALL_CODE, which has no
+    // closed ends, ignores it.
+    open_ends = 1u << 5,
 };
 
 // Phases reported to Options::progress, in the order they run. Each layer is stitched to
@@ -2630,6 +2640,8 @@ struct Frame {
     // Layers are flipped on the surface (the surface_flips flag; see "flips on the surface"
     // in >>layer triangulation).
     bool surface_flips;
+    // No end is taken for a closed one (the open_ends flag; read with kClosedEnds only).
+    bool open_ends;
     // The valid points' lowest and highest coordinates (set by choose_frame with kFastLoops).
     Vec3 low, high;
     // (p - origin) * scale, without overflow.
@@ -2805,6 +2817,7 @@ inline Status choose_frame(const CloudReader& cloud, size_t count, const CloudSu
     if (!normalize(e1)) return Status::invalid_axis;
     frame.axis = axis;
     frame.surface_flips = kSurfaceFlips && (options.flags & surface_flips);
+    frame.open_ends = kClosedEnds && (options.flags & open_ends);
     frame.e1 = e1;
     frame.e2 = cross(axis, e1);
     return Status::ok;
@@ -3685,6 +3698,7 @@ struct LoadedLayer {
     Cylinder cyl;
     bool surface_flips;   // Frame::surface_flips
     uint32_t ends;        // kLowPole, kHighPole: the surface's ends (see find_closed_ends)
+    bool open_ends;       // Frame::open_ends
 };
 
 // `staged` (optional): the same points in frame coordinates, in the arena's end room
@@ -3697,6 +3711,7 @@ inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint3
     layer.ends = 0;
     layer.count = count;
     if (kSurfaceFlips) layer.surface_flips = frame.surface_flips;
+    layer.open_ends = kClosedEnds && frame.open_ends;
     layer.points = arena.alloc<Local>(count);
     if (arena.failed) return false;
     if (intact)
@@ -3758,7 +3773,7 @@ inline void find_closed_ends(LoadedLayer& layer, uint32_t ends) {
     Cylinder& c = layer.cyl;
     const Local* points = layer.points;
     const size_t n = layer.count;
-    if (!kClosedEnds || !ends || n == 0) return;
+    if (!kClosedEnds || !ends || n == 0 || layer.open_ends) return;
     double lo = points[0].h, hi = lo;
     for (size_t i = 1; i < n; ++i) {
         lo = points[i].h < lo ? points[i].h : lo;
@@ -6711,7 +6726,8 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
         const bool triangulated = kParallelLayers && ahead && ahead->done && last == first &&
                                   ahead->ends == ends;
         LoadedLayer layer = {ids, n, nullptr, triangulated ? ahead->cylinder : Cylinder{},
-                             kSurfaceFlips && c.frame.surface_flips, ends};
+                             kSurfaceFlips && c.frame.surface_flips, ends,
+                             kClosedEnds && c.frame.open_ends};
         const Local* staged = q.staged ? q.staged + q.start[first] : nullptr;
         if (!triangulated && !load_layer(c.reader, c.frame, ids, staged, n, h0, h1, arena, layer))
             return Status::out_of_memory;

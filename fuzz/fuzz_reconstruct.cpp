@@ -128,6 +128,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const uint8_t last = in.u8();
     if (last & 1) options.flags |= stratmesh::drop_outliers;
     if (last & 2) options.flags |= stratmesh::surface_flips;
+    if (last & 4) options.flags |= stratmesh::open_ends;
     const bool dropping = (options.flags & stratmesh::drop_outliers) != 0;
 
     Run first = run(cloud, options, capacity, layer_capacity, 0xA5);

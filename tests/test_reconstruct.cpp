@@ -1617,6 +1617,67 @@ TEST_CASE("closed ends: a flat-ended cylinder and a capsule are meshed across th
     }
 }
 
+// open_ends: a cloud cut out of a larger object has cuts for ends, however many points lie
+// across them. With the flag no end of the closed shapes above is unrolled around a pole:
+// no layer reports a closed end, and the surface is still one manifold annulus through
+// every point. On the cylinder picture a flat end's points come onto its rim, so its loops
+// run out to the rim (radius 1; around a pole within 0.3); a dome's top still reaches the
+// loop's highest points (0.37 from the axis on the capsule, 0.26 around its pole). A shape
+// with no closed end gives the same triangles with or without the flag.
+TEST_CASE("open_ends: no end is unrolled around a pole, on a manifold tube through every point") {
+    for (int closed = 0; closed < 2; ++closed) {
+        for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
+            for (uint32_t planned : {1u, 4u, 12u}) {
+                Shape s = closed == 0 ? shapes::closed_cylinder(kSmall, pose)
+                                      : shapes::capsule(kSmall, pose);
+                Options o = axis_options(s);
+                o.layer_count = planned;
+                o.flags |= stratmesh::open_ends;
+                Run run = reconstruct_guarded(cloud_of(s), o);
+                CAPTURE(s.name);
+                CAPTURE(planned);
+                REQUIRE(run.status == Status::ok);
+                CHECK(run.report.unused == 0);
+                mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, false);
+                INFO(m.summary());
+                CHECK(m.manifold());
+                CHECK(m.components == 1);
+                CHECK(m.boundary_loops == 2);
+                CHECK(m.euler == 0);
+                CHECK(m.unused_expected == 0);
+                for (size_t k = 0; k < run.layers.size(); ++k) CHECK(run.layers[k].closed_ends == 0);
+                std::map<std::pair<uint32_t, uint32_t>, int> edges;
+                for (size_t t = 0; t < run.count; ++t)
+                    for (size_t k = 0; k < 3; ++k) {
+                        uint32_t a = run.triangles[3 * t + k], b = run.triangles[3 * t + (k + 1) % 3];
+                        ++edges[{std::min(a, b), std::max(a, b)}];
+                    }
+                double widest_loop = 0;
+                for (const auto& e : edges) {
+                    if (e.second != 1) continue;
+                    for (uint32_t v : {e.first.first, e.first.second}) {
+                        double local[3];
+                        s.transform.unapply(s.point(v), local);
+                        widest_loop = std::max(widest_loop, std::hypot(local[0], local[1]));
+                    }
+                }
+                if (closed == 0) CHECK(widest_loop > 0.9);
+            }
+        }
+    }
+    for (Pose pose : {Pose::z, Pose::tilted}) {
+        Shape s = shapes::bumpy_tube(kSmall, pose);
+        Options o = axis_options(s);
+        o.layer_count = 4;
+        Run plain = reconstruct_guarded(cloud_of(s), o);
+        o.flags |= stratmesh::open_ends;
+        Run open = reconstruct_guarded(cloud_of(s), o);
+        REQUIRE(plain.status == Status::ok);
+        CHECK(open.status == Status::ok);
+        CHECK(open.triangles == plain.triangles);
+    }
+}
+
 namespace {
 
 // Reconstructs s in `planned` layers along its axis and checks what every run must give:

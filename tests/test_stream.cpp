@@ -213,6 +213,17 @@ TEST_CASE("stream: with surface_flips, the same triangles as reconstruct() with 
     });
 }
 
+// open_ends reaches both paths: the closed shapes' ends stay open in either.
+TEST_CASE("stream: with open_ends, the same triangles as reconstruct() with it, no end closed") {
+    for_every_shape({equal_fractions(6), {0.03, 0.06, 0.85, 0.97}}, [](const Layered& l, Options o) {
+        o.flags |= stratmesh::open_ends;
+        const Output batch = run_batch(l, o);
+        check_same(batch, run_stream(l, o, l.size()));
+        for (size_t k = 0; k < batch.report.layer_count && k < batch.layers.size(); ++k)
+            CHECK(batch.layers[k].closed_ends == 0);
+    });
+}
+
 TEST_CASE("stream: pushes of one contour each (CT slices) merge into layers as reconstruct() does") {
     for (Pose pose : {Pose::z, Pose::x}) {
         const Shape s = shapes::ct_slices(2000, pose);

@@ -58,6 +58,10 @@ const char kUsage[] =
     "                        default here: closer to the true surface, most where the\n"
     "                        unrolling squeezes it; about 2.5 times the library's time on\n"
     "                        a smooth tube)\n"
+    "  --open-ends           take no end of the cloud for a closed one (a dome, a base):\n"
+    "                        both ends stay a tube's rims along the first and last cut;\n"
+    "                        for a cloud cut out of a larger object (stratmesh's\n"
+    "                        open_ends)\n"
     "  --cap                 close the tube's ends with caps over its boundary loops: a\n"
     "                        closed, watertight surface (a loop that cannot be capped\n"
     "                        stays open; the summary and the report count it)\n"
@@ -206,6 +210,7 @@ bool apply_flag(std::string_view name, CommandLine& line) {
     if (name == "--cap") line.cap = true;
     if (name == "--drop-outliers") line.drop_outliers = true;
     if (name == "--unrolled-delaunay") line.surface_flips = false;
+    if (name == "--open-ends") line.open_ends = true;
     if (name == "--quiet") line.quiet = true;
     if (name == "--stream") line.stream = true;
     return true;
@@ -216,7 +221,7 @@ const char* const kValuedOptions[] = {"--output",  "--report",        "--axis",
                                       "--threads", "--stream-points", "--origin"};
 const char* const kFlags[] = {"--ascii", "--skip-invalid", "--cap",     "--quiet",
                               "--help",  "--version",      "--stream", "--drop-outliers",
-                              "--unrolled-delaunay"};
+                              "--unrolled-delaunay", "--open-ends"};
 
 // What --stream cannot do, or an empty string.
 std::string stream_conflict(const CommandLine& line) {

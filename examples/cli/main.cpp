@@ -79,6 +79,7 @@ void record_command_line(const CommandLine& line, RunRecord& record) {
     record.cap = line.cap;
     record.drop_outliers = line.drop_outliers;
     record.surface_flips = line.surface_flips;
+    record.open_ends = line.open_ends;
     record.threads = line.threads;
     record.origin_given = line.origin_given || line.stream;
     for (size_t k = 0; k < 3; ++k) record.origin[k] = line.origin[k];
@@ -96,7 +97,8 @@ stratmesh::Options make_options(const CommandLine& line, ProgressMonitor& monito
     options.flags = (line.skip_invalid ? stratmesh::skip_invalid_points : 0u) |
                     (line.cap ? stratmesh::close_ends : 0u) |
                     (line.drop_outliers ? stratmesh::drop_outliers : 0u) |
-                    (line.surface_flips ? stratmesh::surface_flips : 0u);
+                    (line.surface_flips ? stratmesh::surface_flips : 0u) |
+                    (line.open_ends ? stratmesh::open_ends : 0u);
     options.progress = &ProgressMonitor::callback;
     options.progress_user = &monitor;
     if (line.origin_given) {

@@ -199,6 +199,7 @@ void write_options(JsonWriter& j, const RunRecord& r) {
     j.flag_field("cap", r.cap);
     j.flag_field("drop_outliers", r.drop_outliers);
     j.flag_field("surface_flips", r.surface_flips);
+    j.flag_field("open_ends", r.open_ends);
     j.count_field("threads", r.threads);
     j.flag_field("stream", r.stream);
     j.key("stream_points");

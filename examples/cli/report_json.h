@@ -34,6 +34,7 @@ struct RunRecord {
     bool cap = false;
     bool drop_outliers = false;
     bool surface_flips = false;
+    bool open_ends = false;
     uint32_t threads = 1;
     bool origin_given = false;
     double origin[3] = {0, 0, 0};

@@ -1537,6 +1537,67 @@ TEST_CASE("a crescent end layer joins its neighbour, a half cylinder keeps its l
     }
 }
 
+namespace {
+
+// Reconstructs s in `planned` layers along its axis and checks what every run must give:
+// ok, one manifold tube (one component, two boundary loops) through every point. The mesh
+// check (with self-intersections if asked) goes to *m; `flags` are added to the options.
+Run reconstruct_tube(const Shape& s, uint32_t planned, bool self_intersections, mesh_check::Result* m,
+                     uint32_t flags = 0) {
+    Options o = axis_options(s);
+    o.layer_count = planned;
+    o.flags |= flags;
+    Run run = reconstruct_guarded(cloud_of(s), o);
+    REQUIRE(run.status == Status::ok);
+    CHECK(run.report.unused == 0);
+    *m = check_mesh(s, run.triangles.data(), run.count, self_intersections);
+    INFO(m->summary());
+    CHECK(m->manifold());
+    CHECK(m->components == 1);
+    CHECK(m->boundary_loops == 2);
+    CHECK(m->unused_expected == 0);
+    return run;
+}
+
+// s (a closed shape) cut in `planned` layers along its axis with `flags`: reconstruct_tube's
+// checks, an Euler characteristic of 0 and no self-intersection.
+Run reconstruct_closed_shape(const Shape& s, uint32_t planned, uint32_t flags) {
+    mesh_check::Result m;
+    Run run = reconstruct_tube(s, planned, true, &m, flags);
+    INFO(m.summary());
+    CHECK(m.euler == 0);
+    CHECK(m.intersecting_pairs == 0);
+    REQUIRE(run.layers.size() == run.report.layer_count);
+    return run;
+}
+
+// How far from s's axis the farthest vertex of run's boundary loops lies.
+double widest_boundary_vertex(const Shape& s, const Run& run) {
+    std::map<std::pair<uint32_t, uint32_t>, int> edges;
+    for (size_t t = 0; t < run.count; ++t)
+        for (size_t k = 0; k < 3; ++k) {
+            uint32_t a = run.triangles[3 * t + k], b = run.triangles[3 * t + (k + 1) % 3];
+            ++edges[{std::min(a, b), std::max(a, b)}];
+        }
+    double widest = 0;
+    for (const auto& e : edges) {
+        if (e.second != 1) continue;
+        for (uint32_t v : {e.first.first, e.first.second}) {
+            double local[3];
+            s.transform.unapply(s.point(v), local);
+            widest = std::max(widest, std::hypot(local[0], local[1]));
+        }
+    }
+    return widest;
+}
+
+// The flat-ended cylinder (`flat`) or the capsule.
+Shape closed_shape(bool flat, Pose pose) {
+    return flat ? shapes::closed_cylinder(kSmall, pose) : shapes::capsule(kSmall, pose);
+}
+
+}  // namespace
+
 // A closed object scanned all round has points across its ends. The surface must still be
 // one manifold annulus through every point, now meshed across each end up to a small loop
 // around its pole, outward, and close to the true surface there too. Before the ends were
@@ -1547,49 +1608,21 @@ TEST_CASE("a crescent end layer joins its neighbour, a half cylinder keeps its l
 // now lie up to 0.26 from the axis (0.37 on the capsule in 12 layers while the end slab was
 // a quarter of the layer: its lower dome was not taken for a closed end).
 TEST_CASE("closed ends: a flat-ended cylinder and a capsule are meshed across their ends") {
-    for (int closed = 0; closed < 2; ++closed) {
+    for (bool flat : {true, false}) {
         for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
             for (uint32_t planned : {1u, 4u, 12u}) {
-                Shape s = closed == 0 ? shapes::closed_cylinder(kSmall, pose)
-                                      : shapes::capsule(kSmall, pose);
-                Options o = axis_options(s);
-                o.layer_count = planned;
-                Run run = reconstruct_guarded(cloud_of(s), o);
+                const Shape s = closed_shape(flat, pose);
                 CAPTURE(s.name);
                 CAPTURE(planned);
-                REQUIRE(run.status == Status::ok);
-                CHECK(run.report.unused == 0);
-                mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, true);
-                INFO(m.summary());
-                CHECK(m.manifold());
-                CHECK(m.components == 1);
-                CHECK(m.boundary_loops == 2);
-                CHECK(m.euler == 0);
-                CHECK(m.unused_expected == 0);
-                CHECK(m.intersecting_pairs == 0);
+                const Run run = reconstruct_closed_shape(s, planned, 0);
                 // The report names the ends: the first layer's bottom, the last one's top.
-                REQUIRE(run.layers.size() == run.report.layer_count);
                 for (size_t k = 0; k < run.layers.size(); ++k) {
                     const uint32_t ends = (k == 0 ? stratmesh::closed_bottom : 0u) |
                                           (k + 1 == run.layers.size() ? stratmesh::closed_top : 0u);
                     CHECK(run.layers[k].closed_ends == ends);
                 }
                 // The boundary: small loops around the poles, off the rims.
-                std::map<std::pair<uint32_t, uint32_t>, int> edges;
-                for (size_t t = 0; t < run.count; ++t)
-                    for (size_t k = 0; k < 3; ++k) {
-                        uint32_t a = run.triangles[3 * t + k], b = run.triangles[3 * t + (k + 1) % 3];
-                        ++edges[{std::min(a, b), std::max(a, b)}];
-                    }
-                double widest_loop = 0;
-                for (const auto& e : edges) {
-                    if (e.second != 1) continue;
-                    for (uint32_t v : {e.first.first, e.first.second}) {
-                        double local[3];
-                        s.transform.unapply(s.point(v), local);
-                        widest_loop = std::max(widest_loop, std::hypot(local[0], local[1]));
-                    }
-                }
+                const double widest_loop = widest_boundary_vertex(s, run);
                 // Outward and covering the ends: the enclosed volume, from the signed
                 // tetrahedra to a point on the axis, is the solid's less the two holes.
                 double origin[3], volume = 0;
@@ -1603,7 +1636,7 @@ TEST_CASE("closed ends: a flat-ended cylinder and a capsule are meshed across th
                                p[0][1] * (p[1][0] * p[2][2] - p[1][2] * p[2][0]) +
                                p[0][2] * (p[1][0] * p[2][1] - p[1][1] * p[2][0])) / 6;
                 }
-                const double solid = closed == 0 ? 6 * shapes::kPi : 4 * shapes::kPi + 4 * shapes::kPi / 3;
+                const double solid = flat ? 6 * shapes::kPi : 4 * shapes::kPi + 4 * shapes::kPi / 3;
                 const double mean = mean_centroid_deviation(s, run.triangles);
                 MESSAGE(s.name << ", " << planned << " layers: mean distance " << mean
                                << ", boundary up to " << widest_loop << " from the axis, volume "
@@ -1625,43 +1658,15 @@ TEST_CASE("closed ends: a flat-ended cylinder and a capsule are meshed across th
 // loop's highest points (0.37 from the axis on the capsule, 0.26 around its pole). A shape
 // with no closed end gives the same triangles with or without the flag.
 TEST_CASE("open_ends: no end is unrolled around a pole, on a manifold tube through every point") {
-    for (int closed = 0; closed < 2; ++closed) {
+    for (bool flat : {true, false}) {
         for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
             for (uint32_t planned : {1u, 4u, 12u}) {
-                Shape s = closed == 0 ? shapes::closed_cylinder(kSmall, pose)
-                                      : shapes::capsule(kSmall, pose);
-                Options o = axis_options(s);
-                o.layer_count = planned;
-                o.flags |= stratmesh::open_ends;
-                Run run = reconstruct_guarded(cloud_of(s), o);
+                const Shape s = closed_shape(flat, pose);
                 CAPTURE(s.name);
                 CAPTURE(planned);
-                REQUIRE(run.status == Status::ok);
-                CHECK(run.report.unused == 0);
-                mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, false);
-                INFO(m.summary());
-                CHECK(m.manifold());
-                CHECK(m.components == 1);
-                CHECK(m.boundary_loops == 2);
-                CHECK(m.euler == 0);
-                CHECK(m.unused_expected == 0);
-                for (size_t k = 0; k < run.layers.size(); ++k) CHECK(run.layers[k].closed_ends == 0);
-                std::map<std::pair<uint32_t, uint32_t>, int> edges;
-                for (size_t t = 0; t < run.count; ++t)
-                    for (size_t k = 0; k < 3; ++k) {
-                        uint32_t a = run.triangles[3 * t + k], b = run.triangles[3 * t + (k + 1) % 3];
-                        ++edges[{std::min(a, b), std::max(a, b)}];
-                    }
-                double widest_loop = 0;
-                for (const auto& e : edges) {
-                    if (e.second != 1) continue;
-                    for (uint32_t v : {e.first.first, e.first.second}) {
-                        double local[3];
-                        s.transform.unapply(s.point(v), local);
-                        widest_loop = std::max(widest_loop, std::hypot(local[0], local[1]));
-                    }
-                }
-                if (closed == 0) CHECK(widest_loop > 0.9);
+                const Run run = reconstruct_closed_shape(s, planned, stratmesh::open_ends);
+                for (const LayerInfo& layer : run.layers) CHECK(layer.closed_ends == 0);
+                if (flat) CHECK(widest_boundary_vertex(s, run) > 0.9);
             }
         }
     }
@@ -1678,27 +1683,6 @@ TEST_CASE("open_ends: no end is unrolled around a pole, on a manifold tube throu
     }
 }
 
-namespace {
-
-// Reconstructs s in `planned` layers along its axis and checks what every run must give:
-// ok, one manifold tube (one component, two boundary loops) through every point. The mesh
-// check (with self-intersections if asked) goes to *m.
-Run reconstruct_tube(const Shape& s, uint32_t planned, bool self_intersections, mesh_check::Result* m) {
-    Options o = axis_options(s);
-    o.layer_count = planned;
-    Run run = reconstruct_guarded(cloud_of(s), o);
-    REQUIRE(run.status == Status::ok);
-    CHECK(run.report.unused == 0);
-    *m = check_mesh(s, run.triangles.data(), run.count, self_intersections);
-    INFO(m->summary());
-    CHECK(m->manifold());
-    CHECK(m->components == 1);
-    CHECK(m->boundary_loops == 2);
-    CHECK(m->unused_expected == 0);
-    return run;
-}
-
-}  // namespace
 
 // A tube that forks at its end (two horns on a head): no centre sees both horns' outlines,
 // so the top layer folds, and its hull runs from tip to tip over a web of triangles down to

@@ -90,7 +90,9 @@
 //                            and triangles differ from the full build's. So do closed
 //                            ends (a dome or a flat base at the cloud's end, see
 //                            kPoleDepth), which it unrolls on the cylinder like the rest:
-//                            a flat base folds and its loop runs through its points.
+//                            a flat base folds and its loop runs through its points
+//                            (as the full build does with the open_ends flag, which
+//                            this one therefore ignores).
 //                            The drop_outliers flag is refused (invalid_argument):
 //                            filter the cloud before it reaches the device. The
 //                            surface_flips flag is ignored (about 4 KiB): the layers

@@ -2642,7 +2642,7 @@ struct Frame {
     // Layers are flipped on the surface (the surface_flips flag; see "flips on the surface"
     // in >>layer triangulation).
     bool surface_flips;
-    // No end is taken for a closed one (the open_ends flag; read with kClosedEnds only).
+    // No end is taken for a closed one (the open_ends flag; false without kClosedEnds).
     bool open_ends;
     // The valid points' lowest and highest coordinates (set by choose_frame with kFastLoops).
     Vec3 low, high;

@@ -81,8 +81,9 @@
 //                            wall leaning over a ragged loop more often, and their ear
 //                            clipping's restarts (kCapEarStarts) and the exhaustive
 //                            search that follows (kCapSearchCorners) and the flips of
-//                            fins (kCapFinFlips), so a few more loops are left open. It leaves out cap_ends() too (not
-//                            declared: 0.6 KiB on the Cortex-M7); reconstruct()'s
+//                            fins (kCapFinFlips), so a few more loops are left open. It leaves out cap_ends() and
+//                            find_parting() too (not declared: 0.6 KiB and about 4 KiB
+//                            on the Cortex-M7); reconstruct()'s
 //                            close_ends stays. And it leaves out the
 //                            crescent rule (a layer next to a slanted end of the tube
 //                            joins it, see Options and kRingGap; 1.2 KiB): a slanted end
@@ -122,7 +123,9 @@
 // jobs runner (Options::run_jobs); its output is at most 2n triangles. A stream needs about
 // 190 bytes per point it holds at once, whatever the size of the whole cloud; cap_ends()
 // 78 bytes per point of the whole cloud (its loops may pass through every point) plus 12
-// per triangle, plus the same 32 KiB: about 102 per point for a tube.
+// per triangle, plus the same 32 KiB: about 102 per point for a tube. find_parting() needs
+// about 101 bytes per point plus up to 0.5 MiB (its scale's sample, or a cache of grid
+// blocks), 1 bit per point more with drop_outliers.
 //
 // The whole workspace belongs to the call while it runs, including what it does not need:
 // without a runner, reconstruct keeps the points grouped by layer (24 bytes each) at the
@@ -718,6 +721,82 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count);
 Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
                 size_t workspace_bytes, uint32_t* triangles, size_t triangle_capacity,
                 size_t* triangle_count, Report* report);
+
+// ---- Where the cloud parts into branches ----
+//
+// One tube cannot follow an object that forks (the horns on a head, the fingers of a hand,
+// the condyles at a femur's end): it wraps the branches and the gaps between them (README,
+// Known limitations). find_parting() finds where along the axis the cloud parts: the lowest
+// cut above which the points make two separate branches or more, and the highest below
+// which they do. A caller can then mesh each side on its own, the branches with open_ends
+// (README, "Where the cloud parts").
+//
+// Points join one piece when they lie within Parting::gap of each other (single linkage).
+// The gap is kPartingGap times the median distance from a point to its nearest distinct
+// neighbour (over at most 16,384 points, every k-th in the order of a grid). Cuts are tried
+// every half gap along the axis (at most one per point). A side of a cut parts when it is
+// four gaps thick or more (a thinner one is a rim, which falls apart into arcs). Its pieces
+// count from kSmallestBranch points and a twentieth of the side's (specks and scraps do not
+// make a branch); of those, the ones whose nearest point lies within a gap of the cut start
+// there, the others are left aside (a patch that a hole in the scan cut off, the tip of a
+// thin branch sampled too sparsely to stay joined to it). The side parts when two pieces
+// or more start at the cut and every one of them is a branch: its farthest point lies two
+// gaps or more from the cut (else it is a bump, or the crown of a skull between two horns),
+// and the centroids of its points within a gap of the cut and within the next gap lie less
+// than two gaps apart across the axis (else it is a cap joined to a branch, whose section
+// jumps). Measured on the clouds of ../shared/data, the bundled bust and
+// a bust with horns (README, "Where the cloud parts"): the horns are found above the skull,
+// on that cloud and on 70% to 90% of its points alike; nothing on the hand, the kitten,
+// the bundled bust, nor the femur, whose condyles part for only a gap below their notch,
+// as a bump would.
+
+// The most branches a side can hold: each counts with a twentieth of the side's points.
+const uint32_t kMaxBranches = 20;
+// The fewest points a branch holds.
+const uint32_t kSmallestBranch = 64;
+// The gap, in median nearest-neighbour distances.
+const double kPartingGap = 4.0;
+
+struct Parting {
+    double gap;               // the linking distance, in the cloud's units; 0 if the cloud
+                              // has no scale (too many points without a neighbour in the
+                              // grid, as drop_outliers measures it): nothing is found then
+    double axis[3];           // unit axis used, as Report::axis
+    // The lowest cut, as dot(point, axis), above which the points part into
+    // branches_above branches (0: no cut where they do; `above` is then 0).
+    double above;
+    uint32_t branches_above;
+    // The highest cut below which the points part into branches_below branches.
+    double below;
+    uint32_t branches_below;
+    // The branches' point counts, largest first (branches_above and branches_below of them).
+    uint32_t above_points[kMaxBranches];
+    uint32_t below_points[kMaxBranches];
+    size_t workspace_used;    // peak workspace bytes, from the start of the buffer
+    const char* detail;       // a static sentence on why, when the call failed or, with
+                              // ok, searched nothing (a cloud without a scale, gap 0; one
+                              // too crowded to search: see kPartingChecksPerPoint in the
+                              // implementation)
+};
+
+// Bytes of workspace find_parting() needs for point_count points (about 100 a point);
+// 0 if that is beyond what this platform can address.
+size_t find_parting_workspace_size(size_t point_count, const Options& options);
+
+// Finds where the cloud parts into branches (see above). options: axis, direction, and
+// the flags skip_invalid_points and drop_outliers (outliers are left out first); the rest
+// is not used. The same axis as reconstruct() with these options. Deterministic; the
+// order of the points changes only rounding (the frame's origin is their centroid) on up
+// to 16,384 points, and on more the sample the scale is measured on (the gap by a fraction
+// of a percent). Returns ok (parting filled, whether or not
+// a cut was found); invalid_argument (a null parting, or workspace with points; a bad
+// stride or scalar; buffers sharing a byte); too_many_points; invalid_point (a NaN or
+// infinite point without skip_invalid_points); invalid_axis; too_few_points (fewer than 3
+// distinct valid points); flat_cloud (every point at the same height); out_of_memory (a
+// workspace below find_parting_workspace_size()). On a status other than ok only
+// workspace_used and detail are meaningful.
+Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
+                    size_t workspace_bytes, Parting* parting);
 #endif
 
 } // namespace stratmesh
@@ -2449,9 +2528,31 @@ inline CellScratch allocate_cell_scratch(Arena& arena, size_t count) {
     return g;
 }
 
+// Sorts items[0 .. n) by key (ties in their given order; the result may be in either
+// array: the pointers are swapped as the passes go). An LSD radix sort, a byte a pass,
+// skipping the bytes that every key shares: `any` and `every` are the keys' bitwise or
+// and and.
+inline void sort_items(GridItem*& items, GridItem*& spare, size_t n, uint64_t any, uint64_t every) {
+    for (uint32_t shift = 0; shift < 64; shift += 8) {
+        if ((((any ^ every) >> shift) & 0xFFu) == 0) continue;
+        size_t histogram[256] = {};
+        for (size_t i = 0; i < n; ++i) ++histogram[(items[i].cell >> shift) & 0xFFu];
+        size_t total = 0;
+        for (size_t& h : histogram) {
+            const size_t c = h;
+            h = total;
+            total += c;
+        }
+        for (size_t i = 0; i < n; ++i) spare[histogram[(items[i].cell >> shift) & 0xFFu]++] = items[i];
+        GridItem* t = items;
+        items = spare;
+        spare = t;
+    }
+}
+
 // The valid points in g.items, sorted by their cell of side `side` from `low` and by index
-// within a cell; returns their count. An LSD radix sort, a byte a pass, skipping the bytes
-// that every key shares (most of them: a grid rarely spans more than 2^8 cells an axis).
+// within a cell; returns their count. Most key bytes are shared: a grid rarely spans more
+// than 2^8 cells an axis.
 inline size_t sort_into_cells(const CloudReader& reader, size_t count, Vec3 low, double side,
                               CellScratch& g) {
     size_t n = 0;
@@ -2466,27 +2567,26 @@ inline size_t sort_into_cells(const CloudReader& reader, size_t count, Vec3 low,
         any |= cell;
         every &= cell;
     }
-    for (uint32_t shift = 0; shift < 64; shift += 8) {
-        if ((((any ^ every) >> shift) & 0xFFu) == 0) continue;
-        size_t histogram[256] = {};
-        for (size_t i = 0; i < n; ++i) ++histogram[(g.items[i].cell >> shift) & 0xFFu];
-        size_t total = 0;
-        for (size_t& h : histogram) {
-            const size_t c = h;
-            h = total;
-            total += c;
-        }
-        for (size_t i = 0; i < n; ++i) g.spare[histogram[(g.items[i].cell >> shift) & 0xFFu]++] = g.items[i];
-        GridItem* t = g.items;
-        g.items = g.spare;
-        g.spare = t;
-    }
+    sort_items(g.items, g.spare, n, any, every);
     return n;
 }
 
-// The first item at or after `cell`.
-inline size_t first_in_cell(const GridItem* items, size_t count, uint64_t cell) {
-    size_t lo = 0, hi = count;
+// The first item at or after `cell`, searched from items[from] outward (from < count):
+// the steps double until they pass it, then halve. The cells around a point's lie near it
+// in the array, so the search stays in memory the point's cell brought in.
+inline size_t first_in_cell(const GridItem* items, size_t count, uint64_t cell, size_t from) {
+    size_t lo = from, hi = from;  // the answer lies in [lo, hi] once the steps pass it
+    if (items[from].cell < cell) {
+        for (size_t step = 1; hi < count && items[hi].cell < cell; step *= 2) {
+            lo = hi + 1;
+            hi = count - from > step ? from + step : count;
+        }
+    } else {
+        for (size_t step = 1; lo > 0 && items[lo - 1].cell >= cell; step *= 2) {
+            hi = lo - 1;
+            lo = from > step ? from - step : 0;
+        }
+    }
     while (lo < hi) {
         const size_t mid = lo + (hi - lo) / 2;
         if (items[mid].cell < cell) lo = mid + 1; else hi = mid;
@@ -2507,7 +2607,12 @@ struct CellBlock {
     }
 };
 
-inline CellBlock block_around(const GridItem* items, size_t count, uint64_t cell) {
+// `member` is an item of `cell`. With `fingers` (18 valid positions, updated), each range
+// end is searched from where the same end was found last: a caller that goes through cells
+// in key order then finds each a few items on.
+inline CellBlock block_around(const GridItem* items, size_t count, size_t member,
+                              size_t* fingers = nullptr) {
+    const uint64_t cell = items[member].cell;
     CellBlock b;
     b.count = 0;
     const uint64_t x = cell >> (2 * kCellBits), y = (cell >> kCellBits) & kCellTop, z = cell & kCellTop;
@@ -2516,8 +2621,15 @@ inline CellBlock block_around(const GridItem* items, size_t count, uint64_t cell
         const uint32_t k = (m + 4) % 9;  // 4: the row (x, y) itself
         const uint64_t row_x = x + k % 3, row_y = y + k / 3;  // x - 1 .. x + 1, shifted by one
         if (row_x < 1 || row_x - 1 > kCellTop || row_y < 1 || row_y - 1 > kCellTop) continue;
-        b.begin[b.count] = first_in_cell(items, count, cell_key(row_x - 1, row_y - 1, z_low));
-        b.end[b.count] = first_in_cell(items, count, cell_key(row_x - 1, row_y - 1, z_high) + 1);
+        size_t* finger = fingers ? fingers + 2 * k : nullptr;
+        b.begin[b.count] = first_in_cell(items, count, cell_key(row_x - 1, row_y - 1, z_low),
+                                         finger ? finger[0] : member);
+        b.end[b.count] = first_in_cell(items, count, cell_key(row_x - 1, row_y - 1, z_high) + 1,
+                                       finger ? finger[1] : member);
+        if (finger) {
+            finger[0] = b.begin[b.count] < count ? b.begin[b.count] : count - 1;
+            finger[1] = b.end[b.count] < count ? b.end[b.count] : count - 1;
+        }
         if (b.end[b.count] > b.begin[b.count]) ++b.count;
     }
     return b;
@@ -2538,7 +2650,7 @@ inline double nearest_distance_decile(const CloudReader& reader, const CellScrat
         while (last < count && items[last].cell == items[first].cell) ++last;
         const size_t sample = (first + step - 1) / step * step;  // the cell's first k-th point
         if (sample < last) {
-            const CellBlock block = block_around(items, count, items[first].cell);
+            const CellBlock block = block_around(items, count, first);
             for (size_t i = sample; i < last; i += step, ++sampled) {
                 const Vec3 p = g.sorted[i];
                 double nearest = side * side;
@@ -2569,6 +2681,50 @@ inline double nearest_distance_decile(const CloudReader& reader, const CellScrat
     return side * std::sqrt(std::ldexp(1.0, -static_cast<int>(kNearestBins - 2)));
 }
 
+// The valid points' bounding box and count.
+struct CloudBox {
+    Vec3 low, high;
+    size_t valid;
+};
+
+inline CloudBox box_of(const CloudReader& reader, size_t count) {
+    CloudBox box = {{DBL_MAX, DBL_MAX, DBL_MAX}, {-DBL_MAX, -DBL_MAX, -DBL_MAX}, 0};
+    for (size_t i = 0; i < count; ++i) {
+        if (!reader.valid(i)) continue;
+        const Vec3 p = reader.point(i);
+        const Vec3 lo = box.low, hi = box.high;
+        box.low = {p.x < lo.x ? p.x : lo.x, p.y < lo.y ? p.y : lo.y, p.z < lo.z ? p.z : lo.z};
+        box.high = {p.x > hi.x ? p.x : hi.x, p.y > hi.y ? p.y : hi.y, p.z > hi.z ? p.z : hi.z};
+        ++box.valid;
+    }
+    return box;
+}
+
+// The cloud's scale d (see "outliers" above): the distance that nine points in ten do not
+// exceed to their nearest distinct point, on grids of cells of about 4 points; 0 where no
+// grid serves. A box wider than the double range (points near +-1e308) gives an infinite
+// side, which is refused: such a cloud has no scale.
+inline double nearest_spacing(const CloudReader& reader, size_t count, const CloudBox& box,
+                              CellScratch& g) {
+    const Vec3 half = scaled(box.high - box.low, 0.5);
+    double side = 4 * std::sqrt(dot(half, half)) / std::sqrt(static_cast<double>(box.valid));
+    double nearest = 0;
+    for (uint32_t tries = 0; nearest == 0 && tries < kGridTries; ++tries) {
+        if (!(side * side > 0) || !is_finite(side * side)) break;
+        const size_t n = sort_into_cells(reader, count, box.low, side, g);
+        size_t occupied = 0;
+        for (size_t i = 0; i < n; ++i) occupied += i == 0 || g.items[i].cell != g.items[i - 1].cell;
+        if (n > kCrowdedCell * occupied) {  // as on a surface: cells of 4 points on average
+            const double shrink = std::sqrt(4 * static_cast<double>(occupied) / static_cast<double>(n));
+            side *= shrink > 0.0625 ? shrink : 0.0625;
+            continue;
+        }
+        nearest = nearest_distance_decile(reader, g, n, side);
+        side *= 4;
+    }
+    return nearest;
+}
+
 // Marks the outliers in `dropped` (zeroed, a bit per point) and returns how many; from
 // here on reader.valid() leaves them out. See "outliers" above.
 inline size_t drop_outliers_of(CloudReader& reader, size_t count, unsigned char* dropped,
@@ -2576,42 +2732,17 @@ inline size_t drop_outliers_of(CloudReader& reader, size_t count, unsigned char*
     reader.dropped = dropped;
     size_t total = 0;
     for (uint32_t round = 0; round < kOutlierRounds; ++round) {
-        Vec3 low = {DBL_MAX, DBL_MAX, DBL_MAX}, high = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
-        size_t n = 0;
-        for (size_t i = 0; i < count; ++i) {
-            if (!reader.valid(i)) continue;
-            const Vec3 p = reader.point(i);
-            low = {p.x < low.x ? p.x : low.x, p.y < low.y ? p.y : low.y, p.z < low.z ? p.z : low.z};
-            high = {p.x > high.x ? p.x : high.x, p.y > high.y ? p.y : high.y, p.z > high.z ? p.z : high.z};
-            ++n;
-        }
-        if (n < 2 * kOutlierNeighbours) break;
-        // A box wider than the double range (points near +-1e308) gives an infinite side,
-        // which the loop below refuses: such a cloud loses no point.
-        const Vec3 half = scaled(high - low, 0.5);
-        double side = 4 * std::sqrt(dot(half, half)) / std::sqrt(static_cast<double>(n));
-        double nearest = 0;
-        for (uint32_t tries = 0; nearest == 0 && tries < kGridTries; ++tries) {
-            if (!(side * side > 0) || !is_finite(side * side)) break;
-            n = sort_into_cells(reader, count, low, side, g);
-            size_t occupied = 0;
-            for (size_t i = 0; i < n; ++i) occupied += i == 0 || g.items[i].cell != g.items[i - 1].cell;
-            if (n > kCrowdedCell * occupied) {  // as on a surface: cells of 4 points on average
-                const double shrink = std::sqrt(4 * static_cast<double>(occupied) / static_cast<double>(n));
-                side *= shrink > 0.0625 ? shrink : 0.0625;
-                continue;
-            }
-            nearest = nearest_distance_decile(reader, g, n, side);
-            side *= 4;
-        }
+        const CloudBox box = box_of(reader, count);
+        if (box.valid < 2 * kOutlierNeighbours) break;
+        const double nearest = nearest_spacing(reader, count, box, g);
         if (!(nearest > 0)) break;
-        n = sort_into_cells(reader, count, low, kOutlierReach * nearest, g);
+        const size_t n = sort_into_cells(reader, count, box.low, kOutlierReach * nearest, g);
         const GridItem* items = g.items;
         size_t found = 0;
         for (size_t first = 0; first < n;) {
             size_t last = first;
             while (last < n && items[last].cell == items[first].cell) ++last;
-            if (block_around(items, n, items[first].cell).points() < kOutlierNeighbours)
+            if (block_around(items, n, first).points() < kOutlierNeighbours)
                 for (size_t i = first; i < last; ++i) {
                     dropped[items[i].index >> 3] |= static_cast<unsigned char>(1u << (items[i].index & 7));
                     ++found;
@@ -7235,6 +7366,13 @@ inline void notify(const Options& options, Phase phase, double fraction) {
     if (options.progress) options.progress(options.progress_user, phase, fraction);
 }
 
+// The bytes the cloud's coordinates lie in.
+inline ByteRange cloud_bytes(const Cloud& cloud) {
+    const size_t point_bytes = 3 * (cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double));
+    return strided_range(cloud.xyz, cloud.count, cloud.stride_bytes ? cloud.stride_bytes : point_bytes,
+                         point_bytes);
+}
+
 // True if any two of the caller's buffers share a byte (the report and its layer array
 // included): checked before anything is written. A count beyond the limit is refused as
 // too_many_points instead.
@@ -7243,10 +7381,8 @@ inline bool reconstruct_buffers_overlap(const Cloud& cloud, void* workspace,
                                         size_t triangle_capacity, size_t* triangle_count,
                                         const Report* report) {
     if (cloud.count > kMaxPoints - 1) return false;
-    size_t point_bytes = 3 * (cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double));
     const ByteRange buffers[] = {
-        strided_range(cloud.xyz, cloud.count, cloud.stride_bytes ? cloud.stride_bytes : point_bytes,
-                      point_bytes),
+        cloud_bytes(cloud),
         byte_range(workspace, workspace_bytes),
         byte_range(triangles, saturating_product(triangle_capacity, 3 * sizeof(uint32_t))),
         byte_range(triangle_count, sizeof(size_t)),
@@ -8052,6 +8188,465 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
     else if (caps.left_open > 0)
         checks.detail = detail::kLoopLeftOpenDetail;
     return finish(status);
+}
+
+// >>parting =================================================================================
+//
+// find_parting(): the cuts lie every half gap along the axis (at most one per point), and
+// each point falls in the step between two of them. Two sweeps, one from the top down for
+// the cuts above which the cloud parts and one from the bottom up for those below, add the
+// points a step at a time to a union-find of pieces (union by size, path halving: no
+// recursion), each point joining the pieces of those already added within the gap, found
+// in its block of 3 x 3 x 3 grid cells of side gap. Which points lie on a cut's side is
+// decided by their step, so it is the same for both sweeps and any order; within a step
+// the points go in grid order, which lies in the frame with its cells sorted by height
+// first, so that a point's neighbours are near in memory and their blocks were just used.
+// After each step, the pieces that count are checked for branches at the cut the step
+// reaches; the points within two gaps of it are those of the last four steps.
+
+namespace detail {
+
+const uint32_t kStepsPerGap = 2;
+// The blocks of the grid cells met last, by a hash of the cell: a step's points share
+// cells, and each block costs 18 searches to find.
+const uint32_t kBlockCacheSize = 2048;
+const uint64_t kNoCell = ~uint64_t{0};  // no key: keys take 63 bits
+const uint32_t kNotAdded = ~uint32_t{0};
+// The most points a sweep may compare, on average per point: a surface's block of cells
+// holds about 40; a cloud crowded beyond this (many repeats of the same points, a solid
+// volume of points) is not searched, so that no cloud costs time quadratic in its size.
+const uint64_t kPartingChecksPerPoint = 1024;
+
+struct CachedBlock {
+    uint64_t cell;
+    CellBlock block;
+};
+
+// The size from which a piece of a side of `points` points counts: kSmallestBranch, and a
+// twentieth of the side.
+inline uint32_t counting_size(size_t points) {
+    const size_t twentieth = (points + 19) / 20;
+    return twentieth > kSmallestBranch ? static_cast<uint32_t>(twentieth) : kSmallestBranch;
+}
+
+// The sweep's state. Pieces are named by the order in which their root was added. A
+// point's level is its height as the sweep sees it: the frame height, negated for the sweep
+// from the bottom up, so that both sweeps go down and a cut's side lies above it.
+// `listed` holds every root whose piece counts (see counting_size), and others that
+// branches_at drops: a root joins it when its piece grows to the size that counts at that
+// moment, which never exceeds the size that counts at the next cut.
+struct PartingSweep {
+    const Local* position;    // grid order, in the frame
+    const GridItem* cells;    // grid order
+    size_t count;
+    double gap;               // in frame units
+    double sign;              // +1 from the top, -1 from the bottom
+    uint32_t* added;          // order -> grid position
+    uint32_t* order_of;       // grid position -> order, or kNotAdded
+    uint32_t* parent;         // order -> order
+    uint32_t* size;           // root -> points
+    double* lowest;           // root -> its lowest level
+    double* highest;          // root -> its highest level
+    CachedBlock* blocks;      // kBlockCacheSize of them
+    size_t fingers[18];       // block_around's
+    uint32_t* listed;         // roots, see above
+    unsigned char* is_listed; // order -> whether it is in `listed`
+    size_t listed_count;
+    uint32_t counting;        // counting_size(points added so far)
+    uint64_t checks_left;     // see kPartingChecksPerPoint
+    bool crowded;             // the checks ran out: the sweep stopped
+
+    double level(uint32_t t) const { return sign * position[added[t]].h; }
+    uint32_t root(uint32_t t) {
+        while (parent[t] != t) {
+            parent[t] = parent[parent[t]];
+            t = parent[t];
+        }
+        return t;
+    }
+    void join(uint32_t a, uint32_t b) {
+        a = root(a);
+        b = root(b);
+        if (a == b) return;
+        if (size[a] < size[b] || (size[a] == size[b] && b < a)) {
+            const uint32_t t = a;
+            a = b;
+            b = t;
+        }
+        parent[b] = a;
+        size[a] += size[b];
+        if (lowest[b] < lowest[a]) lowest[a] = lowest[b];
+        if (highest[b] > highest[a]) highest[a] = highest[b];
+        if (size[a] >= counting && !is_listed[a]) {
+            is_listed[a] = 1;
+            listed[listed_count++] = a;  // at most one entry per point: `count` of room
+        }
+    }
+    // Adds the point at grid position j as the t-th, joined to the points added before it.
+    void add(uint32_t t, uint32_t j) {
+        added[t] = j;
+        order_of[j] = t;
+        parent[t] = t;
+        size[t] = 1;
+        lowest[t] = highest[t] = level(t);
+        is_listed[t] = 0;
+        counting = counting_size(t + 1);
+        const uint64_t cell = cells[j].cell;
+        CachedBlock& cached = blocks[(cell * 0x9E3779B97F4A7C15u) >> 53];  // 11 bits
+        if (cached.cell != cell) cached = {cell, block_around(cells, count, j, fingers)};
+        const CellBlock& block = cached.block;
+        const size_t checks = block.points();
+        if (checks > checks_left) {
+            crowded = true;
+            return;
+        }
+        checks_left -= checks;
+        const Local p = position[j];
+        for (uint32_t k = 0; k < block.count; ++k)
+            for (size_t i = block.begin[k]; i < block.end[k]; ++i) {
+                if (order_of[i] >= t) continue;  // not added yet (or p itself)
+                const Local q = position[i];
+                const double dx = q.x - p.x, dy = q.y - p.y, dh = q.h - p.h;
+                if (dx * dx + dy * dy + dh * dh < gap * gap) join(t, order_of[i]);
+            }
+    }
+};
+
+// A piece that counts at a cut: its root and its points' sums within the two gaps above.
+struct BranchCandidate {
+    uint32_t root;
+    double sum[2][2];
+    uint32_t slice_points[2];
+};
+
+// Whether the `added` points added so far, on the side of the cut at level `cut`, part into
+// branches there; if so their sizes go to `sizes`, largest first, and their count is
+// returned (else 0). The points of orders [slab_start, added) are those within two gaps of
+// the cut.
+inline uint32_t branches_at(PartingSweep& s, uint32_t added, uint32_t slab_start, double cut,
+                            uint32_t* sizes) {
+    BranchCandidate found[kMaxBranches];
+    uint32_t pieces = 0;
+    bool bump = false;
+    size_t kept = 0;
+    const uint32_t counting = counting_size(added);
+    for (size_t k = 0; k < s.listed_count; ++k) {
+        const uint32_t r = s.listed[k];
+        if (s.parent[r] != r || s.size[r] < counting) {  // merged since, or too small now
+            s.is_listed[r] = 0;
+            continue;
+        }
+        s.listed[kept++] = r;
+        if (s.lowest[r] - cut > s.gap) continue;  // apart from the cut: left aside
+        if (s.highest[r] - cut < 2 * s.gap)
+            bump = true;
+        else if (pieces < kMaxBranches)  // disjoint twentieths of the side: never more
+            found[pieces++] = {r, {{0, 0}, {0, 0}}, {0, 0}};
+    }
+    s.listed_count = kept;
+    if (bump || pieces < 2) return 0;
+    for (uint32_t t = slab_start; t < added; ++t) {
+        const uint32_t r = s.root(t);
+        for (uint32_t k = 0; k < pieces; ++k) {
+            if (found[k].root != r) continue;
+            const Local l = s.position[s.added[t]];
+            const int slice = s.level(t) - cut < s.gap ? 0 : 1;
+            found[k].sum[slice][0] += l.x;
+            found[k].sum[slice][1] += l.y;
+            ++found[k].slice_points[slice];
+        }
+    }
+    for (uint32_t k = 0; k < pieces; ++k) {
+        const BranchCandidate& b = found[k];
+        if (b.slice_points[1] == 0) continue;
+        double d2 = 0;
+        for (int c = 0; c < 2; ++c) {
+            const double d = b.sum[0][c] / b.slice_points[0] - b.sum[1][c] / b.slice_points[1];
+            d2 += d * d;
+        }
+        if (!(d2 < 4 * s.gap * s.gap)) return 0;
+    }
+    for (uint32_t k = 0; k < pieces; ++k) {
+        uint32_t largest = k;
+        for (uint32_t m = k + 1; m < pieces; ++m)
+            if (s.size[found[m].root] > s.size[found[largest].root]) largest = m;
+        const BranchCandidate t = found[k];
+        found[k] = found[largest];
+        found[largest] = t;
+        sizes[k] = s.size[found[k].root];
+    }
+    return pieces;
+}
+
+// The points' steps: step k holds the points between the cuts at lo + k step_height and
+// lo + (k + 1) step_height (the cut at lo + k step_height is cut k, for k in [1, steps)).
+// by_step lists the grid positions step by step, each step in grid order, from
+// step_start[k] to step_start[k + 1].
+struct PartingSteps {
+    uint32_t steps;
+    double lo, step_height;
+    uint32_t* step_start;     // steps + 1 entries
+    uint32_t* by_step;
+};
+
+// One sweep: down from the top (`from_top`) or up from the bottom. Returns the branches at
+// the last cut of the sweep where the cloud parts (the lowest above, the highest below),
+// its height in *cut_height.
+inline uint32_t sweep_for_parting(PartingSweep& s, const PartingSteps& p, bool from_top,
+                                  double* cut_height, uint32_t* sizes) {
+    s.sign = from_top ? 1 : -1;
+    s.listed_count = 0;
+    s.counting = kSmallestBranch;
+    for (uint32_t k = 0; k < kBlockCacheSize; ++k) s.blocks[k].cell = kNoCell;
+    for (size_t j = 0; j < s.count; ++j) s.order_of[j] = kNotAdded;
+    for (size_t& f : s.fingers) f = 0;
+    s.checks_left = kPartingChecksPerPoint * s.count;
+    const double top = from_top ? p.lo + p.steps * p.step_height : -p.lo;
+    uint32_t best = 0, added = 0;
+    for (uint32_t m = 0; m + 1 < p.steps; ++m) {
+        // Add step k, then try the cut on its far side: cut k from the top, k + 1 from below.
+        const uint32_t k = from_top ? p.steps - 1 - m : m;
+        for (uint32_t i = p.step_start[k]; i < p.step_start[k + 1] && !s.crowded; ++i)
+            s.add(added++, p.by_step[i]);
+        if (s.crowded) return 0;
+        const uint32_t cut_index = from_top ? k : k + 1;
+        const double h = p.lo + cut_index * p.step_height;
+        const double cut = s.sign * h;
+        // A side thinner than four gaps is a rim, which falls apart into arcs.
+        if (top - cut < 4 * s.gap || added == 0) continue;
+        const uint32_t slab = 2 * kStepsPerGap;  // two gaps
+        const uint32_t slab_step = from_top ? (cut_index + slab < p.steps ? cut_index + slab : p.steps)
+                                            : (cut_index > slab ? cut_index - slab : 0);
+        const uint32_t slab_start = from_top ? static_cast<uint32_t>(s.count) - p.step_start[slab_step]
+                                             : p.step_start[slab_step];
+        uint32_t found[kMaxBranches];
+        const uint32_t pieces = branches_at(s, added, slab_start, cut, found);
+        if (pieces == 0) continue;
+        best = pieces;
+        *cut_height = h;
+        for (uint32_t b = 0; b < pieces; ++b) sizes[b] = found[b];
+    }
+    return best;
+}
+
+struct PartingMemory {
+    GridItem* items;          // with spare: the cell sort's arrays
+    GridItem* spare;
+    Local* position;
+    PartingSteps steps;
+    PartingSweep sweep;
+};
+
+// Allocated after the scale is measured, whose grid is given back first.
+inline void allocate_parting(PartingMemory& m, size_t count, Arena& arena) {
+    m.items = arena.alloc<GridItem>(count);
+    m.spare = arena.alloc<GridItem>(count);
+    m.position = arena.alloc<Local>(count);
+    m.steps.step_start = arena.alloc<uint32_t>(count + 2);
+    m.steps.by_step = arena.alloc<uint32_t>(count);
+    m.sweep.added = arena.alloc<uint32_t>(count);
+    m.sweep.order_of = arena.alloc<uint32_t>(count);
+    m.sweep.parent = arena.alloc<uint32_t>(count);
+    m.sweep.size = arena.alloc<uint32_t>(count);
+    m.sweep.lowest = arena.alloc<double>(count);
+    m.sweep.highest = arena.alloc<double>(count);
+    m.sweep.blocks = arena.alloc<CachedBlock>(kBlockCacheSize);
+    m.sweep.listed = arena.alloc<uint32_t>(count);
+    m.sweep.is_listed = arena.alloc<unsigned char>(count);
+}
+
+// The valid points in the frame, in cells of side `side` sorted by height, then across;
+// returns their count. `low` is their lowest frame coordinates.
+inline size_t grid_in_frame(const CloudReader& reader, size_t count, const Frame& frame,
+                            Local low, double side, PartingMemory& m) {
+    size_t n = 0;
+    uint64_t any = 0, every = ~uint64_t{0};
+    for (size_t i = 0; i < count; ++i) {
+        if (!reader.valid(i)) continue;
+        const Local l = frame.local(reader.point(i));
+        const uint64_t cell = cell_key(cell_coordinate(l.h - low.h, side),
+                                       cell_coordinate(l.x - low.x, side),
+                                       cell_coordinate(l.y - low.y, side));
+        m.items[n++] = {cell, static_cast<uint32_t>(i)};
+        any |= cell;
+        every &= cell;
+    }
+    sort_items(m.items, m.spare, n, any, every);
+    for (size_t j = 0; j < n; ++j) m.position[j] = frame.local(reader.point(m.items[j].index));
+    return n;
+}
+
+// The steps of the n points in grid order (a counting sort), every half gap from lo to hi,
+// fewer where that would make more steps than points.
+inline void split_into_steps(const Local* position, size_t n, double lo, double hi, double gap,
+                             PartingSteps& p) {
+    const double most = static_cast<double>(n);
+    double steps = std::ceil((hi - lo) / (gap / kStepsPerGap));
+    if (!(steps <= most)) steps = most;
+    if (steps < 1) steps = 1;
+    p.steps = static_cast<uint32_t>(steps);
+    p.lo = lo;
+    p.step_height = (hi - lo) / steps;
+    std::memset(p.step_start, 0, sizeof(uint32_t) * (p.steps + 2));
+    auto step_of = [&](double h) {
+        const double k = std::floor((h - lo) / p.step_height);
+        return k < 0 ? 0u : k >= steps ? p.steps - 1 : static_cast<uint32_t>(k);
+    };
+    for (size_t j = 0; j < n; ++j) ++p.step_start[step_of(position[j].h) + 2];
+    for (uint32_t k = 0; k < p.steps; ++k) p.step_start[k + 2] += p.step_start[k + 1];
+    for (size_t j = 0; j < n; ++j)
+        p.by_step[p.step_start[step_of(position[j].h) + 1]++] = static_cast<uint32_t>(j);
+}
+
+// The median distance from a point to its nearest distinct neighbour, on every k-th point
+// in cell order, at most kDecileSample of them; 0 where more than half find none. The
+// cells are those of side `decile` (nearest_spacing's), within which nine points in ten
+// find theirs; a point looks at kNearestCandidates points at most, its own cell first.
+// Exact where nearest_spacing is not: that one is rounded up to a half-octave, too coarse
+// for a threshold that tells a notch from a gap.
+inline double median_nearest_distance(const CloudReader& reader, size_t count, const CloudBox& box,
+                                      double decile, CellScratch& g, GridItem* sample,
+                                      GridItem* sample_spare) {
+    const size_t n = sort_into_cells(reader, count, box.low, decile, g);
+    const GridItem* items = g.items;
+    for (size_t i = 0; i < n; ++i) g.sorted[i] = reader.point(items[i].index);
+    const size_t step = (n + kDecileSample - 1) / kDecileSample;  // at most kDecileSample
+    size_t sampled = 0;
+    uint64_t any = 0, every = ~uint64_t{0};
+    for (size_t i = 0; i < n; i += step) {
+        const CellBlock block = block_around(items, n, i);
+        const Vec3 p = g.sorted[i];
+        double nearest = DBL_MAX;
+        uint32_t seen = 0;
+        for (uint32_t k = 0; k < block.count && seen < kNearestCandidates; ++k)
+            for (size_t j = block.begin[k]; j < block.end[k] && seen < kNearestCandidates; ++j) {
+                const Vec3 d = g.sorted[j] - p;
+                const double q = dot(d, d);
+                ++seen;
+                if (q > 0 && q < nearest) nearest = q;
+            }
+        uint64_t key = 0;  // a positive double's bits sort as the double does
+        std::memcpy(&key, &nearest, sizeof key);
+        sample[sampled++] = {key, 0};
+        any |= key;
+        every &= key;
+    }
+    sort_items(sample, sample_spare, sampled, any, every);
+    double median = DBL_MAX;
+    if (sampled > 0) std::memcpy(&median, &sample[sampled / 2].cell, sizeof median);
+    return median < DBL_MAX ? std::sqrt(median) : 0;
+}
+
+inline Status out_of_workspace(Report& rep) {
+    rep.detail = "the workspace is smaller than find_parting_workspace_size()";
+    return Status::out_of_memory;
+}
+
+}  // namespace detail
+
+size_t find_parting_workspace_size(size_t point_count, const Options& options) {
+    if (point_count > detail::kMaxPoints - 1) return 0;
+    detail::Arena arena = detail::Arena::measuring();
+    if (options.flags & drop_outliers) arena.alloc<unsigned char>(point_count / 8 + 1);
+    const size_t mark = arena.mark();
+    detail::allocate_cell_scratch(arena, point_count);  // the outliers' and the scale's grid
+    arena.alloc<detail::GridItem>(2 * detail::kDecileSample);
+    arena.rewind(mark);
+    detail::PartingMemory m;
+    detail::allocate_parting(m, point_count, arena);
+    return arena.failed ? 0 : arena.required_bytes();
+}
+
+Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
+                    size_t workspace_bytes, Parting* parting) {
+    using namespace detail;
+    if (!parting) return Status::invalid_argument;
+    // Checked before anything is written (a count beyond the limit is refused below).
+    const ByteRange buffers[] = {cloud.count > kMaxPoints - 1 ? ByteRange{0, 0} : cloud_bytes(cloud),
+                                 byte_range(workspace, workspace_bytes),
+                                 byte_range(parting, sizeof *parting)};
+    if (any_overlap(buffers, 3)) return Status::invalid_argument;
+    std::memset(parting, 0, sizeof *parting);
+    Report rep = {};
+    size_t no_triangles = 0;
+    Arena arena = Arena::over(workspace, workspace_bytes);
+    auto finish = [&](Status status) {
+        parting->workspace_used = arena.peak_from_buffer();
+        parting->detail = rep.detail;
+        return status;
+    };
+    Status status = check_reconstruct_arguments(cloud, nullptr, 0, &no_triangles, workspace, rep);
+    if (status != Status::ok) return finish(status);
+    CloudReader reader = reader_of(cloud);
+    CloudSums sums = sum_cloud(reader, cloud.count);
+    status = reject_invalid_points(reader, cloud.count, sums, options, rep);
+    if (status != Status::ok) return finish(status);
+    if (options.flags & drop_outliers) {
+        if (!find_outliers(reader, cloud.count, arena, rep)) return finish(out_of_workspace(rep));
+        sums = sum_cloud(reader, cloud.count);
+    }
+    Frame frame;
+    status = choose_frame(reader, cloud.count, sums, options, frame);
+    if (status != Status::ok) return finish(status);
+    parting->axis[0] = frame.axis.x;
+    parting->axis[1] = frame.axis.y;
+    parting->axis[2] = frame.axis.z;
+    if (sums.distinct < 3) {
+        rep.detail = "fewer than 3 distinct valid points";
+        return finish(Status::too_few_points);
+    }
+    const size_t mark = arena.mark();
+    CellScratch scale_grid = allocate_cell_scratch(arena, cloud.count);
+    if (arena.failed) return finish(out_of_workspace(rep));
+    GridItem* sample = arena.alloc<GridItem>(2 * kDecileSample);
+    if (arena.failed) return finish(out_of_workspace(rep));
+    const CloudBox box = box_of(reader, cloud.count);
+    const double decile = nearest_spacing(reader, cloud.count, box, scale_grid);
+    const double spacing = decile > 0 ? median_nearest_distance(reader, cloud.count, box, decile,
+                                                                scale_grid, sample,
+                                                                sample + kDecileSample)
+                                      : 0;
+    arena.rewind(mark);
+    PartingMemory m;
+    allocate_parting(m, cloud.count, arena);
+    if (arena.failed) return finish(out_of_workspace(rep));
+    Local low = {DBL_MAX, DBL_MAX, DBL_MAX}, high = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+    for (size_t i = 0; i < cloud.count; ++i) {
+        if (!reader.valid(i)) continue;
+        const Local l = frame.local(reader.point(i));
+        low = {l.x < low.x ? l.x : low.x, l.y < low.y ? l.y : low.y, l.h < low.h ? l.h : low.h};
+        high = {l.x > high.x ? l.x : high.x, l.y > high.y ? l.y : high.y, l.h > high.h ? l.h : high.h};
+    }
+    if (!(high.h > low.h)) {
+        rep.detail = "every point has the same height along the axis";
+        return finish(Status::flat_cloud);
+    }
+    const double gap = kPartingGap * spacing;
+    if (!(gap > 0) || !is_finite(gap * frame.scale)) {
+        rep.detail = "the cloud has no scale (too many of its points have no distinct "
+                     "neighbour near them: repeats, scattered points): no parting is reported";
+        return finish(Status::ok);
+    }
+    parting->gap = gap;
+    PartingSweep& s = m.sweep;
+    s.crowded = false;
+    s.gap = gap * frame.scale;
+    s.count = grid_in_frame(reader, cloud.count, frame, low, s.gap, m);
+    s.cells = m.items;
+    s.position = m.position;
+    split_into_steps(m.position, s.count, low.h, high.h, s.gap, m.steps);
+    double cut = 0;
+    parting->branches_above = sweep_for_parting(s, m.steps, true, &cut, parting->above_points);
+    if (parting->branches_above) parting->above = frame.user_height(cut);
+    parting->branches_below = sweep_for_parting(s, m.steps, false, &cut, parting->below_points);
+    if (s.crowded) {
+        parting->branches_above = parting->branches_below = 0;
+        parting->above = 0;
+        rep.detail = "the cloud is too crowded to search (over 1024 points within a gap of "
+                     "each, on average: repeated or solid): no parting is reported";
+    }
+    if (parting->branches_below) parting->below = frame.user_height(cut);
+    return finish(Status::ok);
 }
 #endif
 

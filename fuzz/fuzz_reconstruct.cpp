@@ -15,6 +15,9 @@
 // (tests/support/mesh_check.h), vertices only distinct valid points and points_used equal
 // to the vertices used; a second run on a differently-filled workspace, with the layers
 // triangulated ahead by jobs (Options::run_jobs, run in reverse order), gives the same bits.
+// find_parting() runs on every cloud too, in a workspace of exactly
+// find_parting_workspace_size(): a documented status, and on ok branches that a side of
+// the cloud can hold (sizes from kSmallestBranch, largest first, adding up to at most n).
 #include "fuzz_cloud.h"
 #include "fuzz_common.h"
 #include "known_bugs.h"
@@ -59,6 +62,38 @@ Run run(const stratmesh::Cloud& cloud, const stratmesh::Options& options, size_t
 }
 
 bool same_double(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// One side of a parting: no branch, or 2 to kMaxBranches of them, largest first, each of
+// kSmallestBranch points or more, together at most n, at a finite cut.
+void check_parting_side(uint32_t branches, const uint32_t* points, double cut, size_t n) {
+    if (branches == 0) return;
+    STRATMESH_FUZZ_CHECK(branches >= 2 && branches <= stratmesh::kMaxBranches, "parting: branch count");
+    STRATMESH_FUZZ_CHECK(std::isfinite(cut), "parting: a cut that is not finite");
+    size_t total = 0;
+    for (uint32_t k = 0; k < branches; ++k) {
+        STRATMESH_FUZZ_CHECK(points[k] >= stratmesh::kSmallestBranch, "parting: a branch too small");
+        STRATMESH_FUZZ_CHECK(k == 0 || points[k] <= points[k - 1], "parting: branches out of order");
+        total += points[k];
+    }
+    STRATMESH_FUZZ_CHECK(total <= n, "parting: more points in branches than in the cloud");
+}
+
+void check_parting(const stratmesh::Cloud& cloud, const stratmesh::Options& options) {
+    const size_t bytes = stratmesh::find_parting_workspace_size(cloud.count, options);
+    std::vector<unsigned char> work(bytes, 0xC3);
+    stratmesh::Parting p;
+    const stratmesh::Status status =
+        stratmesh::find_parting(cloud, options, work.empty() ? nullptr : work.data(), bytes, &p);
+    using stratmesh::Status;
+    if (status != Status::ok && status != Status::invalid_point && status != Status::too_few_points &&
+        status != Status::invalid_axis && status != Status::flat_cloud)
+        stratmesh_fuzz::fail("find_parting returned an unexpected status", stratmesh::status_string(status));
+    STRATMESH_FUZZ_CHECK(p.workspace_used <= bytes, "find_parting: more workspace than its size");
+    if (status != Status::ok) return;
+    STRATMESH_FUZZ_CHECK(std::isfinite(p.gap) && p.gap >= 0, "parting: a gap that is not finite");
+    check_parting_side(p.branches_above, p.above_points, p.above, cloud.count);
+    check_parting_side(p.branches_below, p.below_points, p.below, cloud.count);
+}
 
 void run_jobs_in_reverse(void*, uint32_t count, stratmesh::JobFunction job, void* context) {
     for (uint32_t i = count; i-- > 0;) job(context, i);
@@ -131,6 +166,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (last & 4) options.flags |= stratmesh::open_ends;
     const bool dropping = (options.flags & stratmesh::drop_outliers) != 0;
 
+    check_parting(cloud, options);
     Run first = run(cloud, options, capacity, layer_capacity, 0xA5);
     const stratmesh::Report& rep = first.report;
     if (std::getenv("STRATMESH_FUZZ_VERBOSE"))

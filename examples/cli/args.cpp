@@ -62,6 +62,13 @@ const char kUsage[] =
     "                        otherwise meshed across from a pole): both are unrolled on\n"
     "                        the cylinder like the rest; for a cloud cut out of a larger\n"
     "                        object (stratmesh's open_ends)\n"
+    "  --branches            also find where the cloud parts into branches along the\n"
+    "                        axis (horns, fingers: a tube wraps them), as the lowest cut\n"
+    "                        above which and the highest below which the points make\n"
+    "                        separate branches, for meshing each side apart; in the\n"
+    "                        summary and the report (stratmesh's find_parting; about\n"
+    "                        100 bytes a point more, and twice the library's time on a\n"
+    "                        smooth tube)\n"
     "  --cap                 close the tube's ends with caps over its boundary loops: a\n"
     "                        closed, watertight surface (a loop that cannot be capped\n"
     "                        stays open; the summary and the report count it)\n"
@@ -211,6 +218,7 @@ bool apply_flag(std::string_view name, CommandLine& line) {
     if (name == "--drop-outliers") line.drop_outliers = true;
     if (name == "--unrolled-delaunay") line.surface_flips = false;
     if (name == "--open-ends") line.open_ends = true;
+    if (name == "--branches") line.find_branches = true;
     if (name == "--quiet") line.quiet = true;
     if (name == "--stream") line.stream = true;
     return true;
@@ -221,7 +229,7 @@ const char* const kValuedOptions[] = {"--output",  "--report",        "--axis",
                                       "--threads", "--stream-points", "--origin"};
 const char* const kFlags[] = {"--ascii", "--skip-invalid", "--cap",     "--quiet",
                               "--help",  "--version",      "--stream", "--drop-outliers",
-                              "--unrolled-delaunay", "--open-ends"};
+                              "--unrolled-delaunay", "--open-ends", "--branches"};
 
 // What --stream cannot do, or an empty string.
 std::string stream_conflict(const CommandLine& line) {
@@ -234,6 +242,9 @@ std::string stream_conflict(const CommandLine& line) {
     if (line.drop_outliers)
         return "--stream cannot --drop-outliers: an outlier is told from the whole cloud's "
                "spacing, which the stream never holds";
+    if (line.find_branches)
+        return "--stream cannot find --branches: where a cloud parts is told from all of its "
+               "points, which the stream never holds";
     if (mesh_format_from_extension(line.output) == MeshFormat::stl)
         return "--stream cannot write STL (its triangles repeat their corners' coordinates, "
                "which the stream no longer holds): write PLY, OBJ or OFF";

@@ -80,6 +80,7 @@ void record_command_line(const CommandLine& line, RunRecord& record) {
     record.drop_outliers = line.drop_outliers;
     record.surface_flips = line.surface_flips;
     record.open_ends = line.open_ends;
+    record.find_branches = line.find_branches;
     record.threads = line.threads;
     record.origin_given = line.origin_given || line.stream;
     for (size_t k = 0; k < 3; ++k) record.origin[k] = line.origin[k];
@@ -193,6 +194,26 @@ bool reconstruct_points(const std::vector<double>& xyz, const CommandLine& line,
     return true;
 }
 
+// With --branches: where the cloud parts, into the record. False if the buffer cannot be
+// allocated.
+bool find_branches(const std::vector<double>& xyz, const stratmesh::Options& options,
+                   RunRecord& record) {
+    const size_t count = xyz.size() / 3;
+    const size_t bytes = stratmesh::find_parting_workspace_size(count, options);
+    std::unique_ptr<unsigned char, FreeDeleter> workspace = allocate<unsigned char>(bytes);
+    if (!workspace) {
+        std::fprintf(stderr, "stratmesh: cannot allocate %zu bytes to find the branches\n", bytes);
+        return false;
+    }
+    const stratmesh::Cloud cloud = {xyz.data(), count, 0, stratmesh::Scalar::float64};
+    Clock::time_point start = Clock::now();
+    record.parting_status =
+        stratmesh::find_parting(cloud, options, workspace.get(), bytes, &record.parting);
+    record.branches_seconds = seconds_since(start);
+    record.parting_run = true;
+    return true;
+}
+
 void explain_refusal(const CommandLine& line, const RunRecord& record) {
     std::fprintf(stderr, "stratmesh: cannot reconstruct %s: %s\n", line.input.c_str(),
                  stratmesh::status_string(record.status));
@@ -272,6 +293,11 @@ int run(const CommandLine& line) {
     if (!read_input(line, xyz, record)) return kExitFile;
     if (!reconstruct_points(xyz, line, result, record)) return kExitRefused;
     if (record.status != stratmesh::Status::ok) return refuse(line, record);
+    if (line.find_branches) {
+        ProgressMonitor silent(false, stderr);
+        ThreadJobs jobs;
+        if (!find_branches(xyz, make_options(line, silent, jobs), record)) return kExitRefused;
+    }
     if (!write_output(line, xyz, result, record)) return kExitFile;
     return finish_run(line, record);
 }

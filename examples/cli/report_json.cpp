@@ -200,6 +200,7 @@ void write_options(JsonWriter& j, const RunRecord& r) {
     j.flag_field("drop_outliers", r.drop_outliers);
     j.flag_field("surface_flips", r.surface_flips);
     j.flag_field("open_ends", r.open_ends);
+    j.flag_field("branches", r.find_branches);
     j.count_field("threads", r.threads);
     j.flag_field("stream", r.stream);
     j.key("stream_points");
@@ -263,6 +264,34 @@ void write_counts(JsonWriter& j, const stratmesh::Report& rep, stratmesh::Status
     j.count_field("points_held", rep.points_held);
 }
 
+// One side of the parting: its cut and its branches' point counts, or null.
+void write_parting_side(JsonWriter& j, const char* name, double cut, const uint32_t* points,
+                        uint32_t branches) {
+    j.key(name);
+    if (branches == 0) return j.null();
+    j.begin_object();
+    j.number_field("cut", cut);
+    j.key("points");
+    j.begin_array();
+    for (uint32_t k = 0; k < branches; ++k) j.integer(points[k]);
+    j.end_array();
+    j.end_object();
+}
+
+void write_branches(JsonWriter& j, const RunRecord& r) {
+    j.key("branches");
+    if (!r.parting_run) return j.null();
+    const stratmesh::Parting& p = r.parting;
+    j.begin_object();
+    const char* message = stratmesh::status_string(r.parting_status);
+    const char* colon = std::strchr(message, ':');
+    j.text_field("status", colon ? std::string_view(message, size_t(colon - message)) : message);
+    j.number_field("gap", p.gap);
+    write_parting_side(j, "above", p.above, p.above_points, p.branches_above);
+    write_parting_side(j, "below", p.below, p.below_points, p.branches_below);
+    j.end_object();
+}
+
 void write_stream(JsonWriter& j, const RunRecord& r) {
     j.key("stream");
     if (!r.stream) return j.null();
@@ -300,6 +329,7 @@ void write_costs(JsonWriter& j, const RunRecord& r) {
     j.number_field("read", r.read_seconds);
     j.number_field("reconstruct", r.reconstruct_seconds);
     j.number_field("write", r.write_seconds);
+    j.number_field("branches", r.branches_seconds);
     j.key("phases");
     j.begin_object();
     for (size_t p = 0; p < kTimedPhases; ++p)
@@ -339,7 +369,7 @@ const char* phase_name(stratmesh::Phase phase) {
 
 RunRecord::RunRecord() {
     const double unknown = std::numeric_limits<double>::quiet_NaN();
-    read_seconds = reconstruct_seconds = write_seconds = unknown;
+    read_seconds = reconstruct_seconds = write_seconds = branches_seconds = unknown;
     for (double& s : phase_seconds) s = unknown;
 }
 
@@ -385,6 +415,7 @@ std::string run_record_json(const RunRecord& record) {
     write_counts(j, record.report, record.status);
     write_layers(j, record);
     write_stream(j, record);
+    write_branches(j, record);
     write_costs(j, record);
     j.end_object();
     return j.text();

@@ -35,6 +35,7 @@ struct RunRecord {
     bool drop_outliers = false;
     bool surface_flips = false;
     bool open_ends = false;
+    bool find_branches = false;
     uint32_t threads = 1;
     bool origin_given = false;
     double origin[3] = {0, 0, 0};
@@ -50,11 +51,15 @@ struct RunRecord {
     stratmesh::Report report = {};
     std::vector<stratmesh::LayerInfo> layers;
     // The cost; seconds are NaN when unknown (written as null).
-    double read_seconds, reconstruct_seconds, write_seconds;
+    double read_seconds, reconstruct_seconds, write_seconds, branches_seconds;
     double phase_seconds[kTimedPhases];
     size_t workspace_bytes = 0;
     size_t triangle_buffer_bytes = 0;
     size_t peak_rss_bytes = 0; // the process's peak resident memory; 0 if unknown
+    // With --branches, once the reconstruction succeeded: find_parting's status and result.
+    bool parting_run = false;
+    stratmesh::Status parting_status = stratmesh::Status::ok;
+    stratmesh::Parting parting = {};
 
     RunRecord();
 

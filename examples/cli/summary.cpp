@@ -14,6 +14,13 @@ std::string seconds_text(double seconds) {
     return text;
 }
 
+// A coordinate in 6 significant digits.
+std::string number_text(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g", value);
+    return text;
+}
+
 std::string bytes_text(size_t bytes) {
     const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB"};
     double value = static_cast<double>(bytes);
@@ -98,12 +105,40 @@ void print_counts(std::FILE* out, const RunRecord& r) {
                                         : "");
 }
 
+// With --branches: where the cloud parts, each side's cut along the axis (as --cuts takes
+// it) and its branches' point counts.
+void print_branches(std::FILE* out, const RunRecord& r) {
+    if (!r.parting_run) return;
+    const stratmesh::Parting& p = r.parting;
+    if (r.parting_status != stratmesh::Status::ok) {
+        std::fprintf(out, "  branches   not found: %s\n", stratmesh::status_string(r.parting_status));
+        return;
+    }
+    auto side = [&](const char* name, double cut, const uint32_t* points, uint32_t branches) {
+        if (branches == 0) return std::string(name) + ": none";
+        std::string text = std::string(name) + " " + number_text(cut) + ": " +
+                           std::to_string(branches) + " (";
+        for (uint32_t k = 0; k < branches; ++k)
+            text += (k ? ", " : "") + std::to_string(points[k]);
+        return text + " points)";
+    };
+    std::fprintf(out, "  branches   %s; %s (gap %s)\n",
+                 side("above", p.above, p.above_points, p.branches_above).c_str(),
+                 side("below", p.below, p.below_points, p.branches_below).c_str(),
+                 number_text(p.gap).c_str());
+    if (p.branches_above + p.branches_below > 0)
+        std::fprintf(out, "             one tube wraps branches and the gaps between them: mesh "
+                          "each side apart\n             (README, \"Where the cloud parts\")\n");
+}
+
 void print_costs(std::FILE* out, const RunRecord& r) {
     if (!r.stream) // the stream triangulates in order, whatever --threads says
         std::fprintf(out, "  threads    %u\n", static_cast<unsigned>(r.threads));
-    std::fprintf(out, "  time       read %s, reconstruct %s%s, write %s\n",
+    std::fprintf(out, "  time       read %s, reconstruct %s%s, %swrite %s\n",
                  seconds_text(r.read_seconds).c_str(), seconds_text(r.reconstruct_seconds).c_str(),
-                 phase_times_text(r).c_str(), seconds_text(r.write_seconds).c_str());
+                 phase_times_text(r).c_str(),
+                 r.parting_run ? ("branches " + seconds_text(r.branches_seconds) + ", ").c_str() : "",
+                 seconds_text(r.write_seconds).c_str());
     double per_point = r.report.points_in ? static_cast<double>(r.workspace_bytes) /
                                                 static_cast<double>(r.report.points_in)
                                           : 0.0;
@@ -126,6 +161,7 @@ void print_summary(std::FILE* out, const RunRecord& record) {
                  record.output_path.c_str(), record.output_format.c_str(),
                  record.output_ascii ? " text" : "");
     print_counts(out, record);
+    print_branches(out, record);
     print_costs(out, record);
 }
 

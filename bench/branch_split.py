@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """branch_split.py - how close separate tubes per branch come, before any junction.
 
-    bench/branch_split.py CLOUD.ply HEIGHT OUT.ply [--below] [--gap D] [--stratmesh PATH]
-                          [--piece-options "OPTIONS"] [-- TRUNK_OPTIONS...]
+    bench/branch_split.py CLOUD.ply HEIGHT|auto OUT.ply [--below] [--gap D]
+                          [--stratmesh PATH] [--piece-options "OPTIONS"]
+                          [-- TRUNK_OPTIONS...]
 
 An experiment for the branching that stratmesh does not do yet (README, "Known
 limitations"): splits the cloud (x, y, z of the vertex element) at HEIGHT along z into the
@@ -23,6 +24,10 @@ horns leave the skull's section at z = 2.85):
 
     bench/branch_split.py horned.ply 2.85 split.ply -- --axis z --layers 8
     meshq --mesh split.ply --ref horned_reference.off --cloud horned.ply
+
+HEIGHT auto takes the cut, and the gap unless --gap is given, from the library's
+find_parting (the tool's --branches along z): the lowest cut above which the cloud parts,
+or with --below the highest below which it does; none found is an error (exit 1).
 
 The tool is build/examples/cli/stratmesh (relative to the source tree) unless --stratmesh
 or the environment variable STRATMESH says otherwise. Needs python3 only.
@@ -94,6 +99,20 @@ def write_mesh(path, points, faces):
             f.write("3 %d %d %d\n" % t)
 
 
+def library_parting(tool, cloud_path, below):
+    """(cut, gap) of the tool's --branches along z on one side, or None where it finds none."""
+    with tempfile.TemporaryDirectory() as work:
+        report_path = os.path.join(work, "report.json")
+        run = subprocess.run([tool, cloud_path, "-o", os.path.join(work, "mesh.ply"), "--axis",
+                              "z", "--branches", "--report", report_path, "-q"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        if run.returncode != 0:
+            raise SystemExit("the tool could not mesh %s" % cloud_path)
+        branches = json.load(open(report_path))["branches"]
+    side = branches["below" if below else "above"]
+    return None if side is None else (side["cut"], branches["gap"])
+
+
 def main(argv):
     tool = os.environ.get("STRATMESH") or os.path.join(
         os.path.dirname(os.path.abspath(__file__)), "..", "build", "examples", "cli", "stratmesh")
@@ -123,7 +142,17 @@ def main(argv):
         print(__doc__.split("\n\n")[1], file=sys.stderr)
         return 2
     points, _ = read_ply(argv[0])
-    height, out_path = float(argv[1]), argv[2]
+    out_path = argv[2]
+    if argv[1] == "auto":
+        found = library_parting(tool, argv[0], below_first)
+        if found is None:
+            print("branch_split.py: the library finds no parting %s any cut"
+                  % ("below" if below_first else "above"), file=sys.stderr)
+            return 1
+        height = found[0]
+        gap = gap or found[1]
+    else:
+        height = float(argv[1])
     if gap is None:
         gap = 4 * median_spacing(points)
     trunk = [i for i, p in enumerate(points) if (p[2] >= height) == below_first]
@@ -135,7 +164,7 @@ def main(argv):
             small += len(piece)
             continue
         parts.append(("piece %d" % k, [branches[i] for i in piece], piece_options))
-    summary = {"gap": gap, "points": len(points), "left_out_in_small_pieces": small, "runs": []}
+    summary = {"height": height, "gap": gap, "points": len(points), "left_out_in_small_pieces": small, "runs": []}
     faces = []
     with tempfile.TemporaryDirectory() as work:
         for name, indices, options in parts:

@@ -783,6 +783,15 @@ struct Parting {
 // 0 if that is beyond what this platform can address.
 size_t find_parting_workspace_size(size_t point_count, const Options& options);
 
+// Labels of find_parting()'s branch_of: a point in no branch (the trunk, a NaN point, every
+// point where the cloud does not part), in the k-th branch above the cut (k from 0, largest
+// first: kFirstAboveBranch + k) or below it (kFirstBelowBranch + k), or beyond a cut but in
+// no branch (a piece left aside, or too small to count).
+const uint8_t kInTrunk = 0;
+const uint8_t kFirstAboveBranch = 1;
+const uint8_t kFirstBelowBranch = 1 + kMaxBranches;
+const uint8_t kBeyondBranches = 255;
+
 // Finds where the cloud parts into branches (see above). options: axis, direction, and
 // the flags skip_invalid_points and drop_outliers (outliers are left out first); the rest
 // is not used. The same axis as reconstruct() with these options. Deterministic; the
@@ -795,8 +804,12 @@ size_t find_parting_workspace_size(size_t point_count, const Options& options);
 // distinct valid points); flat_cloud (every point at the same height); out_of_memory (a
 // workspace below find_parting_workspace_size()). On a status other than ok only
 // workspace_used and detail are meaningful.
+// branch_of (optional, cloud.count bytes): on ok, each point's label (see kInTrunk), so
+// that the caller can mesh the trunk and each branch apart. Where the two sides overlap
+// (the cloud is apart all along, as two tubes side by side), a point keeps the label of the
+// side above. It must not share a byte with the other buffers (invalid_argument).
 Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
-                    size_t workspace_bytes, Parting* parting);
+                    size_t workspace_bytes, Parting* parting, uint8_t* branch_of = nullptr);
 #endif
 
 } // namespace stratmesh
@@ -8320,11 +8333,11 @@ struct BranchCandidate {
 };
 
 // Whether the `added` points added so far, on the side of the cut at level `cut`, part into
-// branches there; if so their sizes go to `sizes`, largest first, and their count is
-// returned (else 0). The points of orders [slab_start, added) are those within two gaps of
-// the cut.
+// branches there; if so their sizes and roots go to `sizes` and `roots`, largest first, and
+// their count is returned (else 0). The points of orders [slab_start, added) are those
+// within two gaps of the cut.
 inline uint32_t branches_at(PartingSweep& s, uint32_t added, uint32_t slab_start, double cut,
-                            uint32_t* sizes) {
+                            uint32_t* sizes, uint32_t* roots) {
     BranchCandidate found[kMaxBranches];
     uint32_t pieces = 0;
     bool bump = false;
@@ -8374,6 +8387,7 @@ inline uint32_t branches_at(PartingSweep& s, uint32_t added, uint32_t slab_start
         found[k] = found[largest];
         found[largest] = t;
         sizes[k] = s.size[found[k].root];
+        roots[k] = found[k].root;
     }
     return pieces;
 }
@@ -8389,11 +8403,22 @@ struct PartingSteps {
     uint32_t* by_step;
 };
 
-// One sweep: down from the top (`from_top`) or up from the bottom. Returns the branches at
-// the last cut of the sweep where the cloud parts (the lowest above, the highest below),
-// its height in *cut_height.
-inline uint32_t sweep_for_parting(PartingSweep& s, const PartingSteps& p, bool from_top,
-                                  double* cut_height, uint32_t* sizes) {
+// Where one side of the cloud parts: the branches' count (0: nowhere), the cut's index,
+// and the branches' sizes and roots, largest first.
+struct SideParting {
+    uint32_t branches;
+    uint32_t cut_index;
+    uint32_t added;           // the points on the side of that cut
+    uint32_t sizes[kMaxBranches];
+    uint32_t roots[kMaxBranches];
+};
+
+// One sweep: down from the top (`from_top`) or up from the bottom; the last cut of the
+// sweep where the cloud parts (the lowest above, the highest below). With `stop` (a cut
+// index, 0 for none), it stops once that cut is tried: the roots then name the pieces as
+// the union-find holds them, for labelling.
+inline SideParting sweep_for_parting(PartingSweep& s, const PartingSteps& p, bool from_top,
+                                     uint32_t stop) {
     s.sign = from_top ? 1 : -1;
     s.listed_count = 0;
     s.counting = kSmallestBranch;
@@ -8402,16 +8427,16 @@ inline uint32_t sweep_for_parting(PartingSweep& s, const PartingSteps& p, bool f
     for (size_t& f : s.fingers) f = 0;
     s.checks_left = kPartingChecksPerPoint * s.count;
     const double top = from_top ? p.lo + p.steps * p.step_height : -p.lo;
-    uint32_t best = 0, added = 0;
+    SideParting best = {};
+    uint32_t added = 0;
     for (uint32_t m = 0; m + 1 < p.steps; ++m) {
         // Add step k, then try the cut on its far side: cut k from the top, k + 1 from below.
         const uint32_t k = from_top ? p.steps - 1 - m : m;
         for (uint32_t i = p.step_start[k]; i < p.step_start[k + 1] && !s.crowded; ++i)
             s.add(added++, p.by_step[i]);
-        if (s.crowded) return 0;
+        if (s.crowded) return SideParting{};
         const uint32_t cut_index = from_top ? k : k + 1;
-        const double h = p.lo + cut_index * p.step_height;
-        const double cut = s.sign * h;
+        const double cut = s.sign * (p.lo + cut_index * p.step_height);
         // A side thinner than four gaps is a rim, which falls apart into arcs.
         if (top - cut < 4 * s.gap || added == 0) continue;
         const uint32_t slab = 2 * kStepsPerGap;  // two gaps
@@ -8419,14 +8444,30 @@ inline uint32_t sweep_for_parting(PartingSweep& s, const PartingSteps& p, bool f
                                             : (cut_index > slab ? cut_index - slab : 0);
         const uint32_t slab_start = from_top ? static_cast<uint32_t>(s.count) - p.step_start[slab_step]
                                              : p.step_start[slab_step];
-        uint32_t found[kMaxBranches];
-        const uint32_t pieces = branches_at(s, added, slab_start, cut, found);
-        if (pieces == 0) continue;
-        best = pieces;
-        *cut_height = h;
-        for (uint32_t b = 0; b < pieces; ++b) sizes[b] = found[b];
+        SideParting here = {};
+        here.branches = branches_at(s, added, slab_start, cut, here.sizes, here.roots);
+        here.cut_index = cut_index;
+        here.added = added;
+        if (here.branches > 0) best = here;
+        if (cut_index == stop) break;
     }
     return best;
+}
+
+// With find_parting's branch_of: sweeps again to the side's cut and labels the points
+// there by their piece, keeping the labels already given (the side above is labelled
+// first). `first` is the label of the side's largest branch.
+inline void label_branches(PartingSweep& s, const PartingSteps& p, bool from_top,
+                           uint32_t cut_index, uint8_t first, uint8_t* branch_of) {
+    const SideParting side = sweep_for_parting(s, p, from_top, cut_index);
+    for (uint32_t t = 0; t < side.added; ++t) {
+        const uint32_t r = s.root(t);
+        uint8_t label = kBeyondBranches;
+        for (uint32_t k = 0; k < side.branches; ++k)
+            if (side.roots[k] == r) label = static_cast<uint8_t>(first + k);
+        uint8_t& l = branch_of[s.cells[s.added[t]].index];
+        if (l == kInTrunk) l = label;
+    }
 }
 
 struct PartingMemory {
@@ -8558,14 +8599,16 @@ size_t find_parting_workspace_size(size_t point_count, const Options& options) {
 }
 
 Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
-                    size_t workspace_bytes, Parting* parting) {
+                    size_t workspace_bytes, Parting* parting, uint8_t* branch_of) {
     using namespace detail;
     if (!parting) return Status::invalid_argument;
     // Checked before anything is written (a count beyond the limit is refused below).
-    const ByteRange buffers[] = {cloud.count > kMaxPoints - 1 ? ByteRange{0, 0} : cloud_bytes(cloud),
+    const bool countable = cloud.count <= kMaxPoints - 1;
+    const ByteRange buffers[] = {countable ? cloud_bytes(cloud) : ByteRange{0, 0},
                                  byte_range(workspace, workspace_bytes),
-                                 byte_range(parting, sizeof *parting)};
-    if (any_overlap(buffers, 3)) return Status::invalid_argument;
+                                 byte_range(parting, sizeof *parting),
+                                 byte_range(branch_of, countable ? cloud.count : 0)};
+    if (any_overlap(buffers, 4)) return Status::invalid_argument;
     std::memset(parting, 0, sizeof *parting);
     Report rep = {};
     size_t no_triangles = 0;
@@ -8577,6 +8620,7 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
     };
     Status status = check_reconstruct_arguments(cloud, nullptr, 0, &no_triangles, workspace, rep);
     if (status != Status::ok) return finish(status);
+    if (branch_of) std::memset(branch_of, kInTrunk, cloud.count);
     CloudReader reader = reader_of(cloud);
     CloudSums sums = sum_cloud(reader, cloud.count);
     status = reject_invalid_points(reader, cloud.count, sums, options, rep);
@@ -8635,17 +8679,27 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
     s.cells = m.items;
     s.position = m.position;
     split_into_steps(m.position, s.count, low.h, high.h, s.gap, m.steps);
-    double cut = 0;
-    parting->branches_above = sweep_for_parting(s, m.steps, true, &cut, parting->above_points);
-    if (parting->branches_above) parting->above = frame.user_height(cut);
-    parting->branches_below = sweep_for_parting(s, m.steps, false, &cut, parting->below_points);
+    const SideParting above = sweep_for_parting(s, m.steps, true, 0);
+    const SideParting below = sweep_for_parting(s, m.steps, false, 0);
+    auto report_side = [&](const SideParting& side, double* cut, uint32_t* branches,
+                           uint32_t* points) {
+        *branches = side.branches;
+        if (side.branches) *cut = frame.user_height(m.steps.lo + side.cut_index * m.steps.step_height);
+        for (uint32_t k = 0; k < side.branches; ++k) points[k] = side.sizes[k];
+    };
+    report_side(above, &parting->above, &parting->branches_above, parting->above_points);
+    report_side(below, &parting->below, &parting->branches_below, parting->below_points);
     if (s.crowded) {
         parting->branches_above = parting->branches_below = 0;
         parting->above = 0;
         rep.detail = "the cloud is too crowded to search (over 1024 points within a gap of "
                      "each, on average: repeated or solid): no parting is reported";
+        return finish(Status::ok);
     }
-    if (parting->branches_below) parting->below = frame.user_height(cut);
+    if (branch_of && above.branches)
+        label_branches(s, m.steps, true, above.cut_index, kFirstAboveBranch, branch_of);
+    if (branch_of && below.branches)
+        label_branches(s, m.steps, false, below.cut_index, kFirstBelowBranch, branch_of);
     return finish(Status::ok);
 }
 #endif

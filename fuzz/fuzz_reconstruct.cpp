@@ -17,7 +17,9 @@
 // triangulated ahead by jobs (Options::run_jobs, run in reverse order), gives the same bits.
 // find_parting() runs on every cloud too, in a workspace of exactly
 // find_parting_workspace_size(): a documented status, and on ok branches that a side of
-// the cloud can hold (sizes from kSmallestBranch, largest first, adding up to at most n).
+// the cloud can hold (sizes from kSmallestBranch, largest first, adding up to at most n),
+// each point labelled (the branches above exactly as large as reported, those below at
+// most: the side above keeps the points of both).
 #include "fuzz_cloud.h"
 #include "fuzz_common.h"
 #include "known_bugs.h"
@@ -82,8 +84,10 @@ void check_parting(const stratmesh::Cloud& cloud, const stratmesh::Options& opti
     const size_t bytes = stratmesh::find_parting_workspace_size(cloud.count, options);
     std::vector<unsigned char> work(bytes, 0xC3);
     stratmesh::Parting p;
+    std::vector<uint8_t> label(cloud.count, 0xA5);
     const stratmesh::Status status =
-        stratmesh::find_parting(cloud, options, work.empty() ? nullptr : work.data(), bytes, &p);
+        stratmesh::find_parting(cloud, options, work.empty() ? nullptr : work.data(), bytes, &p,
+                                label.empty() ? nullptr : label.data());
     using stratmesh::Status;
     if (status != Status::ok && status != Status::invalid_point && status != Status::too_few_points &&
         status != Status::invalid_axis && status != Status::flat_cloud)
@@ -93,6 +97,20 @@ void check_parting(const stratmesh::Cloud& cloud, const stratmesh::Options& opti
     STRATMESH_FUZZ_CHECK(std::isfinite(p.gap) && p.gap >= 0, "parting: a gap that is not finite");
     check_parting_side(p.branches_above, p.above_points, p.above, cloud.count);
     check_parting_side(p.branches_below, p.below_points, p.below, cloud.count);
+    std::vector<uint32_t> in_label(256, 0);
+    for (uint8_t l : label) ++in_label[l];
+    for (uint32_t l = 0; l < 256; ++l) {
+        const bool above = l >= stratmesh::kFirstAboveBranch && l < stratmesh::kFirstAboveBranch + p.branches_above;
+        const bool below = l >= stratmesh::kFirstBelowBranch && l < stratmesh::kFirstBelowBranch + p.branches_below;
+        if (above)
+            STRATMESH_FUZZ_CHECK(in_label[l] == p.above_points[l - stratmesh::kFirstAboveBranch],
+                                 "parting: a branch above labelled with another size");
+        else if (below)
+            STRATMESH_FUZZ_CHECK(in_label[l] <= p.below_points[l - stratmesh::kFirstBelowBranch],
+                                 "parting: a branch below labelled with more points");
+        else if (l != stratmesh::kInTrunk && l != stratmesh::kBeyondBranches)
+            STRATMESH_FUZZ_CHECK(in_label[l] == 0, "parting: a label that names no branch");
+    }
 }
 
 void run_jobs_in_reverse(void*, uint32_t count, stratmesh::JobFunction job, void* context) {

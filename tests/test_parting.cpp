@@ -32,54 +32,89 @@ struct PartingRun {
     size_t workspace_bytes;
 };
 
-PartingRun find_parting_of(const Cloud& cloud, const Options& options) {
+PartingRun find_parting_of(const Cloud& cloud, const Options& options,
+                           uint8_t* branch_of = nullptr) {
     PartingRun run;
     run.workspace_bytes = stratmesh::find_parting_workspace_size(cloud.count, options);
     std::vector<unsigned char> workspace(run.workspace_bytes);
     run.status = stratmesh::find_parting(cloud, options, workspace.data(), workspace.size(),
-                                         &run.parting);
+                                         &run.parting, branch_of);
     return run;
 }
 
-// The sizes of the single-linkage pieces (points nearer than `gap` join) of the points on
-// one side of `cut` along the unit `axis` (at or above it, or below it), largest first:
-// those with at least `least` points whose nearest point lies within a gap of the cut; by
-// brute force over every pair.
-std::vector<size_t> pieces_beyond(const Shape& s, const double axis[3], double cut, bool above,
-                                  double gap, size_t least_points) {
-    std::vector<const double*> side;
-    std::vector<double> distance;
+// The single-linkage pieces (points nearer than `gap` join) of the points on one side of
+// `cut` along the unit `axis` (at or above it, or below it) that count: at least `least`
+// points and a twentieth of the side, the nearest within a gap of the cut; by brute force
+// over every pair. piece[i] numbers point i's piece, largest first, or is -1.
+struct Pieces {
+    std::vector<size_t> sizes;
+    std::vector<int> piece;
+};
+
+Pieces pieces_beyond(const Shape& s, const double axis[3], double cut, bool above, double gap,
+                     size_t least_points) {
+    std::vector<size_t> side;
+    std::vector<double> distance(s.size(), 0);
     for (size_t i = 0; i < s.size(); ++i) {
         const double* p = s.point(i);
         const double h = p[0] * axis[0] + p[1] * axis[1] + p[2] * axis[2];
         if ((h >= cut) != above) continue;
-        side.push_back(p);
-        distance.push_back(std::fabs(h - cut));
+        side.push_back(i);
+        distance[i] = std::fabs(h - cut);
     }
-    std::vector<size_t> parent(side.size());
+    std::vector<size_t> parent(s.size());
     for (size_t i = 0; i < parent.size(); ++i) parent[i] = i;
     auto root = [&](size_t i) {
         while (parent[i] != i) i = parent[i] = parent[parent[i]];
         return i;
     };
-    for (size_t i = 0; i < side.size(); ++i)
-        for (size_t j = i + 1; j < side.size(); ++j) {
+    for (size_t a = 0; a < side.size(); ++a)
+        for (size_t b = a + 1; b < side.size(); ++b) {
+            const double* p = s.point(side[a]);
+            const double* q = s.point(side[b]);
             double d2 = 0;
-            for (int c = 0; c < 3; ++c) d2 += (side[i][c] - side[j][c]) * (side[i][c] - side[j][c]);
-            if (d2 < gap * gap) parent[root(i)] = root(j);
+            for (int c = 0; c < 3; ++c) d2 += (p[c] - q[c]) * (p[c] - q[c]);
+            if (d2 < gap * gap) parent[root(side[a])] = root(side[b]);
         }
-    std::vector<size_t> size(side.size(), 0);
-    std::vector<double> nearest(side.size(), std::numeric_limits<double>::infinity());
-    for (size_t i = 0; i < side.size(); ++i) {
+    std::vector<size_t> size(s.size(), 0);
+    std::vector<double> nearest(s.size(), std::numeric_limits<double>::infinity());
+    for (size_t i : side) {
         ++size[root(i)];
         nearest[root(i)] = std::min(nearest[root(i)], distance[i]);
     }
     const size_t least = std::max(least_points, (side.size() + 19) / 20);
-    std::vector<size_t> counted;
-    for (size_t i = 0; i < side.size(); ++i)
-        if (size[i] >= least && nearest[i] <= gap) counted.push_back(size[i]);
-    std::sort(counted.rbegin(), counted.rend());
-    return counted;
+    std::vector<size_t> roots;
+    for (size_t i : side)
+        if (root(i) == i && size[i] >= least && nearest[i] <= gap) roots.push_back(i);
+    std::stable_sort(roots.begin(), roots.end(), [&](size_t a, size_t b) { return size[a] > size[b]; });
+    Pieces out;
+    out.piece.assign(s.size(), -1);
+    for (size_t k = 0; k < roots.size(); ++k) out.sizes.push_back(size[roots[k]]);
+    for (size_t i : side)
+        for (size_t k = 0; k < roots.size(); ++k)
+            if (root(i) == roots[k]) out.piece[i] = static_cast<int>(k);
+    return out;
+}
+
+// Each labelled branch is one of the brute-force pieces, and each piece one branch; every
+// point not on the side is in the trunk.
+void check_labels(const Pieces& pieces, const std::vector<uint8_t>& label, uint8_t first,
+                  uint32_t branches) {
+    REQUIRE(pieces.sizes.size() == branches);
+    std::vector<int> piece_of_branch(branches, -2);
+    for (size_t i = 0; i < label.size(); ++i) {
+        const bool in_branch = label[i] >= first && label[i] < first + branches;
+        if (!in_branch) {
+            CHECK(pieces.piece[i] == -1);
+            continue;
+        }
+        int& mapped = piece_of_branch[label[i] - first];
+        if (mapped == -2) mapped = pieces.piece[i];
+        CHECK(pieces.piece[i] == mapped);
+        CHECK(mapped >= 0);
+    }
+    for (uint32_t k = 0; k < branches; ++k)
+        for (uint32_t m = k + 1; m < branches; ++m) CHECK(piece_of_branch[k] != piece_of_branch[m]);
 }
 
 // The branches find_parting() reported on one side, as sizes.
@@ -93,7 +128,8 @@ TEST_CASE("find_parting: the prongs of a forked tube part above its dome, as sin
     for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
         const Shape s = shapes::forked_tube(20000, pose);
         CAPTURE(shapes::pose_name(pose));
-        const PartingRun run = find_parting_of(cloud_of(s), axis_options(s));
+        std::vector<uint8_t> label(s.size(), 77);
+        const PartingRun run = find_parting_of(cloud_of(s), axis_options(s), label.data());
         REQUIRE(run.status == Status::ok);
         const Parting& p = run.parting;
         double axis[3];
@@ -110,8 +146,16 @@ TEST_CASE("find_parting: the prongs of a forked tube part above its dome, as sin
         // The pieces are single linkage's at the reported gap, largest first (a prong's
         // thin tip may break off, sampled too sparsely to stay joined: it is left aside).
         CHECK(p.above_points[0] >= p.above_points[1]);
-        CHECK(reported(p.above_points, p.branches_above) ==
-              pieces_beyond(s, axis, p.above, true, p.gap, stratmesh::kSmallestBranch));
+        const Pieces pieces = pieces_beyond(s, axis, p.above, true, p.gap, stratmesh::kSmallestBranch);
+        CHECK(reported(p.above_points, p.branches_above) == pieces.sizes);
+        // Each point's label: a prong's points, the trunk's, those left aside above the cut.
+        check_labels(pieces, label, stratmesh::kFirstAboveBranch, p.branches_above);
+        for (size_t i = 0; i < s.size(); ++i) {
+            const double* q = s.point(i);
+            const double h = q[0] * axis[0] + q[1] * axis[1] + q[2] * axis[2];
+            if (h < p.above) CHECK(label[i] == stratmesh::kInTrunk);
+            if (h >= p.above && pieces.piece[i] < 0) CHECK(label[i] == stratmesh::kBeyondBranches);
+        }
         CHECK(run.parting.workspace_used <= run.workspace_bytes);
         CHECK(run.parting.detail == nullptr);
     }
@@ -121,7 +165,8 @@ TEST_CASE("find_parting: the knobs under a tube part below the pole of its dome"
     for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
         const Shape s = shapes::knobbed_tube(20000, pose);
         CAPTURE(shapes::pose_name(pose));
-        const PartingRun run = find_parting_of(cloud_of(s), axis_options(s));
+        std::vector<uint8_t> label(s.size(), 77);
+        const PartingRun run = find_parting_of(cloud_of(s), axis_options(s), label.data());
         REQUIRE(run.status == Status::ok);
         const Parting& p = run.parting;
         double axis[3];
@@ -133,8 +178,9 @@ TEST_CASE("find_parting: the knobs under a tube part below the pole of its dome"
         CHECK(p.below <= s.along_axis(-1.0) + p.gap);
         CHECK(p.below >= s.along_axis(-1.7) + 4 * p.gap);
         CHECK(p.below_points[1] * 5 >= p.below_points[0] * 4);
-        CHECK(reported(p.below_points, p.branches_below) ==
-              pieces_beyond(s, axis, p.below, false, p.gap, stratmesh::kSmallestBranch));
+        const Pieces pieces = pieces_beyond(s, axis, p.below, false, p.gap, stratmesh::kSmallestBranch);
+        CHECK(reported(p.below_points, p.branches_below) == pieces.sizes);
+        check_labels(pieces, label, stratmesh::kFirstBelowBranch, p.branches_below);
     }
 }
 
@@ -157,11 +203,14 @@ TEST_CASE("find_parting: no tube that does not fork parts, at any size or pose")
                 CAPTURE(s.name);
                 CAPTURE(n);
                 CAPTURE(shapes::pose_name(pose));
-                const PartingRun run = find_parting_of(cloud_of(s), axis_options(s));
+                std::vector<uint8_t> label(s.size(), 77);
+                const PartingRun run = find_parting_of(cloud_of(s), axis_options(s), label.data());
                 REQUIRE(run.status == Status::ok);
                 CHECK(run.parting.gap > 0);
                 CHECK(run.parting.branches_above == 0);
                 CHECK(run.parting.branches_below == 0);
+                CHECK(std::count(label.begin(), label.end(), stratmesh::kInTrunk) ==
+                      static_cast<std::ptrdiff_t>(s.size()));
             }
 }
 
@@ -282,6 +331,12 @@ TEST_CASE("find_parting: bad input gets a status, and the workspace bound is exa
                                       reinterpret_cast<Parting*>(copy.data() + 6)) ==
               Status::invalid_argument);
         CHECK(copy == s.xyz);
+        std::vector<uint8_t> label(s.size());
+        CHECK(stratmesh::find_parting(cloud_of(s), o, workspace.data(), bytes, &p,
+                                      workspace.data() + 100) == Status::invalid_argument);
+        CHECK(stratmesh::find_parting(cloud_of(s), o, workspace.data(), bytes,
+                                      reinterpret_cast<Parting*>(label.data()), label.data()) ==
+              Status::invalid_argument);
     }
     SUBCASE("a NaN point: refused, or skipped with skip_invalid_points") {
         std::vector<double> xyz = s.xyz;

@@ -69,6 +69,11 @@ const char kUsage[] =
     "                        summary and the report (stratmesh's find_parting; about\n"
     "                        100 bytes a point more, and twice the library's time on a\n"
     "                        smooth tube)\n"
+    "  --split-branches      as --branches, then where the cloud parts, mesh the trunk\n"
+    "                        (with the options given) and each branch (around its own\n"
+    "                        automatic axis and layers) as tubes of their own, written\n"
+    "                        together but not joined: each junction leaves two loops;\n"
+    "                        points past a cut in no branch are left unused\n"
     "  --cap                 close the tube's ends with caps over its boundary loops: a\n"
     "                        closed, watertight surface (a loop that cannot be capped\n"
     "                        stays open; the summary and the report count it)\n"
@@ -219,6 +224,7 @@ bool apply_flag(std::string_view name, CommandLine& line) {
     if (name == "--unrolled-delaunay") line.surface_flips = false;
     if (name == "--open-ends") line.open_ends = true;
     if (name == "--branches") line.find_branches = true;
+    if (name == "--split-branches") line.find_branches = line.split_branches = true;
     if (name == "--quiet") line.quiet = true;
     if (name == "--stream") line.stream = true;
     return true;
@@ -229,7 +235,8 @@ const char* const kValuedOptions[] = {"--output",  "--report",        "--axis",
                                       "--threads", "--stream-points", "--origin"};
 const char* const kFlags[] = {"--ascii", "--skip-invalid", "--cap",     "--quiet",
                               "--help",  "--version",      "--stream", "--drop-outliers",
-                              "--unrolled-delaunay", "--open-ends", "--branches"};
+                              "--unrolled-delaunay", "--open-ends", "--branches",
+                              "--split-branches"};
 
 // What --stream cannot do, or an empty string.
 std::string stream_conflict(const CommandLine& line) {
@@ -243,8 +250,8 @@ std::string stream_conflict(const CommandLine& line) {
         return "--stream cannot --drop-outliers: an outlier is told from the whole cloud's "
                "spacing, which the stream never holds";
     if (line.find_branches)
-        return "--stream cannot find --branches: where a cloud parts is told from all of its "
-               "points, which the stream never holds";
+        return "--stream cannot find --branches (nor --split-branches): where a cloud parts "
+               "is told from all of its points, which the stream never holds";
     if (mesh_format_from_extension(line.output) == MeshFormat::stl)
         return "--stream cannot write STL (its triangles repeat their corners' coordinates, "
                "which the stream no longer holds): write PLY, OBJ or OFF";

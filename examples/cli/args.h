@@ -26,6 +26,7 @@ struct CommandLine {
     bool surface_flips = true;     // off with --unrolled-delaunay (stratmesh::surface_flips)
     bool open_ends = false;        // --open-ends (stratmesh::open_ends)
     bool find_branches = false;    // --branches: where the cloud parts (stratmesh::find_parting)
+    bool split_branches = false;   // --split-branches: mesh the trunk and each branch apart
     bool quiet = false;
     uint32_t threads = 1;           // --threads (default: the hardware's threads, at least 1)
     bool stream = false;            // --stream: read and reconstruct layer by layer

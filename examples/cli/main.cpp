@@ -15,7 +15,9 @@
 #include "summary.h"
 #include "thread_jobs.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -81,6 +83,7 @@ void record_command_line(const CommandLine& line, RunRecord& record) {
     record.surface_flips = line.surface_flips;
     record.open_ends = line.open_ends;
     record.find_branches = line.find_branches;
+    record.split_branches = line.split_branches;
     record.threads = line.threads;
     record.origin_given = line.origin_given || line.stream;
     for (size_t k = 0; k < 3; ++k) record.origin[k] = line.origin[k];
@@ -166,6 +169,29 @@ void record_outcome(stratmesh::Report report, std::vector<stratmesh::LayerInfo>&
     record.take_report(report, layers);
 }
 
+// One call of reconstruct() on packed points, with its buffers: the workspace and
+// triangle buffer sizes go to *workspace_bytes and *triangle_buffer_bytes. False if the
+// buffers cannot be allocated.
+bool run_reconstruct(const std::vector<double>& xyz, const stratmesh::Options& options,
+                     std::vector<stratmesh::LayerInfo>& layers, Reconstruction& result,
+                     stratmesh::Status& status, stratmesh::Report& report,
+                     size_t* workspace_bytes, size_t* triangle_buffer_bytes) {
+    const size_t count = xyz.size() / 3;
+    *workspace_bytes = stratmesh::reconstruct_workspace_size(count, options);
+    const size_t max_triangles = stratmesh::reconstruct_max_triangles(count, options);
+    *triangle_buffer_bytes = max_triangles <= SIZE_MAX / 12 ? 12 * max_triangles : SIZE_MAX;
+    std::unique_ptr<unsigned char, FreeDeleter> workspace;
+    if (!allocate_buffers(*workspace_bytes, max_triangles, workspace, result)) return false;
+    report = {};
+    report.layers = layers.data();
+    report.layer_capacity = layers.size();
+    const stratmesh::Cloud cloud = {xyz.data(), count, 0, stratmesh::Scalar::float64};
+    status = stratmesh::reconstruct(cloud, options, workspace.get(), *workspace_bytes,
+                                    result.triangles.get(), max_triangles,
+                                    &result.triangle_count, &report);
+    return true;
+}
+
 // Runs reconstruct() and records its outcome; false if the buffers cannot be allocated.
 bool reconstruct_points(const std::vector<double>& xyz, const CommandLine& line,
                         Reconstruction& result, RunRecord& record) {
@@ -174,30 +200,114 @@ bool reconstruct_points(const std::vector<double>& xyz, const CommandLine& line,
     ProgressMonitor monitor(show, stderr);
     ThreadJobs jobs;
     stratmesh::Options options = make_options(line, monitor, jobs);
-    record.workspace_bytes = stratmesh::reconstruct_workspace_size(count, options);
-    size_t max_triangles = stratmesh::reconstruct_max_triangles(count, options);
-    record.triangle_buffer_bytes = max_triangles <= SIZE_MAX / 12 ? 12 * max_triangles : SIZE_MAX;
-    std::unique_ptr<unsigned char, FreeDeleter> workspace;
-    if (!allocate_buffers(record.workspace_bytes, max_triangles, workspace, result)) return false;
-
     std::vector<stratmesh::LayerInfo> layers(layer_capacity(line, count));
-    stratmesh::Report report = {};
-    report.layers = layers.data();
-    report.layer_capacity = layers.size();
-    stratmesh::Cloud cloud = {xyz.data(), count, 0, stratmesh::Scalar::float64};
+    stratmesh::Report report;
     monitor.begin();
-    record.status = stratmesh::reconstruct(cloud, options, workspace.get(), record.workspace_bytes,
-                                           result.triangles.get(), max_triangles,
-                                           &result.triangle_count, &report);
+    if (!run_reconstruct(xyz, options, layers, result, record.status, report,
+                         &record.workspace_bytes, &record.triangle_buffer_bytes))
+        return false;
     monitor.end();
     record_outcome(report, layers, monitor, record);
     return true;
 }
 
-// With --branches: where the cloud parts, into the record. False if the buffer cannot be
-// allocated.
-bool find_branches(const std::vector<double>& xyz, const stratmesh::Options& options,
-                   RunRecord& record) {
+// The points of `xyz` whose label is `label`, packed, and their indices.
+std::vector<double> points_labelled(const std::vector<double>& xyz,
+                                    const std::vector<uint8_t>& labels, uint8_t label,
+                                    std::vector<uint32_t>& indices) {
+    std::vector<double> part;
+    indices.clear();
+    for (size_t i = 0; i < labels.size(); ++i) {
+        if (labels[i] != label) continue;
+        indices.push_back(static_cast<uint32_t>(i));
+        part.insert(part.end(), xyz.begin() + static_cast<std::ptrdiff_t>(3 * i),
+                    xyz.begin() + static_cast<std::ptrdiff_t>(3 * i + 3));
+    }
+    return part;
+}
+
+// Appends a part's triangles to `all`, its indices back into the whole cloud.
+void append_part(const Reconstruction& part, const std::vector<uint32_t>& indices,
+                 std::vector<uint32_t>& all) {
+    for (size_t k = 0; k < 3 * part.triangle_count; ++k)
+        all.push_back(indices[part.triangles.get()[k]]);
+}
+
+// --split-branches where the cloud parts: the trunk (the points labelled kInTrunk) with the
+// options given, through reconstruct_points (its report becomes the record's, with the
+// whole cloud's counts and the branches' time), then each branch around its own automatic
+// axis and layers, every part's triangles into `result` with the whole cloud's indices.
+// False if buffers cannot be allocated.
+bool reconstruct_split(const std::vector<double>& xyz, const CommandLine& line,
+                       const std::vector<uint8_t>& labels, Reconstruction& result,
+                       RunRecord& record) {
+    std::vector<uint32_t> indices;
+    const std::vector<double> trunk = points_labelled(xyz, labels, stratmesh::kInTrunk, indices);
+    Reconstruction part;
+    if (!reconstruct_points(trunk, line, part, record)) return false;
+    record.split.push_back({"trunk", indices.size(), record.status, record.report.layer_count,
+                            part.triangle_count, record.report.folds});
+    if (record.status != stratmesh::Status::ok) return true;
+    std::vector<uint32_t> all;
+    append_part(part, indices, all);
+    stratmesh::Report& whole = record.report;
+    const stratmesh::Parting& p = record.parting;
+    for (uint32_t b = 0; b < p.branches_above + p.branches_below; ++b) {
+        const bool above = b < p.branches_above;
+        const uint32_t k = above ? b : b - p.branches_above;
+        const uint8_t label = static_cast<uint8_t>(
+            (above ? stratmesh::kFirstAboveBranch : stratmesh::kFirstBelowBranch) + k);
+        const std::vector<double> branch = points_labelled(xyz, labels, label, indices);
+        if (indices.empty()) continue;  // the side above took its points
+        ProgressMonitor silent(false, stderr);
+        ThreadJobs jobs;
+        stratmesh::Options options = make_options(line, silent, jobs);
+        options.axis = stratmesh::Axis::automatic;
+        options.cuts = nullptr;
+        options.cut_count = 0;
+        options.layer_count = 0;
+        options.layer_height = 0;
+        options.flags &= ~static_cast<uint32_t>(stratmesh::origin_given);
+        std::vector<stratmesh::LayerInfo> no_layers;
+        stratmesh::Status status;
+        stratmesh::Report report;
+        size_t workspace_bytes = 0, triangle_bytes = 0;
+        const Clock::time_point start = Clock::now();
+        if (!run_reconstruct(branch, options, no_layers, part, status, report, &workspace_bytes,
+                             &triangle_bytes))
+            return false;
+        record.reconstruct_seconds += seconds_since(start);
+        record.split.push_back({std::string(above ? "branch above " : "branch below ") +
+                                    std::to_string(k + 1),
+                                indices.size(), status, report.layer_count,
+                                status == stratmesh::Status::ok ? part.triangle_count : 0,
+                                report.folds});
+        if (status != stratmesh::Status::ok) continue;  // its points stay unused
+        append_part(part, indices, all);
+        whole.points_used += report.points_used;
+        whole.duplicates += report.duplicates;
+        whole.rejected += report.rejected;
+        whole.outliers += report.outliers;
+        whole.illegal_removed += report.illegal_removed;
+        whole.folds += report.folds;
+    }
+    whole.points_in = labels.size();
+    whole.unused = whole.points_in - whole.points_used - whole.duplicates - whole.rejected;
+    whole.triangle_count = all.size() / 3;
+    result.triangle_count = all.size() / 3;
+    result.triangles = allocate<uint32_t>(all.size());
+    if (!result.triangles) return false;
+    std::copy(all.begin(), all.end(), result.triangles.get());
+    return true;
+}
+
+// With --branches: where the cloud parts, into the record, and each point's branch into
+// `labels` (with --split-branches). False if the buffer cannot be allocated.
+bool find_branches(const std::vector<double>& xyz, const CommandLine& line,
+                   std::vector<uint8_t>& labels, RunRecord& record) {
+    ProgressMonitor silent(false, stderr);
+    ThreadJobs jobs;
+    const stratmesh::Options options = make_options(line, silent, jobs);
     const size_t count = xyz.size() / 3;
     const size_t bytes = stratmesh::find_parting_workspace_size(count, options);
     std::unique_ptr<unsigned char, FreeDeleter> workspace = allocate<unsigned char>(bytes);
@@ -207,8 +317,10 @@ bool find_branches(const std::vector<double>& xyz, const stratmesh::Options& opt
     }
     const stratmesh::Cloud cloud = {xyz.data(), count, 0, stratmesh::Scalar::float64};
     Clock::time_point start = Clock::now();
+    if (line.split_branches) labels.assign(count, stratmesh::kInTrunk);
     record.parting_status =
-        stratmesh::find_parting(cloud, options, workspace.get(), bytes, &record.parting);
+        stratmesh::find_parting(cloud, options, workspace.get(), bytes, &record.parting,
+                                labels.empty() ? nullptr : labels.data());
     record.branches_seconds = seconds_since(start);
     record.parting_run = true;
     return true;
@@ -291,13 +403,18 @@ int run(const CommandLine& line) {
     std::vector<double> xyz;
     Reconstruction result;
     if (!read_input(line, xyz, record)) return kExitFile;
-    if (!reconstruct_points(xyz, line, result, record)) return kExitRefused;
+    std::vector<uint8_t> labels;
+    if (line.find_branches && !find_branches(xyz, line, labels, record)) return kExitRefused;
+    // A trunk of fewer points than a branch is no trunk: the cloud is apart all along
+    // (separate objects), and is meshed as one tube.
+    const bool split = line.split_branches && record.parting_status == stratmesh::Status::ok &&
+                       record.parting.branches_above + record.parting.branches_below > 0 &&
+                       std::count(labels.begin(), labels.end(), stratmesh::kInTrunk) >=
+                           static_cast<std::ptrdiff_t>(stratmesh::kSmallestBranch);
+    if (!(split ? reconstruct_split(xyz, line, labels, result, record)
+                : reconstruct_points(xyz, line, result, record)))
+        return kExitRefused;
     if (record.status != stratmesh::Status::ok) return refuse(line, record);
-    if (line.find_branches) {
-        ProgressMonitor silent(false, stderr);
-        ThreadJobs jobs;
-        if (!find_branches(xyz, make_options(line, silent, jobs), record)) return kExitRefused;
-    }
     if (!write_output(line, xyz, result, record)) return kExitFile;
     return finish_run(line, record);
 }

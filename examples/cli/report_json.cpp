@@ -201,6 +201,7 @@ void write_options(JsonWriter& j, const RunRecord& r) {
     j.flag_field("surface_flips", r.surface_flips);
     j.flag_field("open_ends", r.open_ends);
     j.flag_field("branches", r.find_branches);
+    j.flag_field("split_branches", r.split_branches);
     j.count_field("threads", r.threads);
     j.flag_field("stream", r.stream);
     j.key("stream_points");
@@ -216,12 +217,16 @@ void write_options(JsonWriter& j, const RunRecord& r) {
     j.end_object();
 }
 
-void write_status(JsonWriter& j, const RunRecord& r) {
-    const char* message = stratmesh::status_string(r.status);
+// The status's name: its message up to the colon.
+std::string_view status_name(stratmesh::Status status) {
+    const char* message = stratmesh::status_string(status);
     const char* colon = std::strchr(message, ':');
-    std::string_view name = colon ? std::string_view(message, size_t(colon - message)) : message;
-    j.text_field("status", name);
-    j.text_field("status_message", message);
+    return colon ? std::string_view(message, size_t(colon - message)) : message;
+}
+
+void write_status(JsonWriter& j, const RunRecord& r) {
+    j.text_field("status", status_name(r.status));
+    j.text_field("status_message", stratmesh::status_string(r.status));
     j.key("detail");
     if (r.report.detail)
         j.string(r.report.detail);
@@ -283,13 +288,28 @@ void write_branches(JsonWriter& j, const RunRecord& r) {
     if (!r.parting_run) return j.null();
     const stratmesh::Parting& p = r.parting;
     j.begin_object();
-    const char* message = stratmesh::status_string(r.parting_status);
-    const char* colon = std::strchr(message, ':');
-    j.text_field("status", colon ? std::string_view(message, size_t(colon - message)) : message);
+    j.text_field("status", status_name(r.parting_status));
     j.number_field("gap", p.gap);
     write_parting_side(j, "above", p.above, p.above_points, p.branches_above);
     write_parting_side(j, "below", p.below, p.below_points, p.branches_below);
     j.end_object();
+}
+
+void write_split(JsonWriter& j, const RunRecord& r) {
+    j.key("split");
+    if (r.split.empty()) return j.null();
+    j.begin_array();
+    for (const RunRecord::SplitPart& part : r.split) {
+        j.begin_object();
+        j.text_field("part", part.name);
+        j.count_field("points", part.points);
+        j.text_field("status", status_name(part.status));
+        j.count_field("layers", part.layers);
+        j.count_field("triangles", part.triangles);
+        j.count_field("folds", part.folds);
+        j.end_object();
+    }
+    j.end_array();
 }
 
 void write_stream(JsonWriter& j, const RunRecord& r) {
@@ -416,6 +436,7 @@ std::string run_record_json(const RunRecord& record) {
     write_layers(j, record);
     write_stream(j, record);
     write_branches(j, record);
+    write_split(j, record);
     write_costs(j, record);
     j.end_object();
     return j.text();

@@ -36,6 +36,7 @@ struct RunRecord {
     bool surface_flips = false;
     bool open_ends = false;
     bool find_branches = false;
+    bool split_branches = false;
     uint32_t threads = 1;
     bool origin_given = false;
     double origin[3] = {0, 0, 0};
@@ -60,6 +61,15 @@ struct RunRecord {
     bool parting_run = false;
     stratmesh::Status parting_status = stratmesh::Status::ok;
     stratmesh::Parting parting = {};
+    // With --split-branches where the cloud parts: each tube meshed apart, the trunk first
+    // (whose report, with the whole cloud's counts, is `report`).
+    struct SplitPart {
+        std::string name;       // "trunk", "branch above 1", "branch below 2", ...
+        size_t points = 0;
+        stratmesh::Status status = stratmesh::Status::ok;
+        size_t layers = 0, triangles = 0, folds = 0;
+    };
+    std::vector<SplitPart> split;
 
     RunRecord();
 

@@ -126,9 +126,25 @@ void print_branches(std::FILE* out, const RunRecord& r) {
                  side("above", p.above, p.above_points, p.branches_above).c_str(),
                  side("below", p.below, p.below_points, p.branches_below).c_str(),
                  number_text(p.gap).c_str());
-    if (p.branches_above + p.branches_below > 0)
+    if (p.branches_above + p.branches_below > 0 && r.split.empty())
         std::fprintf(out, "             one tube wraps branches and the gaps between them: mesh "
                           "each side apart\n             (README, \"Where the cloud parts\")\n");
+}
+
+// With --split-branches where the cloud parts: each tube meshed apart.
+void print_split(std::FILE* out, const RunRecord& r) {
+    if (r.split.empty()) return;
+    for (size_t k = 0; k < r.split.size(); ++k) {
+        const RunRecord::SplitPart& part = r.split[k];
+        const bool ok = part.status == stratmesh::Status::ok;
+        std::fprintf(out, "  %s %s, %zu points: %s%zu layer%s, %zu triangles, %zu folds\n",
+                     k == 0 ? "split     " : "          ", part.name.c_str(), part.points,
+                     ok ? "" : (std::string(stratmesh::status_string(part.status)) +
+                                " (its points unused); ").c_str(),
+                     part.layers, part.layers == 1 ? "" : "s", part.triangles, part.folds);
+    }
+    std::fprintf(out, "             tubes of their own, not joined: each junction leaves two "
+                      "loops\n");
 }
 
 void print_costs(std::FILE* out, const RunRecord& r) {
@@ -162,6 +178,7 @@ void print_summary(std::FILE* out, const RunRecord& record) {
                  record.output_ascii ? " text" : "");
     print_counts(out, record);
     print_branches(out, record);
+    print_split(out, record);
     print_costs(out, record);
 }
 

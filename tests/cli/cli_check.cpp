@@ -71,6 +71,25 @@ std::vector<double> twin_tube_points(size_t count) {
     return xyz;
 }
 
+// A fork: a trunk of radius 10 for z in [0, 60] and two prongs of radius 3 around
+// x = -7 and 7 for z in [60, 100], touching the trunk's wall at its top; golden-angle
+// spirals with about 1.1 points per unit of area.
+std::vector<double> forked_points() {
+    std::vector<double> xyz;
+    const double golden = kPi * (3 - std::sqrt(5.0));
+    auto spiral = [&](size_t count, double cx, double radius, double z0, double z1) {
+        for (size_t i = 0; i < count; ++i) {
+            const double t = static_cast<double>(i), angle = golden * t;
+            const double z = z0 + (z1 - z0) * (t + 0.5) / static_cast<double>(count);
+            xyz.insert(xyz.end(), {cx + radius * std::cos(angle), radius * std::sin(angle), z});
+        }
+    };
+    spiral(4200, 0, 10, 0, 60);
+    spiral(850, -7, 3, 60, 100);
+    spiral(850, 7, 3, 60, 100);
+    return xyz;
+}
+
 // The cylinder and 9 stray points: 6 single ones 3 to 10 heights away, and a speck of 3
 // points 0.1 apart above it.
 std::vector<double> with_strays(std::vector<double> xyz) {
@@ -139,6 +158,7 @@ int make_inputs(const std::string& dir) {
               write_file(dir + "/two_points.xyz", "0 0 0\n1 1 1\n") &&
               write_file(dir + "/cylinder.xyz", as_xyz(cylinder, 0)) &&
               write_file(dir + "/twin_tubes.xyz", as_xyz(twin_tube_points(3000), 0, "two cylinders")) &&
+              write_file(dir + "/forked.xyz", as_xyz(forked_points(), 0, "a forked tube")) &&
               write_file(dir + "/cylinder_nan.xyz", as_xyz(cylinder, 500)) &&
               write_file(dir + "/cylinder_strays.xyz", as_xyz(with_strays(cylinder), 0)) &&
               write_file(dir + "/cylinder_obj.ply", as_obj(cylinder)) &&

@@ -385,6 +385,38 @@ TEST_CASE("the stream and its caps allocate nothing: open, every push, close, ca
     CHECK(capped == emitted.count + report.cap_triangles);
 }
 
+TEST_CASE("find_parting allocates nothing: a fork found and labelled, no parting, refusals") {
+    using shapes::Pose;
+    const shapes::Shape fork = shapes::forked_tube(20000, Pose::z);
+    const shapes::Shape tube = shapes::bumpy_tube(2000, Pose::x);
+    std::vector<double> nan_cloud = tube.xyz;
+    nan_cloud[7] = std::numeric_limits<double>::quiet_NaN();
+    const stratmesh::Options z = no_heap::z_axis();
+    stratmesh::Options x = {};
+    x.axis = stratmesh::Axis::x;
+    std::vector<unsigned char> work(stratmesh::find_parting_workspace_size(fork.size(), z));
+    std::vector<uint8_t> labels(fork.size());
+    stratmesh::Parting found = {}, none = {}, refused = {}, short_of = {};
+    stratmesh::Status statuses[4] = {};
+    const size_t n = alloc_counter::allocations_during([&] {
+        statuses[0] = stratmesh::find_parting({fork.xyz.data(), fork.size(), 0, stratmesh::Scalar::float64},
+                                              z, work.data(), work.size(), &found, labels.data());
+        statuses[1] = stratmesh::find_parting({tube.xyz.data(), tube.size(), 0, stratmesh::Scalar::float64},
+                                              x, work.data(), work.size(), &none);
+        statuses[2] = stratmesh::find_parting({nan_cloud.data(), tube.size(), 0, stratmesh::Scalar::float64},
+                                              x, work.data(), work.size(), &refused);
+        statuses[3] = stratmesh::find_parting({fork.xyz.data(), fork.size(), 0, stratmesh::Scalar::float64},
+                                              z, work.data(), 1000, &short_of);
+    });
+    CHECK(n == 0);
+    CHECK(statuses[0] == stratmesh::Status::ok);
+    CHECK(found.branches_above == 2);
+    CHECK(statuses[1] == stratmesh::Status::ok);
+    CHECK(none.branches_above + none.branches_below == 0);
+    CHECK(statuses[2] == stratmesh::Status::invalid_point);
+    CHECK(statuses[3] == stratmesh::Status::out_of_memory);
+}
+
 TEST_CASE("delaunay_2d allocates nothing, on success and on every error status") {
     std::vector<no_heap::DelaunayCase> cases = no_heap::delaunay_cases();
     size_t total = 0;
@@ -410,6 +442,7 @@ TEST_CASE("the sizing functions, predicates and status strings allocate nothing"
         sink = sink + stratmesh::delaunay_2d_workspace_size(100000);
         sink = sink + stratmesh::delaunay_2d_max_triangles(100000);
         sink = sink + stratmesh::cap_ends_workspace_size(100000, 200000);
+        sink = sink + stratmesh::find_parting_workspace_size(100000, o);
         sink = sink + (stratmesh::orient2d(a, b, c) > 0) + (stratmesh::incircle(a, b, c, d) > 0);
         sink = sink + (stratmesh::status_string(stratmesh::Status::collinear)[0] != 0);
     });

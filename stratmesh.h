@@ -442,8 +442,10 @@ struct Options {
     // radius, or whose points do not surround its centre, is merged with the next one (a
     // remainder that small or thin, with the last), and so is a layer next to a crescent
     // (a slanted end of the tube: an arc of the section with a gap of over 34 degrees that
-    // the two layers together narrow; a half cylinder's gap stays); the report lists the
-    // layers actually used (Report::layers: bottom and top).
+    // the two layers together narrow; a half cylinder's gap stays); a layer with triangles
+    // facing the axis is joined with the next one or two where that leaves fewer (see
+    // "folding layers" at add_group); the report lists the layers actually used
+    // (Report::layers: bottom and top).
     const double* cuts;
     size_t cut_count;
     uint32_t layer_count;
@@ -892,6 +894,8 @@ const bool kDropOutliers = false;
 const bool kSurfaceFlips = false;
 const bool kLocalUnpeel = false;
 const bool kPeelFoldedEnds = false;
+const bool kFoldMerge = false;
+const uint32_t kFoldMergeReach = 0;
 const bool kFastLoops = false;
 #else
 const bool kNetShortcut = true;  // a chunk whose loop fans are whole skips the net
@@ -924,6 +928,11 @@ const bool kLocalUnpeel = true;
 // The surface's end loops are peeled in layers that fold too (see "peeling" in >>layer
 // triangulation).
 const bool kPeelFoldedEnds = true;
+// A layer that folds is tried again with the next one joined (see "folding layers" at
+// add_group).
+const bool kFoldMerge = true;
+// The most planned layers joined to a folding one (see kFoldMerge).
+const uint32_t kFoldMergeReach = 2;
 // Per-point loops in forms that cost code for speed, the same bits either way: the equal-
 // layer guess in layer_of, pseudo_angle without branches, floor by truncation in
 // exp_portable, the height range from choose_frame's extremes, count_folds' prefetching.
@@ -6853,10 +6862,30 @@ inline bool flip_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
 // triangulated ahead: used when the group is that layer alone. Returns ok (also when
 // waiting), not_columnar when the rest of the queue cannot form a layer (counted in
 // c.trailing), or an error.
+//
+// Folding layers (kFoldMerge): a group whose triangles or band face the axis anywhere,
+// with a planned layer above it, is triangulated and stitched again with that layer
+// joined (then, if that folds no less, with the next one too: kFoldMergeReach), and the
+// first longer group that has fewer such triangles than the group alone is kept (else the
+// group is made again, as it was). A cut
+// through a layer that is not star-shaped (the notch between a femur's condyles, a
+// thumb beside the fist) leaves thin layers whose loops skip across the notch, and bands
+// between such loops cross the layers next to them; a taller layer gives the centre search
+// more of the section to choose a centre from, and one band fewer. The femur of
+// ../shared/data along z in 40 layers: 57 self-intersecting pairs, all at one band, and
+// 31 folds before; none with it (README, "Known limitations"). It costs up to four
+// triangulations more, only where a layer folds (at most seven times that layer's time);
+// the stream waits for the layers above as it does for crescents, and makes the same
+// groups.
 inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Arena& arena,
                         TriangleSink& sink, GroupResult& result, const LayerAhead* ahead) {
     result.waiting = false;
     uint32_t last = first;
+    // Folding layers: the group's last layer and folds before any layer was joined, the
+    // layers joined in the current try, and whether the group is settled.
+    uint32_t single_last = first, joined = 0;
+    size_t single_folds = 0;
+    bool merge_settled = false;
     for (;;) {
         const bool final = q.complete && last + 1 == q.planned;
         if (!final && last + 1 >= q.planned) {
@@ -6974,6 +7003,29 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
             }
             result.triangles = sink.count - chunk_start;
             result.folds = sink.folds - folds;
+            if (kFoldMerge && !merge_settled &&
+                (joined > 0 || (status == Status::ok && result.folds > 0 && !final))) {
+                if (joined > 0 && status == Status::ok && result.folds < single_folds) {
+                    merge_settled = true;
+                } else {
+                    sink.count = chunk_start;
+                    sink.folds = folds;
+                    c.swaps = swaps;
+                    arena.rewind(mark);
+                    if (joined == 0) {
+                        single_last = last;
+                        single_folds = result.folds;
+                    }
+                    if (!final && joined < kFoldMergeReach) {
+                        ++joined;
+                        ++last;
+                    } else {
+                        merge_settled = true;
+                        last = single_last;
+                    }
+                    continue;
+                }
+            }
             // The layer's points are no longer needed: the safety net takes their room. A
             // chunk triangulated here whose border and band show it sound is only renamed.
             arena.rewind(mark);

@@ -6867,11 +6867,11 @@ inline bool flip_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
 // with a planned layer above it, is triangulated and stitched again with that layer
 // joined (then, if that folds no less, with the next one too: kFoldMergeReach), and the
 // first longer group that has fewer such triangles than the group alone is kept (else the
-// group is made again, as it was). A cut
-// through a layer that is not star-shaped (the notch between a femur's condyles, a
-// thumb beside the fist) leaves thin layers whose loops skip across the notch, and bands
-// between such loops cross the layers next to them; a taller layer gives the centre search
-// more of the section to choose a centre from, and one band fewer. The femur of
+// group is made again, as it was). Where cuts run through a part that is not star-shaped
+// (the notch between a femur's condyles, a thumb beside the fist), the thin layers there
+// fold, their loops skip across the notch, and the bands between such loops cross the
+// layers next to them; a taller layer gives the centre search more of the section to
+// choose a centre from, and has one band fewer. The femur of
 // ../shared/data along z in 40 layers: 57 self-intersecting pairs, all at one band, and
 // 31 folds before; none with it (README, "Known limitations"). It costs up to four
 // triangulations more, only where a layer folds (at most seven times that layer's time);

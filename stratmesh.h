@@ -6975,34 +6975,19 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
                         round = kUnpeelRounds - 2;  // no group near a fold: the last round
                 }
             };
-            // A job's result in reader indices goes in as it is when its chunk needs no
-            // safety net; else the layer is loaded and triangulated again, in order, to the
-            // same triangles. One the job left in layer-local indices (not replayable) goes
-            // through finish_chunk. Past the caller's capacity only the count goes on
-            // (triangle_capacity follows).
-            bool finished = false, retriangulate = !triangulated;
-            if (triangulated) {
-                status = take_ahead(*ahead, sink, loops, result.counts);
-                stitch();
-                finished = status != Status::ok || sink.count > sink.capacity ||
-                           (ahead->replayable &&
-                            replay_chunk(c, layer, loops, *ahead, chunk_start, arena, sink));
-                if (!finished && ahead->replayable) {
-                    sink.count = chunk_start;
-                    sink.folds = folds;
-                    c.swaps = swaps;
-                    if (!load_layer(c.reader, c.frame, ids, staged, n, h0, h1, arena, layer))
-                        return Status::out_of_memory;
-                    retriangulate = true;
-                }
-            }
-            if (retriangulate) {
+            auto triangulate_here = [&]() {
                 find_closed_ends(layer, ends);
                 status = triangulate_layer(c.reader, layer, arena, sink, loops, result.counts);
                 stitch();
+            };
+            if (triangulated) {
+                status = take_ahead(*ahead, sink, loops, result.counts);
+                stitch();
+            } else {
+                triangulate_here();
             }
-            result.triangles = sink.count - chunk_start;
             result.folds = sink.folds - folds;
+            // Folding layers: decided before the chunk is named (naming counts its points).
             if (kFoldMerge && !merge_settled &&
                 (joined > 0 || (status == Status::ok && result.folds > 0 && !final))) {
                 if (joined > 0 && status == Status::ok && result.folds < single_folds) {
@@ -7026,6 +7011,27 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
                     continue;
                 }
             }
+            // A job's result in reader indices goes in as it is when its chunk needs no
+            // safety net; else the layer is loaded and triangulated again, in order, to the
+            // same triangles. One the job left in layer-local indices (not replayable) goes
+            // through finish_chunk. Past the caller's capacity only the count goes on
+            // (triangle_capacity follows).
+            bool finished = false, retriangulate = !triangulated;
+            if (triangulated) {
+                finished = status != Status::ok || sink.count > sink.capacity ||
+                           (ahead->replayable &&
+                            replay_chunk(c, layer, loops, *ahead, chunk_start, arena, sink));
+                if (!finished && ahead->replayable) {
+                    sink.count = chunk_start;
+                    sink.folds = folds;
+                    c.swaps = swaps;
+                    if (!load_layer(c.reader, c.frame, ids, staged, n, h0, h1, arena, layer))
+                        return Status::out_of_memory;
+                    triangulate_here();
+                    retriangulate = true;
+                }
+            }
+            result.triangles = sink.count - chunk_start;
             // The layer's points are no longer needed: the safety net takes their room. A
             // chunk triangulated here whose border and band show it sound is only renamed.
             arena.rewind(mark);

@@ -170,6 +170,40 @@ TEST_CASE("parallel layers: chunks the safety net repairs come out the same") {
     }
 }
 
+TEST_CASE("parallel layers: a folding layer tried again with the next one joined comes out the same") {
+    // A job's layer that folds is triangulated again, joined, before its chunk is named: the
+    // try that is not kept must leave nothing behind (points counted as used, triangles).
+    unsigned two = 2;
+    struct Folding {
+        Shape shape;
+        uint32_t layers;
+    };
+    // Two parallel tubes, every other point shifted to one side: each layer holds both and
+    // folds, yet its chunk is sound: a job's result is replayed (its points named) there.
+    Shape twin = shapes::cylinder(3000, Pose::z);
+    twin.name = "twin tubes";
+    for (size_t i = 0; i < twin.size(); ++i) twin.xyz[3 * i] += i % 2 ? 2.5 : -2.5;
+    const Folding cases[] = {{twin, 2},
+                             {twin, 5},
+                             {shapes::knobbed_tube(10000, Pose::z), 16},
+                             {shapes::knobbed_tube(10000, Pose::tilted), 16}};
+    for (const Folding& f : cases) {
+        INFO(f.shape.name << ", " << f.layers << " layers");
+        Options o = axis_options(f.shape);
+        o.layer_count = f.layers;
+        const Result sequential = run(f.shape, o);
+        REQUIRE(sequential.status == Status::ok);
+        for (stratmesh::JobRunner runner : {run_in_order, run_on_threads}) {
+            Options p = o;
+            p.run_jobs = runner;
+            p.jobs_user = &two;
+            const Result parallel = run(f.shape, p);
+            check_same(sequential, parallel);
+            CHECK(parallel.report.parallel_layers > 0);
+        }
+    }
+}
+
 TEST_CASE("parallel layers: a workspace too small for the jobs falls back to working in order") {
     const Shape s = shapes::bumpy_tube(4000, Pose::z);
     Options o = axis_options(s);

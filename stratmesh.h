@@ -812,6 +812,69 @@ const uint8_t kBeyondBranches = 255;
 // side above. It must not share a byte with the other buffers (invalid_argument).
 Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
                     size_t workspace_bytes, Parting* parting, uint8_t* branch_of = nullptr);
+
+// ---- Joining the branches to the trunk ----
+//
+// join_branches() joins a trunk and its branches, meshed apart (each label of find_parting's
+// branch_of its own reconstruct(), as the tool's --split-branches does), into one surface.
+// At each side that parts, the trunk's boundary loop nearest the branches (the highest of
+// the loops whose points are all kInTrunk, seen from that side) is joined to each branch's
+// loop nearest the cut: the trunk's loop is split at the gaps between the branches, in
+// their order around the trunk's centre (the vertex whose angle is nearest the middle of
+// each gap); each arc is zipped to its branch's whole loop, which is opened at its point
+// nearest the trunk's centre (the two chains merged in the order of their angle around the
+// branch's centre: on the tool tests' fork, trunk in 4 layers, meshq counts 3
+// self-intersecting pairs where shortest diagonals first, as contour stitching does, made
+// 79); and
+// the crotch is closed by a triangle per gap, from the trunk's vertex there to the two
+// branches' opening points, and a fan over those points where three branches or more meet.
+//
+//       trunk's loop   ... m0 ---- branch 1's arc ---- m1 ---- branch 2's arc ---- m0 ...
+//       branch loops   p1 (opened) around to p1        p2 (opened) around to p2
+//       crotch         (p1, m1, p2) and (p2, m0, p1)
+//
+// The new triangles run each loop's edges against the surface's direction, and every
+// vertex keeps one fan, so a surface that is an oriented edge- and vertex-manifold (as
+// reconstruct()'s) stays one, whatever the geometry. The geometry decides whether a side
+// is joined (else it is counted in sides_left_apart, the reason in detail): the trunk's
+// loop must lie within four gaps of the cut (a trunk closed there keeps only its far
+// loop), at least two branches must have a loop there whose points are all theirs, each
+// branch's centre must lie within the trunk loop's mean radius across the axis (branches
+// standing on a closed end, as horns on a skull, are not joined: that needs a hole cut in
+// the end), and the gaps must follow one another along the trunk's loop.
+struct JoinReport {
+    uint32_t sides_joined;      // 0, 1 or 2
+    uint32_t sides_left_apart;  // sides that part whose loops could not be joined (detail)
+    size_t triangles_added;
+    size_t workspace_used;      // peak workspace bytes, from the start of the buffer
+    const char* detail;         // a static sentence on why, on failure or a side left apart
+};
+
+// Bytes of workspace join_branches() needs for a surface of triangle_count triangles over
+// point_count points (about 24 bytes a point and 12 a triangle); 0 if that is beyond what
+// this platform can address.
+size_t join_branches_workspace_size(size_t point_count, size_t triangle_count);
+
+// The most triangles join_branches() adds: one per boundary vertex and four per branch.
+size_t join_branches_max_triangles(size_t point_count);
+
+// Appends the junctions' triangles to triangles[0 .. 3 * *triangle_count) (indices into
+// `cloud`) and sets *triangle_count to the new total. parting and branch_of: find_parting()'s
+// on the same cloud (its axis is used); options: only skip_invalid_points is read. report
+// (optional) is filled on every status. Returns ok (sides that could not be joined are
+// counted in sides_left_apart, their triangles left as they were); invalid_argument (a
+// null triangle_count, branch_of, workspace or triangles where needed; a bad stride or
+// scalar; *triangle_count above triangle_capacity; an index outside the cloud or naming an
+// invalid point; a vertex with two boundary edges leaving it (not vertex-manifold);
+// buffers sharing a byte); too_many_points; invalid_point (a NaN or infinite point
+// without skip_invalid_points); invalid_axis (a parting whose axis is not a unit vector);
+// out_of_memory (a workspace below join_branches_workspace_size()); triangle_capacity
+// (*triangle_count set to the triangles needed; nothing written). On every status but ok
+// the triangles are unchanged.
+Status join_branches(const Cloud& cloud, const Options& options, const Parting& parting,
+                     const uint8_t* branch_of, void* workspace, size_t workspace_bytes,
+                     uint32_t* triangles, size_t triangle_capacity, size_t* triangle_count,
+                     JoinReport* report);
 #endif
 
 } // namespace stratmesh
@@ -8758,6 +8821,380 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
         label_branches(s, m.steps, true, above.cut_index, kFirstAboveBranch, branch_of);
     if (branch_of && below.branches)
         label_branches(s, m.steps, false, below.cut_index, kFirstBelowBranch, branch_of);
+    return finish(Status::ok);
+}
+
+// >>join branches ===========================================================================
+//
+// join_branches(): the boundary loops of the caller's surface are traced as the caps trace
+// them (build_cap_graph, trace_boundary_loops: each loop in cap order, the boundary
+// reversed), each side that parts is planned (its loops chosen, the trunk's loop split at
+// the gaps), the triangles counted, then written. A side is seen turned half a turn about
+// e1 when it is the side below, so that on both its branches lie above its cut and the
+// trunk's loop in cap order runs the way the branches' boundary runs: each band is then
+// the same zipper, whose triangles (a, a', b) and (a, b', b) run the trunk's loop in cap
+// order and the branch's loop against its boundary.
+
+namespace detail {
+
+struct JoinMemory {
+    CapGraph graph;
+    CapLoop loops;  // only ids and starts
+};
+
+inline bool allocate_join(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
+    allocate_cap_graph(m.graph, point_count, triangle_count, arena);
+    m.loops.ids = arena.alloc<uint32_t>(point_count);  // every point on a loop at most
+    m.loops.starts = arena.alloc<unsigned char>(point_count);
+    return !arena.failed;
+}
+
+// A traced loop: its entries in CapLoop::ids, in cap order.
+struct TracedLoop {
+    const uint32_t* ids;
+    uint32_t length;
+};
+
+// One side's junction: the trunk's loop, the branches' loops in their order around the
+// trunk's centre, where each branch's loop opens (a position in cap order) and the trunk's
+// vertex at the gap after each branch (a position on the trunk's loop).
+struct SideJunction {
+    TracedLoop trunk;
+    uint32_t branches;
+    TracedLoop branch[kMaxBranches];
+    uint32_t opening[kMaxBranches];
+    uint32_t gap[kMaxBranches];
+    double centre[kMaxBranches][2];  // of each branch's loop, across the axis
+    double sense;                    // +1 where the trunk's loop turns counter-clockwise
+
+    size_t triangles() const {
+        size_t total = trunk.length + 2 * static_cast<size_t>(branches) - 2;
+        for (uint32_t i = 0; i < branches; ++i) total += branch[i].length;
+        return total;
+    }
+};
+
+// Frame coordinates of one side: the side below turned half a turn about e1.
+struct SideView {
+    const CloudReader& reader;
+    const Frame& frame;
+    double sign;  // +1 above, -1 below
+
+    Local at(uint32_t id) const {
+        const Local l = frame.local(reader.point(id));
+        return {l.x, sign * l.y, sign * l.h};
+    }
+};
+
+inline double loop_mean_height(const TracedLoop& loop, const SideView& view) {
+    double sum = 0;
+    for (uint32_t i = 0; i < loop.length; ++i) sum += view.at(loop.ids[i]).h;
+    return sum / loop.length;
+}
+
+// The label every point of the loop has, or kBeyondBranches where they differ.
+inline uint8_t loop_label(const TracedLoop& loop, const uint8_t* branch_of) {
+    const uint8_t label = branch_of[loop.ids[0]];
+    for (uint32_t i = 1; i < loop.length; ++i)
+        if (branch_of[loop.ids[i]] != label) return kBeyondBranches;
+    return label;
+}
+
+const double kJoinReach = 4;
+
+// Plans the side whose branches carry labels first_label .. first_label + branches - 1,
+// with its cut and gap as heights of the view: false (detail set) if it cannot be joined. `taken` is the trunk loop the other side
+// joined (nullptr if none), which this side may not take.
+inline bool plan_junction(const CapLoop& loops, size_t entries, const uint8_t* branch_of,
+                          uint8_t first_label, uint32_t branches, double cut, double gap,
+                          const SideView& view, const uint32_t* taken, SideJunction& side,
+                          const char*& detail) {
+    double trunk_height = -DBL_MAX, branch_height[kMaxBranches];
+    TracedLoop found[kMaxBranches] = {};
+    side.trunk = {nullptr, 0};
+    for (size_t start = 0; start < entries;) {
+        size_t end = start + 1;
+        while (end < entries && loops.starts[end] == 0) ++end;
+        const TracedLoop loop = {loops.ids + start, static_cast<uint32_t>(end - start)};
+        const bool closed = loops.starts[start] == kLoopStart;
+        start = end;
+        if (!closed || loop.ids == taken) continue;
+        const uint8_t label = loop_label(loop, branch_of);
+        const double height = loop_mean_height(loop, view);
+        if (label == kInTrunk) {
+            if (height > trunk_height) {
+                trunk_height = height;
+                side.trunk = loop;
+            }
+        } else if (label >= first_label && label - first_label < static_cast<int>(branches)) {
+            const uint32_t b = static_cast<uint32_t>(label - first_label);
+            if (!found[b].ids || height < branch_height[b]) {
+                found[b] = loop;
+                branch_height[b] = height;
+            }
+        }
+    }
+    // Loops farther than kJoinReach gaps from the cut are not the junction's: a trunk
+    // closed at the cut keeps only its far loop, a branch closed there only its tip's.
+    auto near_cut = [&](double height) { return std::fabs(height - cut) <= kJoinReach * gap; };
+    if (!side.trunk.ids || !near_cut(trunk_height)) {
+        detail = "the trunk has no boundary loop near the cut to join a side's branches to "
+                 "(a trunk closed there: the branches stand on a closed end)";
+        return false;
+    }
+    // The trunk's centre, and the sense its loop turns in (+1 counter-clockwise).
+    const TracedLoop& trunk = side.trunk;
+    double cx = 0, cy = 0, area = 0;
+    for (uint32_t i = 0; i < trunk.length; ++i) {
+        const Local p = view.at(trunk.ids[i]);
+        const Local q = view.at(trunk.ids[(i + 1) % trunk.length]);
+        cx += p.x;
+        cy += p.y;
+        area += p.x * q.y - q.x * p.y;
+    }
+    cx /= trunk.length;
+    cy /= trunk.length;
+    double trunk_radius = 0;
+    for (uint32_t i = 0; i < trunk.length; ++i) {
+        const Local p = view.at(trunk.ids[i]);
+        trunk_radius += std::sqrt((p.x - cx) * (p.x - cx) + (p.y - cy) * (p.y - cy));
+    }
+    trunk_radius /= trunk.length;
+    const double sense = area < 0 ? -1 : 1;
+    side.sense = sense;
+    auto angle = [&](double x, double y) { return std::atan2(sense * (y - cy), x - cx); };
+    double branch_angle[kMaxBranches];
+    side.branches = 0;
+    for (uint32_t b = 0; b < branches; ++b) {
+        if (!found[b].ids || !near_cut(branch_height[b])) continue;
+        const TracedLoop& loop = found[b];
+        double bx = 0, by = 0, nearest = DBL_MAX;
+        uint32_t opening = 0;
+        for (uint32_t i = 0; i < loop.length; ++i) {
+            const Local p = view.at(loop.ids[i]);
+            bx += p.x;
+            by += p.y;
+            const double d = (p.x - cx) * (p.x - cx) + (p.y - cy) * (p.y - cy);
+            if (d < nearest) {
+                nearest = d;
+                opening = i;
+            }
+        }
+        bx /= loop.length;
+        by /= loop.length;
+        if ((bx - cx) * (bx - cx) + (by - cy) * (by - cy) >= trunk_radius * trunk_radius) {
+            detail = "a branch's loop is not within the trunk's loop nearest it, across the axis "
+                     "(a branch standing on a closed end, not on a rim around the branches)";
+            return false;
+        }
+        // Inserted in the order of their angles around the trunk's centre.
+        const double a = angle(bx, by);
+        uint32_t k = side.branches++;
+        for (; k > 0 && branch_angle[k - 1] > a; --k) {
+            branch_angle[k] = branch_angle[k - 1];
+            side.branch[k] = side.branch[k - 1];
+            side.opening[k] = side.opening[k - 1];
+            side.centre[k][0] = side.centre[k - 1][0];
+            side.centre[k][1] = side.centre[k - 1][1];
+        }
+        branch_angle[k] = a;
+        side.branch[k] = loop;
+        side.opening[k] = opening;
+        side.centre[k][0] = bx;
+        side.centre[k][1] = by;
+    }
+    if (side.branches < 2) {
+        detail = "fewer than two of a side's branches have a boundary loop of their own";
+        return false;
+    }
+    // The gap after branch i: the trunk's vertex nearest in angle to the middle between
+    // branch i and the next one.
+    const double two_pi = 6.28318530717958647693;
+    for (uint32_t i = 0; i < side.branches; ++i) {
+        const uint32_t next = (i + 1) % side.branches;
+        double span = branch_angle[next] - branch_angle[i];
+        if (span <= 0) span += two_pi;
+        const double middle = branch_angle[i] + span / 2;
+        double nearest = DBL_MAX;
+        for (uint32_t j = 0; j < trunk.length; ++j) {
+            const Local p = view.at(trunk.ids[j]);
+            const double off = std::fabs(std::remainder(angle(p.x, p.y) - middle, two_pi));
+            if (off < nearest) {
+                nearest = off;
+                side.gap[i] = j;
+            }
+        }
+    }
+    // The gaps must follow one another along the trunk's loop as the branches do.
+    const uint32_t last = side.gap[side.branches - 1];
+    uint32_t before = 0;
+    for (uint32_t i = 0; i + 1 < side.branches; ++i) {
+        const uint32_t along = (side.gap[i] + trunk.length - last) % trunk.length;
+        if (along <= before) {
+            detail = "the trunk's loop does not go around a side's branches in their order";
+            return false;
+        }
+        before = along;
+    }
+    return true;
+}
+
+// Writes the junction's side.triangles() triangles at out.
+inline void write_junction(const SideJunction& side, const SideView& view, uint32_t* out) {
+    const TracedLoop& trunk = side.trunk;
+    auto emit = [&out](uint32_t a, uint32_t b, uint32_t c) {
+        out[0] = a;
+        out[1] = b;
+        out[2] = c;
+        out += 3;
+    };
+    auto opening_point = [&](uint32_t i) { return side.branch[i].ids[side.opening[i]]; };
+    for (uint32_t i = 0; i < side.branches; ++i) {
+        // The trunk's arc from the gap before branch i to the gap after it, in cap order;
+        // the branch's loop from its opening round to it again, against its cap order.
+        const uint32_t from = side.gap[(i + side.branches - 1) % side.branches];
+        const uint32_t steps = (side.gap[i] + trunk.length - from) % trunk.length;
+        const TracedLoop& loop = side.branch[i];
+        const uint32_t n = loop.length;
+        auto a = [&](uint32_t j) { return trunk.ids[(from + j) % trunk.length]; };
+        auto b = [&](uint32_t l) { return loop.ids[(side.opening[i] + n - l % n) % n]; };
+        // Both chains in the order of their angle around the branch's centre, from the
+        // opening on: a zipper by angle lays a band between two curves that go once around
+        // a point in triangles that do not overlap, where shortest diagonals can fold.
+        const double cx = side.centre[i][0], cy = side.centre[i][1];
+        const Local opening = view.at(b(0));
+        const double rx = opening.x - cx, ry = opening.y - cy;
+        auto turn = [&](uint32_t id) {
+            const Local q = view.at(id);
+            const double dx = q.x - cx, dy = q.y - cy;
+            const double t = std::atan2(side.sense * (rx * dy - ry * dx), rx * dx + ry * dy);
+            return t < 0 ? t + 6.28318530717958647693 : t;
+        };
+        emit(a(0), b(1), b(0));
+        uint32_t j = 0, l = 1;
+        while (j < steps || l + 1 < n) {
+            const bool along_trunk = l + 1 == n || (j < steps && turn(a(j + 1)) <= turn(b(l + 1)));
+            if (along_trunk) {
+                emit(a(j), a(j + 1), b(l));
+                ++j;
+            } else {
+                emit(a(j), b(l + 1), b(l));
+                ++l;
+            }
+        }
+        emit(a(steps), b(n), b(n - 1));
+    }
+    // The crotch: a triangle per gap, and a fan over the openings where three or more meet.
+    for (uint32_t i = 0; i < side.branches; ++i)
+        emit(opening_point(i), trunk.ids[side.gap[i]], opening_point((i + 1) % side.branches));
+    for (uint32_t i = 1; i + 1 < side.branches; ++i)
+        emit(opening_point(0), opening_point(i), opening_point(i + 1));
+}
+
+}  // namespace detail
+
+size_t join_branches_workspace_size(size_t point_count, size_t triangle_count) {
+    if (point_count > detail::kMaxPoints - 1) return 0;
+    detail::Arena arena = detail::Arena::measuring();
+    detail::JoinMemory m;
+    detail::allocate_join(m, point_count, triangle_count, arena);
+    return arena.failed ? 0 : arena.required_bytes();
+}
+
+size_t join_branches_max_triangles(size_t point_count) {
+    return point_count + 4 * static_cast<size_t>(kMaxBranches);
+}
+
+Status join_branches(const Cloud& cloud, const Options& options, const Parting& parting,
+                     const uint8_t* branch_of, void* workspace, size_t workspace_bytes,
+                     uint32_t* triangles, size_t triangle_capacity, size_t* triangle_count,
+                     JoinReport* report) {
+    using namespace detail;
+    const bool countable = cloud.count <= kMaxPoints - 1;
+    const ByteRange buffers[] = {
+        countable ? cloud_bytes(cloud) : ByteRange{0, 0},
+        byte_range(workspace, workspace_bytes),
+        byte_range(triangles, saturating_product(triangle_capacity, 3 * sizeof(uint32_t))),
+        byte_range(triangle_count, sizeof(size_t)),
+        byte_range(report, sizeof(JoinReport)),
+        byte_range(branch_of, countable ? cloud.count : 0)};
+    if (any_overlap(buffers, 6)) return Status::invalid_argument;
+    JoinReport r = {0, 0, 0, 0, nullptr};
+    Report checks = {};
+    Arena arena = Arena::over(workspace, workspace_bytes);
+    const size_t given = triangle_count ? *triangle_count : 0;
+    size_t needed = given;
+    auto finish = [&](Status status) {
+        r.workspace_used = arena.peak_from_buffer();
+        if (!r.detail) r.detail = checks.detail;
+        if (report) *report = r;
+        if (status == Status::triangle_capacity) *triangle_count = needed;
+        return status;
+    };
+    Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
+                                                triangle_count, workspace, checks);
+    if (status != Status::ok) return finish(status);
+    if (given > triangle_capacity || (cloud.count > 0 && !branch_of)) {
+        checks.detail = given > triangle_capacity ? "triangle_count is above triangle_capacity"
+                                                  : "branch_of is null";
+        return finish(Status::invalid_argument);
+    }
+    const CloudReader reader = reader_of(cloud);
+    const CloudSums sums = sum_cloud(reader, cloud.count);
+    status = reject_invalid_points(reader, cloud.count, sums, options, checks);
+    if (status != Status::ok) return finish(status);
+    for (size_t k = 0; k < 3 * given; ++k)
+        if (triangles[k] >= cloud.count || !reader.valid(triangles[k])) {
+            checks.detail = "a triangle names a point outside the cloud, or an invalid one";
+            return finish(Status::invalid_argument);
+        }
+    Options along = options;
+    along.axis = Axis::direction;
+    along.flags &= ~static_cast<uint32_t>(origin_given);
+    for (int k = 0; k < 3; ++k) along.direction[k] = parting.axis[k];
+    Frame frame;
+    status = choose_frame(reader, cloud.count, sums, along, frame);
+    if (status != Status::ok) return finish(status);
+    const uint32_t sides[2] = {parting.branches_above < kMaxBranches ? parting.branches_above : kMaxBranches,
+                               parting.branches_below < kMaxBranches ? parting.branches_below : kMaxBranches};
+    if (given == 0 || (sides[0] == 0 && sides[1] == 0)) return finish(Status::ok);
+    JoinMemory m;
+    if (!allocate_join(m, cloud.count, given, arena)) {
+        checks.detail = "the workspace is smaller than join_branches_workspace_size()";
+        return finish(Status::out_of_memory);
+    }
+    build_cap_graph(triangles, given, cloud.count, m.graph);
+    size_t entries = 0;
+    trace_boundary_loops(m.graph, cloud.count, m.loops, &entries);
+    SideJunction plan[2];
+    bool joined[2] = {false, false};
+    const uint32_t* taken = nullptr;
+    for (int k = 0; k < 2; ++k) {
+        if (sides[k] == 0) continue;
+        const SideView view = {reader, frame, k == 0 ? 1.0 : -1.0};
+        const uint8_t first = static_cast<uint8_t>(k == 0 ? kFirstAboveBranch : kFirstBelowBranch);
+        const double cut = (k == 0 ? parting.above : parting.below) - dot(frame.origin, frame.axis);
+        joined[k] = plan_junction(m.loops, entries, branch_of, first, sides[k],
+                                  view.sign * cut * frame.scale, parting.gap * frame.scale, view,
+                                  taken, plan[k], r.detail);
+        if (joined[k]) {
+            taken = plan[k].trunk.ids;
+            needed += plan[k].triangles();
+        }
+    }
+    if (needed > triangle_capacity) return finish(Status::triangle_capacity);
+    for (int k = 0; k < 2; ++k) {
+        if (sides[k] == 0) continue;
+        if (!joined[k]) {
+            ++r.sides_left_apart;
+            continue;
+        }
+        const SideView view = {reader, frame, k == 0 ? 1.0 : -1.0};
+        write_junction(plan[k], view, triangles + 3 * (given + r.triangles_added));
+        r.triangles_added += plan[k].triangles();
+        ++r.sides_joined;
+    }
+    *triangle_count = given + r.triangles_added;
     return finish(Status::ok);
 }
 #endif

@@ -233,6 +233,35 @@ void append_part(const Reconstruction& part, const std::vector<uint32_t>& indice
         all.push_back(indices[part.triangles.get()[k]]);
 }
 
+// Joins the parts' triangles in `all` at each side that parts (join_branches); where a
+// side cannot be joined its parts stay apart, as the record says. False if buffers cannot
+// be allocated.
+bool join_parts(const std::vector<double>& xyz, const CommandLine& line,
+                const std::vector<uint8_t>& labels, std::vector<uint32_t>& all,
+                RunRecord& record) {
+    ProgressMonitor silent(false, stderr);
+    ThreadJobs jobs;
+    const stratmesh::Options options = make_options(line, silent, jobs);
+    const size_t count = xyz.size() / 3, given = all.size() / 3;
+    const size_t bytes = stratmesh::join_branches_workspace_size(count, given);
+    std::unique_ptr<unsigned char, FreeDeleter> workspace = allocate<unsigned char>(bytes);
+    if (!workspace) {
+        std::fprintf(stderr, "stratmesh: cannot allocate %zu bytes to join the branches\n", bytes);
+        return false;
+    }
+    const Clock::time_point start = Clock::now();
+    all.resize(3 * (given + stratmesh::join_branches_max_triangles(count)));
+    size_t joined = given;
+    const stratmesh::Cloud cloud = {xyz.data(), count, 0, stratmesh::Scalar::float64};
+    record.junction_status =
+        stratmesh::join_branches(cloud, options, record.parting, labels.data(), workspace.get(),
+                                 bytes, all.data(), all.size() / 3, &joined, &record.junction);
+    record.junction_run = true;
+    all.resize(3 * (record.junction_status == stratmesh::Status::ok ? joined : given));
+    record.reconstruct_seconds += seconds_since(start);
+    return true;
+}
+
 // --split-branches where the cloud parts: the trunk (the points labelled kInTrunk) with the
 // options given, through reconstruct_points (its report becomes the record's, with the
 // whole cloud's counts and the branches' time), then each branch around its own automatic
@@ -293,6 +322,7 @@ bool reconstruct_split(const std::vector<double>& xyz, const CommandLine& line,
     }
     whole.points_in = labels.size();
     whole.unused = whole.points_in - whole.points_used - whole.duplicates - whole.rejected;
+    if (!join_parts(xyz, line, labels, all, record)) return false;
     whole.triangle_count = all.size() / 3;
     result.triangle_count = all.size() / 3;
     result.triangles = allocate<uint32_t>(all.size());

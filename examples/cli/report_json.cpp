@@ -312,6 +312,22 @@ void write_split(JsonWriter& j, const RunRecord& r) {
     j.end_array();
 }
 
+void write_junction(JsonWriter& j, const RunRecord& r) {
+    j.key("junction");
+    if (!r.junction_run) return j.null();
+    j.begin_object();
+    j.text_field("status", status_name(r.junction_status));
+    j.count_field("sides_joined", r.junction.sides_joined);
+    j.count_field("sides_left_apart", r.junction.sides_left_apart);
+    j.count_field("triangles", r.junction.triangles_added);
+    j.key("detail");
+    if (r.junction.detail)
+        j.string(r.junction.detail);
+    else
+        j.null();
+    j.end_object();
+}
+
 void write_stream(JsonWriter& j, const RunRecord& r) {
     j.key("stream");
     if (!r.stream) return j.null();
@@ -437,6 +453,7 @@ std::string run_record_json(const RunRecord& record) {
     write_stream(j, record);
     write_branches(j, record);
     write_split(j, record);
+    write_junction(j, record);
     write_costs(j, record);
     j.end_object();
     return j.text();

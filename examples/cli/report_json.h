@@ -70,6 +70,10 @@ struct RunRecord {
         size_t layers = 0, triangles = 0, folds = 0;
     };
     std::vector<SplitPart> split;
+    // With --split-branches where the cloud parts: join_branches()'s status and report.
+    bool junction_run = false;
+    stratmesh::Status junction_status = stratmesh::Status::ok;
+    stratmesh::JoinReport junction = {};
 
     RunRecord();
 

@@ -143,8 +143,16 @@ void print_split(std::FILE* out, const RunRecord& r) {
                                 " (its points unused); ").c_str(),
                      part.layers, part.layers == 1 ? "" : "s", part.triangles, part.folds);
     }
-    std::fprintf(out, "             tubes of their own, not joined: each junction leaves two "
-                      "loops\n");
+    if (!r.junction_run) return;
+    const stratmesh::JoinReport& j = r.junction;
+    if (r.junction_status != stratmesh::Status::ok)
+        std::fprintf(out, "             not joined: %s\n", stratmesh::status_string(r.junction_status));
+    else if (j.sides_joined > 0)
+        std::fprintf(out, "             joined at %u side%s by %zu triangles%s\n", j.sides_joined,
+                     j.sides_joined == 1 ? "" : "s", j.triangles_added,
+                     j.sides_left_apart ? " (one side left apart)" : "");
+    if (j.detail)
+        std::fprintf(out, "             %s%s\n", j.sides_joined ? "" : "left apart: ", j.detail);
 }
 
 void print_costs(std::FILE* out, const RunRecord& r) {

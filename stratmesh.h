@@ -867,7 +867,7 @@ size_t join_branches_max_triangles(size_t point_count);
 // scalar; *triangle_count above triangle_capacity; an index outside the cloud or naming an
 // invalid point; a vertex with two boundary edges leaving it (not vertex-manifold);
 // buffers sharing a byte); too_many_points; invalid_point (a NaN or infinite point
-// without skip_invalid_points); invalid_axis (a parting whose axis is not a unit vector);
+// without skip_invalid_points); invalid_axis (a parting whose axis is zero or not finite);
 // out_of_memory (a workspace below join_branches_workspace_size()); triangle_capacity
 // (*triangle_count set to the triangles needed; nothing written). On every status but ok
 // the triangles are unchanged.

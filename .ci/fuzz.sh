@@ -15,7 +15,7 @@ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER="$
   -DSTRATMESH_BUILD_FUZZ=ON -DSTRATMESH_BUILD_TESTS=OFF -DSTRATMESH_BUILD_EXAMPLES=ON \
   -DSTRATMESH_INSTALL=OFF -DSTRATMESH_WERROR=ON \
   -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
-cmake --build "$build" -j"$jobs" --target fuzz_predicates fuzz_delaunay fuzz_reconstruct fuzz_stream fuzz_cloud_reader
+cmake --build "$build" -j"$jobs" --target fuzz_predicates fuzz_delaunay fuzz_reconstruct fuzz_stream fuzz_join fuzz_cloud_reader
 
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
@@ -53,7 +53,7 @@ set_aside_stalls() {
 }
 
 status=0
-for harness in fuzz_predicates fuzz_delaunay fuzz_reconstruct fuzz_stream fuzz_cloud_reader; do
+for harness in fuzz_predicates fuzz_delaunay fuzz_reconstruct fuzz_stream fuzz_join fuzz_cloud_reader; do
   work="$build/run/$harness"
   rm -rf "$work"
   mkdir -p "$work/corpus" "$work/artifacts"

@@ -19,7 +19,7 @@ jobs=$(nproc 2>/dev/null || echo 2)
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER=clang++ \
   -DSTRATMESH_BUILD_TESTS=ON -DSTRATMESH_BUILD_EXAMPLES=ON -DSTRATMESH_INSTALL=OFF \
   -DCMAKE_CXX_FLAGS="-fprofile-instr-generate -fcoverage-mapping" >/dev/null
-harnesses=(fuzz_predicates fuzz_delaunay fuzz_reconstruct fuzz_stream fuzz_cloud_reader)
+harnesses=(fuzz_predicates fuzz_delaunay fuzz_reconstruct fuzz_stream fuzz_join fuzz_cloud_reader)
 targets=()
 for h in "${harnesses[@]}"; do targets+=("fuzz_replay_$h"); done
 [ "$with_tests" = 1 ] && targets+=(stratmesh_tests)

@@ -417,6 +417,57 @@ TEST_CASE("find_parting allocates nothing: a fork found and labelled, no parting
     CHECK(statuses[3] == stratmesh::Status::out_of_memory);
 }
 
+TEST_CASE("join_branches allocates nothing: a fork's parts traced and planned, refusals") {
+    // The fork's prongs stand on its dome: the side is planned and left apart.
+    const shapes::Shape fork = shapes::forked_tube(20000, shapes::Pose::z);
+    const stratmesh::Options z = no_heap::z_axis();
+    const stratmesh::Cloud cloud = {fork.xyz.data(), fork.size(), 0, stratmesh::Scalar::float64};
+    std::vector<unsigned char> work(stratmesh::find_parting_workspace_size(fork.size(), z));
+    std::vector<uint8_t> labels(fork.size());
+    stratmesh::Parting parting = {};
+    REQUIRE(stratmesh::find_parting(cloud, z, work.data(), work.size(), &parting, labels.data()) ==
+            stratmesh::Status::ok);
+    REQUIRE(parting.branches_above == 2);
+    std::vector<uint32_t> triangles;
+    for (uint8_t label : {stratmesh::kInTrunk, stratmesh::kFirstAboveBranch,
+                          static_cast<uint8_t>(stratmesh::kFirstAboveBranch + 1)}) {
+        std::vector<double> part;
+        std::vector<uint32_t> index;
+        for (size_t i = 0; i < fork.size(); ++i)
+            if (labels[i] == label) {
+                index.push_back(static_cast<uint32_t>(i));
+                part.insert(part.end(), fork.point(i), fork.point(i) + 3);
+            }
+        stratmesh::Options o = z;
+        if (label != stratmesh::kInTrunk) o.axis = stratmesh::Axis::automatic;
+        std::vector<unsigned char> space(stratmesh::reconstruct_workspace_size(index.size(), o));
+        std::vector<uint32_t> t(3 * stratmesh::reconstruct_max_triangles(index.size(), o));
+        size_t count = 0;
+        REQUIRE(stratmesh::reconstruct({part.data(), index.size(), 0, stratmesh::Scalar::float64}, o,
+                                       space.data(), space.size(), t.data(), t.size() / 3, &count,
+                                       nullptr) == stratmesh::Status::ok);
+        for (size_t k = 0; k < 3 * count; ++k) triangles.push_back(index[t[k]]);
+    }
+    const size_t given = triangles.size() / 3;
+    triangles.resize(3 * (given + stratmesh::join_branches_max_triangles(fork.size())));
+    std::vector<unsigned char> joining(stratmesh::join_branches_workspace_size(fork.size(), given));
+    stratmesh::JoinReport planned = {}, short_of = {};
+    size_t count = given, refused_count = given;
+    stratmesh::Status statuses[2] = {};
+    const size_t n = alloc_counter::allocations_during([&] {
+        statuses[0] = stratmesh::join_branches(cloud, z, parting, labels.data(), joining.data(),
+                                               joining.size(), triangles.data(), triangles.size() / 3,
+                                               &count, &planned);
+        statuses[1] = stratmesh::join_branches(cloud, z, parting, labels.data(), joining.data(), 1000,
+                                               triangles.data(), triangles.size() / 3, &refused_count,
+                                               &short_of);
+    });
+    CHECK(n == 0);
+    CHECK(statuses[0] == stratmesh::Status::ok);
+    CHECK(planned.sides_left_apart == 1);
+    CHECK(statuses[1] == stratmesh::Status::out_of_memory);
+}
+
 TEST_CASE("delaunay_2d allocates nothing, on success and on every error status") {
     std::vector<no_heap::DelaunayCase> cases = no_heap::delaunay_cases();
     size_t total = 0;
@@ -443,6 +494,8 @@ TEST_CASE("the sizing functions, predicates and status strings allocate nothing"
         sink = sink + stratmesh::delaunay_2d_max_triangles(100000);
         sink = sink + stratmesh::cap_ends_workspace_size(100000, 200000);
         sink = sink + stratmesh::find_parting_workspace_size(100000, o);
+        sink = sink + stratmesh::join_branches_workspace_size(100000, 200000);
+        sink = sink + stratmesh::join_branches_max_triangles(100000);
         sink = sink + (stratmesh::orient2d(a, b, c) > 0) + (stratmesh::incircle(a, b, c, d) > 0);
         sink = sink + (stratmesh::status_string(stratmesh::Status::collinear)[0] != 0);
     });

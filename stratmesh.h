@@ -815,19 +815,19 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 
 // ---- Joining the branches to the trunk ----
 //
-// join_branches() joins a trunk and its branches, meshed apart (each label of find_parting's
-// branch_of its own reconstruct(), as the tool's --split-branches does), into one surface.
-// At each side that parts, the trunk's boundary loop nearest the branches (the highest of
-// the loops whose points are all kInTrunk, seen from that side) is joined to each branch's
-// loop nearest the cut: the trunk's loop is split at the gaps between the branches, in
-// their order around the trunk's centre (the vertex whose angle is nearest the middle of
-// each gap); each arc is zipped to its branch's whole loop, which is opened at its point
-// nearest the trunk's centre (the two chains merged in the order of their angle around the
-// branch's centre: on the tool tests' fork, trunk in 4 layers, meshq counts 3
-// self-intersecting pairs where shortest diagonals first, as contour stitching does, made
-// 79); and
-// the crotch is closed by a triangle per gap, from the trunk's vertex there to the two
-// branches' opening points, and a fan over those points where three branches or more meet.
+// join_branches() joins a trunk and its branches, meshed apart (each label of
+// find_parting's branch_of its own reconstruct(), as the tool's --split-branches does),
+// into one surface. At each side that parts, the trunk's boundary loop nearest the
+// branches (the highest of the loops whose points are all kInTrunk, seen from that side)
+// is joined to each branch's loop nearest the cut: the trunk's loop is split at the gaps
+// between the branches, in their order around the trunk's centre (the vertex whose angle
+// is nearest the middle of each gap); each arc is zipped to its branch's whole loop, which
+// is opened at its point nearest the trunk's centre (the two chains merged in the order of
+// their angle around the branch's centre: on the tool tests' fork, trunk in 4 layers,
+// meshq counts 3 self-intersecting pairs where shortest diagonals first, as contour
+// stitching does, made 79); and the crotch is closed by a triangle per gap, from the
+// trunk's vertex there to the two branches' opening points, and a fan over those points
+// where three branches or more meet.
 //
 //       trunk's loop   ... m0 ---- branch 1's arc ---- m1 ---- branch 2's arc ---- m0 ...
 //       branch loops   p1 (opened) around to p1        p2 (opened) around to p2
@@ -865,12 +865,12 @@ size_t join_branches_max_triangles(size_t point_count);
 // counted in sides_left_apart, their triangles left as they were); invalid_argument (a
 // null triangle_count, branch_of, workspace or triangles where needed; a bad stride or
 // scalar; *triangle_count above triangle_capacity; an index outside the cloud or naming an
-// invalid point; a vertex with two boundary edges leaving it (not vertex-manifold);
-// buffers sharing a byte); too_many_points; invalid_point (a NaN or infinite point
+// invalid point; buffers sharing a byte); too_many_points; invalid_point (a NaN or infinite point
 // without skip_invalid_points); invalid_axis (a parting whose axis is zero or not finite);
 // out_of_memory (a workspace below join_branches_workspace_size()); triangle_capacity
 // (*triangle_count set to the triangles needed; nothing written). On every status but ok
-// the triangles are unchanged.
+// the triangles are unchanged. On a surface that is not a vertex-manifold the call stays
+// within its buffers, but the junctions may join edges that were already full.
 Status join_branches(const Cloud& cloud, const Options& options, const Parting& parting,
                      const uint8_t* branch_of, void* workspace, size_t workspace_bytes,
                      uint32_t* triangles, size_t triangle_capacity, size_t* triangle_count,
@@ -8903,13 +8903,14 @@ inline uint8_t loop_label(const TracedLoop& loop, const uint8_t* branch_of) {
 const double kJoinReach = 4;
 
 // Plans the side whose branches carry labels first_label .. first_label + branches - 1,
-// with its cut and gap as heights of the view: false (detail set) if it cannot be joined. `taken` is the trunk loop the other side
-// joined (nullptr if none), which this side may not take.
+// with its cut and gap as heights of the view: false (detail set) if it cannot be joined.
+// `taken` is the trunk loop the other side joined (nullptr if none), which this side may
+// not take.
 inline bool plan_junction(const CapLoop& loops, size_t entries, const uint8_t* branch_of,
                           uint8_t first_label, uint32_t branches, double cut, double gap,
                           const SideView& view, const uint32_t* taken, SideJunction& side,
                           const char*& detail) {
-    double trunk_height = -DBL_MAX, branch_height[kMaxBranches];
+    double trunk_height = -DBL_MAX, branch_height[kMaxBranches] = {};
     TracedLoop found[kMaxBranches] = {};
     side.trunk = {nullptr, 0};
     for (size_t start = 0; start < entries;) {

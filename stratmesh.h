@@ -851,7 +851,7 @@ struct JoinReport {
 };
 
 // Bytes of workspace join_branches() needs for a surface of triangle_count triangles over
-// point_count points (about 24 bytes a point and 12 a triangle); 0 if that is beyond what
+// point_count points (17 bytes a point and 12 a triangle); 0 if that is beyond what
 // this platform can address.
 size_t join_branches_workspace_size(size_t point_count, size_t triangle_count);
 

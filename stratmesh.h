@@ -839,30 +839,44 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 // is joined (else it is counted in sides_left_apart, the reason in detail): the trunk's
 // loop must lie within four gaps of the cut (a trunk closed there keeps only its far
 // loop), at least two branches must have a loop there whose points are all theirs, each
-// branch's centre must lie within the trunk loop's mean radius across the axis (branches
-// standing on a closed end, as horns on a skull, are not joined: that needs a hole cut in
-// the end), and the gaps must follow one another along the trunk's loop.
+// branch's centre must lie within the trunk loop's mean radius across the axis, and the
+// gaps must follow one another along the trunk's loop.
+//
+// Where that fails (branches standing on a closed end, as horns on a skull: no trunk loop
+// goes around them), each branch is grafted instead: the trunk's triangles under the
+// branch's loop (seen along the axis, facing the branch, within four gaps below it) are
+// taken out as a disc that keeps every vertex on a triangle, and the hole's loop is zipped
+// to the branch's by angle around the branch's centre. The surface stays an oriented edge-
+// and vertex-manifold and every point stays a vertex; the band can cross the trunk's
+// triangles beside the stump where the stump's wall leans over the hole (the bust with horns
+// of bench/README.md: 92 self-intersecting pairs, all between the bands and the trunk).
 struct JoinReport {
     uint32_t sides_joined;      // 0, 1 or 2
     uint32_t sides_left_apart;  // sides that part whose loops could not be joined (detail)
+    uint32_t branches_grafted;  // branches joined through a hole in the trunk's closed end
     size_t triangles_added;
+    size_t triangles_removed;   // the trunk's triangles the holes took out
     size_t workspace_used;      // peak workspace bytes, from the start of the buffer
     const char* detail;         // a static sentence on why, on failure or a side left apart
 };
 
 // Bytes of workspace join_branches() needs for a surface of triangle_count triangles over
-// point_count points (17 bytes a point and 12 a triangle); 0 if that is beyond what
-// this platform can address.
+// point_count points: 5 bytes a point, plus the larger of 12 a point and 12 a triangle (the
+// loops' tracing) and 8 a point, 1 a triangle and 56 for each triangle up to 65,536 (the
+// grafts); 0 if that is beyond what this platform can address.
 size_t join_branches_workspace_size(size_t point_count, size_t triangle_count);
 
-// The most triangles join_branches() adds: one per boundary vertex and four per branch.
+// The most triangles join_branches() adds: one per vertex of a loop it zips and four per
+// branch (each point on one loop at most).
 size_t join_branches_max_triangles(size_t point_count);
 
-// Appends the junctions' triangles to triangles[0 .. 3 * *triangle_count) (indices into
-// `cloud`) and sets *triangle_count to the new total. parting and branch_of: find_parting()'s
-// on the same cloud (its axis is used); options: only skip_invalid_points is read. report
-// (optional) is filled on every status. Returns ok (sides that could not be joined are
-// counted in sides_left_apart, their triangles left as they were); invalid_argument (a
+// Takes the grafts' holes out of triangles[0 .. 3 * *triangle_count) (indices into
+// `cloud`; the triangles kept stay in their order, triangles_removed fewer), appends the
+// junctions' triangles and sets *triangle_count to the new total. parting and branch_of:
+// find_parting()'s on the same cloud (its axis is used); options: only skip_invalid_points
+// is read. report (optional) is filled on every status. Returns ok (a side counts as joined
+// when all its branches are; the others in sides_left_apart, their branches grafted where
+// they could be, the rest of their triangles left as they were); invalid_argument (a
 // null triangle_count, branch_of, workspace or triangles where needed; a bad stride or
 // scalar; *triangle_count above triangle_capacity; an index outside the cloud or naming an
 // invalid point; buffers sharing a byte); too_many_points; invalid_point (a NaN or infinite point
@@ -8837,15 +8851,53 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 
 namespace detail {
 
-struct JoinMemory {
-    CapGraph graph;
-    CapLoop loops;  // only ids and starts
+// The most trunk triangles a graft looks at under one branch's loop (see plan_graft): its
+// arrays are sized for them, not for the whole surface.
+const size_t kGraftMaxTriangles = size_t{1} << 16;
+
+// A directed edge of a triangle under a branch's loop, and which of them it belongs to.
+struct GraftEdge {
+    uint32_t from, to, slot;
+    bool operator<(const GraftEdge& o) const { return from != o.from ? from < o.from : to < o.to; }
+    bool operator>(const GraftEdge& o) const { return o < *this; }
 };
 
+struct JoinMemory {
+    CapLoop loops;  // only ids and starts
+    CapGraph graph;  // until the loops are traced; the grafts' arrays then take its memory
+    uint32_t* hole_next;     // per point: its successor on a planned hole, kNoIndex if free,
+                             // kHeldVertex where no hole may pass (the trunk's boundary)
+    uint32_t* holes;         // the planned holes' loops, one after another
+    unsigned char* removed;  // per triangle: 1 where a planned hole takes it out
+    uint32_t* under;         // the triangles under the branch's loop being grafted
+    GraftEdge* edges;        // 3 per triangle of `under`, sorted
+    uint64_t* queue;         // hole edges to grow across, (from << 32) | to
+    size_t under_capacity;
+    size_t room;  // the arena's mark after the loops
+};
+
+const uint32_t kHeldVertex = kNoIndex - 1;
+
+// The arena sequence of the call, shared with join_branches_workspace_size(): the loops,
+// then the graph after them, then (allocate_grafts) once the loops are traced, the grafts'
+// arrays in the graph's room.
 inline bool allocate_join(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
-    allocate_cap_graph(m.graph, point_count, triangle_count, arena);
     m.loops.ids = arena.alloc<uint32_t>(point_count);  // every point on a loop at most
     m.loops.starts = arena.alloc<unsigned char>(point_count);
+    m.room = arena.mark();
+    allocate_cap_graph(m.graph, point_count, triangle_count, arena);
+    return !arena.failed;
+}
+
+inline bool allocate_grafts(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
+    arena.rewind(m.room);
+    m.under_capacity = triangle_count < kGraftMaxTriangles ? triangle_count : kGraftMaxTriangles;
+    m.hole_next = arena.alloc<uint32_t>(point_count);
+    m.holes = arena.alloc<uint32_t>(point_count);
+    m.removed = arena.alloc<unsigned char>(triangle_count);
+    m.under = arena.alloc<uint32_t>(m.under_capacity);
+    m.edges = arena.alloc<GraftEdge>(3 * m.under_capacity);
+    m.queue = arena.alloc<uint64_t>(2 * m.under_capacity + 3);
     return !arena.failed;
 }
 
@@ -8902,17 +8954,22 @@ inline uint8_t loop_label(const TracedLoop& loop, const uint8_t* branch_of) {
 
 const double kJoinReach = 4;
 
-// Plans the side whose branches carry labels first_label .. first_label + branches - 1,
-// with its cut and gap as heights of the view: false (detail set) if it cannot be joined.
-// `taken` is the trunk loop the other side joined (nullptr if none), which this side may
-// not take.
-inline bool plan_junction(const CapLoop& loops, size_t entries, const uint8_t* branch_of,
-                          uint8_t first_label, uint32_t branches, double cut, double gap,
-                          const SideView& view, const uint32_t* taken, SideJunction& side,
-                          const char*& detail) {
-    double trunk_height = -DBL_MAX, branch_height[kMaxBranches] = {};
-    TracedLoop found[kMaxBranches] = {};
+// The loops a side's junction starts from: the trunk's highest (its points all kInTrunk;
+// not `taken`, the trunk loop the other side joined) and each branch's lowest (ids null
+// where a branch has none), with their mean heights in the view.
+struct SideLoops {
+    TracedLoop trunk;
+    double trunk_height;
+    TracedLoop branch[kMaxBranches];
+    double branch_height[kMaxBranches];
+};
+
+inline void find_side_loops(const CapLoop& loops, size_t entries, const uint8_t* branch_of,
+                            uint8_t first_label, uint32_t branches, const SideView& view,
+                            const uint32_t* taken, SideLoops& side) {
     side.trunk = {nullptr, 0};
+    side.trunk_height = -DBL_MAX;
+    for (uint32_t b = 0; b < branches; ++b) side.branch[b] = {nullptr, 0};
     for (size_t start = 0; start < entries;) {
         size_t end = start + 1;
         while (end < entries && loops.starts[end] == 0) ++end;
@@ -8923,18 +8980,28 @@ inline bool plan_junction(const CapLoop& loops, size_t entries, const uint8_t* b
         const uint8_t label = loop_label(loop, branch_of);
         const double height = loop_mean_height(loop, view);
         if (label == kInTrunk) {
-            if (height > trunk_height) {
-                trunk_height = height;
+            if (height > side.trunk_height) {
+                side.trunk_height = height;
                 side.trunk = loop;
             }
         } else if (label >= first_label && label - first_label < static_cast<int>(branches)) {
             const uint32_t b = static_cast<uint32_t>(label - first_label);
-            if (!found[b].ids || height < branch_height[b]) {
-                found[b] = loop;
-                branch_height[b] = height;
+            if (!side.branch[b].ids || height < side.branch_height[b]) {
+                side.branch[b] = loop;
+                side.branch_height[b] = height;
             }
         }
     }
+}
+
+// Plans the rim junction of a side with `branches` branches, from its loops, with its cut
+// and gap as heights of the view: false (detail set) if it cannot be joined so.
+inline bool plan_junction(const SideLoops& loops, uint32_t branches, double cut, double gap,
+                          const SideView& view, SideJunction& side, const char*& detail) {
+    const double trunk_height = loops.trunk_height;
+    const double* branch_height = loops.branch_height;
+    const TracedLoop* found = loops.branch;
+    side.trunk = loops.trunk;
     // Loops farther than kJoinReach gaps from the cut are not the junction's: a trunk
     // closed at the cut keeps only its far loop, a branch closed there only its tip's.
     auto near_cut = [&](double height) { return std::fabs(height - cut) <= kJoinReach * gap; };
@@ -9040,6 +9107,23 @@ inline bool plan_junction(const CapLoop& loops, size_t entries, const uint8_t* b
     return true;
 }
 
+// Angles around a centre across the axis, from the direction of a reference point, in
+// [0, 2 pi), counter-clockwise where sense is +1.
+struct AngleAround {
+    const SideView& view;
+    double cx, cy;
+    Local reference;
+    double sense;
+
+    double operator()(uint32_t id) const {
+        const Local q = view.at(id);
+        const double rx = reference.x - cx, ry = reference.y - cy;
+        const double dx = q.x - cx, dy = q.y - cy;
+        const double t = std::atan2(sense * (rx * dy - ry * dx), rx * dx + ry * dy);
+        return t < 0 ? t + 6.28318530717958647693 : t;
+    }
+};
+
 // Writes the junction's side.triangles() triangles at out.
 inline void write_junction(const SideJunction& side, const SideView& view, uint32_t* out) {
     const TracedLoop& trunk = side.trunk;
@@ -9062,15 +9146,8 @@ inline void write_junction(const SideJunction& side, const SideView& view, uint3
         // Both chains in the order of their angle around the branch's centre, from the
         // opening on: a zipper by angle lays a band between two curves that go once around
         // a point in triangles that do not overlap, where shortest diagonals can fold.
-        const double cx = side.centre[i][0], cy = side.centre[i][1];
-        const Local opening = view.at(b(0));
-        const double rx = opening.x - cx, ry = opening.y - cy;
-        auto turn = [&](uint32_t id) {
-            const Local q = view.at(id);
-            const double dx = q.x - cx, dy = q.y - cy;
-            const double t = std::atan2(side.sense * (rx * dy - ry * dx), rx * dx + ry * dy);
-            return t < 0 ? t + 6.28318530717958647693 : t;
-        };
+        const AngleAround turn = {view, side.centre[i][0], side.centre[i][1], view.at(b(0)),
+                                  side.sense};
         emit(a(0), b(1), b(0));
         uint32_t j = 0, l = 1;
         while (j < steps || l + 1 < n) {
@@ -9092,6 +9169,222 @@ inline void write_junction(const SideJunction& side, const SideView& view, uint3
         emit(opening_point(0), opening_point(i), opening_point(i + 1));
 }
 
+// ---- grafts ----
+//
+// A branch standing on a closed end of the trunk (horns on a skull) has no trunk loop
+// around it: the trunk's mesh runs over the stump under the branch's loop instead. It is
+// grafted: the trunk's triangles under the loop that face the branch are taken out as a
+// disc (grown from the one nearest the loop's centre across the edges they share, each
+// triangle added bringing a vertex new to the disc, so every vertex keeps a triangle of
+// the trunk and the hole's loop is simple), and the hole's loop is zipped to the branch's
+// by angle around the branch's centre, as the rim junction zips its arcs. "Under" is seen
+// along the axis: the triangle's centroid inside the branch's loop and at most kJoinReach
+// gaps below its mean height, its normal within acos(kGraftFacing) of the axis; the hole
+// never reaches a vertex of the trunk's boundary nor one of another hole, so the surface
+// stays an oriented edge- and vertex-manifold. Refused (the branch left apart) where no
+// such triangle is free, where more than kGraftMaxTriangles are under the loop, or where
+// the hole or the branch's loop does not go once around the branch's centre in the sense
+// a junction's do.
+
+const double kGraftFacing = 0.25;
+
+struct Graft {
+    TracedLoop hole;    // in the direction of the triangles it replaces (in JoinMemory::holes)
+    TracedLoop branch;  // in cap order
+    double centre[2];
+    double side;        // the view's sign: +1 above the cut, -1 below
+    size_t removed;     // the trunk's triangles the hole takes out
+
+    size_t triangles() const { return static_cast<size_t>(hole.length) + branch.length; }
+};
+
+// How many times the loop winds around (cx, cy) across the axis, counter-clockwise positive
+// (the sum of its turns, rounded).
+inline long winding_around(const TracedLoop& loop, const SideView& view, double cx, double cy) {
+    double sum = 0;
+    Local p = view.at(loop.ids[loop.length - 1]);
+    for (uint32_t i = 0; i < loop.length; ++i) {
+        const Local q = view.at(loop.ids[i]);
+        const double ax = p.x - cx, ay = p.y - cy, bx = q.x - cx, by = q.y - cy;
+        sum += std::atan2(ax * by - ay * bx, ax * bx + ay * by);
+        p = q;
+    }
+    return std::lround(sum / 6.28318530717958647693);
+}
+
+// Whether (x, y) lies inside the loop across the axis (even-odd rule).
+inline bool inside_loop(const TracedLoop& loop, const SideView& view, double x, double y) {
+    bool inside = false;
+    Local p = view.at(loop.ids[loop.length - 1]);
+    for (uint32_t i = 0; i < loop.length; ++i) {
+        const Local q = view.at(loop.ids[i]);
+        if ((q.y > y) != (p.y > y) && x < q.x + (y - q.y) * (p.x - q.x) / (p.y - q.y))
+            inside = !inside;
+        p = q;
+    }
+    return inside;
+}
+
+// Plans the graft of the branch whose loop (nearest the cut) is `loop`, taking the hole's
+// triangles out in m.removed and its vertices in m.hole_next, its loop appended to m.holes
+// at holes_used; false (nothing taken, detail set) if it cannot be grafted.
+inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_of,
+                       const TracedLoop& loop, double gap, const SideView& view, JoinMemory& m,
+                       size_t& holes_used, Graft& graft, const char*& detail) {
+    double cx = 0, cy = 0, height = 0;
+    for (uint32_t i = 0; i < loop.length; ++i) {
+        const Local p = view.at(loop.ids[i]);
+        cx += p.x;
+        cy += p.y;
+        height += p.h;
+    }
+    cx /= loop.length;
+    cy /= loop.length;
+    height /= loop.length;
+    // In cap order a branch's loop turns clockwise seen from the branch (its cap would face
+    // away from it), once around its centre.
+    if (winding_around(loop, view, cx, cy) != -1) {
+        detail = "a branch's loop does not go once around its centre, seen along the axis";
+        return false;
+    }
+    double reach = 0;
+    for (uint32_t i = 0; i < loop.length; ++i) {
+        const Local p = view.at(loop.ids[i]);
+        const double d = (p.x - cx) * (p.x - cx) + (p.y - cy) * (p.y - cy);
+        if (d > reach) reach = d;
+    }
+    size_t found = 0;
+    for (size_t t = 0; t < count; ++t) {
+        const uint32_t* c = tri + 3 * t;
+        if (m.removed[t] || c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;
+        if (branch_of[c[0]] != kInTrunk || branch_of[c[1]] != kInTrunk || branch_of[c[2]] != kInTrunk)
+            continue;
+        const Local a = view.at(c[0]), b = view.at(c[1]), d = view.at(c[2]);
+        const double gx = (a.x + b.x + d.x) / 3, gy = (a.y + b.y + d.y) / 3, gh = (a.h + b.h + d.h) / 3;
+        if (gh < height - kJoinReach * gap || gh > height + gap) continue;
+        if ((gx - cx) * (gx - cx) + (gy - cy) * (gy - cy) > reach) continue;
+        const Vec3 normal = cross({b.x - a.x, b.y - a.y, b.h - a.h}, {d.x - a.x, d.y - a.y, d.h - a.h});
+        if (!(normal.z > kGraftFacing * std::sqrt(dot(normal, normal)))) continue;
+        if (!inside_loop(loop, view, gx, gy)) continue;
+        if (found == m.under_capacity) {
+            detail = "more of the trunk's triangles lie under a branch's loop than a graft takes "
+                     "(kGraftMaxTriangles)";
+            return false;
+        }
+        m.under[found++] = static_cast<uint32_t>(t);
+    }
+    // The seed: the triangle under the loop nearest its centre whose vertices are free.
+    size_t seed = found;
+    double nearest = DBL_MAX;
+    for (size_t k = 0; k < found; ++k) {
+        const uint32_t* c = tri + 3 * static_cast<size_t>(m.under[k]);
+        if (m.hole_next[c[0]] != kNoIndex || m.hole_next[c[1]] != kNoIndex ||
+            m.hole_next[c[2]] != kNoIndex)
+            continue;
+        const Local a = view.at(c[0]), b = view.at(c[1]), d = view.at(c[2]);
+        const double gx = (a.x + b.x + d.x) / 3 - cx, gy = (a.y + b.y + d.y) / 3 - cy;
+        if (gx * gx + gy * gy < nearest) {
+            nearest = gx * gx + gy * gy;
+            seed = k;
+        }
+    }
+    if (seed == found) {
+        detail = "no triangle of the trunk under a branch's loop faces it (and is free to take)";
+        return false;
+    }
+    for (size_t k = 0; k < found; ++k)
+        for (size_t e = 0; e < 3; ++e) {
+            const uint32_t* c = tri + 3 * static_cast<size_t>(m.under[k]);
+            m.edges[3 * k + e] = {c[e], c[(e + 1) % 3], static_cast<uint32_t>(k)};
+        }
+    heap_sort(m.edges, 3 * found);
+    // The disc grows across its loop's edges: a triangle (x, y, z) beyond the hole's edge
+    // y -> x joins when z is free, and the loop then runs y -> z -> x.
+    uint32_t* next = m.hole_next;
+    const uint32_t* first = tri + 3 * static_cast<size_t>(m.under[seed]);
+    size_t queued = 0, taken = 1;
+    for (size_t e = 0; e < 3; ++e) {
+        next[first[e]] = first[(e + 1) % 3];
+        m.queue[queued++] = (uint64_t{first[e]} << 32) | first[(e + 1) % 3];
+    }
+    m.removed[m.under[seed]] = 1;
+    for (size_t head = 0; head < queued; ++head) {
+        const uint32_t y = static_cast<uint32_t>(m.queue[head] >> 32);
+        const uint32_t x = static_cast<uint32_t>(m.queue[head]);
+        if (next[y] != x) continue;
+        const GraftEdge key = {x, y, 0};
+        size_t lo = 0, hi = 3 * found;
+        while (lo < hi) {
+            const size_t mid = lo + (hi - lo) / 2;
+            if (m.edges[mid] < key) lo = mid + 1; else hi = mid;
+        }
+        for (; lo < 3 * found && m.edges[lo].from == x && m.edges[lo].to == y; ++lo) {
+            const uint32_t t = m.under[m.edges[lo].slot];
+            const uint32_t* c = tri + 3 * static_cast<size_t>(t);
+            const uint32_t z = c[0] ^ c[1] ^ c[2] ^ x ^ y;
+            if (m.removed[t] || next[z] != kNoIndex) continue;
+
+            next[y] = z;
+            next[z] = x;
+            m.removed[t] = 1;
+            ++taken;
+            m.queue[queued++] = (uint64_t{y} << 32) | z;
+            m.queue[queued++] = (uint64_t{z} << 32) | x;
+            break;
+        }
+    }
+    uint32_t* hole = m.holes + holes_used;
+    const uint32_t length = static_cast<uint32_t>(taken + 2);
+    hole[0] = first[0];
+    for (uint32_t i = 1; i < length; ++i) hole[i] = next[hole[i - 1]];
+    graft.hole = {hole, length};
+    if (winding_around(graft.hole, view, cx, cy) != 1) {
+        for (uint32_t i = 0; i < length; ++i) next[hole[i]] = kNoIndex;
+        for (size_t k = 0; k < found; ++k) m.removed[m.under[k]] = 0;
+        detail = "the hole under a branch's loop does not go once around the branch's centre";
+        return false;
+    }
+    holes_used += length;
+    graft.branch = loop;
+    graft.centre[0] = cx;
+    graft.centre[1] = cy;
+    graft.side = view.sign;
+    graft.removed = taken;
+    return true;
+}
+
+// Writes the graft's graft.triangles() triangles at out: the hole's loop, counter-clockwise
+// from its vertex first in angle after the branch loop's first vertex, and the branch's loop
+// against its cap order, merged by angle around the branch's centre.
+inline void write_graft(const Graft& graft, const SideView& view, uint32_t* out) {
+    const uint32_t m = graft.hole.length, n = graft.branch.length;
+    const uint32_t* branch = graft.branch.ids;
+    const AngleAround turn = {view, graft.centre[0], graft.centre[1], view.at(branch[0]), 1.0};
+    uint32_t start = 0;
+    for (uint32_t i = 1; i < m; ++i)
+        if (turn(graft.hole.ids[i]) < turn(graft.hole.ids[start])) start = i;
+    auto a = [&](uint32_t j) { return graft.hole.ids[(start + j) % m]; };
+    auto b = [&](uint32_t l) { return branch[(n - l % n) % n]; };
+    const double two_pi = 6.28318530717958647693;
+    auto hole_turn = [&](uint32_t j) { return j == m ? two_pi + turn(a(0)) : turn(a(j)); };
+    auto branch_turn = [&](uint32_t l) { return l == n ? two_pi : turn(b(l)); };
+    auto emit = [&out](uint32_t p, uint32_t q, uint32_t r) {
+        out[0] = p;
+        out[1] = q;
+        out[2] = r;
+        out += 3;
+    };
+    for (uint32_t j = 0, l = 0; j < m || l < n;) {
+        if (l == n || (j < m && hole_turn(j + 1) <= branch_turn(l + 1))) {
+            emit(a(j), a(j + 1), b(l));
+            ++j;
+        } else {
+            emit(a(j), b(l + 1), b(l));
+            ++l;
+        }
+    }
+}
+
 }  // namespace detail
 
 size_t join_branches_workspace_size(size_t point_count, size_t triangle_count) {
@@ -9099,6 +9392,7 @@ size_t join_branches_workspace_size(size_t point_count, size_t triangle_count) {
     detail::Arena arena = detail::Arena::measuring();
     detail::JoinMemory m;
     detail::allocate_join(m, point_count, triangle_count, arena);
+    detail::allocate_grafts(m, point_count, triangle_count, arena);
     return arena.failed ? 0 : arena.required_bytes();
 }
 
@@ -9120,7 +9414,7 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
         byte_range(report, sizeof(JoinReport)),
         byte_range(branch_of, countable ? cloud.count : 0)};
     if (any_overlap(buffers, 6)) return Status::invalid_argument;
-    JoinReport r = {0, 0, 0, 0, nullptr};
+    JoinReport r = {0, 0, 0, 0, 0, 0, nullptr};
     Report checks = {};
     Arena arena = Arena::over(workspace, workspace_bytes);
     const size_t given = triangle_count ? *triangle_count : 0;
@@ -9167,35 +9461,83 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
     build_cap_graph(triangles, given, cloud.count, m.graph);
     size_t entries = 0;
     trace_boundary_loops(m.graph, cloud.count, m.loops, &entries);
+    if (!allocate_grafts(m, cloud.count, given, arena)) {
+        checks.detail = "the workspace is smaller than join_branches_workspace_size()";
+        return finish(Status::out_of_memory);
+    }
+    std::memset(m.hole_next, 0xFF, sizeof(uint32_t) * cloud.count);
+    for (size_t i = 0; i < entries; ++i) m.hole_next[m.loops.ids[i]] = kHeldVertex;
+    std::memset(m.removed, 0, given);
     SideJunction plan[2];
-    bool joined[2] = {false, false};
+    bool rim[2] = {false, false};
+    Graft grafts[2 * kMaxBranches];
+    uint32_t graft_count = 0;
+    size_t holes_used = 0, removed = 0;
     const uint32_t* taken = nullptr;
     for (int k = 0; k < 2; ++k) {
         if (sides[k] == 0) continue;
         const SideView view = {reader, frame, k == 0 ? 1.0 : -1.0};
         const uint8_t first = static_cast<uint8_t>(k == 0 ? kFirstAboveBranch : kFirstBelowBranch);
         const double cut = (k == 0 ? parting.above : parting.below) - dot(frame.origin, frame.axis);
-        joined[k] = plan_junction(m.loops, entries, branch_of, first, sides[k],
-                                  view.sign * cut * frame.scale, parting.gap * frame.scale, view,
-                                  taken, plan[k], r.detail);
-        if (joined[k]) {
+        const double gap = parting.gap * frame.scale;
+        SideLoops loops;
+        find_side_loops(m.loops, entries, branch_of, first, sides[k], view, taken, loops);
+        const char* rim_why = nullptr;  // superseded by the grafts' reasons
+        rim[k] = plan_junction(loops, sides[k], view.sign * cut * frame.scale, gap, view,
+                               plan[k], rim_why);
+        if (rim[k]) {
             taken = plan[k].trunk.ids;
             needed += plan[k].triangles();
-        }
-    }
-    if (needed > triangle_capacity) return finish(Status::triangle_capacity);
-    for (int k = 0; k < 2; ++k) {
-        if (sides[k] == 0) continue;
-        if (!joined[k]) {
-            ++r.sides_left_apart;
+            ++r.sides_joined;
             continue;
         }
-        const SideView view = {reader, frame, k == 0 ? 1.0 : -1.0};
-        write_junction(plan[k], view, triangles + 3 * (given + r.triangles_added));
-        r.triangles_added += plan[k].triangles();
-        ++r.sides_joined;
+        // No rim goes around the branches: each is grafted where it stands on the trunk.
+        uint32_t grafted = 0;
+        for (uint32_t b = 0; b < sides[k]; ++b) {
+            const char* graft_why = nullptr;
+            if (!loops.branch[b].ids) {
+                graft_why = "a branch has no boundary loop of its own to join";
+            } else if (plan_graft(triangles, given, branch_of, loops.branch[b], gap, view, m,
+                                  holes_used, grafts[graft_count], graft_why)) {
+                needed += grafts[graft_count].triangles();
+                removed += grafts[graft_count].removed;
+                ++graft_count;
+                ++grafted;
+                continue;
+            }
+            if (!r.detail) r.detail = graft_why;
+        }
+        r.branches_grafted += grafted;
+        if (grafted == sides[k])
+            ++r.sides_joined;
+        else
+            ++r.sides_left_apart;
     }
-    *triangle_count = given + r.triangles_added;
+    needed -= removed;
+    if (needed > triangle_capacity) return finish(Status::triangle_capacity);
+    size_t kept = 0;
+    for (size_t t = 0; t < given; ++t) {
+        if (m.removed[t]) continue;
+        if (kept != t)
+            for (size_t e = 0; e < 3; ++e) triangles[3 * kept + e] = triangles[3 * t + e];
+        ++kept;
+    }
+    r.triangles_removed = removed;
+    uint32_t* out = triangles + 3 * kept;
+    for (int k = 0; k < 2; ++k) {
+        if (!rim[k]) continue;
+        const SideView view = {reader, frame, k == 0 ? 1.0 : -1.0};
+        write_junction(plan[k], view, out);
+        out += 3 * plan[k].triangles();
+        r.triangles_added += plan[k].triangles();
+    }
+    for (uint32_t g = 0; g < graft_count; ++g) {
+        const SideView view = {reader, frame, grafts[g].side};
+        write_graft(grafts[g], view, out);
+        out += 3 * grafts[g].triangles();
+        r.triangles_added += grafts[g].triangles();
+    }
+    *triangle_count = kept + r.triangles_added;
     return finish(Status::ok);
 }
 #endif

@@ -319,7 +319,9 @@ void write_junction(JsonWriter& j, const RunRecord& r) {
     j.text_field("status", status_name(r.junction_status));
     j.count_field("sides_joined", r.junction.sides_joined);
     j.count_field("sides_left_apart", r.junction.sides_left_apart);
+    j.count_field("branches_grafted", r.junction.branches_grafted);
     j.count_field("triangles", r.junction.triangles_added);
+    j.count_field("triangles_removed", r.junction.triangles_removed);
     j.key("detail");
     if (r.junction.detail)
         j.string(r.junction.detail);

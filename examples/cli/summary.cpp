@@ -107,6 +107,14 @@ void print_counts(std::FILE* out, const RunRecord& r) {
 
 // With --branches: where the cloud parts, each side's cut along the axis (as --cuts takes
 // it) and its branches' point counts.
+// ", 2 branches grafted (41 triangles of the trunk taken out)", or nothing.
+std::string grafted_note(const stratmesh::JoinReport& j) {
+    if (j.branches_grafted == 0) return "";
+    return ", " + std::to_string(j.branches_grafted) + " branch" +
+           (j.branches_grafted == 1 ? "" : "es") + " grafted (" +
+           std::to_string(j.triangles_removed) + " triangles of the trunk taken out)";
+}
+
 void print_branches(std::FILE* out, const RunRecord& r) {
     if (!r.parting_run) return;
     const stratmesh::Parting& p = r.parting;
@@ -147,10 +155,11 @@ void print_split(std::FILE* out, const RunRecord& r) {
     const stratmesh::JoinReport& j = r.junction;
     if (r.junction_status != stratmesh::Status::ok)
         std::fprintf(out, "             not joined: %s\n", stratmesh::status_string(r.junction_status));
-    else if (j.sides_joined > 0)
-        std::fprintf(out, "             joined at %u side%s by %zu triangles%s\n", j.sides_joined,
+    else if (j.sides_joined > 0 || j.branches_grafted > 0)
+        std::fprintf(out, "             joined at %u side%s by %zu triangles%s%s\n", j.sides_joined,
                      j.sides_joined == 1 ? "" : "s", j.triangles_added,
-                     j.sides_left_apart ? " (one side left apart)" : "");
+                     j.sides_left_apart ? " (a side left apart)" : "",
+                     grafted_note(j).c_str());
     if (j.detail)
         std::fprintf(out, "             %s%s\n", j.sides_joined ? "" : "left apart: ", j.detail);
 }

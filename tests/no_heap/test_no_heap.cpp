@@ -418,7 +418,7 @@ TEST_CASE("find_parting allocates nothing: a fork found and labelled, no parting
 }
 
 TEST_CASE("join_branches allocates nothing: a fork's parts traced and planned, refusals") {
-    // The fork's prongs stand on its dome: the side is planned and left apart.
+    // The fork's prongs stand on its dome: each is grafted onto a hole cut in it.
     const shapes::Shape fork = shapes::forked_tube(20000, shapes::Pose::z);
     const stratmesh::Options z = no_heap::z_axis();
     const stratmesh::Cloud cloud = {fork.xyz.data(), fork.size(), 0, stratmesh::Scalar::float64};
@@ -464,7 +464,7 @@ TEST_CASE("join_branches allocates nothing: a fork's parts traced and planned, r
     });
     CHECK(n == 0);
     CHECK(statuses[0] == stratmesh::Status::ok);
-    CHECK(planned.sides_left_apart == 1);
+    CHECK(planned.branches_grafted == 2);  // the fork stands on a dome: grafted, holes and all
     CHECK(statuses[1] == stratmesh::Status::out_of_memory);
 }
 

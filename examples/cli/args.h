@@ -25,8 +25,12 @@ struct CommandLine {
     bool drop_outliers = false;    // --drop-outliers (stratmesh::drop_outliers)
     bool surface_flips = true;     // off with --unrolled-delaunay (stratmesh::surface_flips)
     bool open_ends = false;        // --open-ends (stratmesh::open_ends)
-    bool find_branches = false;    // --branches: where the cloud parts (stratmesh::find_parting)
-    bool split_branches = false;   // --split-branches: mesh the trunk and each branch apart
+    // Where the cloud parts into branches (stratmesh::find_parting). Without any of these
+    // three the tool looks, meshes the parts apart and joins them, and keeps that only if
+    // every part was meshed and joined (else one tube, see main.cpp).
+    bool find_branches = false;    // --branches: only find and report where it parts
+    bool split_branches = false;   // --split-branches: keep the parts, joined or apart
+    bool one_tube = false;         // --one-tube: do not look; one tube through every point
     bool quiet = false;
     uint32_t threads = 1;           // --threads (default: the hardware's threads, at least 1)
     bool stream = false;            // --stream: read and reconstruct layer by layer

@@ -84,6 +84,7 @@ void record_command_line(const CommandLine& line, RunRecord& record) {
     record.open_ends = line.open_ends;
     record.find_branches = line.find_branches;
     record.split_branches = line.split_branches;
+    record.one_tube = line.one_tube;
     record.threads = line.threads;
     record.origin_given = line.origin_given || line.stream;
     for (size_t k = 0; k < 3; ++k) record.origin[k] = line.origin[k];
@@ -262,14 +263,51 @@ bool join_parts(const std::vector<double>& xyz, const CommandLine& line,
     return true;
 }
 
-// --split-branches where the cloud parts: the trunk (the points labelled kInTrunk) with the
+// Caps the joined parts' boundary loops (cap_ends), its counts into the record's report.
+// False if buffers cannot be allocated.
+bool cap_parts(const std::vector<double>& xyz, const CommandLine& line,
+               std::vector<uint32_t>& all, RunRecord& record) {
+    ProgressMonitor silent(false, stderr);
+    ThreadJobs jobs;
+    const stratmesh::Options options = make_options(line, silent, jobs);
+    const size_t count = xyz.size() / 3, given = all.size() / 3;
+    const size_t bytes = stratmesh::cap_ends_workspace_size(count, given);
+    std::unique_ptr<unsigned char, FreeDeleter> workspace = allocate<unsigned char>(bytes);
+    if (!workspace) {
+        std::fprintf(stderr, "stratmesh: cannot allocate %zu bytes to cap the ends\n", bytes);
+        return false;
+    }
+    const Clock::time_point start = Clock::now();
+    // A vertex-manifold surface passes each vertex at most once along its boundary loops,
+    // so the caps add fewer triangles than there are points.
+    all.resize(3 * (given + count));
+    size_t capped = given;
+    const stratmesh::Cloud cloud = {xyz.data(), count, 0, stratmesh::Scalar::float64};
+    stratmesh::Report caps = {};
+    const stratmesh::Status status =
+        stratmesh::cap_ends(cloud, options, workspace.get(), bytes, all.data(), all.size() / 3,
+                            &capped, &caps);
+    all.resize(3 * (status == stratmesh::Status::ok ? capped : given));
+    stratmesh::Report& whole = record.report;
+    whole.caps_closed = caps.caps_closed;
+    whole.caps_left_open = caps.caps_left_open;
+    whole.cap_triangles = caps.cap_triangles;
+    whole.cap_wall_flips = caps.cap_wall_flips;
+    record.reconstruct_seconds += seconds_since(start);
+    return true;
+}
+
+// Where the cloud parts (by default or with --split-branches): the trunk (the points labelled kInTrunk) with the
 // options given, through reconstruct_points (its report becomes the record's, with the
 // whole cloud's counts and the branches' time), then each branch around its own automatic
 // axis and layers, every part's triangles into `result` with the whole cloud's indices.
 // False if buffers cannot be allocated.
-bool reconstruct_split(const std::vector<double>& xyz, const CommandLine& line,
+bool reconstruct_split(const std::vector<double>& xyz, const CommandLine& given,
                        const std::vector<uint8_t>& labels, Reconstruction& result,
                        RunRecord& record) {
+    // With --cap the parts are capped once joined: capped apart, they could not be.
+    CommandLine line = given;
+    line.cap = false;
     std::vector<uint32_t> indices;
     const std::vector<double> trunk = points_labelled(xyz, labels, stratmesh::kInTrunk, indices);
     Reconstruction part;
@@ -323,6 +361,7 @@ bool reconstruct_split(const std::vector<double>& xyz, const CommandLine& line,
     whole.points_in = labels.size();
     whole.unused = whole.points_in - whole.points_used - whole.duplicates - whole.rejected;
     if (!join_parts(xyz, line, labels, all, record)) return false;
+    if (given.cap && !cap_parts(xyz, given, all, record)) return false;
     whole.triangle_count = all.size() / 3;
     result.triangle_count = all.size() / 3;
     result.triangles = allocate<uint32_t>(all.size());
@@ -331,8 +370,8 @@ bool reconstruct_split(const std::vector<double>& xyz, const CommandLine& line,
     return true;
 }
 
-// With --branches: where the cloud parts, into the record, and each point's branch into
-// `labels` (with --split-branches). False if the buffer cannot be allocated.
+// Where the cloud parts, into the record, and each point's branch into `labels` (unless
+// --branches only asks where). False if the buffer cannot be allocated.
 bool find_branches(const std::vector<double>& xyz, const CommandLine& line,
                    std::vector<uint8_t>& labels, RunRecord& record) {
     ProgressMonitor silent(false, stderr);
@@ -347,13 +386,23 @@ bool find_branches(const std::vector<double>& xyz, const CommandLine& line,
     }
     const stratmesh::Cloud cloud = {xyz.data(), count, 0, stratmesh::Scalar::float64};
     Clock::time_point start = Clock::now();
-    if (line.split_branches) labels.assign(count, stratmesh::kInTrunk);
+    if (!line.find_branches) labels.assign(count, stratmesh::kInTrunk);
     record.parting_status =
         stratmesh::find_parting(cloud, options, workspace.get(), bytes, &record.parting,
                                 labels.empty() ? nullptr : labels.data());
     record.branches_seconds = seconds_since(start);
     record.parting_run = true;
     return true;
+}
+
+// Whether the split meshed every part and joined every side, with every point in a part.
+bool split_complete(const std::vector<uint8_t>& labels, const RunRecord& record) {
+    if (record.status != stratmesh::Status::ok || !record.junction_run ||
+        record.junction_status != stratmesh::Status::ok || record.junction.sides_left_apart > 0)
+        return false;
+    for (const RunRecord::SplitPart& part : record.split)
+        if (part.status != stratmesh::Status::ok) return false;
+    return std::find(labels.begin(), labels.end(), stratmesh::kBeyondBranches) == labels.end();
 }
 
 void explain_refusal(const CommandLine& line, const RunRecord& record) {
@@ -434,16 +483,27 @@ int run(const CommandLine& line) {
     Reconstruction result;
     if (!read_input(line, xyz, record)) return kExitFile;
     std::vector<uint8_t> labels;
-    if (line.find_branches && !find_branches(xyz, line, labels, record)) return kExitRefused;
+    const bool automatic = !line.one_tube && !line.find_branches && !line.split_branches;
+    if ((automatic || line.find_branches || line.split_branches) &&
+        !find_branches(xyz, line, labels, record))
+        return kExitRefused;
     // A trunk of fewer points than a branch is no trunk: the cloud is apart all along
     // (separate objects), and is meshed as one tube.
-    const bool split = line.split_branches && record.parting_status == stratmesh::Status::ok &&
+    const bool split = (automatic || line.split_branches) &&
+                       record.parting_status == stratmesh::Status::ok &&
                        record.parting.branches_above + record.parting.branches_below > 0 &&
                        std::count(labels.begin(), labels.end(), stratmesh::kInTrunk) >=
                            static_cast<std::ptrdiff_t>(stratmesh::kSmallestBranch);
     if (!(split ? reconstruct_split(xyz, line, labels, result, record)
                 : reconstruct_points(xyz, line, result, record)))
         return kExitRefused;
+    if (split && automatic && !split_complete(labels, record)) {
+        // Parts left apart or points left out would be worse than the one tube's wrap.
+        const double split_seconds = record.reconstruct_seconds;
+        record.split_undone = true;
+        if (!reconstruct_points(xyz, line, result, record)) return kExitRefused;
+        record.reconstruct_seconds += split_seconds;
+    }
     if (record.status != stratmesh::Status::ok) return refuse(line, record);
     if (!write_output(line, xyz, result, record)) return kExitFile;
     return finish_run(line, record);

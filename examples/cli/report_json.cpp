@@ -202,6 +202,7 @@ void write_options(JsonWriter& j, const RunRecord& r) {
     j.flag_field("open_ends", r.open_ends);
     j.flag_field("branches", r.find_branches);
     j.flag_field("split_branches", r.split_branches);
+    j.flag_field("one_tube", r.one_tube);
     j.count_field("threads", r.threads);
     j.flag_field("stream", r.stream);
     j.key("stream_points");
@@ -455,6 +456,7 @@ std::string run_record_json(const RunRecord& record) {
     write_stream(j, record);
     write_branches(j, record);
     write_split(j, record);
+    j.flag_field("split_undone", record.split_undone);
     write_junction(j, record);
     write_costs(j, record);
     j.end_object();

@@ -37,6 +37,7 @@ struct RunRecord {
     bool open_ends = false;
     bool find_branches = false;
     bool split_branches = false;
+    bool one_tube = false;
     uint32_t threads = 1;
     bool origin_given = false;
     double origin[3] = {0, 0, 0};
@@ -61,7 +62,7 @@ struct RunRecord {
     bool parting_run = false;
     stratmesh::Status parting_status = stratmesh::Status::ok;
     stratmesh::Parting parting = {};
-    // With --split-branches where the cloud parts: each tube meshed apart, the trunk first
+    // Where the cloud parts and the parts are meshed: each tube meshed apart, the trunk first
     // (whose report, with the whole cloud's counts, is `report`).
     struct SplitPart {
         std::string name;       // "trunk", "branch above 1", "branch below 2", ...
@@ -70,7 +71,10 @@ struct RunRecord {
         size_t layers = 0, triangles = 0, folds = 0;
     };
     std::vector<SplitPart> split;
-    // With --split-branches where the cloud parts: join_branches()'s status and report.
+    // By default where the cloud parts: the parts were meshed but not kept (a side left
+    // apart, a part not meshed, points in no part), the cloud meshed as one tube instead.
+    bool split_undone = false;
+    // Where the cloud parts and the parts were meshed: join_branches()'s status and report.
     bool junction_run = false;
     stratmesh::Status junction_status = stratmesh::Status::ok;
     stratmesh::JoinReport junction = {};

@@ -139,7 +139,7 @@ void print_branches(std::FILE* out, const RunRecord& r) {
                           "each side apart\n             (README, \"Where the cloud parts\")\n");
 }
 
-// With --split-branches where the cloud parts: each tube meshed apart.
+// Where the cloud parts and the parts are meshed: each tube meshed apart.
 void print_split(std::FILE* out, const RunRecord& r) {
     if (r.split.empty()) return;
     for (size_t k = 0; k < r.split.size(); ++k) {
@@ -162,6 +162,9 @@ void print_split(std::FILE* out, const RunRecord& r) {
                      grafted_note(j).c_str());
     if (j.detail)
         std::fprintf(out, "             %s%s\n", j.sides_joined ? "" : "left apart: ", j.detail);
+    if (r.split_undone)
+        std::fprintf(out, "             not kept: meshed as one tube instead (--split-branches "
+                          "keeps the parts)\n");
 }
 
 void print_costs(std::FILE* out, const RunRecord& r) {

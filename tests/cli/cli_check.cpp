@@ -90,6 +90,15 @@ std::vector<double> forked_points() {
     return xyz;
 }
 
+// The fork and a speck of 12 points 0.5 apart 20 above its prongs: beyond the cut but in
+// no branch (find_parting's kBeyondBranches).
+std::vector<double> forked_speck_points() {
+    std::vector<double> xyz = forked_points();
+    for (int i = 0; i < 12; ++i)
+        xyz.insert(xyz.end(), {0.5 * (i % 3), 0.5 * (i / 3 % 2), 120 + 0.5 * (i / 6)});
+    return xyz;
+}
+
 // The cylinder and 9 stray points: 6 single ones 3 to 10 heights away, and a speck of 3
 // points 0.1 apart above it.
 std::vector<double> with_strays(std::vector<double> xyz) {
@@ -159,6 +168,8 @@ int make_inputs(const std::string& dir) {
               write_file(dir + "/cylinder.xyz", as_xyz(cylinder, 0)) &&
               write_file(dir + "/twin_tubes.xyz", as_xyz(twin_tube_points(3000), 0, "two cylinders")) &&
               write_file(dir + "/forked.xyz", as_xyz(forked_points(), 0, "a forked tube")) &&
+              write_file(dir + "/forked_speck.xyz",
+                         as_xyz(forked_speck_points(), 0, "a forked tube and a speck")) &&
               write_file(dir + "/cylinder_nan.xyz", as_xyz(cylinder, 500)) &&
               write_file(dir + "/cylinder_strays.xyz", as_xyz(with_strays(cylinder), 0)) &&
               write_file(dir + "/cylinder_obj.ply", as_obj(cylinder)) &&

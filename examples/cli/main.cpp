@@ -297,10 +297,11 @@ bool cap_parts(const std::vector<double>& xyz, const CommandLine& line,
     return true;
 }
 
-// Where the cloud parts (by default or with --split-branches): the trunk (the points labelled kInTrunk) with the
-// options given, through reconstruct_points (its report becomes the record's, with the
-// whole cloud's counts and the branches' time), then each branch around its own automatic
-// axis and layers, every part's triangles into `result` with the whole cloud's indices.
+// Where the cloud parts (by default or with --split-branches): the trunk (the points
+// labelled kInTrunk) with the options given, through reconstruct_points (its report becomes
+// the record's, with the whole cloud's counts and the branches' time), then each branch
+// around its own automatic axis and layers, every part's triangles into `result` with the
+// whole cloud's indices; with --cap the joined parts are capped.
 // False if buffers cannot be allocated.
 bool reconstruct_split(const std::vector<double>& xyz, const CommandLine& given,
                        const std::vector<uint8_t>& labels, Reconstruction& result,

@@ -45,10 +45,13 @@ PartingRun find_parting_of(const Cloud& cloud, const Options& options,
 // The single-linkage pieces (points nearer than `gap` join) of the points on one side of
 // `cut` along the unit `axis` (at or above it, or below it) that count: at least `least`
 // points and a twentieth of the side, the nearest within a gap of the cut; by brute force
-// over every pair. piece[i] numbers point i's piece, largest first, or is -1.
+// over every pair. piece[i] numbers point i's piece, largest first, or is -1;
+// starts_at_cut[i] tells whether point i's piece, counted or not, has a point within a gap
+// of the cut.
 struct Pieces {
     std::vector<size_t> sizes;
     std::vector<int> piece;
+    std::vector<bool> starts_at_cut;
 };
 
 Pieces pieces_beyond(const Shape& s, const double axis[3], double cut, bool above, double gap,
@@ -89,6 +92,8 @@ Pieces pieces_beyond(const Shape& s, const double axis[3], double cut, bool abov
     std::stable_sort(roots.begin(), roots.end(), [&](size_t a, size_t b) { return size[a] > size[b]; });
     Pieces out;
     out.piece.assign(s.size(), -1);
+    out.starts_at_cut.assign(s.size(), false);
+    for (size_t i : side) out.starts_at_cut[i] = nearest[root(i)] <= gap;
     for (size_t k = 0; k < roots.size(); ++k) out.sizes.push_back(size[roots[k]]);
     for (size_t i : side)
         for (size_t k = 0; k < roots.size(); ++k)
@@ -148,14 +153,22 @@ TEST_CASE("find_parting: the prongs of a forked tube part above its dome, as sin
         CHECK(p.above_points[0] >= p.above_points[1]);
         const Pieces pieces = pieces_beyond(s, axis, p.above, true, p.gap, stratmesh::kSmallestBranch);
         CHECK(reported(p.above_points, p.branches_above) == pieces.sizes);
-        // Each point's label: a prong's points, the trunk's, those left aside above the cut.
+        // Each point's label: a prong's points, the trunk's (below the cut, and the dome's
+        // crown above it: a piece too small to count that starts at the cut), those left
+        // aside above the cut (a prong's tip broken off).
         check_labels(pieces, label, stratmesh::kFirstAboveBranch, p.branches_above);
+        size_t crown = 0;
         for (size_t i = 0; i < s.size(); ++i) {
             const double* q = s.point(i);
             const double h = q[0] * axis[0] + q[1] * axis[1] + q[2] * axis[2];
             if (h < p.above) CHECK(label[i] == stratmesh::kInTrunk);
-            if (h >= p.above && pieces.piece[i] < 0) CHECK(label[i] == stratmesh::kBeyondBranches);
+            if (h >= p.above && pieces.piece[i] < 0) {
+                CHECK(label[i] == (pieces.starts_at_cut[i] ? stratmesh::kInTrunk
+                                                           : stratmesh::kBeyondBranches));
+                crown += pieces.starts_at_cut[i];
+            }
         }
+        CHECK(crown > 0);  // the case this checks arises
         CHECK(run.parting.workspace_used <= run.workspace_bytes);
         CHECK(run.parting.detail == nullptr);
     }

@@ -297,6 +297,45 @@ bool cap_parts(const std::vector<double>& xyz, const CommandLine& line,
     return true;
 }
 
+// A closed end projects from a pole one radius in from the end, but at most three quarters
+// of the way into its layer (stratmesh's kPoleDepth, find_closed_ends): so an end layer
+// at least this many radii tall has its pole a full radius in.
+const double kPoleLayerRadii = 4.0 / 3.0;
+
+// Where branches stand on a closed end of the trunk (the end layer at a side that parts is
+// closed, as under horns on a skull), the cuts that merge that end layer with the layers
+// next to it until it is kPoleLayerRadii times the largest of their radii tall; false
+// where no end needs it. A thinner end layer projects from a pole too near the end: the
+// branches' stumps in it fold over the crown, and their grafts cross the trunk beside
+// them (the bust with horns in 4 to 16 trunk layers: 24 to 117 self-intersecting pairs,
+// or a graft refused; merged, none; README, "Where the cloud parts"). The trunk's layers
+// are the record's. *merged counts the layers merged away.
+bool cuts_for_tall_ends(const RunRecord& record, std::vector<double>& cuts, size_t* merged) {
+    const std::vector<stratmesh::LayerInfo>& layers = record.layers;
+    const size_t n = layers.size();
+    if (n < 2 || record.report.layer_count != n) return false;
+    size_t first = 0, last = n - 1;  // the layers kept whole: [first, last]
+    if (record.parting.branches_above > 0 && (layers[n - 1].closed_ends & stratmesh::closed_top)) {
+        double radius = layers[last].radius;
+        while (last > 0 && layers[n - 1].top - layers[last].bottom < kPoleLayerRadii * radius) {
+            --last;
+            radius = std::max(radius, layers[last].radius);
+        }
+    }
+    if (record.parting.branches_below > 0 && (layers[0].closed_ends & stratmesh::closed_bottom)) {
+        double radius = layers[first].radius;
+        while (first < last && layers[first].top - layers[0].bottom < kPoleLayerRadii * radius) {
+            ++first;
+            radius = std::max(radius, layers[first].radius);
+        }
+    }
+    if (first == 0 && last == n - 1) return false;
+    cuts.clear();
+    for (size_t k = first; k < last; ++k) cuts.push_back(layers[k].top);
+    *merged = n - 1 - cuts.size();
+    return true;
+}
+
 // Where the cloud parts (by default or with --split-branches): the trunk (the points
 // labelled kInTrunk) with the options given, through reconstruct_points (its report becomes
 // the record's, with the whole cloud's counts and the branches' time), then each branch
@@ -313,8 +352,22 @@ bool reconstruct_split(const std::vector<double>& xyz, const CommandLine& given,
     const std::vector<double> trunk = points_labelled(xyz, labels, stratmesh::kInTrunk, indices);
     Reconstruction part;
     if (!reconstruct_points(trunk, line, part, record)) return false;
+    std::vector<double> cuts;
+    size_t merged = 0;
+    if (record.status == stratmesh::Status::ok && cuts_for_tall_ends(record, cuts, &merged)) {
+        // Again along the same axis, through the layers' own cuts but those merged.
+        CommandLine tall = line;
+        tall.axis = stratmesh::Axis::direction;
+        for (size_t k = 0; k < 3; ++k) tall.direction[k] = record.report.axis[k];
+        tall.cuts = cuts;
+        tall.layer_count = cuts.empty() ? 1 : 0;
+        tall.layer_height = 0;
+        const double first_seconds = record.reconstruct_seconds;
+        if (!reconstruct_points(trunk, tall, part, record)) return false;
+        record.reconstruct_seconds += first_seconds;
+    }
     record.split.push_back({"trunk", indices.size(), record.status, record.report.layer_count,
-                            part.triangle_count, record.report.folds});
+                            part.triangle_count, record.report.folds, merged});
     if (record.status != stratmesh::Status::ok) return true;
     std::vector<uint32_t> all;
     append_part(part, indices, all);

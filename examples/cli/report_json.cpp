@@ -308,6 +308,7 @@ void write_split(JsonWriter& j, const RunRecord& r) {
         j.count_field("layers", part.layers);
         j.count_field("triangles", part.triangles);
         j.count_field("folds", part.folds);
+        j.count_field("end_layers_merged", part.end_layers_merged);
         j.end_object();
     }
     j.end_array();

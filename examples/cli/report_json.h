@@ -69,6 +69,7 @@ struct RunRecord {
         size_t points = 0;
         stratmesh::Status status = stratmesh::Status::ok;
         size_t layers = 0, triangles = 0, folds = 0;
+        size_t end_layers_merged = 0;  // the trunk's: merged into an end under branches
     };
     std::vector<SplitPart> split;
     // By default where the cloud parts: the parts were meshed but not kept (a side left

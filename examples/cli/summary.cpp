@@ -145,11 +145,17 @@ void print_split(std::FILE* out, const RunRecord& r) {
     for (size_t k = 0; k < r.split.size(); ++k) {
         const RunRecord::SplitPart& part = r.split[k];
         const bool ok = part.status == stratmesh::Status::ok;
-        std::fprintf(out, "  %s %s, %zu points: %s%zu layer%s, %zu triangles, %zu folds\n",
+        const std::string merged =
+            part.end_layers_merged == 0
+                ? ""
+                : " (" + std::to_string(part.end_layers_merged) + " merged into its closed end " +
+                      "under the branches)";
+        std::fprintf(out, "  %s %s, %zu points: %s%zu layer%s%s, %zu triangles, %zu folds\n",
                      k == 0 ? "split     " : "          ", part.name.c_str(), part.points,
                      ok ? "" : (std::string(stratmesh::status_string(part.status)) +
                                 " (its points unused); ").c_str(),
-                     part.layers, part.layers == 1 ? "" : "s", part.triangles, part.folds);
+                     part.layers, part.layers == 1 ? "" : "s", merged.c_str(), part.triangles,
+                     part.folds);
     }
     if (!r.junction_run) return;
     const stratmesh::JoinReport& j = r.junction;

@@ -132,7 +132,7 @@
 // end of the workspace when they fit above what it has taken, and loads each layer from
 // there as long as the layers before it have left that room untouched, instead of reading
 // the cloud at random once per layer. The output is the same either way, and
-// Report::workspace_used leaves that room out (it is the least workspace that suffices).
+// Report::workspace_used_bytes leaves that room out (it is the least workspace that suffices).
 //
 // Stack: no recursion anywhere. The exact incircle's expansions (about 8 KiB) live in the
 // workspace when called from the triangulation, and on the stack only when you call
@@ -191,7 +191,7 @@
 //   are built, removes (and counts) any triangle that would break that, keeping the seams
 //   between them manifold too. The stream's output has the same guarantee. The output is
 //   not guaranteed free of self-intersections where a layer is
-//   not star-shaped around its centre (Report::folds counts the triangles facing the
+//   not star-shaped around its centre (Report::diagnostics.fold_count counts the triangles facing the
 //   axis there); a layer that folds is unrolled around the centre, of 25 tried, where it
 //   folds least (see "the centre search" in >>layer triangulation).
 // - reconstruct's triangles depend on the order of the points, not only on their
@@ -269,8 +269,8 @@ struct Delaunay2dInfo {
     size_t triangle_count;      // triangles written (or needed, on triangle_capacity)
     size_t duplicate_count;     // points that repeat an earlier point's coordinates
     size_t hull_vertex_count;   // points on the convex hull boundary, collinear ones too
-    size_t first_invalid_point; // index of the first NaN/Inf point, on invalid_point
-    size_t workspace_used;      // peak workspace bytes, from the start of the buffer
+    size_t first_invalid_index; // index of the first NaN/Inf point, on invalid_point
+    size_t workspace_used_bytes;      // peak workspace bytes, from the start of the buffer
 };
 
 // A size in bytes that is always enough workspace for delaunay_2d of point_count points;
@@ -337,7 +337,7 @@ enum class Axis : uint32_t {
 };
 
 enum Flags : uint32_t {
-    // NaN/Inf points are skipped and counted (Report::rejected) instead of refused with
+    // NaN/Inf points are skipped and counted (Report::points.rejected_count) instead of refused with
     // Status::invalid_point.
     skip_invalid_points = 1u << 0,
     // Closes the surface's boundary loops with caps, so a tube becomes a closed, edge- and
@@ -351,10 +351,10 @@ enum Flags : uint32_t {
     // with two edges on the loop) leave no such cap, the edge under a fin may be flipped
     // (the fin and the triangle beyond it become two others: same corners, same count; the
     // loop unchanged), which frees its chord for the cap; only flips the cap then uses are
-    // made (Report::cap_wall_flips counts them). A loop whose projection is not a simple
+    // made (Report::caps.wall_flip_count counts them). A loop whose projection is not a simple
     // polygon, or that neither ear clipping nor (for loops of at most 256 corners) an
     // exhaustive search closes, with or without those flips, stays open: the call
-    // still returns ok, Report::caps_left_open counts it and Report::detail says so. Caps
+    // still returns ok, Report::caps.open_count counts it and Report::detail says so. Caps
     // do not cross one another; like the rest of the surface, they are not checked against
     // the tube. The workspace bound grows by about 6 bytes per point with this flag, plus
     // up to 32 KiB for that search; reconstruct_max_triangles() still suffices (a closed
@@ -367,8 +367,8 @@ enum Flags : uint32_t {
     // the same one.
     origin_given = 1u << 2,
     // Points far from the rest of the cloud (stray returns, flying pixels, specks of fewer
-    // than 8 points) are left out before anything else and counted (Report::outliers, part
-    // of Report::rejected), so they neither tilt the automatic axis nor stretch the layers
+    // than 8 points) are left out before anything else and counted (Report::points.outlier_count, part
+    // of Report::points.rejected_count), so they neither tilt the automatic axis nor stretch the layers
     // nor become spikes: a point with fewer than 8 points, itself included, within 4 to 12
     // times the distance that nine points in ten have to their nearest neighbour (the rule
     // is "outliers" in >>layers). Meant for raw sensor clouds; off by default, since
@@ -445,7 +445,7 @@ struct Options {
     // the two layers together narrow; a half cylinder's gap stays); a layer with triangles
     // facing the axis is joined with the next one or two where that leaves fewer (see
     // "folding layers" at add_group); the report lists the layers actually used
-    // (Report::layers: bottom and top).
+    // (Report::layers.info: bottom and top).
     const double* cuts;
     size_t cut_count;
     uint32_t layer_count;
@@ -460,9 +460,9 @@ struct Options {
     // independent jobs (at most kMaxJobs of them, each over a run of consecutive layers with
     // its own scratch in the workspace); grouping layers, stitching them and the safety net
     // stay in order. The triangles and the report are the same bytes whatever the runner
-    // does (see JobRunner), Report::parallel_layers aside.
+    // does (see JobRunner), Report::layers.parallel_count aside.
     // reconstruct_workspace_size() grows with a runner (see there); a workspace too small
-    // for the jobs' scratch runs them in order instead (Report::parallel_layers says how
+    // for the jobs' scratch runs them in order instead (Report::layers.parallel_count says how
     // many layers were triangulated by jobs). Jobs call no user code, not even progress.
     JobRunner run_jobs;
     void* jobs_user;
@@ -490,54 +490,69 @@ struct LayerInfo {
     uint32_t closed_ends;    // ClosedEnd bits: which of the layer's ends closes the surface
 };
 
+// Report::points. in_count = used_count + duplicate_count + rejected_count + unused_count,
+// on every status.
+struct PointCounts {
+    size_t in_count;         // points given (the stream: pushed so far)
+    size_t used_count;       // vertices of the output
+    size_t duplicate_count;  // same coordinates as a lower-indexed point: merged into it
+    size_t rejected_count;   // NaN/Inf (with skip_invalid_points), and outliers
+    size_t outlier_count;    // of rejected_count: left out by the drop_outliers flag
+    size_t unused_count;     // valid but not a vertex (Report::detail says why); repeats of
+                             // a point that is itself unused count here, not as duplicates
+    size_t first_invalid_index;  // on Status::invalid_point: the first NaN/Inf point
+    size_t held_count;       // the stream only: the most points it held at once (compare
+                             // with the max_points_held given to stream_workspace_size())
+};
+
+// Report::layers.
+struct LayerCounts {
+    size_t used_count;       // layers of the output
+    size_t parallel_count;   // of those, triangulated by Options::run_jobs' jobs (0 without
+                             // a runner, or when the workspace was too small for the jobs)
+    // Optional per-layer details: the caller points `info` at an array of `info_capacity`
+    // entries; the first min(used_count, info_capacity) are filled.
+    LayerInfo* info;
+    size_t info_capacity;
+};
+
+// Report::caps, with close_ends (and from cap_ends()); all 0 without it.
+struct CapCounts {
+    size_t closed_count;     // boundary loops closed by a cap
+    size_t open_count;       // loops left open: their projection across the axis is not a
+                             // simple polygon, or every cap found would repeat an edge
+    size_t triangle_count;   // the caps' triangles: the last ones of the output, included
+                             // in Report::triangle_count
+    size_t wall_flip_count;  // the surface's edges flipped under fins so that a loop could
+                             // be capped, each changing two triangles in place (see
+                             // close_ends); 0 in STRATMESH_SMALL_CODE
+};
+
+// Report::diagnostics: what a user checks before trusting the mesh.
+struct Diagnostics {
+    size_t fold_count;             // output triangles whose normal faces the axis
+    size_t illegal_removed_count;  // triangles removed by the manifold safety net
+    size_t diagonal_swap_count;    // band diagonals swapped when stitching layers
+};
+
 struct Report {
-    // points_in = points_used + duplicates + rejected + unused, always.
-    size_t points_in;
-    size_t points_used;      // vertices of the output
-    size_t duplicates;       // same coordinates as a lower-indexed point: merged into it
-    size_t rejected;         // NaN/Inf (with skip_invalid_points), and outliers
-    size_t outliers;         // of rejected: left out by the drop_outliers flag
-    size_t unused;           // valid but not a vertex (see `detail`); repeats of a point
-                             // that is itself unused count here, not as duplicates
-    size_t first_invalid_point;  // on Status::invalid_point
     size_t triangle_count;
-    size_t illegal_removed;  // triangles removed by the manifold safety net
-    size_t folds;            // output triangles whose normal faces the axis
     double axis[3];          // unit axis used
     double axis_origin[3];   // a point on it
-    size_t layer_count;
-    // Optional per-layer details: the caller points `layers` at an array of
-    // `layer_capacity` entries; the first min(layer_count, layer_capacity) are filled.
-    LayerInfo* layers;
-    size_t layer_capacity;
+    PointCounts points;
+    LayerCounts layers;
+    CapCounts caps;
+    Diagnostics diagnostics;
     const char* detail;      // a static sentence on why, when something failed or was dropped
     // The workspace bytes this call used at its peak, counted from the start of the
     // buffer: a buffer of exactly this size at the same address suffices for the same
     // input, one byte less does not. Compare with reconstruct_workspace_size().
-    size_t workspace_used;
-    size_t diagonal_swaps;   // band diagonals swapped when stitching layers (paper's step 4)
-    // With close_ends: boundary loops closed by a cap, loops left open (their projection
-    // across the axis is not a simple polygon, or every cap found for them would repeat
-    // edges of the surface), and the cap triangles, which are the last
-    // cap_triangles of the output (included in triangle_count). All 0 without the flag.
-    size_t caps_closed;
-    size_t caps_left_open;
-    size_t cap_triangles;
-    // With close_ends (and from cap_ends()): the surface's edges flipped under fins so that
-    // a loop could be capped; each changed two triangles of the surface in place (see
-    // close_ends). 0 where every loop closed without them, and in STRATMESH_SMALL_CODE.
-    size_t cap_wall_flips;
-    // The stream only: the most points it held at once (compare with the max_points_held
-    // given to stream_workspace_size()).
-    size_t points_held;
-    // With Options::run_jobs: the layers triangulated by jobs (0 if the workspace was too
-    // small for them, or without a runner).
-    size_t parallel_layers;
+    size_t workspace_used_bytes;
 };
 
 // A size in bytes that is always enough workspace for reconstruct() of point_count
 // points with these options. It assumes the worst layout (every point in one layer);
-// Report::workspace_used tells what a run really needed, which follows its largest layer
+// Report::workspace_used_bytes tells what a run really needed, which follows its largest layer
 // (measured on 2000-point tubes: the bound is 1.05 times the peak for one layer, 3.1 to
 // 3.3 times it with six or more layers). With Options::run_jobs it also covers the
 // layers triangulated ahead and the jobs' scratch (about 166 bytes per point instead of
@@ -579,7 +594,7 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // drop_outliers in a build with STRATMESH_SMALL_CODE, or any two of the span of the cloud's
 // points, the workspace, the triangle array, *triangle_count, *report and the report's
 // layer array sharing a byte: then nothing at all is written, not even the report);
-// too_many_points; invalid_point (Report::first_invalid_point, unless
+// too_many_points; invalid_point (Report::points.first_invalid_index, unless
 // skip_invalid_points); invalid_axis (an unknown Axis, or Axis::direction zero, NaN,
 // infinite, or of a length outside 1.5e-154 to 1.3e154);
 // invalid_layers (a NaN or infinite cut, more than 2^32 - 2 cuts, a negative or
@@ -628,7 +643,7 @@ Status reconstruct(const Cloud& cloud, const Options& options,
 // included) and the pushes after it until they can form a layer: when every push is at
 // least 16 points and 1.5 rows of points thick and none is a crescent, three times the
 // largest push suffices.
-// A push that would hold more returns out_of_memory and changes nothing; Report::points_held
+// A push that would hold more returns out_of_memory and changes nothing; Report::points.held_count
 // says what a run needed.
 
 struct Stream;  // lives in the caller's workspace
@@ -711,8 +726,8 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count);
 // change, in place. options: axis, direction, origin (with
 // origin_given) and skip_invalid_points as given to the stream or reconstruct(); the rest
 // is not used. report (optional): only caps_closed, caps_left_open, cap_triangles,
-// cap_wall_flips, workspace_used (this call's) and detail are set, the rest left as it
-// is: the stream's report can be passed, its counts kept (its workspace_used replaced).
+// cap_wall_flips, workspace_used_bytes (this call's) and detail are set, the rest left as it
+// is: the stream's report can be passed, its counts kept (its workspace_used_bytes replaced).
 // Returns ok (loops whose projection is not simple stay open: caps_left_open);
 // invalid_argument (a null triangle_count, triangles or workspace where needed, a bad
 // stride or scalar, *triangle_count above triangle_capacity, an index outside the cloud or
@@ -765,16 +780,16 @@ struct Parting {
                               // grid, as drop_outliers measures it): nothing is found then
     double axis[3];           // unit axis used, as Report::axis
     // The lowest cut, as dot(point, axis), above which the points part into
-    // branches_above branches (0: no cut where they do; `above` is then 0).
+    // above_branch_count branches (0: no cut where they do; `above` is then 0).
     double above;
-    uint32_t branches_above;
-    // The highest cut below which the points part into branches_below branches.
+    uint32_t above_branch_count;
+    // The highest cut below which the points part into below_branch_count branches.
     double below;
-    uint32_t branches_below;
-    // The branches' point counts, largest first (branches_above and branches_below of them).
-    uint32_t above_points[kMaxBranches];
-    uint32_t below_points[kMaxBranches];
-    size_t workspace_used;    // peak workspace bytes, from the start of the buffer
+    uint32_t below_branch_count;
+    // The branches' point counts, largest first (above_branch_count and below_branch_count of them).
+    uint32_t above_point_counts[kMaxBranches];
+    uint32_t below_point_counts[kMaxBranches];
+    size_t workspace_used_bytes;    // peak workspace bytes, from the start of the buffer
     const char* detail;       // a static sentence on why, when the call failed or, with
                               // ok, searched nothing (a cloud without a scale, gap 0; one
                               // too crowded to search: see kPartingChecksPerPoint in the
@@ -807,13 +822,13 @@ const uint8_t kBeyondBranches = 255;
 // infinite point without skip_invalid_points); invalid_axis; too_few_points (fewer than 3
 // distinct valid points); flat_cloud (every point at the same height); out_of_memory (a
 // workspace below find_parting_workspace_size()). On a status other than ok only
-// workspace_used and detail are meaningful.
+// workspace_used_bytes and detail are meaningful.
 // branch_of (optional, cloud.count bytes): on ok, each point's label (see kInTrunk), so
 // that the caller can mesh the trunk and each branch apart. Where the two sides overlap
 // (the cloud is apart all along, as two tubes side by side), a point keeps the label of the
 // side above. It must not share a byte with the other buffers (invalid_argument).
 Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
-                    size_t workspace_bytes, Parting* parting, uint8_t* branch_of = nullptr);
+                    size_t workspace_bytes, Parting* parting, uint8_t* branch_of);
 
 // ---- Joining the branches to the trunk ----
 //
@@ -838,7 +853,7 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 // The new triangles run each loop's edges against the surface's direction, and every
 // vertex keeps one fan, so a surface that is an oriented edge- and vertex-manifold (as
 // reconstruct()'s) stays one, whatever the geometry. The geometry decides whether a side
-// is joined (else it is counted in sides_left_apart, the reason in detail): the trunk's
+// is joined (else it is counted in apart_side_count, the reason in detail): the trunk's
 // loop must lie within four gaps of the cut (a trunk closed there keeps only its far
 // loop), at least two branches must have a loop there whose points are all theirs, each
 // branch's centre must lie within the trunk loop's mean radius across the axis, and the
@@ -853,12 +868,12 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 // triangles beside the stump where the stump's wall leans over the hole (the bust with horns
 // of bench/README.md: 92 self-intersecting pairs, all between the bands and the trunk).
 struct JoinReport {
-    uint32_t sides_joined;      // 0, 1 or 2
-    uint32_t sides_left_apart;  // sides that part whose loops could not be joined (detail)
-    uint32_t branches_grafted;  // branches joined through a hole in the trunk's closed end
-    size_t triangles_added;
-    size_t triangles_removed;   // the trunk's triangles the holes took out
-    size_t workspace_used;      // peak workspace bytes, from the start of the buffer
+    uint32_t joined_side_count;      // 0, 1 or 2
+    uint32_t apart_side_count;  // sides that part whose loops could not be joined (detail)
+    uint32_t grafted_branch_count;  // branches joined through a hole in the trunk's closed end
+    size_t added_triangle_count;
+    size_t removed_triangle_count;   // the trunk's triangles the holes took out
+    size_t workspace_used_bytes;      // peak workspace bytes, from the start of the buffer
     const char* detail;         // a static sentence on why, on failure or a side left apart
 };
 
@@ -873,11 +888,11 @@ size_t join_branches_workspace_size(size_t point_count, size_t triangle_count);
 size_t join_branches_max_triangles(size_t point_count);
 
 // Takes the grafts' holes out of triangles[0 .. 3 * *triangle_count) (indices into
-// `cloud`; the triangles kept stay in their order, triangles_removed fewer), appends the
+// `cloud`; the triangles kept stay in their order, removed_triangle_count fewer), appends the
 // junctions' triangles and sets *triangle_count to the new total. parting and branch_of:
 // find_parting()'s on the same cloud (its axis is used); options: only skip_invalid_points
 // is read. report (optional) is filled on every status. Returns ok (a side counts as joined
-// when all its branches are; the others in sides_left_apart, their branches grafted where
+// when all its branches are; the others in apart_side_count, their branches grafted where
 // they could be, the rest of their triangles left as they were); invalid_argument (a
 // null triangle_count, branch_of, workspace or triangles where needed; a bad stride or
 // scalar; *triangle_count above triangle_capacity; an index outside the cloud or naming an
@@ -2460,7 +2475,7 @@ Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
         for (size_t k = 0; k < 2; ++k) {
             double v = detail::read_double(p + k * sizeof(double));
             if (!detail::is_finite(v)) {
-                out.first_invalid_point = i;
+                out.first_invalid_index = i;
                 return Status::invalid_point;
             }
             if (v < box.min[k]) box.min[k] = v;
@@ -2472,7 +2487,7 @@ Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
     detail::Delaunay2dMemory m;
     if (!detail::plan_delaunay_2d(m, point_count, arena, base, stride_bytes, &box))
         {
-        out.workspace_used = arena.peak_from_buffer();
+        out.workspace_used_bytes = arena.peak_from_buffer();
         return Status::out_of_memory;
     }
     for (size_t k = 0; k < point_count; ++k) {
@@ -2488,7 +2503,7 @@ Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
     uint32_t inserted = 0;
     Status status = detail::triangulate_points(m.tr, static_cast<uint32_t>(point_count),
                                                sink, &inserted);
-    out.workspace_used = arena.peak_from_buffer();
+    out.workspace_used_bytes = arena.peak_from_buffer();
     if (status != Status::ok) return status;
 
     size_t ghosts = 0;
@@ -6661,7 +6676,7 @@ inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerL
 //    would stand where the next band or a cap goes; both new triangles keep that corner,
 //    so they stay in the seam;
 //  - only gentle flips (kGentleFlip), which need no crossing test, and none that makes or
-//    unmakes a fold (the layer's cylinder), so Report::folds keeps its count.
+//    unmakes a fold (the layer's cylinder), so Report::diagnostics.fold_count keeps its count.
 // Vertex normals come from every triangle of the chunk. The seam's memory, at most about
 // 72 bytes per vertex of the chunk and 4 per point read, fits in the safety net's room
 // (reconstruct_scratch_size: 91 per point) because a seam of more triangles than three
@@ -7537,8 +7552,8 @@ inline bool reconstruct_buffers_overlap(const Cloud& cloud, void* workspace,
         byte_range(triangles, saturating_product(triangle_capacity, 3 * sizeof(uint32_t))),
         byte_range(triangle_count, sizeof(size_t)),
         byte_range(report, sizeof(Report)),
-        byte_range(report ? report->layers : nullptr,
-                   report ? saturating_product(report->layer_capacity, sizeof(LayerInfo)) : 0)};
+        byte_range(report ? report->layers.info : nullptr,
+                   report ? saturating_product(report->layers.info_capacity, sizeof(LayerInfo)) : 0)};
     return any_overlap(buffers, 6);
 }
 
@@ -7571,8 +7586,8 @@ inline bool find_outliers(CloudReader& reader, size_t count, Arena& arena, Repor
     CellScratch g = allocate_cell_scratch(arena, count);
     if (arena.failed) return false;
     std::memset(dropped, 0, count / 8 + 1);
-    rep.outliers = drop_outliers_of(reader, count, dropped, g);
-    rep.rejected += rep.outliers;
+    rep.points.outlier_count = drop_outliers_of(reader, count, dropped, g);
+    rep.points.rejected_count += rep.points.outlier_count;
     arena.rewind(mark);
     return true;
 }
@@ -7585,7 +7600,7 @@ inline CloudReader reader_of(const Cloud& cloud) {
 }
 
 const char* const kInvalidPointDetail =
-    "a point has a NaN or infinite coordinate (see first_invalid_point; the "
+    "a point has a NaN or infinite coordinate (see first_invalid_index; the "
     "skip_invalid_points flag skips such points instead)";
 
 // Where a cloud of `count` points (`sums` is its sum_cloud) is refused with invalid_point:
@@ -7599,18 +7614,18 @@ inline size_t refused_at(const CloudReader& reader, size_t count, const CloudSum
     return first;
 }
 
-// Counts the points with a NaN or infinite coordinate in rep.rejected, or refuses the
+// Counts the points with a NaN or infinite coordinate in rep.points.rejected_count, or refuses the
 // cloud (see refused_at).
 inline Status reject_invalid_points(const CloudReader& reader, size_t count,
                                     const CloudSums& sums, const Options& options, Report& rep) {
     const size_t first = refused_at(reader, count, sums, options);
     if (first < count) {
-        rep.first_invalid_point = first;
-        rep.rejected = count;
+        rep.points.first_invalid_index = first;
+        rep.points.rejected_count = count;
         rep.detail = kInvalidPointDetail;
         return Status::invalid_point;
     }
-    rep.rejected += count - sums.valid;
+    rep.points.rejected_count += count - sums.valid;
     return Status::ok;
 }
 
@@ -7735,28 +7750,28 @@ namespace detail {
 
 // The chain's counts into the report, with the reason when a valid point is not a vertex.
 inline void report_chain(const SurfaceChain& chain, size_t valid, Report& rep) {
-    rep.duplicates = chain.duplicates;
-    rep.illegal_removed = chain.removed;
-    rep.points_used = chain.used;
-    rep.diagonal_swaps = chain.swaps;
+    rep.points.duplicate_count = chain.duplicates;
+    rep.diagnostics.illegal_removed_count = chain.removed;
+    rep.points.used_count = chain.used;
+    rep.diagnostics.diagonal_swap_count = chain.swaps;
     if (chain.trailing > 0)
         rep.detail = "the points of the last layers do not surround the axis: they are not "
                      "vertices";
     else if (chain.collisions > 0)
         rep.detail = "some points share their place on the unrolled layer with another point "
                      "(the layer is not star-shaped around its centre there): not vertices";
-    else if (valid - rep.duplicates > chain.used)
+    else if (valid - rep.points.duplicate_count > chain.used)
         rep.detail = "the manifold safety net removed the triangles of some points";
 }
 
-// The whole reconstruction; `rep` arrives zeroed but for its layer array. Report::unused
+// The whole reconstruction; `rep` arrives zeroed but for its layer array. Report::points.unused_count
 // is left to the caller, who derives it so the counts add up on every path.
 inline Status run_reconstruction(const Cloud& cloud, const Options& options, void* workspace,
                                  size_t workspace_bytes, uint32_t* triangles,
                                  size_t triangle_capacity, size_t* triangle_count,
                                  Report& rep) {
-    LayerInfo* layer_infos = rep.layers;
-    size_t layer_capacity = rep.layer_capacity;
+    LayerInfo* layer_infos = rep.layers.info;
+    size_t layer_capacity = rep.layers.info_capacity;
 
     Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
                                                 triangle_count, workspace, rep);
@@ -7772,7 +7787,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     Arena arena = Arena::over(workspace, workspace_bytes);
     // Every exit from here records the peak workspace.
     auto finish = [&](Status result) {
-        rep.workspace_used = arena.peak_from_buffer();
+        rep.workspace_used_bytes = arena.peak_from_buffer();
         return result;
     };
     if (options.flags & drop_outliers) {
@@ -7780,7 +7795,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
         if (!find_outliers(reader, cloud.count, arena, rep)) return finish(Status::out_of_memory);
         sums = sum_cloud(reader, cloud.count);  // without the outliers
     }
-    size_t valid = cloud.count - rep.rejected;
+    size_t valid = cloud.count - rep.points.rejected_count;
     Frame frame;
     status = choose_frame(reader, cloud.count, sums, options, frame);
     if (status != Status::ok) return status;
@@ -7842,23 +7857,23 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     chain.output_id = nullptr;
     const LayerQueue queue = {m.order, staged, m.layer_start, plan.bounds, plan.count, true};
     ParallelLayers parallel;
-    rep.parallel_layers = start_parallel_layers(options, reader, frame, queue, arena, parallel);
+    rep.layers.parallel_count = start_parallel_layers(options, reader, frame, queue, arena, parallel);
     for (uint32_t first = 0; first < plan.count;) {
         GroupResult group;
         status = add_group(chain, queue, first, arena, sink, group,
                            parallel.ready ? parallel.ahead_of(first) : nullptr);
         if (status == Status::not_columnar) break;
         if (status != Status::ok) return finish(status);
-        if (rep.layer_count < layer_capacity)
+        if (rep.layers.used_count < layer_capacity)
             describe_layer(frame, group.cylinder, plan.bounds[first], plan.bounds[group.last + 1],
                            group.points - group.counts.duplicates, group.triangles, group.folds,
-                           layer_infos[rep.layer_count]);
-        ++rep.layer_count;
+                           layer_infos[rep.layers.used_count]);
+        ++rep.layers.used_count;
         first = group.last + 1;
         notify(options, Phase::triangulate, static_cast<double>(first) / plan.count);
     }
-    rep.duplicates = chain.duplicates;
-    if (rep.layer_count == 0) {
+    rep.points.duplicate_count = chain.duplicates;
+    if (rep.layers.used_count == 0) {
         rep.detail = "no layer's points surround the axis: the cloud is not columnar around "
                      "it (try another axis)";
         return finish(Status::not_columnar);
@@ -7890,13 +7905,13 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
         }
         if (status != Status::ok) return finish(status);
     }
-    rep.caps_closed = caps.closed;
-    rep.caps_left_open = caps.left_open;
-    rep.cap_triangles = caps.triangles;
-    rep.cap_wall_flips = caps.wall_flips;
+    rep.caps.closed_count = caps.closed;
+    rep.caps.open_count = caps.left_open;
+    rep.caps.triangle_count = caps.triangles;
+    rep.caps.wall_flip_count = caps.wall_flips;
     *triangle_count = count;
     rep.triangle_count = count;
-    rep.folds = sink.folds;
+    rep.diagnostics.fold_count = sink.folds;
     report_chain(chain, valid, rep);
     if (!rep.detail && caps.left_open > 0) rep.detail = kLoopLeftOpenDetail;
     notify(options, Phase::done, 1);
@@ -7913,17 +7928,17 @@ Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
         return Status::invalid_argument;
     Report local_report;
     Report& rep = report ? *report : local_report;
-    LayerInfo* layers = report ? report->layers : nullptr;
-    size_t layer_capacity = layers ? report->layer_capacity : 0;
+    LayerInfo* layers = report ? report->layers.info : nullptr;
+    size_t layer_capacity = layers ? report->layers.info_capacity : 0;
     std::memset(&rep, 0, sizeof rep);
-    rep.layers = layers;
-    rep.layer_capacity = layer_capacity;
-    rep.points_in = cloud.count;
+    rep.layers.info = layers;
+    rep.layers.info_capacity = layer_capacity;
+    rep.points.in_count = cloud.count;
     if (triangle_count) *triangle_count = 0;
     Status status = detail::run_reconstruction(cloud, options, workspace, workspace_bytes,
                                                triangles, triangle_capacity, triangle_count,
                                                rep);
-    rep.unused = rep.points_in - rep.points_used - rep.duplicates - rep.rejected;
+    rep.points.unused_count = rep.points.in_count - rep.points.used_count - rep.points.duplicate_count - rep.points.rejected_count;
     return status;
 }
 
@@ -7996,8 +8011,8 @@ inline size_t stream_bytes(size_t capacity) {
 }
 
 inline void publish(Stream& s) {
-    s.rep.unused = s.rep.points_in - s.rep.points_used - s.rep.duplicates - s.rep.rejected;
-    s.rep.workspace_used = s.arena.peak_from_buffer();
+    s.rep.points.unused_count = s.rep.points.in_count - s.rep.points.used_count - s.rep.points.duplicate_count - s.rep.points.rejected_count;
+    s.rep.workspace_used_bytes = s.arena.peak_from_buffer();
     if (s.user_report) *s.user_report = s.rep;
 }
 
@@ -8049,11 +8064,11 @@ inline Status advance(Stream& s, bool complete) {
         if (group.waiting) return Status::ok;
         if (s.sink.count > 0) s.emit(s.emit_user, s.sink.triangles, s.sink.count);
         s.rep.triangle_count += s.sink.count;
-        if (s.rep.layer_count < s.rep.layer_capacity)
+        if (s.rep.layers.used_count < s.rep.layers.info_capacity)
             describe_layer(s.chain.frame, group.cylinder, s.bounds[0], s.bounds[group.last + 1],
                            group.points - group.counts.duplicates, group.triangles, group.folds,
-                           s.rep.layers[s.rep.layer_count]);
-        ++s.rep.layer_count;
+                           s.rep.layers.info[s.rep.layers.used_count]);
+        ++s.rep.layers.used_count;
         drop_group(s, group.last);
     }
     return Status::ok;
@@ -8074,8 +8089,8 @@ Status stream_open(const Options& options, void* workspace, size_t workspace_byt
     if (report) {
         const detail::ByteRange ranges[] = {
             work, detail::byte_range(report, sizeof(Report)),
-            detail::byte_range(report->layers,
-                               detail::saturating_product(report->layer_capacity, sizeof(LayerInfo)))};
+            detail::byte_range(report->layers.info,
+                               detail::saturating_product(report->layers.info_capacity, sizeof(LayerInfo)))};
         if (detail::any_overlap(ranges, 3)) return Status::invalid_argument;
     }
     if (options.axis == Axis::automatic) return Status::invalid_axis;
@@ -8101,8 +8116,8 @@ Status stream_open(const Options& options, void* workspace, size_t workspace_byt
     s->emit = emit;
     s->emit_user = emit_user;
     s->user_report = report;
-    s->rep.layers = report ? report->layers : nullptr;
-    s->rep.layer_capacity = s->rep.layers ? report->layer_capacity : 0;
+    s->rep.layers.info = report ? report->layers.info : nullptr;
+    s->rep.layers.info_capacity = s->rep.layers.info ? report->layers.info_capacity : 0;
     s->failure = Status::ok;
     s->early_top = -DBL_MAX;
     for (size_t i = 0; i < low; ++i) s->positions[i] = static_cast<uint32_t>(i);
@@ -8135,7 +8150,7 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     } else if (!detail::is_finite(top)) {
         refusal = Status::invalid_layers;
         why = "a pushed layer's top is NaN or infinite";
-    } else if (points.count > detail::kMaxPoints - 1 - s.rep.points_in) {
+    } else if (points.count > detail::kMaxPoints - 1 - s.rep.points.in_count) {
         refusal = Status::too_many_points;
         why = "more points pushed than 32-bit triangle indices can address";
     }
@@ -8147,15 +8162,15 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     const size_t valid = sums.valid;
     const size_t first_invalid = detail::refused_at(reader, points.count, sums, s.options);
     if (first_invalid < points.count) {
-        s.rep.first_invalid_point = s.rep.points_in + first_invalid;
+        s.rep.points.first_invalid_index = s.rep.points.in_count + first_invalid;
         return detail::refuse_push(s, Status::invalid_point, detail::kInvalidPointDetail);
     }
     const char* const top_below = "a pushed layer's top is below the previous layer's top";
     if (!s.has_frame && top < s.early_top)
         return detail::refuse_push(s, Status::out_of_order, top_below);
     if (!s.has_frame && valid == 0) {  // nothing to place yet: pushes before the first point
-        s.rep.points_in += points.count;
-        s.rep.rejected += points.count;
+        s.rep.points.in_count += points.count;
+        s.rep.points.rejected_count += points.count;
         s.early_top = top;
         detail::publish(s);
         return Status::ok;
@@ -8180,7 +8195,7 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
         if (!(detail::abs_value(p.x) <= detail::kStreamRange &&
               detail::abs_value(p.y) <= detail::kStreamRange &&
               detail::abs_value(p.h) <= detail::kStreamRange)) {
-            s.rep.first_invalid_point = s.rep.points_in + i;
+            s.rep.points.first_invalid_index = s.rep.points.in_count + i;
             return detail::refuse_push(s, Status::invalid_point,
                                        "a pushed point lies more than 2^60 times the first "
                                        "layer's size away from it");
@@ -8196,7 +8211,7 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
         return detail::refuse_push(s, Status::out_of_memory,
                                    "the stream would hold more points or layers than its workspace: "
                                    "push thicker layers, or give more workspace (see "
-                                   "Report::points_held)");
+                                   "Report::points.held_count)");
     // Commit.
     if (!s.has_frame) {
         s.has_frame = true;
@@ -8213,28 +8228,28 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     }
     for (size_t i = 0; i < points.count; ++i) {
         if (!reader.valid(i)) {
-            ++s.rep.rejected;
+            ++s.rep.points.rejected_count;
             continue;
         }
         detail::Vec3 p = reader.point(i);
         s.distinct.add(p);
         s.points[s.fill] = p;
-        s.global[s.fill] = static_cast<uint32_t>(s.rep.points_in + i);
+        s.global[s.fill] = static_cast<uint32_t>(s.rep.points.in_count + i);
         ++s.fill;
     }
-    s.rep.points_in += points.count;
+    s.rep.points.in_count += points.count;
     if (valid > 0 && high > s.highest) s.highest = high;
     ++s.planned;
     s.start[s.planned] = static_cast<uint32_t>(s.fill);
     s.bounds[s.planned] = s.highest;
     s.last_top = top_height;
-    if (s.fill > s.rep.points_held) s.rep.points_held = s.fill;
+    if (s.fill > s.rep.points.held_count) s.rep.points.held_count = s.fill;
     Status status = detail::advance(s, false);
     if (status != Status::ok) s.failure = status;
     // The counts so far; why a point is not a vertex is only known at the close.
-    detail::report_chain(s.chain, s.rep.points_in - s.rep.rejected, s.rep);
+    detail::report_chain(s.chain, s.rep.points.in_count - s.rep.points.rejected_count, s.rep);
     s.rep.detail = nullptr;
-    s.rep.folds = s.sink.folds;
+    s.rep.diagnostics.fold_count = s.sink.folds;
     detail::publish(s);
     return status;
 }
@@ -8244,7 +8259,7 @@ Status stream_close(Stream* stream) {
     Stream& s = *stream;
     s.closed = true;
     Status status = s.failure;
-    const size_t valid = s.rep.points_in - s.rep.rejected;
+    const size_t valid = s.rep.points.in_count - s.rep.points.rejected_count;
     if (status == Status::ok && (valid < 3 || s.distinct.count < 3)) {
         s.rep.detail = "fewer than 3 distinct valid points";
         status = Status::too_few_points;
@@ -8255,8 +8270,8 @@ Status stream_close(Stream* stream) {
     if (status == Status::ok) status = detail::advance(s, true);
     if (status == Status::ok) {
         detail::report_chain(s.chain, valid, s.rep);
-        s.rep.folds = s.sink.folds;
-        if (s.rep.layer_count == 0) {
+        s.rep.diagnostics.fold_count = s.sink.folds;
+        if (s.rep.layers.used_count == 0) {
             s.rep.detail = "no layer's points surround the axis: the cloud is not columnar "
                            "around it (try another axis)";
             status = Status::not_columnar;
@@ -8299,11 +8314,11 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
     size_t count = given, needed = 0;
     auto finish = [&](Status status) {
         if (report) {
-            report->caps_closed = caps.closed;
-            report->caps_left_open = caps.left_open;
-            report->cap_triangles = caps.triangles;
-            report->cap_wall_flips = caps.wall_flips;
-            report->workspace_used = arena.peak_from_buffer();
+            report->caps.closed_count = caps.closed;
+            report->caps.open_count = caps.left_open;
+            report->caps.triangle_count = caps.triangles;
+            report->caps.wall_flip_count = caps.wall_flips;
+            report->workspace_used_bytes = arena.peak_from_buffer();
             report->detail = checks.detail;
         }
         if (status == Status::ok) *triangle_count = count;
@@ -8755,7 +8770,7 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
     size_t no_triangles = 0;
     Arena arena = Arena::over(workspace, workspace_bytes);
     auto finish = [&](Status status) {
-        parting->workspace_used = arena.peak_from_buffer();
+        parting->workspace_used_bytes = arena.peak_from_buffer();
         parting->detail = rep.detail;
         return status;
     };
@@ -8828,10 +8843,10 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
         if (side.branches) *cut = frame.user_height(m.steps.lo + side.cut_index * m.steps.step_height);
         for (uint32_t k = 0; k < side.branches; ++k) points[k] = side.sizes[k];
     };
-    report_side(above, &parting->above, &parting->branches_above, parting->above_points);
-    report_side(below, &parting->below, &parting->branches_below, parting->below_points);
+    report_side(above, &parting->above, &parting->above_branch_count, parting->above_point_counts);
+    report_side(below, &parting->below, &parting->below_branch_count, parting->below_point_counts);
     if (s.crowded) {
-        parting->branches_above = parting->branches_below = 0;
+        parting->above_branch_count = parting->below_branch_count = 0;
         parting->above = 0;
         rep.detail = "the cloud is too crowded to search (over 1024 points within a gap of "
                      "each, on average: repeated or solid): no parting is reported";
@@ -9426,7 +9441,7 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
     const size_t given = triangle_count ? *triangle_count : 0;
     size_t needed = given;
     auto finish = [&](Status status) {
-        r.workspace_used = arena.peak_from_buffer();
+        r.workspace_used_bytes = arena.peak_from_buffer();
         if (!r.detail) r.detail = checks.detail;
         if (report) *report = r;
         if (status == Status::triangle_capacity) *triangle_count = needed;
@@ -9456,8 +9471,8 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
     Frame frame;
     status = choose_frame(reader, cloud.count, sums, along, frame);
     if (status != Status::ok) return finish(status);
-    const uint32_t sides[2] = {parting.branches_above < kMaxBranches ? parting.branches_above : kMaxBranches,
-                               parting.branches_below < kMaxBranches ? parting.branches_below : kMaxBranches};
+    const uint32_t sides[2] = {parting.above_branch_count < kMaxBranches ? parting.above_branch_count : kMaxBranches,
+                               parting.below_branch_count < kMaxBranches ? parting.below_branch_count : kMaxBranches};
     if (given == 0 || (sides[0] == 0 && sides[1] == 0)) return finish(Status::ok);
     JoinMemory m;
     if (!allocate_join(m, cloud.count, given, arena)) {
@@ -9494,7 +9509,7 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
         if (rim[k]) {
             taken = plan[k].trunk.ids;
             needed += plan[k].triangles();
-            ++r.sides_joined;
+            ++r.joined_side_count;
             continue;
         }
         // No rim goes around the branches: each is grafted where it stands on the trunk.
@@ -9513,11 +9528,11 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
             }
             if (!r.detail) r.detail = graft_why;
         }
-        r.branches_grafted += grafted;
+        r.grafted_branch_count += grafted;
         if (grafted == sides[k])
-            ++r.sides_joined;
+            ++r.joined_side_count;
         else
-            ++r.sides_left_apart;
+            ++r.apart_side_count;
     }
     needed -= removed;
     if (needed > triangle_capacity) return finish(Status::triangle_capacity);
@@ -9528,22 +9543,22 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
             for (size_t e = 0; e < 3; ++e) triangles[3 * kept + e] = triangles[3 * t + e];
         ++kept;
     }
-    r.triangles_removed = removed;
+    r.removed_triangle_count = removed;
     uint32_t* out = triangles + 3 * kept;
     for (int k = 0; k < 2; ++k) {
         if (!rim[k]) continue;
         const SideView view = {reader, frame, k == 0 ? 1.0 : -1.0};
         write_junction(plan[k], view, out);
         out += 3 * plan[k].triangles();
-        r.triangles_added += plan[k].triangles();
+        r.added_triangle_count += plan[k].triangles();
     }
     for (uint32_t g = 0; g < graft_count; ++g) {
         const SideView view = {reader, frame, grafts[g].side};
         write_graft(grafts[g], view, out);
         out += 3 * grafts[g].triangles();
-        r.triangles_added += grafts[g].triangles();
+        r.added_triangle_count += grafts[g].triangles();
     }
-    *triangle_count = kept + r.triangles_added;
+    *triangle_count = kept + r.added_triangle_count;
     return finish(Status::ok);
 }
 #endif

@@ -638,9 +638,9 @@ std::string axis_text(const double axis[3]) {
 }
 
 void print_layer_lines(const std::string& name, const stratmesh::Report& report) {
-    size_t shown = std::min(report.layer_count, report.layer_capacity);
+    size_t shown = std::min(report.layers.used_count, report.layers.info_capacity);
     for (size_t i = 0; i < shown; ++i) {
-        const stratmesh::LayerInfo& layer = report.layers[i];
+        const stratmesh::LayerInfo& layer = report.layers.info[i];
         JsonLine line;
         line.add("name", name);
         line.add("layer", i + 1);
@@ -652,9 +652,9 @@ void print_layer_lines(const std::string& name, const stratmesh::Report& report)
         line.add("radius", layer.radius);
         line.print();
     }
-    if (shown < report.layer_count)
+    if (shown < report.layers.used_count)
         std::fprintf(stderr, "stratmesh_bench: %s: %zu layers, the first %zu shown\n",
-                     name.c_str(), report.layer_count, shown);
+                     name.c_str(), report.layers.used_count, shown);
 }
 
 // Times stratmesh::reconstruct and the reference delaunay_2d, alternately, and prints the
@@ -680,8 +680,8 @@ Result measure_reconstruct(const ReconstructCase& job) {
     for (int run = 0; run < job.runs; ++run) {
         clock = PhaseClock();
         report = stratmesh::Report();
-        report.layers = layers.data();
-        report.layer_capacity = layers.size();
+        report.layers.info = layers.data();
+        report.layers.info_capacity = layers.size();
         Clock::time_point start = Clock::now();
         stratmesh::Status s = stratmesh::reconstruct(cloud, options, workspace.get(),
                                                      workspace_bytes, triangles.get(),
@@ -716,13 +716,13 @@ Result measure_reconstruct(const ReconstructCase& job) {
              static_cast<double>(workspace_bytes + triangle_bytes) * per_point);
     line.add("status", status_name(status));
     line.add("triangles", triangle_count);
-    line.add("layers", report.layer_count);
-    line.add("folds", report.folds);
-    line.add("illegal_removed", report.illegal_removed);
-    line.add("unused", report.unused);
-    line.add("points_used", report.points_used);
-    line.add("duplicates", report.duplicates);
-    line.add("rejected", report.rejected);
+    line.add("layers", report.layers.used_count);
+    line.add("folds", report.diagnostics.fold_count);
+    line.add("illegal_removed", report.diagnostics.illegal_removed_count);
+    line.add("unused", report.points.unused_count);
+    line.add("points_used", report.points.used_count);
+    line.add("duplicates", report.points.duplicate_count);
+    line.add("rejected", report.points.rejected_count);
     line.add("delaunay_seconds", result.delaunay_seconds);
     line.add("delaunay_min_seconds", reference_min);
     line.add("ratio_to_delaunay", result.seconds / result.delaunay_seconds);
@@ -858,14 +858,14 @@ Result measure_threads(const std::string& name, const stratmesh::Cloud& cloud,
     Result result = {ok ? Outcome::ok : Outcome::failed, cloud.count, seconds_2_threads,
                      std::nan(""), std::nan(""), std::nan("")};
     JsonLine line = case_line(name, cloud.count, runs);
-    line.add("layers", one.report.layer_count);
+    line.add("layers", one.report.layers.used_count);
     line.add("seconds_no_runner", seconds_no_runner);
     line.add("seconds_2_threads", seconds_2_threads);
     line.add("speedup", speedup);
     line.add("seconds_2_independent", seconds_2_independent);
     line.add("speedup_ceiling", speedup_ceiling);
     line.add("share_of_ceiling", speedup / speedup_ceiling);
-    line.add("parallel_layers", two.report.parallel_layers);
+    line.add("parallel_layers", two.report.layers.parallel_count);
     line.add("identical", one.triangles == two.triangles);
     line.add("independent_identical",
              one.triangles == pair[0].triangles && one.triangles == pair[1].triangles);
@@ -1007,13 +1007,13 @@ Result measure_stream(const std::string& name, const std::vector<double>& coords
     line.add("reconstruct_workspace_bytes", batch_bytes);
     line.add("workspace_ratio",
              static_cast<double>(batch_bytes) / static_cast<double>(stream_bytes));
-    line.add("stream_workspace_used", streamed.report.workspace_used);
-    line.add("reconstruct_workspace_used", whole.report.workspace_used);
-    line.add("workspace_used_ratio", static_cast<double>(whole.report.workspace_used) /
-                                         static_cast<double>(streamed.report.workspace_used));
-    line.add("points_held", streamed.report.points_held);
-    line.add("layers", whole.report.layer_count);
-    line.add("stream_layers", streamed.report.layer_count);
+    line.add("stream_workspace_used", streamed.report.workspace_used_bytes);
+    line.add("reconstruct_workspace_used", whole.report.workspace_used_bytes);
+    line.add("workspace_used_ratio", static_cast<double>(whole.report.workspace_used_bytes) /
+                                         static_cast<double>(streamed.report.workspace_used_bytes));
+    line.add("points_held", streamed.report.points.held_count);
+    line.add("layers", whole.report.layers.used_count);
+    line.add("stream_layers", streamed.report.layers.used_count);
     line.add("identical", streamed.triangles == whole.triangles);
     line.add("triangles", whole.triangles.size() / 3);
     line.add("stream_triangles", streamed.triangles.size() / 3);
@@ -1025,7 +1025,7 @@ Result measure_stream(const std::string& name, const std::vector<double>& coords
     line.add("cap_ends_bytes_per_point",
              static_cast<double>(cap_bytes) / static_cast<double>(cloud.count));
     line.add("cap_ends_status", status_name(cap_status));
-    line.add("caps_closed", cap_report.caps_closed);
+    line.add("caps_closed", cap_report.caps.closed_count);
     line.add("close_ends_seconds", closed.seconds);
     line.add("stream_and_cap_ends_over_close_ends",
              (median(stream_times) + cap_seconds) / closed.seconds);
@@ -1236,7 +1236,7 @@ void print_help(std::FILE* out) {
         "  speedup_ceiling           2 x seconds_no_runner / seconds_2_independent: what\n"
         "                            two cores give on two independent copies of the work\n"
         "  share_of_ceiling          speedup / speedup_ceiling\n"
-        "  parallel_layers           Report::parallel_layers of the threaded run\n"
+        "  parallel_layers           Report::layers.parallel_count of the threaded run\n"
         "  identical                 the serial and threaded arrays are the same bytes\n"
         "  independent_identical     both independent calls gave the serial call's bytes\n"
         "  workspace_bytes_no_runner, workspace_bytes_2_threads   the two bounds\n"
@@ -1247,8 +1247,8 @@ void print_help(std::FILE* out) {
         "  stream_workspace_bytes    stream_workspace_size(2.5 x largest_push)\n"
         "  reconstruct_workspace_bytes, workspace_ratio (reconstruct / stream)\n"
         "  stream_workspace_used, reconstruct_workspace_used, workspace_used_ratio\n"
-        "                            Report::workspace_used of each\n"
-        "  points_held, identical    the stream's Report::points_held; same triangles\n"
+        "                            Report::workspace_used_bytes of each\n"
+        "  points_held, identical    the stream's Report::points.held_count; same triangles\n"
         "  cap_ends_seconds, cap_ends_workspace_bytes, cap_ends_bytes_per_point,\n"
         "  cap_ends_status, caps_closed   cap_ends() on the stream's triangles, once\n"
         "  close_ends_seconds        reconstruct with close_ends on the same cuts, once\n"

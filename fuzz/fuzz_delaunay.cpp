@@ -145,7 +145,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         STRATMESH_FUZZ_CHECK(s == Status::invalid_point || (n < 3 && s == Status::too_few_points),
                              "a NaN/Inf point was not refused");
         if (s == Status::invalid_point)
-            STRATMESH_FUZZ_CHECK(info.first_invalid_point == first_bad, "wrong first_invalid_point");
+            STRATMESH_FUZZ_CHECK(info.first_invalid_index == first_bad, "wrong first_invalid_index");
         STRATMESH_FUZZ_CHECK(info.triangle_count == 0, "triangles reported on failure");
         return 0;
     }

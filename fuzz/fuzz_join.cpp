@@ -10,8 +10,8 @@
 //
 // Checked after each call: the status is a documented one; on every status but ok the
 // triangles are unchanged (on triangle_capacity the count needed is above the capacity);
-// on ok the given triangles are kept in their order but triangles_removed of them, the
-// count is the kept ones and triangles_added (at most join_branches_max_triangles()), nothing
+// on ok the given triangles are kept in their order but removed_triangle_count of them, the
+// count is the kept ones and added_triangle_count (at most join_branches_max_triangles()), nothing
 // is written past them, every new index names a valid point, no new triangle
 // repeats one, the sides joined and left apart are at most the sides that part, and where
 // the given surface was an oriented edge- and vertex-manifold (tests/support/mesh_check.h),
@@ -71,8 +71,8 @@ void raw_surface(Bytes& in, Surface& s, stratmesh_fuzz::FuzzCloud& fc) {
         const uint8_t b = in.u8();
         s.label.push_back(b < 240 ? labels[b % 4] : b);
     }
-    s.parting.branches_above = in.below(stratmesh::kMaxBranches + 4);
-    s.parting.branches_below = in.below(4);
+    s.parting.above_branch_count = in.below(stratmesh::kMaxBranches + 4);
+    s.parting.below_branch_count = in.below(4);
     const uint8_t axis = in.u8();
     if (axis < 200) {
         s.parting.axis[axis % 3] = 1;
@@ -176,18 +176,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         bytes > short_by ? bytes - short_by : 0, t.empty() ? nullptr : t.data(), capacity, &count,
         &report);
     STRATMESH_FUZZ_CHECK(documented(status), "an undocumented status");
-    STRATMESH_FUZZ_CHECK(report.workspace_used <= (bytes > short_by ? bytes - short_by : 0),
-                         "workspace_used beyond the workspace");
+    STRATMESH_FUZZ_CHECK(report.workspace_used_bytes <= (bytes > short_by ? bytes - short_by : 0),
+                         "workspace_used_bytes beyond the workspace");
     if (status != stratmesh::Status::ok) {
         STRATMESH_FUZZ_CHECK(t == before, "triangles changed on a failure");
         if (status == stratmesh::Status::triangle_capacity)
             STRATMESH_FUZZ_CHECK(count > capacity, "triangle_capacity but the count fits");
         return 0;
     }
-    STRATMESH_FUZZ_CHECK(report.triangles_removed <= given, "more triangles removed than given");
-    const size_t kept = given - report.triangles_removed;
-    STRATMESH_FUZZ_CHECK(count == kept + report.triangles_added, "count != kept + added");
-    STRATMESH_FUZZ_CHECK(report.triangles_added <= stratmesh::join_branches_max_triangles(n),
+    STRATMESH_FUZZ_CHECK(report.removed_triangle_count <= given, "more triangles removed than given");
+    const size_t kept = given - report.removed_triangle_count;
+    STRATMESH_FUZZ_CHECK(count == kept + report.added_triangle_count, "count != kept + added");
+    STRATMESH_FUZZ_CHECK(report.added_triangle_count <= stratmesh::join_branches_max_triangles(n),
                          "more triangles than join_branches_max_triangles()");
     size_t matched = 0;
     for (size_t g = 0; g < given && matched < kept; ++g)
@@ -196,9 +196,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const auto added_end = static_cast<std::ptrdiff_t>(3 * count);
     STRATMESH_FUZZ_CHECK(std::equal(before.begin() + added_end, before.end(), t.begin() + added_end),
                          "a write past the triangles added");
-    const uint32_t sides = static_cast<uint32_t>(s.parting.branches_above > 0) +
-                           static_cast<uint32_t>(s.parting.branches_below > 0);
-    STRATMESH_FUZZ_CHECK(report.sides_joined + report.sides_left_apart <= sides,
+    const uint32_t sides = static_cast<uint32_t>(s.parting.above_branch_count > 0) +
+                           static_cast<uint32_t>(s.parting.below_branch_count > 0);
+    STRATMESH_FUZZ_CHECK(report.joined_side_count + report.apart_side_count <= sides,
                          "more sides than part");
     for (size_t k = 3 * kept; k < 3 * count; k += 3) {
         for (size_t j = 0; j < 3; ++j)

@@ -54,8 +54,8 @@ Run run(const stratmesh::Cloud& cloud, const stratmesh::Options& options, size_t
     r.triangles.assign(3 * capacity, 0xDEADBEEFu);
     r.layers.resize(layer_capacity);
     std::memset(static_cast<void*>(&r.report), fill, sizeof r.report);
-    r.report.layers = layer_capacity ? r.layers.data() : nullptr;
-    r.report.layer_capacity = layer_capacity;
+    r.report.layers.info = layer_capacity ? r.layers.data() : nullptr;
+    r.report.layers.info_capacity = layer_capacity;
     r.count = 12345;
     r.status = stratmesh::reconstruct(cloud, options, work.empty() ? nullptr : work.data(),
                                       work_bytes, capacity ? r.triangles.data() : nullptr,
@@ -92,21 +92,21 @@ void check_parting(const stratmesh::Cloud& cloud, const stratmesh::Options& opti
     if (status != Status::ok && status != Status::invalid_point && status != Status::too_few_points &&
         status != Status::invalid_axis && status != Status::flat_cloud)
         stratmesh_fuzz::fail("find_parting returned an unexpected status", stratmesh::status_string(status));
-    STRATMESH_FUZZ_CHECK(p.workspace_used <= bytes, "find_parting: more workspace than its size");
+    STRATMESH_FUZZ_CHECK(p.workspace_used_bytes <= bytes, "find_parting: more workspace than its size");
     if (status != Status::ok) return;
     STRATMESH_FUZZ_CHECK(std::isfinite(p.gap) && p.gap >= 0, "parting: a gap that is not finite");
-    check_parting_side(p.branches_above, p.above_points, p.above, cloud.count);
-    check_parting_side(p.branches_below, p.below_points, p.below, cloud.count);
+    check_parting_side(p.above_branch_count, p.above_point_counts, p.above, cloud.count);
+    check_parting_side(p.below_branch_count, p.below_point_counts, p.below, cloud.count);
     std::vector<uint32_t> in_label(256, 0);
     for (uint8_t l : label) ++in_label[l];
     for (uint32_t l = 0; l < 256; ++l) {
-        const bool above = l >= stratmesh::kFirstAboveBranch && l < stratmesh::kFirstAboveBranch + p.branches_above;
-        const bool below = l >= stratmesh::kFirstBelowBranch && l < stratmesh::kFirstBelowBranch + p.branches_below;
+        const bool above = l >= stratmesh::kFirstAboveBranch && l < stratmesh::kFirstAboveBranch + p.above_branch_count;
+        const bool below = l >= stratmesh::kFirstBelowBranch && l < stratmesh::kFirstBelowBranch + p.below_branch_count;
         if (above)
-            STRATMESH_FUZZ_CHECK(in_label[l] == p.above_points[l - stratmesh::kFirstAboveBranch],
+            STRATMESH_FUZZ_CHECK(in_label[l] == p.above_point_counts[l - stratmesh::kFirstAboveBranch],
                                  "parting: a branch above labelled with another size");
         else if (below)
-            STRATMESH_FUZZ_CHECK(in_label[l] <= p.below_points[l - stratmesh::kFirstBelowBranch],
+            STRATMESH_FUZZ_CHECK(in_label[l] <= p.below_point_counts[l - stratmesh::kFirstBelowBranch],
                                  "parting: a branch below labelled with more points");
         else if (l != stratmesh::kInTrunk && l != stratmesh::kBeyondBranches)
             STRATMESH_FUZZ_CHECK(in_label[l] == 0, "parting: a label that names no branch");
@@ -189,8 +189,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const stratmesh::Report& rep = first.report;
     if (std::getenv("STRATMESH_FUZZ_VERBOSE"))
         std::fprintf(stderr, "n %zu, %s, %zu triangles, %zu layers, used %zu dup %zu rej %zu unused %zu\n", n,
-                     stratmesh::status_string(first.status), first.count, rep.layer_count, rep.points_used,
-                     rep.duplicates, rep.rejected, rep.unused);
+                     stratmesh::status_string(first.status), first.count, rep.layers.used_count, rep.points.used_count,
+                     rep.points.duplicate_count, rep.points.rejected_count, rep.points.unused_count);
 
     using stratmesh::Status;
     switch (first.status) {
@@ -210,8 +210,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     if (first.status == Status::triangle_capacity)
         STRATMESH_FUZZ_CHECK(small_capacity, "triangle_capacity with reconstruct_max_triangles");
-    STRATMESH_FUZZ_CHECK(rep.points_in == n, "report.points_in != n");
-    STRATMESH_FUZZ_CHECK(rep.points_in == rep.points_used + rep.duplicates + rep.rejected + rep.unused,
+    STRATMESH_FUZZ_CHECK(rep.points.in_count == n, "report.points.in_count != n");
+    STRATMESH_FUZZ_CHECK(rep.points.in_count == rep.points.used_count + rep.points.duplicate_count + rep.points.rejected_count + rep.points.unused_count,
                          "report counts do not add up");
 
     // Valid points and first occurrences (as the library converts them: to double).
@@ -229,7 +229,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         STRATMESH_FUZZ_CHECK(first.status == Status::invalid_point, "a NaN/Inf point was not refused");
     }
     if (first.status == Status::invalid_point)
-        STRATMESH_FUZZ_CHECK(rep.first_invalid_point == first_invalid, "wrong first_invalid_point");
+        STRATMESH_FUZZ_CHECK(rep.points.first_invalid_index == first_invalid, "wrong first_invalid_index");
     if (first.status != Status::ok) return 0;
 
     // ---- ok: the mesh
@@ -237,8 +237,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     STRATMESH_FUZZ_CHECK(count <= max_tris, "more triangles than reconstruct_max_triangles");
     STRATMESH_FUZZ_CHECK(count <= capacity, "more triangles than the capacity");
     STRATMESH_FUZZ_CHECK(rep.triangle_count == count, "report.triangle_count != triangle count");
-    STRATMESH_FUZZ_CHECK(rep.rejected == invalid + rep.outliers, "report.rejected != NaN/Inf points + outliers");
-    STRATMESH_FUZZ_CHECK(dropping || rep.outliers == 0, "outliers without drop_outliers");
+    STRATMESH_FUZZ_CHECK(rep.points.rejected_count == invalid + rep.points.outlier_count, "report.points.rejected_count != NaN/Inf points + outliers");
+    STRATMESH_FUZZ_CHECK(dropping || rep.points.outlier_count == 0, "outliers without drop_outliers");
     const uint32_t* t = first.triangles.data();
     for (size_t k = 0; k < count; ++k) {
         uint32_t a = t[3 * k], b = t[3 * k + 1], c = t[3 * k + 2];
@@ -271,13 +271,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             }
         }
         if (dropping)  // repeats of an outlier are outliers
-            STRATMESH_FUZZ_CHECK(rep.duplicates <= dups && rep.duplicates + rep.unused + rep.outliers >= dups,
-                                 "report.duplicates inconsistent with repeated points and outliers");
+            STRATMESH_FUZZ_CHECK(rep.points.duplicate_count <= dups && rep.points.duplicate_count + rep.points.unused_count + rep.points.outlier_count >= dups,
+                                 "report.points.duplicate_count inconsistent with repeated points and outliers");
         else if (strict)
-            STRATMESH_FUZZ_CHECK(rep.duplicates == dups, "report.duplicates != repeated points");
+            STRATMESH_FUZZ_CHECK(rep.points.duplicate_count == dups, "report.points.duplicate_count != repeated points");
         else  // known bug E: repeats of a point that is not used count as unused
-            STRATMESH_FUZZ_CHECK(rep.duplicates <= dups && rep.duplicates + rep.unused >= dups,
-                                 "report.duplicates inconsistent with repeated points");
+            STRATMESH_FUZZ_CHECK(rep.points.duplicate_count <= dups && rep.points.duplicate_count + rep.points.unused_count >= dups,
+                                 "report.points.duplicate_count inconsistent with repeated points");
         for (size_t k = 0; k < 3 * count; ++k)
             STRATMESH_FUZZ_CHECK(first_of[t[k]], "a duplicate (not the lowest index) is a vertex");
     }
@@ -300,7 +300,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     mesh_check::Result mr = mesh_check::check(mi);
     if (!mr.manifold() || mr.bad_indices || mr.degenerate)
         stratmesh_fuzz::fail("the mesh is not an oriented manifold", mr.summary().c_str());
-    STRATMESH_FUZZ_CHECK(mr.vertices_used == rep.points_used, "report.points_used != vertices used");
+    STRATMESH_FUZZ_CHECK(mr.vertices_used == rep.points.used_count, "report.points.used_count != vertices used");
 
     // ---- determinism, and the same bytes with parallel layers
     stratmesh::Options with_jobs = options;
@@ -310,15 +310,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     STRATMESH_FUZZ_CHECK(second.count == first.count, "second run: different count");
     STRATMESH_FUZZ_CHECK(second.triangles == first.triangles, "second run: different triangles");
     const stratmesh::Report& r2 = second.report;
-    STRATMESH_FUZZ_CHECK(r2.points_used == rep.points_used && r2.duplicates == rep.duplicates &&
-                             r2.rejected == rep.rejected && r2.outliers == rep.outliers && r2.unused == rep.unused &&
-                             r2.illegal_removed == rep.illegal_removed && r2.folds == rep.folds &&
-                             r2.layer_count == rep.layer_count,
+    STRATMESH_FUZZ_CHECK(r2.points.used_count == rep.points.used_count && r2.points.duplicate_count == rep.points.duplicate_count &&
+                             r2.points.rejected_count == rep.points.rejected_count && r2.points.outlier_count == rep.points.outlier_count && r2.points.unused_count == rep.points.unused_count &&
+                             r2.diagnostics.illegal_removed_count == rep.diagnostics.illegal_removed_count && r2.diagnostics.fold_count == rep.diagnostics.fold_count &&
+                             r2.layers.used_count == rep.layers.used_count,
                          "second run: different report");
     for (size_t k = 0; k < 3; ++k)
         STRATMESH_FUZZ_CHECK(same_double(r2.axis[k], rep.axis[k]) && same_double(r2.axis_origin[k], rep.axis_origin[k]),
                              "second run: different axis");
-    size_t filled = std::min(rep.layer_count, layer_capacity);
+    size_t filled = std::min(rep.layers.used_count, layer_capacity);
     for (size_t k = 0; k < filled; ++k) {
         const stratmesh::LayerInfo& a = first.layers[k];
         const stratmesh::LayerInfo& b = second.layers[k];

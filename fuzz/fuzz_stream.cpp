@@ -115,8 +115,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     stratmesh::Report report;
     std::memset(static_cast<void*>(&report), 0xA5, sizeof report);
     std::vector<stratmesh::LayerInfo> layers(in.below(6));
-    report.layers = layers.empty() ? nullptr : layers.data();
-    report.layer_capacity = layers.size();
+    report.layers.info = layers.empty() ? nullptr : layers.data();
+    report.layers.info_capacity = layers.size();
     Emitted emitted;
     size_t accepted = 0;
     emitted.accepted = &accepted;
@@ -155,7 +155,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         }
         const stratmesh::Cloud piece = {count ? pushed.data() + next * fc.step : nullptr, count,
                                         fc.stride, fc.f32 ? stratmesh::Scalar::float32 : stratmesh::Scalar::float64};
-        const size_t before_in = report.points_in, before_triangles = report.triangle_count;
+        const size_t before_in = report.points.in_count, before_triangles = report.triangle_count;
         Status s = stratmesh::stream_push(stream, piece, top);
         if (s == Status::ok) {
             accepted += count;
@@ -164,14 +164,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                 std::memcpy(accepted_points.data() + (accepted - count + k) * fc.step,
                             pushed.data() + (next + k) * fc.step, record);
             tops.push_back(top);
-            STRATMESH_FUZZ_CHECK(report.points_in == before_in + count, "points_in after an accepted push");
+            STRATMESH_FUZZ_CHECK(report.points.in_count == before_in + count, "points_in after an accepted push");
         } else {
             STRATMESH_FUZZ_CHECK(is_refusal(s), stratmesh::status_string(s));
             all_accepted = false;
-            STRATMESH_FUZZ_CHECK(report.points_in == before_in && report.triangle_count == before_triangles,
+            STRATMESH_FUZZ_CHECK(report.points.in_count == before_in && report.triangle_count == before_triangles,
                                  "a refused push changed the stream");
         }
-        STRATMESH_FUZZ_CHECK(report.points_in == report.points_used + report.duplicates + report.rejected + report.unused,
+        STRATMESH_FUZZ_CHECK(report.points.in_count == report.points.used_count + report.points.duplicate_count + report.points.rejected_count + report.points.unused_count,
                              "report counts do not add up after a push");
         next += count;
         if (count == 0 && next >= n) break;
@@ -184,8 +184,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     default:
         stratmesh_fuzz::fail("stream_close returned an unexpected status", stratmesh::status_string(closed));
     }
-    STRATMESH_FUZZ_CHECK(report.points_in == accepted, "points_in != points accepted");
-    STRATMESH_FUZZ_CHECK(report.points_in == report.points_used + report.duplicates + report.rejected + report.unused,
+    STRATMESH_FUZZ_CHECK(report.points.in_count == accepted, "points_in != points accepted");
+    STRATMESH_FUZZ_CHECK(report.points.in_count == report.points.used_count + report.points.duplicate_count + report.points.rejected_count + report.points.unused_count,
                          "report counts do not add up at the close");
     STRATMESH_FUZZ_CHECK(emitted.triangles.size() == 3 * report.triangle_count, "emitted != triangle_count");
     if (closed != Status::ok) return 0;
@@ -215,7 +215,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     size_t vertices = 0;
     for (char u : used) vertices += u != 0;
-    STRATMESH_FUZZ_CHECK(vertices == report.points_used, "points_used != vertices used");
+    STRATMESH_FUZZ_CHECK(vertices == report.points.used_count, "points_used != vertices used");
     std::vector<double> finite(xyz);
     for (double& v : finite)
         if (!std::isfinite(v)) v = 0;
@@ -261,9 +261,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (capping != Status::ok)
         STRATMESH_FUZZ_CHECK(std::equal(given.begin(), given.end(), capped.begin()),
                              "cap_ends changed the triangles on a failure");
-    STRATMESH_FUZZ_CHECK(cap_report.workspace_used <= cap_work.size(), "cap_ends beyond its workspace");
+    STRATMESH_FUZZ_CHECK(cap_report.workspace_used_bytes <= cap_work.size(), "cap_ends beyond its workspace");
     if (capping == Status::ok) {
-        STRATMESH_FUZZ_CHECK(capped_count == surface + cap_report.cap_triangles, "cap triangles miscounted");
+        STRATMESH_FUZZ_CHECK(capped_count == surface + cap_report.caps.triangle_count, "cap triangles miscounted");
         for (size_t k = 3 * surface; k < 3 * capped_count; ++k)
             STRATMESH_FUZZ_CHECK(capped[k] < m && valid[capped[k]], "a cap corner outside the valid points");
     }
@@ -275,12 +275,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         STRATMESH_FUZZ_CHECK(c.nonmanifold_edges == 0 && c.inconsistent_edges == 0,
                              "caps: not an oriented edge-manifold");
         STRATMESH_FUZZ_CHECK(c.nonmanifold_vertices == 0, "caps: not vertex-manifold");
-        STRATMESH_FUZZ_CHECK(c.boundary_loops == cap_report.caps_left_open, "caps: loops neither closed nor counted");
+        STRATMESH_FUZZ_CHECK(c.boundary_loops == cap_report.caps.open_count, "caps: loops neither closed nor counted");
         // Each flip under a fin rewrites two triangles of the surface, in place.
         size_t rewritten = 0;
         for (size_t k = 0; k < 3 * surface; k += 3)
             rewritten += given[k] != capped[k] || given[k + 1] != capped[k + 1] || given[k + 2] != capped[k + 2];
-        STRATMESH_FUZZ_CHECK(rewritten == 2 * cap_report.cap_wall_flips, "wall flips miscounted");
+        STRATMESH_FUZZ_CHECK(rewritten == 2 * cap_report.caps.wall_flip_count, "wall flips miscounted");
     }
 
     // ---- the same as reconstruct() on the same layers (with close_ends: the caps too)

@@ -9,7 +9,7 @@
 // Fixed, kept as regression corpus files: A (NaN from the predicates on all-subnormal
 // points), C (undefined behaviour in reconstruct for coordinates beyond 2^511 or
 // subnormal), D (wrong incircle signs for points a few ulps apart near 2^-218), E (repeats
-// of unused points missing from Report::duplicates: no longer reproduces), G (reconstruct
+// of unused points missing from Report::points.duplicate_count: no longer reproduces), G (reconstruct
 // made a repeated point a vertex instead of its lowest twin for a cloud with one far
 // outlier: the annulus coordinates spread beyond the predicates' exact range), H (undefined
 // behaviour, a NaN cast to an integer, for a cloud whose coordinates span more than the

@@ -638,7 +638,7 @@ TEST_CASE("NaN and infinite coordinates: invalid_point with the first offending 
                 if (at < 19) xy[2 * 19 + 1] = std::numeric_limits<double>::quiet_NaN();  // a later one too
                 Run r = triangulate(xy);
                 CHECK(r.status == Status::invalid_point);
-                CHECK(r.info.first_invalid_point == at);
+                CHECK(r.info.first_invalid_index == at);
                 expect_nothing_written(r);
             }
         }
@@ -803,7 +803,7 @@ TEST_CASE("strided input: odd 27-byte stride from an unaligned buffer") {
     info = sentinel_info();
     CHECK(stratmesh::delaunay_2d(unaligned, n, stride, work.data(), work.size(), tris.data(), tris.size() / 3, &info,
                                  nullptr) == Status::invalid_point);
-    CHECK(info.first_invalid_point == 1234);
+    CHECK(info.first_invalid_index == 1234);
 }
 
 // ==== Capacity and workspace ==================================================================
@@ -1040,11 +1040,11 @@ TEST_CASE("workspace: the reported peak suffices and one byte less is out_of_mem
     };
     stratmesh::Delaunay2dInfo full = {};
     REQUIRE(run(stratmesh::delaunay_2d_workspace_size(n), full) == stratmesh::Status::ok);
-    REQUIRE(full.workspace_used > 0);
-    CHECK(full.workspace_used <= stratmesh::delaunay_2d_workspace_size(n));
+    REQUIRE(full.workspace_used_bytes > 0);
+    CHECK(full.workspace_used_bytes <= stratmesh::delaunay_2d_workspace_size(n));
     stratmesh::Delaunay2dInfo exact = {};
-    CHECK(run(full.workspace_used, exact) == stratmesh::Status::ok);
+    CHECK(run(full.workspace_used_bytes, exact) == stratmesh::Status::ok);
     CHECK(exact.triangle_count == full.triangle_count);
     stratmesh::Delaunay2dInfo short_by_one = {};
-    CHECK(run(full.workspace_used - 1, short_by_one) == stratmesh::Status::out_of_memory);
+    CHECK(run(full.workspace_used_bytes - 1, short_by_one) == stratmesh::Status::out_of_memory);
 }

@@ -131,20 +131,20 @@ TEST_CASE("join_branches: a trunk and two prongs meshed apart become one oriente
         Options options = {};
         options.axis = turned ? Axis::x : Axis::z;
         const Parted parted = mesh_apart(xyz, options);
-        REQUIRE(parted.parting.branches_above == 2);
+        REQUIRE(parted.parting.above_branch_count == 2);
         const mesh_check::Result apart = check(xyz, parted.triangles, parted.parting.axis);
         INFO("apart: " << apart.summary());
         CHECK(apart.components == 3);
 
         const Joined joined = join(xyz, parted, options);
         REQUIRE(joined.status == Status::ok);
-        CHECK(joined.report.sides_joined == 1);
-        CHECK(joined.report.sides_left_apart == 0);
+        CHECK(joined.report.joined_side_count == 1);
+        CHECK(joined.report.apart_side_count == 0);
         CHECK(joined.report.detail == nullptr);
-        CHECK(joined.report.branches_grafted == 0);
-        CHECK(joined.report.triangles_removed == 0);
-        CHECK(joined.triangles.size() == parted.triangles.size() + 3 * joined.report.triangles_added);
-        CHECK(joined.report.workspace_used <= joined.workspace_bytes);
+        CHECK(joined.report.grafted_branch_count == 0);
+        CHECK(joined.report.removed_triangle_count == 0);
+        CHECK(joined.triangles.size() == parted.triangles.size() + 3 * joined.report.added_triangle_count);
+        CHECK(joined.report.workspace_used_bytes <= joined.workspace_bytes);
         // The junction names only points on the loops it joins, each a vertex already.
         const mesh_check::Result m = check(xyz, joined.triangles, parted.parting.axis);
         INFO("joined: " << m.summary());
@@ -183,19 +183,19 @@ TEST_CASE("join_branches: prongs standing on a dome are grafted onto holes cut i
         options.axis = Axis::direction;
         s.axis_direction(options.direction);
         const Parted parted = mesh_apart(s.xyz, options);
-        REQUIRE(parted.parting.branches_above == 2);
+        REQUIRE(parted.parting.above_branch_count == 2);
         const mesh_check::Result apart = check(s.xyz, parted.triangles, parted.parting.axis);
         INFO("apart: " << apart.summary());
 
         const Joined joined = join(s.xyz, parted, options);
         REQUIRE(joined.status == Status::ok);
-        CHECK(joined.report.sides_joined == 1);
-        CHECK(joined.report.sides_left_apart == 0);
-        CHECK(joined.report.branches_grafted == 2);
+        CHECK(joined.report.joined_side_count == 1);
+        CHECK(joined.report.apart_side_count == 0);
+        CHECK(joined.report.grafted_branch_count == 2);
         CHECK(joined.report.detail == nullptr);
-        CHECK(joined.report.triangles_removed > 0);
-        const size_t kept = parted.triangles.size() / 3 - joined.report.triangles_removed;
-        REQUIRE(joined.triangles.size() / 3 == kept + joined.report.triangles_added);
+        CHECK(joined.report.removed_triangle_count > 0);
+        const size_t kept = parted.triangles.size() / 3 - joined.report.removed_triangle_count;
+        REQUIRE(joined.triangles.size() / 3 == kept + joined.report.added_triangle_count);
         CHECK(kept_in_order(parted.triangles, joined.triangles.data(), kept));
         const mesh_check::Result m = check(s.xyz, joined.triangles, parted.parting.axis);
         INFO("joined: " << m.summary());
@@ -265,9 +265,9 @@ TEST_CASE("join_branches: bad input gets a status and leaves the triangles uncha
     CHECK(count == given);
     // No parting: nothing to join, nothing added.
     Parted none = parted;
-    none.parting.branches_above = none.parting.branches_below = 0;
+    none.parting.above_branch_count = none.parting.below_branch_count = 0;
     const Joined nothing = join(xyz, none, options);
     CHECK(nothing.status == Status::ok);
     CHECK(nothing.triangles == parted.triangles);
-    CHECK(nothing.report.sides_joined + nothing.report.sides_left_apart == 0);
+    CHECK(nothing.report.joined_side_count + nothing.report.apart_side_count == 0);
 }

@@ -62,28 +62,28 @@ Result run(const Shape& s, const Options& o) {
     std::vector<unsigned char> work(r.bound);
     r.triangles.resize(3 * stratmesh::reconstruct_max_triangles(cloud.count, o));
     r.layers.resize(300);
-    r.report.layers = r.layers.data();
-    r.report.layer_capacity = r.layers.size();
+    r.report.layers.info = r.layers.data();
+    r.report.layers.info_capacity = r.layers.size();
     size_t count = 0;
     r.status = stratmesh::reconstruct(cloud, o, work.data(), work.size(), r.triangles.data(),
                                       r.triangles.size() / 3, &count, &r.report);
     r.triangles.resize(3 * count);
-    r.layers.resize(std::min<size_t>(r.report.layer_count, r.layers.size()));
+    r.layers.resize(std::min<size_t>(r.report.layers.used_count, r.layers.size()));
     return r;
 }
 
 void check_same(const Result& sequential, const Result& parallel) {
     REQUIRE(parallel.status == sequential.status);
     CHECK(parallel.triangles == sequential.triangles);
-    CHECK(parallel.report.points_used == sequential.report.points_used);
-    CHECK(parallel.report.duplicates == sequential.report.duplicates);
-    CHECK(parallel.report.folds == sequential.report.folds);
-    CHECK(parallel.report.diagonal_swaps == sequential.report.diagonal_swaps);
-    CHECK(parallel.report.illegal_removed == sequential.report.illegal_removed);
+    CHECK(parallel.report.points.used_count == sequential.report.points.used_count);
+    CHECK(parallel.report.points.duplicate_count == sequential.report.points.duplicate_count);
+    CHECK(parallel.report.diagnostics.fold_count == sequential.report.diagnostics.fold_count);
+    CHECK(parallel.report.diagnostics.diagonal_swap_count == sequential.report.diagnostics.diagonal_swap_count);
+    CHECK(parallel.report.diagnostics.illegal_removed_count == sequential.report.diagnostics.illegal_removed_count);
     REQUIRE(parallel.layers.size() == sequential.layers.size());
     for (size_t k = 0; k < parallel.layers.size(); ++k)
         CHECK(std::memcmp(&parallel.layers[k], &sequential.layers[k], sizeof(LayerInfo)) == 0);
-    CHECK(parallel.report.workspace_used <= parallel.bound);
+    CHECK(parallel.report.workspace_used_bytes <= parallel.bound);
 }
 
 struct Layout {
@@ -125,7 +125,7 @@ TEST_CASE("parallel layers: the same bytes as in order, whatever the runner, on 
             layout.apply(o, cuts, s);
             const Result sequential = run(s, o);
             REQUIRE(sequential.status == Status::ok);
-            CHECK(sequential.report.parallel_layers == 0);
+            CHECK(sequential.report.layers.parallel_count == 0);
             struct Runner {
                 stratmesh::JobRunner run;
                 void* user;
@@ -137,7 +137,7 @@ TEST_CASE("parallel layers: the same bytes as in order, whatever the runner, on 
                 p.jobs_user = runner.user;
                 const Result parallel = run(s, p);
                 check_same(sequential, parallel);
-                if (sequential.report.layer_count > 1) CHECK(parallel.report.parallel_layers > 0);
+                if (sequential.report.layers.used_count > 1) CHECK(parallel.report.layers.parallel_count > 0);
             }
         }
     }
@@ -160,13 +160,13 @@ TEST_CASE("parallel layers: chunks the safety net repairs come out the same") {
         o.layer_count = r.layers;
         const Result sequential = run(r.shape, o);
         REQUIRE(sequential.status == Status::ok);
-        CHECK(sequential.report.illegal_removed > 0);
+        CHECK(sequential.report.diagnostics.illegal_removed_count > 0);
         Options p = o;
         p.run_jobs = run_on_threads;
         p.jobs_user = &two;
         const Result parallel = run(r.shape, p);
         check_same(sequential, parallel);
-        CHECK(parallel.report.parallel_layers > 0);
+        CHECK(parallel.report.layers.parallel_count > 0);
     }
 }
 
@@ -199,7 +199,7 @@ TEST_CASE("parallel layers: a folding layer tried again with the next one joined
             p.jobs_user = &two;
             const Result parallel = run(f.shape, p);
             check_same(sequential, parallel);
-            CHECK(parallel.report.parallel_layers > 0);
+            CHECK(parallel.report.layers.parallel_count > 0);
         }
     }
 }
@@ -222,7 +222,7 @@ TEST_CASE("parallel layers: a workspace too small for the jobs falls back to wor
                                    &count, &report) == Status::ok);
     tris.resize(3 * count);
     CHECK(tris == sequential.triangles);
-    CHECK(report.parallel_layers == 0);
+    CHECK(report.layers.parallel_count == 0);
 }
 
 TEST_CASE("parallel layers: any workspace below the bound gives out_of_memory or the same triangles") {
@@ -272,7 +272,7 @@ TEST_CASE("parallel layers: any workspace below the bound gives out_of_memory or
                 smallest_success = std::min(smallest_success, bytes);
                 tris.resize(3 * count);
                 CHECK(tris == sequential.triangles);
-                CHECK(report.points_used == sequential.report.points_used);
+                CHECK(report.points.used_count == sequential.report.points.used_count);
             } else {
                 ++failures;
                 CHECK(status == Status::out_of_memory);
@@ -324,7 +324,7 @@ TEST_CASE("parallel layers: a runner that skips jobs, repeats them or names othe
     REQUIRE(sequential.status == Status::ok);
     Options all = o;
     all.run_jobs = run_in_order;
-    const size_t every_layer = run(s, all).report.parallel_layers;
+    const size_t every_layer = run(s, all).report.layers.parallel_count;
     REQUIRE(every_layer > 2);
     struct Runner {
         const char* name;
@@ -338,12 +338,12 @@ TEST_CASE("parallel layers: a runner that skips jobs, repeats them or names othe
         const Result parallel = run(s, p);
         check_same(sequential, parallel);
         if (runner.run == run_even_only) {
-            CHECK(parallel.report.parallel_layers > 0);
-            CHECK(parallel.report.parallel_layers < every_layer);
+            CHECK(parallel.report.layers.parallel_count > 0);
+            CHECK(parallel.report.layers.parallel_count < every_layer);
         } else if (runner.run == run_none) {
-            CHECK(parallel.report.parallel_layers == 0);
+            CHECK(parallel.report.layers.parallel_count == 0);
         } else {
-            CHECK(parallel.report.parallel_layers == every_layer);
+            CHECK(parallel.report.layers.parallel_count == every_layer);
         }
     }
 }

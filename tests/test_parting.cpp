@@ -140,8 +140,8 @@ TEST_CASE("find_parting: the prongs of a forked tube part above its dome, as sin
         double axis[3];
         s.axis_direction(axis);
         for (int c = 0; c < 3; ++c) CHECK(p.axis[c] == doctest::Approx(axis[c]));
-        CHECK(p.branches_below == 0);  // the trunk's open end
-        REQUIRE(p.branches_above == 2);
+        CHECK(p.below_branch_count == 0);  // the trunk's open end
+        REQUIRE(p.above_branch_count == 2);
         // The prongs leave the trunk's dome, whose pole is at local z = 1.5; below z = 1.2
         // the dome joins them, and its crown ends within two gaps of any cut above that.
         CHECK(p.gap > 0);
@@ -150,13 +150,13 @@ TEST_CASE("find_parting: the prongs of a forked tube part above its dome, as sin
         CHECK(p.above <= s.along_axis(1.5) + 2 * p.gap);
         // The pieces are single linkage's at the reported gap, largest first (a prong's
         // thin tip may break off, sampled too sparsely to stay joined: it is left aside).
-        CHECK(p.above_points[0] >= p.above_points[1]);
+        CHECK(p.above_point_counts[0] >= p.above_point_counts[1]);
         const Pieces pieces = pieces_beyond(s, axis, p.above, true, p.gap, stratmesh::kSmallestBranch);
-        CHECK(reported(p.above_points, p.branches_above) == pieces.sizes);
+        CHECK(reported(p.above_point_counts, p.above_branch_count) == pieces.sizes);
         // Each point's label: a prong's points, the trunk's (below the cut, and the dome's
         // crown above it: a piece too small to count that starts at the cut), those left
         // aside above the cut (a prong's tip broken off).
-        check_labels(pieces, label, stratmesh::kFirstAboveBranch, p.branches_above);
+        check_labels(pieces, label, stratmesh::kFirstAboveBranch, p.above_branch_count);
         size_t crown = 0;
         for (size_t i = 0; i < s.size(); ++i) {
             const double* q = s.point(i);
@@ -169,7 +169,7 @@ TEST_CASE("find_parting: the prongs of a forked tube part above its dome, as sin
             }
         }
         CHECK(crown > 0);  // the case this checks arises
-        CHECK(run.parting.workspace_used <= run.workspace_bytes);
+        CHECK(run.parting.workspace_used_bytes <= run.workspace_bytes);
         CHECK(run.parting.detail == nullptr);
     }
 }
@@ -184,16 +184,16 @@ TEST_CASE("find_parting: the knobs under a tube part below the pole of its dome"
         const Parting& p = run.parting;
         double axis[3];
         s.axis_direction(axis);
-        CHECK(p.branches_above == 0);
-        REQUIRE(p.branches_below == 2);
+        CHECK(p.above_branch_count == 0);
+        REQUIRE(p.below_branch_count == 2);
         // Below the dome's pole (local z = -1) the section is two discs 0.3 apart; the
         // knobs end at z = -1.7.
         CHECK(p.below <= s.along_axis(-1.0) + p.gap);
         CHECK(p.below >= s.along_axis(-1.7) + 4 * p.gap);
-        CHECK(p.below_points[1] * 5 >= p.below_points[0] * 4);
+        CHECK(p.below_point_counts[1] * 5 >= p.below_point_counts[0] * 4);
         const Pieces pieces = pieces_beyond(s, axis, p.below, false, p.gap, stratmesh::kSmallestBranch);
-        CHECK(reported(p.below_points, p.branches_below) == pieces.sizes);
-        check_labels(pieces, label, stratmesh::kFirstBelowBranch, p.branches_below);
+        CHECK(reported(p.below_point_counts, p.below_branch_count) == pieces.sizes);
+        check_labels(pieces, label, stratmesh::kFirstBelowBranch, p.below_branch_count);
     }
 }
 
@@ -220,8 +220,8 @@ TEST_CASE("find_parting: no tube that does not fork parts, at any size or pose")
                 const PartingRun run = find_parting_of(cloud_of(s), axis_options(s), label.data());
                 REQUIRE(run.status == Status::ok);
                 CHECK(run.parting.gap > 0);
-                CHECK(run.parting.branches_above == 0);
-                CHECK(run.parting.branches_below == 0);
+                CHECK(run.parting.above_branch_count == 0);
+                CHECK(run.parting.below_branch_count == 0);
                 CHECK(std::count(label.begin(), label.end(), stratmesh::kInTrunk) ==
                       static_cast<std::ptrdiff_t>(s.size()));
             }
@@ -231,7 +231,7 @@ TEST_CASE("find_parting: the same answer for the points in any order, and read a
     const Shape s = shapes::forked_tube(12000, Pose::tilted);
     const PartingRun first = find_parting_of(cloud_of(s), axis_options(s));
     REQUIRE(first.status == Status::ok);
-    REQUIRE(first.parting.branches_above == 2);
+    REQUIRE(first.parting.above_branch_count == 2);
 
     // Reversed, then every 7th point to the front.
     Shape moved = s;
@@ -248,8 +248,8 @@ TEST_CASE("find_parting: the same answer for the points in any order, and read a
     CHECK(second.parting.gap == first.parting.gap);
     // The frame's origin, a sum over the points, may differ in its last bits.
     CHECK(second.parting.above == doctest::Approx(first.parting.above).epsilon(1e-12));
-    CHECK(second.parting.branches_above == first.parting.branches_above);
-    CHECK(reported(second.parting.above_points, 2) == reported(first.parting.above_points, 2));
+    CHECK(second.parting.above_branch_count == first.parting.above_branch_count);
+    CHECK(reported(second.parting.above_point_counts, 2) == reported(first.parting.above_point_counts, 2));
 
     // float32 records of 4 floats (the 4th a NaN the reader must skip over).
     std::vector<float> records(4 * n);
@@ -260,7 +260,7 @@ TEST_CASE("find_parting: the same answer for the points in any order, and read a
     const PartingRun single = find_parting_of(Cloud{records.data(), n, 4 * sizeof(float), Scalar::float32},
                                               axis_options(s));
     REQUIRE(single.status == Status::ok);
-    CHECK(single.parting.branches_above == 2);
+    CHECK(single.parting.above_branch_count == 2);
     CHECK(single.parting.above == doctest::Approx(first.parting.above).epsilon(0.01));
 }
 
@@ -274,7 +274,7 @@ TEST_CASE("find_parting: clouds it cannot measure or search get nothing found an
         const PartingRun run = find_parting_of(cloud_of(repeated), axis_options(repeated));
         REQUIRE(run.status == Status::ok);
         CHECK(run.parting.gap == 0);
-        CHECK(run.parting.branches_above + run.parting.branches_below == 0);
+        CHECK(run.parting.above_branch_count + run.parting.below_branch_count == 0);
         REQUIRE(run.parting.detail != nullptr);
         CHECK(std::string(run.parting.detail).find("no scale") != std::string::npos);
     }
@@ -290,7 +290,7 @@ TEST_CASE("find_parting: clouds it cannot measure or search get nothing found an
         const PartingRun run = find_parting_of(cloud_of(crowded), axis_options(crowded));
         REQUIRE(run.status == Status::ok);
         CHECK(run.parting.gap > 0);
-        CHECK(run.parting.branches_above + run.parting.branches_below == 0);
+        CHECK(run.parting.above_branch_count + run.parting.below_branch_count == 0);
         REQUIRE(run.parting.detail != nullptr);
         CHECK(std::string(run.parting.detail).find("crowded") != std::string::npos);
     }
@@ -311,37 +311,37 @@ TEST_CASE("find_parting: bad input gets a status, and the workspace bound is exa
     Parting p;
 
     SUBCASE("a null parting") {
-        CHECK(stratmesh::find_parting(cloud_of(s), o, workspace.data(), bytes, nullptr) ==
+        CHECK(stratmesh::find_parting(cloud_of(s), o, workspace.data(), bytes, nullptr, nullptr) ==
               Status::invalid_argument);
     }
     SUBCASE("a workspace one byte short, then just large enough") {
-        CHECK(stratmesh::find_parting(cloud_of(s), o, workspace.data(), bytes, &p) == Status::ok);
-        const size_t used = p.workspace_used;
+        CHECK(stratmesh::find_parting(cloud_of(s), o, workspace.data(), bytes, &p, nullptr) == Status::ok);
+        const size_t used = p.workspace_used_bytes;
         CHECK(used <= bytes);
-        CHECK(stratmesh::find_parting(cloud_of(s), o, workspace.data(), used - 1, &p) ==
+        CHECK(stratmesh::find_parting(cloud_of(s), o, workspace.data(), used - 1, &p, nullptr) ==
               Status::out_of_memory);
         CHECK(p.detail != nullptr);
-        CHECK(stratmesh::find_parting(cloud_of(s), o, workspace.data(), used, &p) == Status::ok);
+        CHECK(stratmesh::find_parting(cloud_of(s), o, workspace.data(), used, &p, nullptr) == Status::ok);
     }
     SUBCASE("no workspace, a null cloud, an unknown scalar, a short stride") {
-        CHECK(stratmesh::find_parting(cloud_of(s), o, nullptr, 0, &p) == Status::invalid_argument);
+        CHECK(stratmesh::find_parting(cloud_of(s), o, nullptr, 0, &p, nullptr) == Status::invalid_argument);
         CHECK(stratmesh::find_parting(Cloud{nullptr, 10, 0, Scalar::float64}, o, workspace.data(),
-                                      bytes, &p) == Status::invalid_argument);
+                                      bytes, &p, nullptr) == Status::invalid_argument);
         CHECK(stratmesh::find_parting(Cloud{s.xyz.data(), s.size(), 0, static_cast<Scalar>(7)}, o,
-                                      workspace.data(), bytes, &p) == Status::invalid_argument);
+                                      workspace.data(), bytes, &p, nullptr) == Status::invalid_argument);
         CHECK(stratmesh::find_parting(Cloud{s.xyz.data(), s.size(), 8, Scalar::float64}, o,
-                                      workspace.data(), bytes, &p) == Status::invalid_argument);
+                                      workspace.data(), bytes, &p, nullptr) == Status::invalid_argument);
     }
     SUBCASE("the parting inside the workspace or the cloud is refused before anything is written") {
         const std::vector<unsigned char> before = workspace;
         Parting* inside = reinterpret_cast<Parting*>(workspace.data());
-        CHECK(stratmesh::find_parting(cloud_of(s), o, workspace.data(), bytes, inside) ==
+        CHECK(stratmesh::find_parting(cloud_of(s), o, workspace.data(), bytes, inside, nullptr) ==
               Status::invalid_argument);
         CHECK(workspace == before);
         std::vector<double> copy = s.xyz;
         CHECK(stratmesh::find_parting(Cloud{copy.data(), s.size(), 0, Scalar::float64}, o,
                                       workspace.data(), bytes,
-                                      reinterpret_cast<Parting*>(copy.data() + 6)) ==
+                                      reinterpret_cast<Parting*>(copy.data() + 6), nullptr) ==
               Status::invalid_argument);
         CHECK(copy == s.xyz);
         std::vector<uint8_t> label(s.size());
@@ -355,21 +355,21 @@ TEST_CASE("find_parting: bad input gets a status, and the workspace bound is exa
         std::vector<double> xyz = s.xyz;
         xyz[3 * 17 + 1] = std::numeric_limits<double>::quiet_NaN();
         const Cloud cloud{xyz.data(), s.size(), 0, Scalar::float64};
-        CHECK(stratmesh::find_parting(cloud, o, workspace.data(), bytes, &p) == Status::invalid_point);
+        CHECK(stratmesh::find_parting(cloud, o, workspace.data(), bytes, &p, nullptr) == Status::invalid_point);
         Options skip = o;
         skip.flags = stratmesh::skip_invalid_points;
-        CHECK(stratmesh::find_parting(cloud, skip, workspace.data(), bytes, &p) == Status::ok);
+        CHECK(stratmesh::find_parting(cloud, skip, workspace.data(), bytes, &p, nullptr) == Status::ok);
     }
     SUBCASE("too few distinct points, every point at one height, a zero axis") {
         const double two[] = {0, 0, 0, 1, 0, 0, 1, 0, 0, 0, 0, 0};
         CHECK(stratmesh::find_parting(Cloud{two, 4, 0, Scalar::float64}, o, workspace.data(),
-                                      bytes, &p) == Status::too_few_points);
+                                      bytes, &p, nullptr) == Status::too_few_points);
         const double flat[] = {0, 0, 5, 1, 0, 5, 0, 1, 5, 1, 1, 5};
         CHECK(stratmesh::find_parting(Cloud{flat, 4, 0, Scalar::float64}, o, workspace.data(),
-                                      bytes, &p) == Status::flat_cloud);
+                                      bytes, &p, nullptr) == Status::flat_cloud);
         Options zero = {};
         zero.axis = stratmesh::Axis::direction;
-        CHECK(stratmesh::find_parting(cloud_of(s), zero, workspace.data(), bytes, &p) ==
+        CHECK(stratmesh::find_parting(cloud_of(s), zero, workspace.data(), bytes, &p, nullptr) ==
               Status::invalid_axis);
     }
     SUBCASE("outliers left out first with drop_outliers") {
@@ -380,8 +380,8 @@ TEST_CASE("find_parting: bad input gets a status, and the workspace bound is exa
         std::vector<double> xyz = s.xyz;
         for (size_t c = 0; c < 3; ++c) xyz[3 * 5 + c] = 1e3;  // far from the rest
         CHECK(stratmesh::find_parting(Cloud{xyz.data(), s.size(), 0, Scalar::float64}, drop,
-                                      larger.data(), larger.size(), &p) == Status::ok);
-        CHECK(p.branches_above == 2);
+                                      larger.data(), larger.size(), &p, nullptr) == Status::ok);
+        CHECK(p.above_branch_count == 2);
     }
     CHECK(stratmesh::find_parting_workspace_size(size_t{0xFFFFFFFFu}, o) == 0);
 }

@@ -12,7 +12,7 @@
 //     triangles facing outward and no self-intersection;
 //   - several layers: the bands between layers hold a few triangles facing the axis (at
 //     most 2 a run in the matrix below, some of them strongly: normals up to 155 degrees
-//     from the outward direction), Report::folds counting them within 2, and some of those
+//     from the outward direction), Report::diagnostics.fold_count counting them within 2, and some of those
 //     folds intersect their neighbours. The strict properties were asserted in a test case
 //     marked may_fail until untangle_runs left none in the matrix; they now hold strictly,
 //     the bounded counts are asserted too;
@@ -68,7 +68,7 @@ struct Run {
     std::vector<uint32_t> triangles;  // 3 * count indices
     size_t count = 0;
     Report report{};
-    std::vector<LayerInfo> layers;    // report.layer_count of them (at most kLayerCapacity)
+    std::vector<LayerInfo> layers;    // report.layers.used_count of them (at most kLayerCapacity)
     size_t workspace_bytes = 0;
     size_t max_triangles = 0;
     bool workspace_guard_intact = true;  // nothing written past the workspace
@@ -84,8 +84,8 @@ Run reconstruct_guarded(const Cloud& cloud, const Options& options, size_t misal
     std::vector<unsigned char> workspace(misalign + run.workspace_bytes + kGuardBytes, kGuardByte);
     std::vector<uint32_t> triangles(3 * (run.max_triangles + kGuardTriangles), kSentinel);
     std::vector<LayerInfo> layers(kLayerCapacity);
-    run.report.layers = layers.data();
-    run.report.layer_capacity = layers.size();
+    run.report.layers.info = layers.data();
+    run.report.layers.info_capacity = layers.size();
     run.status = stratmesh::reconstruct(cloud, options, workspace.data() + misalign,
                                         run.workspace_bytes, triangles.data(), run.max_triangles,
                                         &run.count, &run.report);
@@ -95,9 +95,9 @@ Run reconstruct_guarded(const Cloud& cloud, const Options& options, size_t misal
         if (triangles[i] != kSentinel) run.triangle_guard_intact = false;
     if (run.status == Status::ok && run.count <= run.max_triangles)
         run.triangles.assign(triangles.begin(), triangles.begin() + static_cast<std::ptrdiff_t>(3 * run.count));
-    layers.resize(std::min(run.report.layer_count, kLayerCapacity));
+    layers.resize(std::min(run.report.layers.used_count, kLayerCapacity));
     run.layers = layers;
-    run.report.layers = nullptr;  // the array it pointed to is gone
+    run.report.layers.info = nullptr;  // the array it pointed to is gone
     return run;
 }
 
@@ -193,7 +193,7 @@ const double kLayeredDeviation = 4.0;
 // Several layers: at most this many triangles facing the axis (measured: at most 2 in a run
 // of the matrix; the bound allows 3 per band plus 0.1% of the triangles).
 size_t fold_allowance(const Run& run) {
-    size_t bands = run.report.layer_count > 0 ? run.report.layer_count - 1 : 0;
+    size_t bands = run.report.layers.used_count > 0 ? run.report.layers.used_count - 1 : 0;
     return 3 * bands + run.count / 1000;
 }
 
@@ -261,19 +261,19 @@ Case run_case(const Shape& s, Layering layering, bool self_intersections) {
 void check_report(const Case& c) {
     const Run& run = c.run;
     const Report& r = run.report;
-    CHECK(r.points_in == c.points);
-    CHECK(r.points_in == r.points_used + r.duplicates + r.rejected + r.unused);
-    CHECK(r.unused == 0);
-    CHECK(r.duplicates == 0);
-    CHECK(r.rejected == 0);
-    CHECK(r.points_used == c.points);
+    CHECK(r.points.in_count == c.points);
+    CHECK(r.points.in_count == r.points.used_count + r.points.duplicate_count + r.points.rejected_count + r.points.unused_count);
+    CHECK(r.points.unused_count == 0);
+    CHECK(r.points.duplicate_count == 0);
+    CHECK(r.points.rejected_count == 0);
+    CHECK(r.points.used_count == c.points);
     CHECK(r.triangle_count == run.count);
-    CHECK(r.illegal_removed == 0);  // "on sound input this removes nothing"
+    CHECK(r.diagnostics.illegal_removed_count == 0);  // "on sound input this removes nothing"
     CHECK(run.count <= run.max_triangles);
     CHECK(run.workspace_guard_intact);
     CHECK(run.triangle_guard_intact);
-    REQUIRE(r.layer_count >= 1);
-    REQUIRE(run.layers.size() == r.layer_count);
+    REQUIRE(r.layers.used_count >= 1);
+    REQUIRE(run.layers.size() == r.layers.used_count);
     // Layers tile the extent along the axis, in order, and add up.
     size_t points = 0, triangles = 0, folds = 0;
     for (size_t l = 0; l < run.layers.size(); ++l) {
@@ -286,10 +286,10 @@ void check_report(const Case& c) {
         folds += info.fold_count;
         CHECK(info.closed_ends == 0);  // these shapes are open tubes: both ends are rims
     }
-    CHECK(points == r.points_used + r.unused);
+    CHECK(points == r.points.used_count + r.points.unused_count);
     CHECK(c.layer_count_mismatches == 0);
-    CHECK(triangles == run.count + r.illegal_removed);
-    CHECK(folds == r.folds);
+    CHECK(triangles == run.count + r.diagnostics.illegal_removed_count);
+    CHECK(folds == r.diagnostics.fold_count);
 }
 
 // Topology and coverage: one oriented manifold annulus through every point.
@@ -326,10 +326,10 @@ void check_orientation_bounded(const Case& c) {
     const mesh_check::Result& m = c.mesh;
     if (is_single_layer(c.layering)) {
         CHECK(m.inward == 0);
-        CHECK(c.run.report.folds == 0);
+        CHECK(c.run.report.diagnostics.fold_count == 0);
     } else {
         CHECK(m.inward <= fold_allowance(c.run));
-        size_t diff = m.inward > c.run.report.folds ? m.inward - c.run.report.folds : c.run.report.folds - m.inward;
+        size_t diff = m.inward > c.run.report.diagnostics.fold_count ? m.inward - c.run.report.diagnostics.fold_count : c.run.report.diagnostics.fold_count - m.inward;
         CHECK(diff <= 2 + m.inward / 10);
     }
 }
@@ -337,8 +337,8 @@ void check_orientation_bounded(const Case& c) {
 std::string describe(const Case& c) {
     std::ostringstream s;
     s << c.name << ": status " << stratmesh::status_string(c.run.status) << ", " << c.run.count
-      << " triangles, " << c.run.report.layer_count << " layers, folds " << c.run.report.folds
-      << ", removed " << c.run.report.illegal_removed << ", unused " << c.run.report.unused
+      << " triangles, " << c.run.report.layers.used_count << " layers, folds " << c.run.report.diagnostics.fold_count
+      << ", removed " << c.run.report.diagnostics.illegal_removed_count << ", unused " << c.run.report.points.unused_count
       << ", spacing " << c.spacing << "; " << c.mesh.summary();
     return s.str();
 }
@@ -382,7 +382,7 @@ template <class F> void for_each_case(size_t kind, F&& check, bool layered_only 
     for (const std::vector<Case>* list : {&runs.small, &runs.large})
         for (const Case& c : *list) {
             if (layered_only && is_single_layer(c.layering)) continue;
-            if (layered_only && c.run.report.layer_count < 2) continue;
+            if (layered_only && c.run.report.layers.used_count < 2) continue;
             std::string context = describe(c);
             INFO(context);
             REQUIRE(c.run.status == Status::ok);
@@ -626,7 +626,7 @@ TEST_CASE("reconstruction with several layers: every triangle faces outward, no 
     for (size_t kind = 0; kind < shapes::kinds().size(); ++kind)
         for_each_case(kind, [](const Case& c) {
             CHECK(c.mesh.inward == 0);
-            CHECK(c.run.report.folds == 0);
+            CHECK(c.run.report.diagnostics.fold_count == 0);
             if (!c.checked_intersections) return;
             CHECK(c.mesh.intersecting_pairs == 0);
             CHECK(c.mesh.vertex_overlaps == 0);
@@ -712,7 +712,7 @@ TEST_CASE("seams: many layers stay about as close to the true surface as one lay
             o.layer_count = static_cast<uint32_t>(layers);
             Run run = reconstruct_guarded(cloud_of(s), o);
             REQUIRE(run.status == Status::ok);
-            REQUIRE(run.report.layer_count == layers);
+            REQUIRE(run.report.layers.used_count == layers);
             double mean = mean_centroid_deviation(s, run.triangles);
             MESSAGE(s.name << ", " << layers << " layers: mean distance " << mean);
             if (layers == 1) one = mean;
@@ -795,7 +795,7 @@ TEST_CASE("explicit cuts are positions dot(point, axis), in any order, repeats a
         REQUIRE(ra.status == Status::ok);
         REQUIRE(rb.status == Status::ok);
         CHECK(ra.triangles == rb.triangles);
-        REQUIRE(ra.report.layer_count == 4);
+        REQUIRE(ra.report.layers.used_count == 4);
         for (size_t l = 0; l < 3; ++l) {
             CHECK(ra.layers[l].top == doctest::Approx(sorted[l]).epsilon(1e-12));
         }
@@ -827,7 +827,7 @@ TEST_CASE("a cut on every contour plane: layers of one contour each, the top con
         // The cut on the top plane would leave that contour alone in a last layer of no
         // height, too thin to stand: it joins the layer below.
         const size_t per_contour = s.size() / s.planes.size();
-        REQUIRE(c.run.report.layer_count == s.planes.size() - 1);
+        REQUIRE(c.run.report.layers.used_count == s.planes.size() - 1);
         for (size_t k = 0; k + 1 < c.run.layers.size(); ++k) CHECK(c.run.layers[k].point_count == per_contour);
         CHECK(c.run.layers.back().point_count == 2 * per_contour);
         check_report(c);
@@ -875,8 +875,8 @@ TEST_CASE("cuts on contour planes with a tilted axis") {
         o.layer_count = v.layer_count;
         Run run = reconstruct_guarded(cloud_of(v.shape), o);
         mesh_check::Result m = check_mesh(v.shape, run.triangles.data(), run.count, true);
-        INFO(v.shape.name << ", " << std::string(v.name) << ": " << run.report.layer_count << " layers, folds "
-                          << run.report.folds << "; " << m.summary());
+        INFO(v.shape.name << ", " << std::string(v.name) << ": " << run.report.layers.used_count << " layers, folds "
+                          << run.report.diagnostics.fold_count << "; " << m.summary());
         REQUIRE(run.status == Status::ok);
         CHECK(m.manifold());  // holds
         CHECK(m.euler == 0);  // holds
@@ -899,7 +899,7 @@ TEST_CASE("a layer with fewer than 3 points is merged with the next one") {
     o.cut_count = cuts.size();
     Run run = reconstruct_guarded(cloud_of(s), o);
     REQUIRE(run.status == Status::ok);
-    CHECK(run.report.layer_count == 2);  // three planned, the first merged
+    CHECK(run.report.layers.used_count == 2);  // three planned, the first merged
     REQUIRE(run.layers.size() == 2);
     CHECK(run.layers[0].bottom == doctest::Approx(h.front()).epsilon(1e-12));
     CHECK(run.layers[0].top == doctest::Approx(cuts[1]).epsilon(1e-12));
@@ -944,14 +944,14 @@ TEST_CASE("many thin layers: the documented guarantees hold (manifold, oriented,
     for (const ThinCase& t : thin_layer_cases()) {
         Run run = run_thin(t);
         mesh_check::Result m = check_mesh(t.shape, run.triangles.data(), run.count, false);
-        INFO(std::string(t.name) << ": " << run.report.layer_count << " layers, removed " << run.report.illegal_removed
-                    << ", unused " << run.report.unused << ", folds " << run.report.folds << "; " << m.summary());
+        INFO(std::string(t.name) << ": " << run.report.layers.used_count << " layers, removed " << run.report.diagnostics.illegal_removed_count
+                    << ", unused " << run.report.points.unused_count << ", folds " << run.report.diagnostics.fold_count << "; " << m.summary());
         REQUIRE(run.status == Status::ok);
         CHECK(m.manifold());
         CHECK(m.degenerate == 0);
         CHECK(m.bad_indices == 0);
-        CHECK(run.report.points_in == run.report.points_used + run.report.duplicates + run.report.rejected + run.report.unused);
-        CHECK(m.vertices_used == run.report.points_used);
+        CHECK(run.report.points.in_count == run.report.points.used_count + run.report.points.duplicate_count + run.report.points.rejected_count + run.report.points.unused_count);
+        CHECK(m.vertices_used == run.report.points.used_count);
         CHECK(run.workspace_guard_intact);
         CHECK(run.triangle_guard_intact);
     }
@@ -969,11 +969,11 @@ TEST_CASE("many thin layers: one annulus through every point, outward, no self-i
     for (const ThinCase& t : thin_layer_cases()) {
         Run run = run_thin(t);
         mesh_check::Result m = check_mesh(t.shape, run.triangles.data(), run.count, true);
-        INFO(std::string(t.name) << ": " << run.report.layer_count << " layers, removed " << run.report.illegal_removed
-                    << ", unused " << run.report.unused << ", folds " << run.report.folds << "; " << m.summary());
+        INFO(std::string(t.name) << ": " << run.report.layers.used_count << " layers, removed " << run.report.diagnostics.illegal_removed_count
+                    << ", unused " << run.report.points.unused_count << ", folds " << run.report.diagnostics.fold_count << "; " << m.summary());
         REQUIRE(run.status == Status::ok);
-        CHECK(run.report.illegal_removed == 0);
-        CHECK(run.report.unused == 0);
+        CHECK(run.report.diagnostics.illegal_removed_count == 0);
+        CHECK(run.report.points.unused_count == 0);
         CHECK(m.components == 1);
         CHECK(m.boundary_loops == 2);
         CHECK(m.euler == 0);
@@ -1069,14 +1069,14 @@ TEST_CASE("head: neck, skull and nose with the paper's anatomical cuts") {
         Case c = head_case(pose, 6000);
         INFO(describe(c));
         REQUIRE(c.run.status == Status::ok);
-        CHECK(c.run.report.layer_count == 7);
+        CHECK(c.run.report.layers.used_count == 7);
         check_report(c);
         check_topology(c);
         check_deviation(c);
         check_orientation_bounded(c);
         // Measured: no fold and no self-intersection here, at 2000 to 20000 points.
         CHECK(c.mesh.inward == 0);
-        CHECK(c.run.report.folds == 0);
+        CHECK(c.run.report.diagnostics.fold_count == 0);
         CHECK(c.mesh.intersecting_pairs == 0);
         CHECK(c.mesh.vertex_overlaps == 0);
     }
@@ -1109,8 +1109,8 @@ TEST_CASE("determinism: repeated runs, and any workspace alignment, give identic
             Run again = reconstruct_guarded(cloud_of(item.shape), o, misalign);
             REQUIRE(again.status == Status::ok);
             CHECK(again.triangles == first.triangles);
-            CHECK(again.report.folds == first.report.folds);
-            CHECK(again.report.layer_count == first.report.layer_count);
+            CHECK(again.report.diagnostics.fold_count == first.report.diagnostics.fold_count);
+            CHECK(again.report.layers.used_count == first.report.layers.used_count);
             CHECK(std::memcmp(again.report.axis_origin, first.report.axis_origin, sizeof first.report.axis_origin) == 0);
         }
     }
@@ -1143,7 +1143,7 @@ TEST_CASE("float32 records with a stride of 7 floats give the triangles of the s
             REQUIRE(packed.status == Status::ok);
             REQUIRE(strided.status == Status::ok);
             CHECK(strided.triangles == packed.triangles);
-            CHECK(strided.report.points_used == n);
+            CHECK(strided.report.points.used_count == n);
             // And doubles with the same stride of 56 bytes (7 doubles) read the same.
             std::vector<double> wide(7 * n, 0.0);
             for (size_t i = 0; i < n; ++i)
@@ -1191,10 +1191,10 @@ TEST_CASE("duplicates are merged into the lowest index and counted") {
         Run run = reconstruct_guarded(cloud_of(s), o);
         INFO("layering: " << std::string(layering_name(layering)));
         REQUIRE(run.status == Status::ok);
-        CHECK(run.report.duplicates == copies);
-        CHECK(run.report.points_used == s.size() - copies);
-        CHECK(run.report.unused == 0);
-        CHECK(run.report.points_in == run.report.points_used + run.report.duplicates + run.report.rejected + run.report.unused);
+        CHECK(run.report.points.duplicate_count == copies);
+        CHECK(run.report.points.used_count == s.size() - copies);
+        CHECK(run.report.points.unused_count == 0);
+        CHECK(run.report.points.in_count == run.report.points.used_count + run.report.points.duplicate_count + run.report.points.rejected_count + run.report.points.unused_count);
         mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, false, &first_of_group);
         INFO(m.summary());
         CHECK(m.unused_expected == 0);   // every first occurrence is a vertex
@@ -1231,11 +1231,11 @@ TEST_CASE("report counts add up on every status, with duplicates") {
             Report r{};
             Status status = stratmesh::reconstruct(cloud, o, work.get(), bytes, tris.data(), triangle_capacity, &count, &r);
             INFO(layers << " layers, " << bytes << " of " << bound << " workspace bytes, capacity " << triangle_capacity
-                        << ": " << std::string(stratmesh::status_string(status)) << "; in " << r.points_in << ", used "
-                        << r.points_used << ", duplicates " << r.duplicates << ", rejected " << r.rejected
-                        << ", unused " << r.unused);
-            CHECK(r.points_in == n);
-            CHECK(r.points_in == r.points_used + r.duplicates + r.rejected + r.unused);
+                        << ": " << std::string(stratmesh::status_string(status)) << "; in " << r.points.in_count << ", used "
+                        << r.points.used_count << ", duplicates " << r.points.duplicate_count << ", rejected " << r.points.rejected_count
+                        << ", unused " << r.points.unused_count);
+            CHECK(r.points.in_count == n);
+            CHECK(r.points.in_count == r.points.used_count + r.points.duplicate_count + r.points.rejected_count + r.points.unused_count);
             return status;
         };
         CHECK(check_sum(bound, capacity) == Status::ok);
@@ -1264,17 +1264,17 @@ TEST_CASE("NaN and infinite points: invalid_point with the first index, or skipp
         o.layer_count = 3;
         Run run = reconstruct_guarded(cloud_of(s), o);
         CHECK(run.status == Status::invalid_point);
-        CHECK(run.report.first_invalid_point == 0);
+        CHECK(run.report.points.first_invalid_index == 0);
         CHECK(run.count == 0);
         CHECK(run.triangle_guard_intact);
-        CHECK(run.report.points_in == run.report.points_used + run.report.duplicates + run.report.rejected + run.report.unused);
+        CHECK(run.report.points.in_count == run.report.points.used_count + run.report.points.duplicate_count + run.report.points.rejected_count + run.report.points.unused_count);
         CHECK(run.report.detail != nullptr);
         // Without the point at index 0, the first is 123.
         std::vector<double> later = xyz;
         for (size_t k = 0; k < 3; ++k) later[k] = base.xyz[k];
         Run run2 = reconstruct_guarded(Cloud{later.data(), base.size(), 0, Scalar::float64}, o);
         CHECK(run2.status == Status::invalid_point);
-        CHECK(run2.report.first_invalid_point == 123);
+        CHECK(run2.report.points.first_invalid_index == 123);
         // float32 NaN in a strided record.
         std::vector<float> records(4 * base.size(), 0.0f);
         for (size_t i = 0; i < base.size(); ++i)
@@ -1282,7 +1282,7 @@ TEST_CASE("NaN and infinite points: invalid_point with the first index, or skipp
         records[4 * 500 + 2] = std::numeric_limits<float>::quiet_NaN();
         Run run3 = reconstruct_guarded(Cloud{records.data(), base.size(), 4 * sizeof(float), Scalar::float32}, o);
         CHECK(run3.status == Status::invalid_point);
-        CHECK(run3.report.first_invalid_point == 500);
+        CHECK(run3.report.points.first_invalid_index == 500);
     }
     SUBCASE("skipped with skip_invalid_points: counted as rejected, never a vertex") {
         for (uint32_t layers : {1u, 6u}) {
@@ -1292,10 +1292,10 @@ TEST_CASE("NaN and infinite points: invalid_point with the first index, or skipp
             Run run = reconstruct_guarded(cloud_of(s), o);
             CAPTURE(layers);
             REQUIRE(run.status == Status::ok);
-            CHECK(run.report.rejected == bads.size());
-            CHECK(run.report.unused == 0);
-            CHECK(run.report.points_used == s.size() - bads.size());
-            CHECK(run.report.points_in == run.report.points_used + run.report.duplicates + run.report.rejected + run.report.unused);
+            CHECK(run.report.points.rejected_count == bads.size());
+            CHECK(run.report.points.unused_count == 0);
+            CHECK(run.report.points.used_count == s.size() - bads.size());
+            CHECK(run.report.points.in_count == run.report.points.used_count + run.report.points.duplicate_count + run.report.points.rejected_count + run.report.points.unused_count);
             std::vector<char> mask(s.size(), 1);
             for (const Bad& b : bads) mask[b.index] = 0;
             // The checker needs finite coordinates: check the mesh on the clean copy.
@@ -1372,27 +1372,27 @@ TEST_CASE("drop_outliers: stray points are left out and counted, the rest is mes
                 // No point of a clean sample is taken for an outlier.
                 const Run kept = reconstruct_guarded(cloud_of(s), dropping);
                 REQUIRE(kept.status == Status::ok);
-                CHECK(kept.report.outliers == 0);
-                CHECK(kept.report.rejected == 0);
+                CHECK(kept.report.points.outlier_count == 0);
+                CHECK(kept.report.points.rejected_count == 0);
                 CHECK(kept.triangles == clean.triangles);
                 // Every stray is left out, counted, and the surface is the clean one: the
                 // frame, the axis and the layers come from the same points.
                 const Shape dirty = with_points(s, with_strays(s, far, speck, 31), ", with strays");
                 const Run dropped = reconstruct_guarded(cloud_of(dirty), dropping);
                 REQUIRE(dropped.status == Status::ok);
-                CHECK(dropped.report.outliers == far + speck);
-                CHECK(dropped.report.rejected == far + speck);
-                CHECK(dropped.report.points_used == clean.report.points_used);
-                CHECK(dropped.report.points_in == dropped.report.points_used + dropped.report.duplicates +
-                                                      dropped.report.rejected + dropped.report.unused);
+                CHECK(dropped.report.points.outlier_count == far + speck);
+                CHECK(dropped.report.points.rejected_count == far + speck);
+                CHECK(dropped.report.points.used_count == clean.report.points.used_count);
+                CHECK(dropped.report.points.in_count == dropped.report.points.used_count + dropped.report.points.duplicate_count +
+                                                      dropped.report.points.rejected_count + dropped.report.points.unused_count);
                 CHECK(dropped.triangles == clean.triangles);
                 CHECK(dropped.workspace_guard_intact);
                 // Without the flag every stray is a vertex, and the surface stays one
                 // oriented manifold (its shape is another matter: spikes).
                 const Run spiked = reconstruct_guarded(cloud_of(dirty), plain);
                 REQUIRE(spiked.status == Status::ok);
-                CHECK(spiked.report.unused == 0);
-                CHECK(spiked.report.outliers == 0);
+                CHECK(spiked.report.points.unused_count == 0);
+                CHECK(spiked.report.points.outlier_count == 0);
                 mesh_check::Result m = check_mesh(dirty, spiked.triangles.data(), spiked.count, false);
                 INFO(m.summary());
                 CHECK(m.nonmanifold_edges == 0);
@@ -1420,16 +1420,16 @@ TEST_CASE("drop_outliers: a speck of 7 points is left out and one of 8 kept, rep
         const Shape speck = with_speck(points, 0);
         const Run run = reconstruct_guarded(cloud_of(speck), o);
         REQUIRE(run.status == Status::ok);
-        CHECK(run.report.outliers == (points < 8 ? points : 0));
-        CHECK(run.report.points_in == run.report.points_used + run.report.duplicates +
-                                          run.report.rejected + run.report.unused);
+        CHECK(run.report.points.outlier_count == (points < 8 ? points : 0));
+        CHECK(run.report.points.in_count == run.report.points.used_count + run.report.points.duplicate_count +
+                                          run.report.points.rejected_count + run.report.points.unused_count);
     }
     // A stray read three times: all three copies are outliers, none a duplicate.
     const Run repeated = reconstruct_guarded(cloud_of(with_speck(1, 2)), o);
     REQUIRE(repeated.status == Status::ok);
-    CHECK(repeated.report.outliers == 3);
-    CHECK(repeated.report.duplicates == 0);
-    CHECK(repeated.report.points_used == s.size());
+    CHECK(repeated.report.points.outlier_count == 3);
+    CHECK(repeated.report.points.duplicate_count == 0);
+    CHECK(repeated.report.points.used_count == s.size());
 }
 
 TEST_CASE("drop_outliers: the stream refuses it, and too small a workspace is out_of_memory") {
@@ -1450,7 +1450,7 @@ TEST_CASE("drop_outliers: the stream refuses it, and too small a workspace is ou
     stratmesh::Report report = {};
     CHECK(stratmesh::reconstruct(cloud_of(s), o, small.data(), small.size(), triangles.data(),
                                  triangles.size() / 3, &count, &report) == Status::out_of_memory);
-    CHECK(report.points_in == report.points_used + report.duplicates + report.rejected + report.unused);
+    CHECK(report.points.in_count == report.points.used_count + report.points.duplicate_count + report.points.rejected_count + report.points.unused_count);
 }
 
 TEST_CASE("a flat cloud gives flat_cloud") {
@@ -1466,8 +1466,8 @@ TEST_CASE("a flat cloud gives flat_cloud") {
     CHECK(run.status == Status::flat_cloud);
     CHECK(run.count == 0);
     CHECK(run.triangle_guard_intact);
-    CHECK(run.report.unused == 500);
-    CHECK(run.report.points_in == run.report.points_used + run.report.duplicates + run.report.rejected + run.report.unused);
+    CHECK(run.report.points.unused_count == 500);
+    CHECK(run.report.points.in_count == run.report.points.used_count + run.report.points.duplicate_count + run.report.points.rejected_count + run.report.points.unused_count);
     CHECK(run.report.detail != nullptr);
     // The same disc stood on its edge (axis X across the disc) is not flat.
     o.axis = Axis::x;
@@ -1513,7 +1513,7 @@ TEST_CASE("a crescent end layer joins its neighbour, a half cylinder keeps its l
             CAPTURE(s.name);
             CAPTURE(planned);
             REQUIRE(run.status == Status::ok);
-            CHECK(run.report.layer_count < planned);
+            CHECK(run.report.layers.used_count < planned);
             double widest = 0;
             for (const LayerInfo& layer : run.layers)
                 widest = std::max(widest, widest_empty_angle(s, layer.bottom, layer.top));
@@ -1533,7 +1533,7 @@ TEST_CASE("a crescent end layer joins its neighbour, a half cylinder keeps its l
         o.layer_count = planned;
         Run run = reconstruct_guarded(cloud_of(s), o);
         REQUIRE(run.status == Status::ok);
-        CHECK(run.report.layer_count == planned);
+        CHECK(run.report.layers.used_count == planned);
     }
 }
 
@@ -1549,7 +1549,7 @@ Run reconstruct_tube(const Shape& s, uint32_t planned, bool self_intersections, 
     o.flags |= flags;
     Run run = reconstruct_guarded(cloud_of(s), o);
     REQUIRE(run.status == Status::ok);
-    CHECK(run.report.unused == 0);
+    CHECK(run.report.points.unused_count == 0);
     *m = check_mesh(s, run.triangles.data(), run.count, self_intersections);
     INFO(m->summary());
     CHECK(m->manifold());
@@ -1567,7 +1567,7 @@ Run reconstruct_closed_shape(const Shape& s, uint32_t planned, uint32_t flags) {
     INFO(m.summary());
     CHECK(m.euler == 0);
     CHECK(m.intersecting_pairs == 0);
-    REQUIRE(run.layers.size() == run.report.layer_count);
+    REQUIRE(run.layers.size() == run.report.layers.used_count);
     return run;
 }
 
@@ -1706,7 +1706,7 @@ TEST_CASE("a tube forking at its end: the web between the prongs' tips is peeled
             const double far = mean_centroid_deviation(s.xyz.data(), run.triangles, [&s](const double* p) {
                 return std::fabs(s.deviation(p)) > 3 * s.spacing ? 1.0 : 0.0;
             });
-            MESSAGE(s.name << ", " << planned << " layers: " << run.report.folds << " folds, mean distance "
+            MESSAGE(s.name << ", " << planned << " layers: " << run.report.diagnostics.fold_count << " folds, mean distance "
                            << mean << " spacings, " << far << " of the area farther than 3 spacings");
             mean_sum += mean;
             far_sum += far;
@@ -1741,7 +1741,7 @@ TEST_CASE("closed ends: an end split into two knobs is meshed across too") {
             INFO(m.summary());
             const double mean = mean_centroid_deviation(s, run.triangles) / s.spacing;
             const bool closed = run.layers[0].closed_ends & stratmesh::closed_bottom;
-            MESSAGE(s.name << ", " << planned << " layers: " << run.report.folds << " folds, "
+            MESSAGE(s.name << ", " << planned << " layers: " << run.report.diagnostics.fold_count << " folds, "
                            << m.intersecting_pairs << " self-intersecting pairs, bottom "
                            << std::string(closed ? "closed" : "open") << ", mean distance " << mean
                            << " spacings");
@@ -1775,11 +1775,11 @@ TEST_CASE("folding layers: a thin layer that folds across a notch is joined with
             mesh_check::Result m;
             const Run run = reconstruct_tube(s, planned, true, &m);
             INFO(m.summary());
-            MESSAGE(s.name << ", " << planned << " planned layers: " << run.report.layer_count
-                           << " layers, " << run.report.folds << " folds, "
+            MESSAGE(s.name << ", " << planned << " planned layers: " << run.report.layers.used_count
+                           << " layers, " << run.report.diagnostics.fold_count << " folds, "
                            << m.intersecting_pairs << " self-intersecting pairs");
             pairs += m.intersecting_pairs;
-            folds += run.report.folds;
+            folds += run.report.diagnostics.fold_count;
         }
     }
     MESSAGE("over the runs: " << pairs << " self-intersecting pairs, " << folds << " folds");
@@ -1807,7 +1807,7 @@ TEST_CASE("clouds that do not surround the axis: not_columnar, or ok with a mani
             CHECK(m.boundary_loops == 2);
             CHECK(m.euler == 0);
             CHECK(m.unused_expected == 0);
-            CHECK(run.report.unused == 0);
+            CHECK(run.report.points.unused_count == 0);
         }
     }
     SUBCASE("a plane through the axis: not_columnar, nothing written") {
@@ -1821,8 +1821,8 @@ TEST_CASE("clouds that do not surround the axis: not_columnar, or ok with a mani
             Run run = reconstruct_guarded(Cloud{xyz.data(), 1000, 0, Scalar::float64}, o);
             CHECK(run.status == Status::not_columnar);
             CHECK(run.count == 0);
-            CHECK(run.report.layer_count == 0);
-            CHECK(run.report.unused == 1000);
+            CHECK(run.report.layers.used_count == 0);
+            CHECK(run.report.points.unused_count == 1000);
             CHECK(run.report.detail != nullptr);
         }
     }
@@ -1970,7 +1970,7 @@ TEST_CASE("reconstruct_workspace_size suffices, and smaller workspaces give out_
             size_t count = 12345;
             Report report{};
             Status status = stratmesh::reconstruct(cloud_of(s), o, buffer.get(), bytes, tris.data(), capacity, &count, &report);
-            CHECK(report.points_in == report.points_used + report.duplicates + report.rejected + report.unused);
+            CHECK(report.points.in_count == report.points.used_count + report.points.duplicate_count + report.points.rejected_count + report.points.unused_count);
             if (status == Status::ok) {
                 tris.resize(3 * count);
                 CHECK(tris == reference.triangles);
@@ -2019,12 +2019,12 @@ TEST_CASE("workspace: points staged in spare room give the same triangles, which
         };
         Report ample = {};
         const std::vector<uint32_t> reference = run(2 * bound, ample);
-        const size_t peak = ample.workspace_used;
+        const size_t peak = ample.workspace_used_bytes;
         for (size_t bytes : {peak, peak + peak / 4, peak + peak / 2, bound}) {
             CAPTURE(bytes);
             Report report = {};
             CHECK(run(bytes, report) == reference);
-            CHECK(report.workspace_used == peak);
+            CHECK(report.workspace_used_bytes == peak);
         }
     }
 }
@@ -2036,7 +2036,7 @@ TEST_CASE("a too-small triangle array gives triangle_capacity with the needed co
         o.layer_count = layers;
         Run reference = reconstruct_guarded(cloud_of(s), o);
         REQUIRE(reference.status == Status::ok);
-        const size_t needed = reference.count + reference.report.illegal_removed;
+        const size_t needed = reference.count + reference.report.diagnostics.illegal_removed_count;
         CAPTURE(layers);
         CAPTURE(needed);
         std::vector<unsigned char> work(stratmesh::reconstruct_workspace_size(s.size(), o));
@@ -2058,7 +2058,7 @@ TEST_CASE("a too-small triangle array gives triangle_capacity with the needed co
                 CHECK(status == Status::triangle_capacity);
                 CHECK(count == needed);
                 CHECK(report.triangle_count == needed);
-                CHECK(report.points_in == report.points_used + report.duplicates + report.rejected + report.unused);
+                CHECK(report.points.in_count == report.points.used_count + report.points.duplicate_count + report.points.rejected_count + report.points.unused_count);
             }
         }
     }
@@ -2186,7 +2186,7 @@ TEST_CASE("workspace: the bound suffices, the reported peak is exact, one byte s
         };
         Report full = {};
         REQUIRE(run(bound, full) == Status::ok);
-        const size_t peak = full.workspace_used;
+        const size_t peak = full.workspace_used_bytes;
         REQUIRE(peak > 0);
         CHECK(peak <= bound);
         Report exact = {};
@@ -2194,8 +2194,8 @@ TEST_CASE("workspace: the bound suffices, the reported peak is exact, one byte s
         CHECK(exact.triangle_count == full.triangle_count);
         Report short_by_one = {};
         CHECK(run(peak - 1, short_by_one) == Status::out_of_memory);
-        CHECK(short_by_one.points_in == short_by_one.points_used + short_by_one.duplicates +
-                                           short_by_one.rejected + short_by_one.unused);
+        CHECK(short_by_one.points.in_count == short_by_one.points.used_count + short_by_one.points.duplicate_count +
+                                           short_by_one.points.rejected_count + short_by_one.points.unused_count);
         // The bound is the peak of the worst layout, every point in one layer; with more
         // layers the peak follows the largest layer.
         const double ratio = static_cast<double>(bound) / static_cast<double>(peak);
@@ -2213,7 +2213,7 @@ TEST_CASE("workspace: the bound suffices, the reported peak is exact, one byte s
 namespace {
 
 bool counts_add_up(const Report& r) {
-    return r.points_in == r.points_used + r.duplicates + r.rejected + r.unused;
+    return r.points.in_count == r.points.used_count + r.points.duplicate_count + r.points.rejected_count + r.points.unused_count;
 }
 
 // A unit-radius cylinder (reference_cylinder() unless given) scaled by `scale` about the
@@ -2236,7 +2236,7 @@ void check_annulus_through_every_point(const Shape& s, const Run& run) {
     CHECK(run.workspace_guard_intact);
     CHECK(run.triangle_guard_intact);
     CHECK(counts_add_up(run.report));
-    CHECK(run.report.unused == 0);
+    CHECK(run.report.points.unused_count == 0);
     mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, false);
     INFO(m.summary());
     CHECK(m.bad_indices == 0);
@@ -2282,8 +2282,8 @@ TEST_CASE("buffers that share memory: invalid_argument, nothing written, not eve
         std::vector<unsigned char> before(arena, arena + words.size() * 8);
         Report report;
         std::memset(&report, 0x3C, sizeof report);
-        report.layers = reinterpret_cast<LayerInfo*>(arena + p.layers);
-        report.layer_capacity = 4;
+        report.layers.info = reinterpret_cast<LayerInfo*>(arena + p.layers);
+        report.layers.info_capacity = 4;
         const Report report_before = report;
         Cloud cloud = {arena + cloud_at, s.size(), 0, Scalar::float64};
         Status status = stratmesh::reconstruct(cloud, o, arena + p.work, work_bytes,
@@ -2291,7 +2291,7 @@ TEST_CASE("buffers that share memory: invalid_argument, nothing written, not eve
                                                reinterpret_cast<size_t*>(arena + p.count), &report);
         if (p.work == work_at && p.tri == tri_at && p.count == count_at && p.layers == layers_at) {
             CHECK(status == Status::ok);
-            CHECK(report.layer_count == 3);
+            CHECK(report.layers.used_count == 3);
             continue;
         }
         CHECK(status == Status::invalid_argument);
@@ -2333,7 +2333,7 @@ TEST_CASE("malformed clouds: the documented status, counts that add up, nothing 
         CHECK(stratmesh::reconstruct(Cloud{three, size_t{0xFFFFFFFEu}, 0, Scalar::float64}, along_z, work.data(),
                                      work.size(), tris, 1, &count, &report) == Status::too_many_points);
         CHECK(count == 0);
-        CHECK(report.points_in == size_t{0xFFFFFFFEu});
+        CHECK(report.points.in_count == size_t{0xFFFFFFFEu});
         CHECK(counts_add_up(report));
     }
     SUBCASE("one point repeated: too_few_points, the repeats counted as duplicates") {
@@ -2341,7 +2341,7 @@ TEST_CASE("malformed clouds: the documented status, counts that add up, nothing 
         for (int i = 0; i < 5; ++i) xyz.insert(xyz.end(), {1.0, 2.0, 3.0});
         Run run = reconstruct_guarded(Cloud{xyz.data(), 5, 0, Scalar::float64}, along_z);
         check_refused(run, Status::too_few_points);
-        CHECK(run.report.duplicates + run.report.unused == 5);
+        CHECK(run.report.points.duplicate_count + run.report.points.unused_count == 5);
     }
     SUBCASE("two positions repeated among skipped NaNs: too_few_points until a third comes") {
         const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -2356,14 +2356,14 @@ TEST_CASE("malformed clouds: the documented status, counts that add up, nothing 
         const char* few = "fewer than 3 distinct valid points";
         Run two = reconstruct_guarded(Cloud{xyz.data(), 10, 0, Scalar::float64}, skipping);
         check_refused(two, Status::too_few_points);
-        CHECK(two.report.rejected == 5);
+        CHECK(two.report.points.rejected_count == 5);
         REQUIRE(two.report.detail != nullptr);
         CHECK(std::string(two.report.detail) == few);
         // A third position as the very last point passes that check (what follows refuses
         // three points for its own reason, or meshes them).
         xyz.insert(xyz.end(), c, c + 3);
         Run three = reconstruct_guarded(Cloud{xyz.data(), 11, 0, Scalar::float64}, skipping);
-        CHECK(three.report.rejected == 5);
+        CHECK(three.report.points.rejected_count == 5);
         CHECK(counts_add_up(three.report));
         CHECK((three.report.detail == nullptr || std::string(three.report.detail) != few));
     }
@@ -2380,7 +2380,7 @@ TEST_CASE("malformed clouds: the documented status, counts that add up, nothing 
             Run run = reconstruct_guarded(Cloud{line->data(), 200, 0, Scalar::float64}, along_z);
             CHECK((run.status == Status::not_columnar || run.status == Status::too_few_points));
             check_refused(run, run.status);
-            CHECK(run.report.unused == 200);
+            CHECK(run.report.points.unused_count == 200);
         }
     }
     SUBCASE("all points in one layer: cuts all outside the cloud") {
@@ -2389,7 +2389,7 @@ TEST_CASE("malformed clouds: the documented status, counts that add up, nothing 
         o.cuts = cuts;
         o.cut_count = 3;
         Run run = reconstruct_guarded(cloud_of(s), o);
-        CHECK(run.report.layer_count == 1);
+        CHECK(run.report.layers.used_count == 1);
         check_annulus_through_every_point(s, run);
     }
     SUBCASE("an empty layer: two cuts inside a gap of the cloud") {
@@ -2406,7 +2406,7 @@ TEST_CASE("malformed clouds: the documented status, counts that add up, nothing 
         o.cuts = cuts;
         o.cut_count = 2;
         Run run = reconstruct_guarded(cloud_of(gap), o);
-        CHECK(run.report.layer_count >= 2);
+        CHECK(run.report.layers.used_count >= 2);
         for (const LayerInfo& layer : run.layers) CHECK(layer.point_count > 0);
         check_annulus_through_every_point(gap, run);
     }
@@ -2415,7 +2415,7 @@ TEST_CASE("malformed clouds: the documented status, counts that add up, nothing 
         by_count.layer_count = 5000;
         Run counted = reconstruct_guarded(cloud_of(s), by_count);
         check_annulus_through_every_point(s, counted);
-        CHECK(counted.report.layer_count <= s.size() / 16);
+        CHECK(counted.report.layers.used_count <= s.size() / 16);
         CHECK(stratmesh::reconstruct_workspace_size(s.size(), by_count) ==
               stratmesh::reconstruct_workspace_size(s.size(), [&] {
                   Options o = by_count;
@@ -2431,7 +2431,7 @@ TEST_CASE("malformed clouds: the documented status, counts that add up, nothing 
         by_cuts.cut_count = cuts.size();
         Run cut = reconstruct_guarded(cloud_of(s), by_cuts);
         check_annulus_through_every_point(s, cut);
-        CHECK(cut.report.layer_count <= s.size() / 16);
+        CHECK(cut.report.layers.used_count <= s.size() / 16);
     }
     SUBCASE("a layer height far below the point spacing: layers merge until they hold enough points") {
         Options o = axis_options(s);
@@ -2469,7 +2469,7 @@ TEST_CASE("extreme magnitudes: scaling by a power of two gives the same triangle
         check_annulus_through_every_point(centred, small);
         REQUIRE(run.status == Status::ok);
         CHECK(run.triangles == small.triangles);
-        CHECK(run.report.unused == 0);
+        CHECK(run.report.points.unused_count == 0);
     }
     SUBCASE("1e-30 and 1e30: a manifold annulus through every point") {
         for (double scale : {1e-30, 1e30}) {
@@ -2565,8 +2565,8 @@ TEST_CASE("automatic layers: one layer where one unrolls well, with no fold") {
             CAPTURE(shapes::pose_name(pose));
             Run run = reconstruct_guarded(cloud_of(s), axis_options(s));
             check_annulus_through_every_point(s, run);
-            CHECK(run.report.layer_count == 1);
-            CHECK(run.report.folds == 0);
+            CHECK(run.report.layers.used_count == 1);
+            CHECK(run.report.diagnostics.fold_count == 0);
             mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, true);
             CHECK(m.inward == 0);
             CHECK(m.intersecting_pairs == 0);
@@ -2577,8 +2577,8 @@ TEST_CASE("automatic layers: one layer where one unrolls well, with no fold") {
         Shape s = shapes::head(kLarge, Pose::z);
         Run automatic = reconstruct_guarded(cloud_of(s), axis_options(s));
         REQUIRE(automatic.status == Status::ok);
-        CHECK(automatic.report.folds <= anatomical.run.report.folds);
-        CHECK(automatic.report.layer_count < anatomical.run.report.layer_count);
+        CHECK(automatic.report.diagnostics.fold_count <= anatomical.run.report.diagnostics.fold_count);
+        CHECK(automatic.report.layers.used_count < anatomical.run.report.layers.used_count);
     }
 }
 
@@ -2596,15 +2596,15 @@ TEST_CASE("automatic layers: a bent tube is cut where its centre line drifts, an
         REQUIRE(split.status == Status::ok);
         REQUIRE(whole.status == Status::ok);
         mesh_check::Result s = check_bent_mesh(tube, split), w = check_bent_mesh(tube, whole);
-        MESSAGE("bent tube, amplitude " << amplitude << ": automatic " << split.report.layer_count << " layers, "
-                                        << split.report.folds << " folds, " << s.intersecting_pairs
-                                        << " intersecting pairs; one layer " << whole.report.folds << " folds, "
+        MESSAGE("bent tube, amplitude " << amplitude << ": automatic " << split.report.layers.used_count << " layers, "
+                                        << split.report.diagnostics.fold_count << " folds, " << s.intersecting_pairs
+                                        << " intersecting pairs; one layer " << whole.report.diagnostics.fold_count << " folds, "
                                         << w.intersecting_pairs << " intersecting pairs");
-        CHECK(split.report.layer_count >= 2);
+        CHECK(split.report.layers.used_count >= 2);
         CHECK(s.manifold());
         CHECK(s.boundary_loops == 2);
-        CHECK(split.report.unused == 0);
-        CHECK(split.report.folds < whole.report.folds);
+        CHECK(split.report.points.unused_count == 0);
+        CHECK(split.report.diagnostics.fold_count < whole.report.diagnostics.fold_count);
         CHECK(s.intersecting_pairs < w.intersecting_pairs);
         CHECK(s.max_deviation() < w.max_deviation());
         // The layers tile the height range: each one starts where the one below ends.
@@ -2617,7 +2617,7 @@ TEST_CASE("automatic layers: a tall thin tube is cut into layers at most 24 radi
     Shape s = shapes::thin_tube(kLarge, Pose::z, radius);
     Run run = reconstruct_guarded(cloud_of(s), axis_options(s));
     check_annulus_through_every_point(s, run);
-    CHECK(run.report.layer_count >= 5);
+    CHECK(run.report.layers.used_count >= 5);
     for (const LayerInfo& layer : run.layers) {
         CHECK(layer.top - layer.bottom <= 24 * layer.radius * 1.05);
         CHECK(layer.radius == doctest::Approx(radius).epsilon(0.05));
@@ -2757,24 +2757,24 @@ TEST_CASE("close_ends: cylinder, vase, bumpy tube, head and CT slices become clo
                     Run run = reconstruct_guarded(cloud_of(s), closed);
                     mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, true);
                     INFO(s.name << ", " << points << " points, " << layering_name(layering) << ": "
-                                << run.report.cap_triangles << " cap triangles; " << m.summary());
+                                << run.report.caps.triangle_count << " cap triangles; " << m.summary());
                     REQUIRE(tube.status == Status::ok);
                     REQUIRE(run.status == Status::ok);
                     CHECK(run.workspace_guard_intact);
                     CHECK(run.triangle_guard_intact);
                     // Without the flag: no caps reported, and the same tube comes first with it.
-                    CHECK(tube.report.caps_closed == 0);
-                    CHECK(tube.report.cap_triangles == 0);
-                    REQUIRE(run.count == tube.count + run.report.cap_triangles);
+                    CHECK(tube.report.caps.closed_count == 0);
+                    CHECK(tube.report.caps.triangle_count == 0);
+                    REQUIRE(run.count == tube.count + run.report.caps.triangle_count);
                     CHECK(std::equal(tube.triangles.begin(), tube.triangles.end(), run.triangles.begin()));
-                    CHECK(run.report.cap_wall_flips == 0);
-                    CHECK(run.report.caps_closed == 2);
-                    CHECK(run.report.caps_left_open == 0);
+                    CHECK(run.report.caps.wall_flip_count == 0);
+                    CHECK(run.report.caps.closed_count == 2);
+                    CHECK(run.report.caps.open_count == 0);
                     CHECK(run.report.triangle_count == run.count);
                     CHECK(run.report.detail == nullptr);
                     CHECK(run.count <= run.max_triangles);
                     // A closed surface through V vertices: 2V - 4 triangles.
-                    CHECK(run.count == 2 * run.report.points_used - 4);
+                    CHECK(run.count == 2 * run.report.points.used_count - 4);
                     CHECK(m.bad_indices == 0);
                     CHECK(m.degenerate == 0);
                     CHECK(m.zero_area == 0);
@@ -2812,10 +2812,10 @@ TEST_CASE("close_ends on a noisy tube: caps as low (bottom) and high (top) as th
                 Run run = reconstruct_guarded(cloud_of(s), o);
                 REQUIRE(run.status == Status::ok);
                 mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, true);
-                const size_t first = run.count - run.report.cap_triangles;
+                const size_t first = run.count - run.report.caps.triangle_count;
                 INFO(s.name << ", " << points << " points, " << layering_name(layering) << ": "
                             << m.summary());
-                CHECK(run.report.caps_closed == 2);
+                CHECK(run.report.caps.closed_count == 2);
                 CHECK(m.manifold());
                 CHECK(m.boundary_edges == 0);
                 CHECK(m.euler == 2);
@@ -2838,7 +2838,7 @@ TEST_CASE("close_ends at 20000 points: closed, oriented, the bound on triangles 
         REQUIRE(run.status == Status::ok);
         mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, kind == 2);
         INFO(s.name << ": " << m.summary());
-        CHECK(run.report.caps_closed == 2);
+        CHECK(run.report.caps.closed_count == 2);
         CHECK(m.manifold());
         CHECK(m.boundary_edges == 0);
         CHECK(m.components == 1);
@@ -2858,7 +2858,7 @@ TEST_CASE("close_ends: a triangle array too small for the caps gives triangle_ca
     Run reference = reconstruct_guarded(cloud_of(s), o);
     REQUIRE(reference.status == Status::ok);
     std::vector<unsigned char> work(stratmesh::reconstruct_workspace_size(s.size(), o));
-    for (size_t capacity : {reference.count - reference.report.cap_triangles, reference.count - 1,
+    for (size_t capacity : {reference.count - reference.report.caps.triangle_count, reference.count - 1,
                             reference.count}) {
         CAPTURE(capacity);
         std::vector<uint32_t> tris(3 * (capacity + kGuardTriangles), kSentinel);
@@ -2904,9 +2904,9 @@ TEST_CASE("surface_flips: the same guarantees, the bumpy tube nearer the true su
             const Run flipped = reconstruct_guarded(cloud_of(s), o);
             REQUIRE(plain.status == Status::ok);
             REQUIRE(flipped.status == Status::ok);
-            CHECK(flipped.report.layer_count == plain.report.layer_count);
-            CHECK(flipped.report.points_used == plain.report.points_used);
-            CHECK(flipped.report.folds <= plain.report.folds);
+            CHECK(flipped.report.layers.used_count == plain.report.layers.used_count);
+            CHECK(flipped.report.points.used_count == plain.report.points.used_count);
+            CHECK(flipped.report.diagnostics.fold_count <= plain.report.diagnostics.fold_count);
             CHECK(flipped.workspace_guard_intact);
             CHECK(flipped.triangle_guard_intact);
             CHECK(counts_add_up(flipped.report));
@@ -2918,7 +2918,7 @@ TEST_CASE("surface_flips: the same guarantees, the bumpy tube nearer the true su
             CHECK(m.boundary_loops == 2);
             CHECK(m.vertices_used ==
                   check_mesh(s, plain.triangles.data(), plain.count, false).vertices_used);
-            if (plain.report.folds == 0) {
+            if (plain.report.diagnostics.fold_count == 0) {
                 CHECK(m.intersecting_pairs == 0);
                 CHECK(m.vertex_overlaps == 0);
             }
@@ -2972,7 +2972,7 @@ TEST_CASE("surface_flips: many layers come nearly as close as one, across the se
             CHECK(m.manifold());
             CHECK(m.components == 1);
             CHECK(m.boundary_loops == 2);
-            if (many.report.folds == 0) CHECK(m.intersecting_pairs == 0);
+            if (many.report.diagnostics.fold_count == 0) CHECK(m.intersecting_pairs == 0);
             const double mean = mean_centroid_deviation(s, many.triangles);
             MESSAGE(s.name << ", " << layers << " layers: mean distance " << mean << ", one layer "
                            << single << ", ratio " << mean / single);

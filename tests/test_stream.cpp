@@ -100,8 +100,8 @@ Output run_batch(const Layered& l, Options o) {
     std::vector<unsigned char> work(stratmesh::reconstruct_workspace_size(cloud.count, o));
     out.triangles.resize(3 * stratmesh::reconstruct_max_triangles(cloud.count, o));
     out.layers.resize(512);
-    out.report.layers = out.layers.data();
-    out.report.layer_capacity = out.layers.size();
+    out.report.layers.info = out.layers.data();
+    out.report.layers.info_capacity = out.layers.size();
     size_t count = 0;
     out.status = stratmesh::reconstruct(cloud, o, work.data(), work.size(), out.triangles.data(),
                                         out.triangles.size() / 3, &count, &out.report);
@@ -114,8 +114,8 @@ Output run_stream(const Layered& l, const Options& o, size_t held) {
     Output out;
     std::vector<unsigned char> work(stratmesh::stream_workspace_size(held, o));
     out.layers.resize(512);
-    out.report.layers = out.layers.data();
-    out.report.layer_capacity = out.layers.size();
+    out.report.layers.info = out.layers.data();
+    out.report.layers.info_capacity = out.layers.size();
     stratmesh::Stream* stream = nullptr;
     out.status = stratmesh::stream_open(o, work.data(), work.size(), collect, &out.triangles,
                                         &out.report, &stream);
@@ -143,18 +143,18 @@ void check_same(const Output& batch, const Output& stream) {
     CHECK(stream.status == batch.status);
     CHECK(stream.triangles.size() == batch.triangles.size());
     CHECK(stream.triangles == batch.triangles);
-    CHECK(stream.report.points_in == batch.report.points_in);
-    CHECK(stream.report.points_used == batch.report.points_used);
-    CHECK(stream.report.duplicates == batch.report.duplicates);
-    CHECK(stream.report.unused == batch.report.unused);
+    CHECK(stream.report.points.in_count == batch.report.points.in_count);
+    CHECK(stream.report.points.used_count == batch.report.points.used_count);
+    CHECK(stream.report.points.duplicate_count == batch.report.points.duplicate_count);
+    CHECK(stream.report.points.unused_count == batch.report.points.unused_count);
     CHECK(std::string(stream.report.detail ? stream.report.detail : "") ==
           std::string(batch.report.detail ? batch.report.detail : ""));
     CHECK(stream.report.triangle_count == batch.report.triangle_count);
-    CHECK(stream.report.illegal_removed == batch.report.illegal_removed);
-    CHECK(stream.report.folds == batch.report.folds);
-    CHECK(stream.report.diagonal_swaps == batch.report.diagonal_swaps);
-    REQUIRE(stream.report.layer_count == batch.report.layer_count);
-    for (size_t k = 0; k < batch.report.layer_count && k < batch.layers.size(); ++k) {
+    CHECK(stream.report.diagnostics.illegal_removed_count == batch.report.diagnostics.illegal_removed_count);
+    CHECK(stream.report.diagnostics.fold_count == batch.report.diagnostics.fold_count);
+    CHECK(stream.report.diagnostics.diagonal_swap_count == batch.report.diagnostics.diagonal_swap_count);
+    REQUIRE(stream.report.layers.used_count == batch.report.layers.used_count);
+    for (size_t k = 0; k < batch.report.layers.used_count && k < batch.layers.size(); ++k) {
         CHECK(stream.layers[k].point_count == batch.layers[k].point_count);
         CHECK(stream.layers[k].triangle_count == batch.layers[k].triangle_count);
         CHECK(stream.layers[k].closed_ends == batch.layers[k].closed_ends);
@@ -219,7 +219,7 @@ TEST_CASE("stream: with open_ends, the same triangles as reconstruct() with it, 
         o.flags |= stratmesh::open_ends;
         const Output batch = run_batch(l, o);
         check_same(batch, run_stream(l, o, l.size()));
-        for (size_t k = 0; k < batch.report.layer_count && k < batch.layers.size(); ++k)
+        for (size_t k = 0; k < batch.report.layers.used_count && k < batch.layers.size(); ++k)
             CHECK(batch.layers[k].closed_ends == 0);
     });
 }
@@ -252,13 +252,13 @@ TEST_CASE("stream: 200,000 points in 100 layers run in a workspace sized for 2.5
     const Output stream = run_stream(l, o, held);
     const Output batch = run_batch(l, o);
     check_same(batch, stream);
-    CHECK(stream.report.points_held <= held);
-    CHECK(stream.report.points_held > largest);
+    CHECK(stream.report.points.held_count <= held);
+    CHECK(stream.report.points.held_count > largest);
     const size_t stream_bytes = stratmesh::stream_workspace_size(held, o);
     const size_t batch_bytes = stratmesh::reconstruct_workspace_size(l.size(), o);
-    CHECK(stream.report.workspace_used <= stream_bytes);
+    CHECK(stream.report.workspace_used_bytes <= stream_bytes);
     CHECK(stream_bytes * 20 < batch_bytes);
-    MESSAGE("largest layer " << largest << " points, held at most " << stream.report.points_held
+    MESSAGE("largest layer " << largest << " points, held at most " << stream.report.points.held_count
                              << "; stream workspace " << stream_bytes << " B, batch " << batch_bytes << " B");
 }
 
@@ -292,8 +292,8 @@ TEST_CASE("stream: the output is a manifold tube through every point") {
     CHECK(r.vertices_used == s.size());
     CHECK(r.inward == 0);
     CHECK(r.intersecting_pairs == 0);
-    CHECK(out.report.points_used == s.size());
-    CHECK(out.report.layer_count == 10);
+    CHECK(out.report.points.used_count == s.size());
+    CHECK(out.report.layers.used_count == 10);
 }
 
 TEST_CASE("stream: malformed pushes are refused with their status and change nothing") {
@@ -318,9 +318,9 @@ TEST_CASE("stream: malformed pushes are refused with their status and change not
     Status last_status = Status::ok;
     const char* last_detail = nullptr;
     auto refused = [&](const Cloud& c, double top, Status expected) {
-        const size_t in = report.points_in, emitted = triangles.size();
+        const size_t in = report.points.in_count, emitted = triangles.size();
         CHECK(stratmesh::stream_push(stream, c, top) == expected);
-        CHECK(report.points_in == in);
+        CHECK(report.points.in_count == in);
         CHECK(triangles.size() == emitted);
         CHECK(report.detail != nullptr);
         if (expected != last_status) CHECK(report.detail != last_detail);
@@ -349,16 +349,16 @@ TEST_CASE("stream: malformed pushes are refused with their status and change not
     std::vector<double> with_nan(l.xyz.begin() + 3 * static_cast<std::ptrdiff_t>(l.start[2]),
                                  l.xyz.begin() + 3 * static_cast<std::ptrdiff_t>(l.start[3]));
     with_nan[3 * 5 + 1] = std::nan("");
-    const size_t before = report.points_in;
+    const size_t before = report.points.in_count;
     refused(Cloud{with_nan.data(), with_nan.size() / 3, 0, Scalar::float64}, l.cuts[2],
             Status::invalid_point);
-    CHECK(report.first_invalid_point == before + 5);
+    CHECK(report.points.first_invalid_index == before + 5);
     REQUIRE(stratmesh::stream_push(stream, layer(2), l.cuts[2]) == Status::ok);
     REQUIRE(stratmesh::stream_push(stream, layer(3), l.top) == Status::ok);
     REQUIRE(stratmesh::stream_close(stream) == Status::ok);
     const size_t accepted = l.size() - (l.start[1] - l.start[0]);
-    CHECK(report.points_in == accepted);
-    CHECK(report.points_used == accepted);
+    CHECK(report.points.in_count == accepted);
+    CHECK(report.points.used_count == accepted);
     // The accepted points' global indices: layers 1 to 3 in push order.
     REQUIRE(!triangles.empty());
     CHECK(*std::max_element(triangles.begin(), triangles.end()) < accepted);
@@ -385,7 +385,7 @@ Capped cap_surface(const Layered& l, const Options& o, const std::vector<uint32_
     out.status = stratmesh::cap_ends(cloud, o, work.data(), work.size(), out.triangles.data(),
                                      out.triangles.size() / 3, &out.count, &out.report);
     if (out.status == Status::ok) out.triangles.resize(3 * out.count);
-    CHECK(out.report.workspace_used <= work.size());
+    CHECK(out.report.workspace_used_bytes <= work.size());
     return out;
 }
 
@@ -404,14 +404,14 @@ TEST_CASE("cap_ends: the stream's surface capped is reconstruct()'s with close_e
         const Capped capped = cap_surface(l, o, stream.triangles);
         REQUIRE(capped.status == Status::ok);
         CHECK(capped.triangles == batch.triangles);
-        CHECK(capped.report.caps_closed == batch.report.caps_closed);
-        CHECK(capped.report.caps_left_open == batch.report.caps_left_open);
-        CHECK(capped.report.cap_triangles == batch.report.cap_triangles);
-        CHECK(capped.report.cap_wall_flips == batch.report.cap_wall_flips);
+        CHECK(capped.report.caps.closed_count == batch.report.caps.closed_count);
+        CHECK(capped.report.caps.open_count == batch.report.caps.open_count);
+        CHECK(capped.report.caps.triangle_count == batch.report.caps.triangle_count);
+        CHECK(capped.report.caps.wall_flip_count == batch.report.caps.wall_flip_count);
         // Only the cap fields are set: the stream's counts stay.
-        CHECK(capped.report.points_in == 0);
+        CHECK(capped.report.points.in_count == 0);
         ++compared;
-        closed += batch.report.caps_closed;
+        closed += batch.report.caps.closed_count;
     });
     // The comparison means something only if most runs had caps to make (measured: 162
     // runs, 318 caps).
@@ -429,9 +429,9 @@ TEST_CASE("cap_ends: the capped stream output is a closed manifold through every
     REQUIRE(out.status == Status::ok);
     const Capped capped = cap_surface(l, o, out.triangles);
     REQUIRE(capped.status == Status::ok);
-    CHECK(capped.report.caps_closed == 2);
-    CHECK(capped.report.caps_left_open == 0);
-    CHECK(capped.count == out.triangles.size() / 3 + capped.report.cap_triangles);
+    CHECK(capped.report.caps.closed_count == 2);
+    CHECK(capped.report.caps.open_count == 0);
+    CHECK(capped.count == out.triangles.size() / 3 + capped.report.caps.triangle_count);
     // The surface comes first, unchanged.
     CHECK(std::equal(out.triangles.begin(), out.triangles.end(), capped.triangles.begin()));
     Shape reordered = s;
@@ -505,7 +505,7 @@ FinnedTube cap_finned_tube(uint32_t around, uint32_t fin_step) {
     f.count = surface;
     f.status = stratmesh::cap_ends(cloud, o, work.data(), work.size(), f.capped.data(),
                                    f.capped.size() / 3, &f.count, &f.report);
-    CHECK(f.report.workspace_used <= work.size());
+    CHECK(f.report.workspace_used_bytes <= work.size());
     return f;
 }
 
@@ -533,9 +533,9 @@ TEST_CASE("cap_ends: a loop whose every ear would repeat an edge of the wall (fi
     // corners (it left this loop open); the search finds a cap, the wall as it was.
     const FinnedTube f = cap_finned_tube(24, 6);
     REQUIRE(f.status == Status::ok);
-    CHECK(f.report.caps_left_open == 0);
-    CHECK(f.report.caps_closed == 2);
-    CHECK(f.report.cap_wall_flips == 0);
+    CHECK(f.report.caps.open_count == 0);
+    CHECK(f.report.caps.closed_count == 2);
+    CHECK(f.report.caps.wall_flip_count == 0);
     CHECK(std::equal(f.wall.begin(), f.wall.end(), f.capped.begin()));
     check_closed(f);
 }
@@ -546,8 +546,8 @@ TEST_CASE("cap_ends: where fins leave no cap, the wall's edges under them are fl
     // edge under a fin is flipped where the cap needs its chord.
     const FinnedTube f = cap_finned_tube(24, 2);
     REQUIRE(f.status == Status::ok);
-    CHECK(f.report.caps_left_open == 0);
-    CHECK(f.report.caps_closed == 2);
+    CHECK(f.report.caps.open_count == 0);
+    CHECK(f.report.caps.closed_count == 2);
     check_closed(f);
     // The wall keeps its count and its boundary; what changed are pairs of triangles, each
     // a fin's and the one beyond its chord, now both at the fin's point.
@@ -570,7 +570,7 @@ TEST_CASE("cap_ends: where fins leave no cap, the wall's edges under them are fl
     CHECK(!made.empty());
     CHECK(made.size() == gone.size());
     CHECK(made.size() % 2 == 0);
-    CHECK(f.report.cap_wall_flips == made.size() / 2);
+    CHECK(f.report.caps.wall_flip_count == made.size() / 2);
     auto has_fin = [&f](const std::array<uint32_t, 3>& t) {
         return std::any_of(t.begin(), t.end(), [&f](uint32_t v) {
             return std::find(f.fins.begin(), f.fins.end(), v) != f.fins.end();
@@ -612,15 +612,15 @@ TEST_CASE("cap_ends: bad arguments get their status and leave the triangles as t
         const std::vector<uint32_t> before = room;
         size_t count = given;
         Report report{};
-        report.points_in = 77;
+        report.points.in_count = 77;
         const Status status = stratmesh::cap_ends(c, o, work.data(), work_bytes, room.data(),
                                                   capacity, &count, &report);
         if (status != Status::ok) CHECK(room == before);
-        CHECK(report.points_in == 77);
+        CHECK(report.points.in_count == 77);
         if (status != Status::ok && status != Status::triangle_capacity) CHECK(count == given);
         CHECK((status == Status::ok) == (report.detail == nullptr));
         if (count_out) *count_out = count;
-        if (used) *used = report.workspace_used;
+        if (used) *used = report.workspace_used_bytes;
         return status;
     };
     size_t count = 0, used = 0;
@@ -690,11 +690,11 @@ TEST_CASE("cap_ends: any triangle soup over the cloud stays within the buffers")
                                                   2 * s.size(), &count, &report);
         INFO("trial " << trial);
         REQUIRE(status == Status::ok);
-        CHECK(count == soup + report.cap_triangles);
+        CHECK(count == soup + report.caps.triangle_count);
         CHECK(std::equal(before.begin(), before.begin() + 3 * static_cast<std::ptrdiff_t>(soup), room.begin()));
         CHECK(room.back() == 0xCDCDCDCDu);  // nothing past the capacity
         for (size_t k = 3 * soup; k < 3 * count; ++k) CHECK(room[k] < s.size());
-        CHECK(report.workspace_used <= work.size());
+        CHECK(report.workspace_used_bytes <= work.size());
     }
 }
 #endif

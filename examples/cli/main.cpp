@@ -184,8 +184,8 @@ bool run_reconstruct(const std::vector<double>& xyz, const stratmesh::Options& o
     std::unique_ptr<unsigned char, FreeDeleter> workspace;
     if (!allocate_buffers(*workspace_bytes, max_triangles, workspace, result)) return false;
     report = {};
-    report.layers = layers.data();
-    report.layer_capacity = layers.size();
+    report.layers.info = layers.data();
+    report.layers.info_capacity = layers.size();
     const stratmesh::Cloud cloud = {xyz.data(), count, 0, stratmesh::Scalar::float64};
     status = stratmesh::reconstruct(cloud, options, workspace.get(), *workspace_bytes,
                                     result.triangles.get(), max_triangles,
@@ -289,10 +289,10 @@ bool cap_parts(const std::vector<double>& xyz, const CommandLine& line,
                             &capped, &caps);
     all.resize(3 * (status == stratmesh::Status::ok ? capped : given));
     stratmesh::Report& whole = record.report;
-    whole.caps_closed = caps.caps_closed;
-    whole.caps_left_open = caps.caps_left_open;
-    whole.cap_triangles = caps.cap_triangles;
-    whole.cap_wall_flips = caps.cap_wall_flips;
+    whole.caps.closed_count = caps.caps.closed_count;
+    whole.caps.open_count = caps.caps.open_count;
+    whole.caps.triangle_count = caps.caps.triangle_count;
+    whole.caps.wall_flip_count = caps.caps.wall_flip_count;
     record.reconstruct_seconds += seconds_since(start);
     return true;
 }
@@ -313,16 +313,16 @@ const double kPoleLayerRadii = 4.0 / 3.0;
 bool cuts_for_tall_ends(const RunRecord& record, std::vector<double>& cuts, size_t* merged) {
     const std::vector<stratmesh::LayerInfo>& layers = record.layers;
     const size_t n = layers.size();
-    if (n < 2 || record.report.layer_count != n) return false;
+    if (n < 2 || record.report.layers.used_count != n) return false;
     size_t first = 0, last = n - 1;  // the layers kept whole: [first, last]
-    if (record.parting.branches_above > 0 && (layers[n - 1].closed_ends & stratmesh::closed_top)) {
+    if (record.parting.above_branch_count > 0 && (layers[n - 1].closed_ends & stratmesh::closed_top)) {
         double radius = layers[last].radius;
         while (last > 0 && layers[n - 1].top - layers[last].bottom < kPoleLayerRadii * radius) {
             --last;
             radius = std::max(radius, layers[last].radius);
         }
     }
-    if (record.parting.branches_below > 0 && (layers[0].closed_ends & stratmesh::closed_bottom)) {
+    if (record.parting.below_branch_count > 0 && (layers[0].closed_ends & stratmesh::closed_bottom)) {
         double radius = layers[first].radius;
         while (first < last && layers[first].top - layers[0].bottom < kPoleLayerRadii * radius) {
             ++first;
@@ -366,16 +366,16 @@ bool reconstruct_split(const std::vector<double>& xyz, const CommandLine& given,
         if (!reconstruct_points(trunk, tall, part, record)) return false;
         record.reconstruct_seconds += first_seconds;
     }
-    record.split.push_back({"trunk", indices.size(), record.status, record.report.layer_count,
-                            part.triangle_count, record.report.folds, merged});
+    record.split.push_back({"trunk", indices.size(), record.status, record.report.layers.used_count,
+                            part.triangle_count, record.report.diagnostics.fold_count, merged});
     if (record.status != stratmesh::Status::ok) return true;
     std::vector<uint32_t> all;
     append_part(part, indices, all);
     stratmesh::Report& whole = record.report;
     const stratmesh::Parting& p = record.parting;
-    for (uint32_t b = 0; b < p.branches_above + p.branches_below; ++b) {
-        const bool above = b < p.branches_above;
-        const uint32_t k = above ? b : b - p.branches_above;
+    for (uint32_t b = 0; b < p.above_branch_count + p.below_branch_count; ++b) {
+        const bool above = b < p.above_branch_count;
+        const uint32_t k = above ? b : b - p.above_branch_count;
         const uint8_t label = static_cast<uint8_t>(
             (above ? stratmesh::kFirstAboveBranch : stratmesh::kFirstBelowBranch) + k);
         const std::vector<double> branch = points_labelled(xyz, labels, label, indices);
@@ -400,20 +400,20 @@ bool reconstruct_split(const std::vector<double>& xyz, const CommandLine& given,
         record.reconstruct_seconds += seconds_since(start);
         record.split.push_back({std::string(above ? "branch above " : "branch below ") +
                                     std::to_string(k + 1),
-                                indices.size(), status, report.layer_count,
+                                indices.size(), status, report.layers.used_count,
                                 status == stratmesh::Status::ok ? part.triangle_count : 0,
-                                report.folds});
+                                report.diagnostics.fold_count});
         if (status != stratmesh::Status::ok) continue;  // its points stay unused
         append_part(part, indices, all);
-        whole.points_used += report.points_used;
-        whole.duplicates += report.duplicates;
-        whole.rejected += report.rejected;
-        whole.outliers += report.outliers;
-        whole.illegal_removed += report.illegal_removed;
-        whole.folds += report.folds;
+        whole.points.used_count += report.points.used_count;
+        whole.points.duplicate_count += report.points.duplicate_count;
+        whole.points.rejected_count += report.points.rejected_count;
+        whole.points.outlier_count += report.points.outlier_count;
+        whole.diagnostics.illegal_removed_count += report.diagnostics.illegal_removed_count;
+        whole.diagnostics.fold_count += report.diagnostics.fold_count;
     }
-    whole.points_in = labels.size();
-    whole.unused = whole.points_in - whole.points_used - whole.duplicates - whole.rejected;
+    whole.points.in_count = labels.size();
+    whole.points.unused_count = whole.points.in_count - whole.points.used_count - whole.points.duplicate_count - whole.points.rejected_count;
     if (!join_parts(xyz, line, labels, all, record)) return false;
     if (given.cap && !cap_parts(xyz, given, all, record)) return false;
     whole.triangle_count = all.size() / 3;
@@ -452,7 +452,7 @@ bool find_branches(const std::vector<double>& xyz, const CommandLine& line,
 // Whether the split meshed every part and joined every side, with every point in a part.
 bool split_complete(const std::vector<uint8_t>& labels, const RunRecord& record) {
     if (record.status != stratmesh::Status::ok || !record.junction_run ||
-        record.junction_status != stratmesh::Status::ok || record.junction.sides_left_apart > 0)
+        record.junction_status != stratmesh::Status::ok || record.junction.apart_side_count > 0)
         return false;
     for (const RunRecord::SplitPart& part : record.split)
         if (part.status != stratmesh::Status::ok) return false;
@@ -466,7 +466,7 @@ void explain_refusal(const CommandLine& line, const RunRecord& record) {
         std::fprintf(stderr,
                      "stratmesh: point %zu (counting from 0) has a NaN or infinite coordinate; "
                      "--skip-invalid skips such points\n",
-                     record.report.first_invalid_point);
+                     record.report.points.first_invalid_index);
     if (record.report.detail) std::fprintf(stderr, "stratmesh: %s\n", record.report.detail);
     if (record.stream && record.status == stratmesh::Status::out_of_memory)
         std::fprintf(stderr,
@@ -545,7 +545,7 @@ int run(const CommandLine& line) {
     // (separate objects), and is meshed as one tube.
     const bool split = (automatic || line.split_branches) &&
                        record.parting_status == stratmesh::Status::ok &&
-                       record.parting.branches_above + record.parting.branches_below > 0 &&
+                       record.parting.above_branch_count + record.parting.below_branch_count > 0 &&
                        std::count(labels.begin(), labels.end(), stratmesh::kInTrunk) >=
                            static_cast<std::ptrdiff_t>(stratmesh::kSmallestBranch);
     if (!(split ? reconstruct_split(xyz, line, labels, result, record)

@@ -238,36 +238,36 @@ void write_status(JsonWriter& j, const RunRecord& r) {
 void write_counts(JsonWriter& j, const stratmesh::Report& rep, stratmesh::Status status) {
     j.key("points");
     j.begin_object();
-    j.count_field("in", rep.points_in);
-    j.count_field("used", rep.points_used);
-    j.count_field("duplicates", rep.duplicates);
-    j.count_field("rejected", rep.rejected);
-    j.count_field("outliers", rep.outliers);
-    j.count_field("unused", rep.unused);
+    j.count_field("in", rep.points.in_count);
+    j.count_field("used", rep.points.used_count);
+    j.count_field("duplicates", rep.points.duplicate_count);
+    j.count_field("rejected", rep.points.rejected_count);
+    j.count_field("outliers", rep.points.outlier_count);
+    j.count_field("unused", rep.points.unused_count);
     j.key("first_invalid");
     if (status == stratmesh::Status::invalid_point)
-        j.integer(rep.first_invalid_point);
+        j.integer(rep.points.first_invalid_index);
     else
         j.null();
     j.end_object();
     j.count_field("triangles", rep.triangle_count);
-    j.count_field("illegal_removed", rep.illegal_removed);
-    j.count_field("folds", rep.folds);
+    j.count_field("illegal_removed", rep.diagnostics.illegal_removed_count);
+    j.count_field("folds", rep.diagnostics.fold_count);
     j.key("caps");
     j.begin_object();
-    j.count_field("closed", rep.caps_closed);
-    j.count_field("left_open", rep.caps_left_open);
-    j.count_field("triangles", rep.cap_triangles);
-    j.count_field("wall_flips", rep.cap_wall_flips);
+    j.count_field("closed", rep.caps.closed_count);
+    j.count_field("left_open", rep.caps.open_count);
+    j.count_field("triangles", rep.caps.triangle_count);
+    j.count_field("wall_flips", rep.caps.wall_flip_count);
     j.end_object();
     j.key("axis");
     j.begin_object();
     j.numbers_field("direction", rep.axis, 3);
     j.numbers_field("origin", rep.axis_origin, 3);
     j.end_object();
-    j.count_field("layer_count", rep.layer_count);
-    j.count_field("parallel_layers", rep.parallel_layers);
-    j.count_field("points_held", rep.points_held);
+    j.count_field("layer_count", rep.layers.used_count);
+    j.count_field("parallel_layers", rep.layers.parallel_count);
+    j.count_field("points_held", rep.points.held_count);
 }
 
 // One side of the parting: its cut and its branches' point counts, or null.
@@ -291,8 +291,8 @@ void write_branches(JsonWriter& j, const RunRecord& r) {
     j.begin_object();
     j.text_field("status", status_name(r.parting_status));
     j.number_field("gap", p.gap);
-    write_parting_side(j, "above", p.above, p.above_points, p.branches_above);
-    write_parting_side(j, "below", p.below, p.below_points, p.branches_below);
+    write_parting_side(j, "above", p.above, p.above_point_counts, p.above_branch_count);
+    write_parting_side(j, "below", p.below, p.below_point_counts, p.below_branch_count);
     j.end_object();
 }
 
@@ -319,11 +319,11 @@ void write_junction(JsonWriter& j, const RunRecord& r) {
     if (!r.junction_run) return j.null();
     j.begin_object();
     j.text_field("status", status_name(r.junction_status));
-    j.count_field("sides_joined", r.junction.sides_joined);
-    j.count_field("sides_left_apart", r.junction.sides_left_apart);
-    j.count_field("branches_grafted", r.junction.branches_grafted);
-    j.count_field("triangles", r.junction.triangles_added);
-    j.count_field("triangles_removed", r.junction.triangles_removed);
+    j.count_field("sides_joined", r.junction.joined_side_count);
+    j.count_field("sides_left_apart", r.junction.apart_side_count);
+    j.count_field("branches_grafted", r.junction.grafted_branch_count);
+    j.count_field("triangles", r.junction.added_triangle_count);
+    j.count_field("triangles_removed", r.junction.removed_triangle_count);
     j.key("detail");
     if (r.junction.detail)
         j.string(r.junction.detail);
@@ -360,7 +360,7 @@ void write_layers(JsonWriter& j, const RunRecord& r) {
     j.begin_array();
     for (const stratmesh::LayerInfo& layer : r.layers) write_layer(j, layer);
     j.end_array();
-    j.flag_field("layers_complete", r.layers.size() == r.report.layer_count);
+    j.flag_field("layers_complete", r.layers.size() == r.report.layers.used_count);
 }
 
 void write_costs(JsonWriter& j, const RunRecord& r) {
@@ -376,7 +376,7 @@ void write_costs(JsonWriter& j, const RunRecord& r) {
         j.number_field(phase_name(static_cast<stratmesh::Phase>(p)), r.phase_seconds[p]);
     j.end_object();
     j.end_object();
-    double points = static_cast<double>(r.report.points_in);
+    double points = static_cast<double>(r.report.points.in_count);
     j.key("memory");
     j.begin_object();
     j.count_field("workspace_bytes", r.workspace_bytes);
@@ -415,10 +415,10 @@ RunRecord::RunRecord() {
 
 void RunRecord::take_report(stratmesh::Report outcome,
                             std::vector<stratmesh::LayerInfo>& filled) {
-    if (outcome.layer_count < filled.size()) filled.resize(outcome.layer_count);
+    if (outcome.layers.used_count < filled.size()) filled.resize(outcome.layers.used_count);
     layers = std::move(filled);
-    outcome.layers = nullptr; // it pointed into `filled`
-    outcome.layer_capacity = 0;
+    outcome.layers.info = nullptr; // it pointed into `filled`
+    outcome.layers.info_capacity = 0;
     report = outcome;
 }
 

@@ -47,7 +47,7 @@ struct RunRecord {
     // equivalent run without --stream).
     size_t stream_pushes = 0;
     std::vector<double> batch_cuts;
-    // The outcome. report.layers is not used: the filled entries are copied to `layers`.
+    // The outcome. report.layers.info is not used: the filled entries are copied to `layers`.
     bool reconstructed = false; // reconstruct() ran (the input could be read)
     stratmesh::Status status = stratmesh::Status::ok;
     stratmesh::Report report = {};

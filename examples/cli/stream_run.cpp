@@ -72,8 +72,8 @@ public:
         // The stream refuses close_ends: --cap runs cap_ends() once it is closed.
         options_.flags &= ~static_cast<uint32_t>(stratmesh::close_ends);
         unit_axis(options_, axis_);
-        report_.layers = layers_.data();
-        report_.layer_capacity = layers_.size();
+        report_.layers.info = layers_.data();
+        report_.layers.info_capacity = layers_.size();
     }
 
     StreamOutcome run(std::string& error) {
@@ -203,7 +203,7 @@ private:
         kept_.resize(3 * stratmesh::reconstruct_max_triangles(n, options_));
         size_t count = surface;
         const stratmesh::Cloud cloud = {all_points_.data(), n, 0, stratmesh::Scalar::float64};
-        stratmesh::Report caps = {};  // its workspace_used is the caps' alone
+        stratmesh::Report caps = {};  // its workspace_used_bytes is the caps' alone
         const stratmesh::Status status =
             stratmesh::cap_ends(cloud, options_, work.get(), bytes, kept_.data(),
                                 kept_.size() / 3, &count, &caps);
@@ -211,10 +211,10 @@ private:
         if (caps.detail) report_.detail = caps.detail;
         if (status != stratmesh::Status::ok) return status;
         writer_.add_triangles(kept_.data(), count);
-        report_.caps_closed = caps.caps_closed;
-        report_.caps_left_open = caps.caps_left_open;
-        report_.cap_triangles = caps.cap_triangles;
-        report_.cap_wall_flips = caps.cap_wall_flips;
+        report_.caps.closed_count = caps.caps.closed_count;
+        report_.caps.open_count = caps.caps.open_count;
+        report_.caps.triangle_count = caps.caps.triangle_count;
+        report_.caps.wall_flip_count = caps.caps.wall_flip_count;
         report_.triangle_count = count;
         return status;
     }

@@ -52,7 +52,7 @@ std::string phase_times_text(const RunRecord& r) {
 // The surface's ends: a closed end (a crown, a base) is meshed across to a small loop at
 // its pole; an open one is the rim of the tube. Known only when every layer was recorded.
 void print_ends(std::FILE* out, const RunRecord& r) {
-    if (r.layers.empty() || r.layers.size() != r.report.layer_count) return;
+    if (r.layers.empty() || r.layers.size() != r.report.layers.used_count) return;
     const bool bottom = r.layers.front().closed_ends & stratmesh::closed_bottom;
     const bool top = r.layers.back().closed_ends & stratmesh::closed_top;
     std::fprintf(out, "  ends       bottom %s, top %s\n", bottom ? "closed" : "open",
@@ -63,7 +63,7 @@ void print_ends(std::FILE* out, const RunRecord& r) {
 // their fold counts, so that a user can move the cuts or the axis there. Known only when
 // every layer was recorded.
 void print_folds(std::FILE* out, const RunRecord& r) {
-    if (r.report.folds == 0 || r.layers.empty() || r.layers.size() != r.report.layer_count)
+    if (r.report.diagnostics.fold_count == 0 || r.layers.empty() || r.layers.size() != r.report.layers.used_count)
         return;
     const size_t kListed = 6;
     std::string list;
@@ -88,19 +88,19 @@ void print_folds(std::FILE* out, const RunRecord& r) {
 void print_counts(std::FILE* out, const RunRecord& r) {
     const stratmesh::Report& rep = r.report;
     std::fprintf(out, "  points     %zu read: %zu used, %zu duplicates, %zu rejected%s, %zu unused\n",
-                 rep.points_in, rep.points_used, rep.duplicates, rep.rejected,
-                 rep.outliers ? (" (" + std::to_string(rep.outliers) + " outliers)").c_str() : "",
-                 rep.unused);
-    std::fprintf(out, "  layers     %zu (%zu triangulated in parallel)\n", rep.layer_count,
-                 rep.parallel_layers);
+                 rep.points.in_count, rep.points.used_count, rep.points.duplicate_count, rep.points.rejected_count,
+                 rep.points.outlier_count ? (" (" + std::to_string(rep.points.outlier_count) + " outliers)").c_str() : "",
+                 rep.points.unused_count);
+    std::fprintf(out, "  layers     %zu (%zu triangulated in parallel)\n", rep.layers.used_count,
+                 rep.layers.parallel_count);
     print_ends(out, r);
     std::fprintf(out, "  triangles  %zu (%zu illegal removed, %zu folds)\n", rep.triangle_count,
-                 rep.illegal_removed, rep.folds);
+                 rep.diagnostics.illegal_removed_count, rep.diagnostics.fold_count);
     print_folds(out, r);
-    if (rep.caps_closed + rep.caps_left_open > 0)
+    if (rep.caps.closed_count + rep.caps.open_count > 0)
         std::fprintf(out, "  caps       %zu closed (%zu triangles), %zu left open%s\n",
-                     rep.caps_closed, rep.cap_triangles, rep.caps_left_open,
-                     rep.cap_wall_flips ? (", " + std::to_string(rep.cap_wall_flips) +
+                     rep.caps.closed_count, rep.caps.triangle_count, rep.caps.open_count,
+                     rep.caps.wall_flip_count ? (", " + std::to_string(rep.caps.wall_flip_count) +
                                            " wall edges flipped under fins").c_str()
                                         : "");
 }
@@ -109,10 +109,10 @@ void print_counts(std::FILE* out, const RunRecord& r) {
 // it) and its branches' point counts.
 // ", 2 branches grafted (41 triangles of the trunk taken out)", or nothing.
 std::string grafted_note(const stratmesh::JoinReport& j) {
-    if (j.branches_grafted == 0) return "";
-    return ", " + std::to_string(j.branches_grafted) + " branch" +
-           (j.branches_grafted == 1 ? "" : "es") + " grafted (" +
-           std::to_string(j.triangles_removed) + " triangles of the trunk taken out)";
+    if (j.grafted_branch_count == 0) return "";
+    return ", " + std::to_string(j.grafted_branch_count) + " branch" +
+           (j.grafted_branch_count == 1 ? "" : "es") + " grafted (" +
+           std::to_string(j.removed_triangle_count) + " triangles of the trunk taken out)";
 }
 
 void print_branches(std::FILE* out, const RunRecord& r) {
@@ -131,10 +131,10 @@ void print_branches(std::FILE* out, const RunRecord& r) {
         return text + " points)";
     };
     std::fprintf(out, "  branches   %s; %s (gap %s)\n",
-                 side("above", p.above, p.above_points, p.branches_above).c_str(),
-                 side("below", p.below, p.below_points, p.branches_below).c_str(),
+                 side("above", p.above, p.above_point_counts, p.above_branch_count).c_str(),
+                 side("below", p.below, p.below_point_counts, p.below_branch_count).c_str(),
                  number_text(p.gap).c_str());
-    if (p.branches_above + p.branches_below > 0 && r.split.empty())
+    if (p.above_branch_count + p.below_branch_count > 0 && r.split.empty())
         std::fprintf(out, "             one tube wraps branches and the gaps between them: mesh "
                           "each side apart\n             (README, \"Where the cloud parts\")\n");
 }
@@ -161,13 +161,13 @@ void print_split(std::FILE* out, const RunRecord& r) {
     const stratmesh::JoinReport& j = r.junction;
     if (r.junction_status != stratmesh::Status::ok)
         std::fprintf(out, "             not joined: %s\n", stratmesh::status_string(r.junction_status));
-    else if (j.sides_joined > 0 || j.branches_grafted > 0)
-        std::fprintf(out, "             joined at %u side%s by %zu triangles%s%s\n", j.sides_joined,
-                     j.sides_joined == 1 ? "" : "s", j.triangles_added,
-                     j.sides_left_apart ? " (a side left apart)" : "",
+    else if (j.joined_side_count > 0 || j.grafted_branch_count > 0)
+        std::fprintf(out, "             joined at %u side%s by %zu triangles%s%s\n", j.joined_side_count,
+                     j.joined_side_count == 1 ? "" : "s", j.added_triangle_count,
+                     j.apart_side_count ? " (a side left apart)" : "",
                      grafted_note(j).c_str());
     if (j.detail)
-        std::fprintf(out, "             %s%s\n", j.sides_joined ? "" : "left apart: ", j.detail);
+        std::fprintf(out, "             %s%s\n", j.joined_side_count ? "" : "left apart: ", j.detail);
     if (r.split_undone)
         std::fprintf(out, "             not kept: meshed as one tube instead (--split-branches "
                           "keeps the parts)\n");
@@ -181,8 +181,8 @@ void print_costs(std::FILE* out, const RunRecord& r) {
                  phase_times_text(r).c_str(),
                  r.parting_run ? ("branches " + seconds_text(r.branches_seconds) + ", ").c_str() : "",
                  seconds_text(r.write_seconds).c_str());
-    double per_point = r.report.points_in ? static_cast<double>(r.workspace_bytes) /
-                                                static_cast<double>(r.report.points_in)
+    double per_point = r.report.points.in_count ? static_cast<double>(r.workspace_bytes) /
+                                                static_cast<double>(r.report.points.in_count)
                                           : 0.0;
     std::fprintf(out, "  memory     workspace %s (%zu bytes, %.0f bytes/point), triangles %s%s\n",
                  bytes_text(r.workspace_bytes).c_str(), r.workspace_bytes, per_point,
@@ -191,7 +191,7 @@ void print_costs(std::FILE* out, const RunRecord& r) {
                                   : "");
     if (r.stream)
         std::fprintf(out, "  stream     %zu layers pushed, at most %zu points held (of %llu)\n",
-                     r.stream_pushes, r.report.points_held,
+                     r.stream_pushes, r.report.points.held_count,
                      static_cast<unsigned long long>(r.stream_points));
 }
 

@@ -49,14 +49,14 @@ int main() {
 
     stratmesh::Cloud cloud = {kCloudXyz, kCloudPoints, 0, stratmesh::Scalar::float32};
     stratmesh::Report report = {};
-    report.layers = g_layers;
-    report.layer_capacity = sizeof g_layers / sizeof g_layers[0];
+    report.layers.info = g_layers;
+    report.layers.info_capacity = sizeof g_layers / sizeof g_layers[0];
     size_t count = 0;
     stratmesh::Status status = stratmesh::reconstruct(cloud, options, g_workspace, sizeof g_workspace,
                                                       g_triangles, kMaxTriangles, &count, &report);
     g_status = static_cast<uint32_t>(status);
     g_triangle_count = static_cast<uint32_t>(count);
-    g_points_used = static_cast<uint32_t>(report.points_used);
+    g_points_used = static_cast<uint32_t>(report.points.used_count);
     if (status != stratmesh::Status::ok) return 3 + static_cast<int>(status);
     return 0;
 }

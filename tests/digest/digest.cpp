@@ -85,7 +85,7 @@ void reconstruct_case(const char* name, const std::vector<double>& raw, stratmes
     stratmesh::Status s = stratmesh::reconstruct(cloud, o, work.data(), work.size(), tris.data(),
                                                  tris.size() / 3, &count, &report);
     record(output, "reconstruct", name, n, s, tris.data(), count,
-           {report.layer_count, report.rejected, report.caps_closed}, report.layer_count, "layers");
+           {report.layers.used_count, report.points.rejected_count, report.caps.closed_count}, report.layers.used_count, "layers");
 }
 
 void collect_triangles(void* user, const uint32_t* triangles, size_t count) {
@@ -130,8 +130,8 @@ std::vector<uint32_t> stream_case(const char* name, const std::vector<double>& r
         s = stratmesh::stream_push(stream, layer, top);
     }
     if (s == stratmesh::Status::ok) s = stratmesh::stream_close(stream);
-    record(g_output, "stream", name, n, s, tris.data(), tris.size() / 3, {report.layer_count},
-           report.layer_count, "layers");
+    record(g_output, "stream", name, n, s, tris.data(), tris.size() / 3, {report.layers.used_count},
+           report.layers.used_count, "layers");
     return tris;
 }
 
@@ -148,8 +148,8 @@ void cap_ends_case(const char* name, const std::vector<double>& pushed, std::vec
     stratmesh::Cloud cloud = {pushed.data(), n, 0, stratmesh::Scalar::float64};
     stratmesh::Status s = stratmesh::cap_ends(cloud, o, work.data(), work.size(), tris.data(),
                                               tris.size() / 3, &count, &report);
-    record(g_full, "cap_ends", name, n, s, tris.data(), count, {report.caps_closed},
-           report.caps_closed, "caps");
+    record(g_full, "cap_ends", name, n, s, tris.data(), count, {report.caps.closed_count},
+           report.caps.closed_count, "caps");
 }
 #endif
 

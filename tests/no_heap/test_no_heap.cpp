@@ -89,8 +89,8 @@ struct ReconstructCase {
     }
     stratmesh::Status run() {
         report = {};
-        report.layers = layers.data();
-        report.layer_capacity = layers.size();
+        report.layers.info = layers.data();
+        report.layers.info_capacity = layers.size();
         count = 0;
         return stratmesh::reconstruct(cloud(), options, work.data(), work.size(), tris.data(),
                                       (tris.size() - 3) / 3, &count, &report);
@@ -380,9 +380,9 @@ TEST_CASE("the stream and its caps allocate nothing: open, every push, close, ca
     CHECK(n == 0);
     for (stratmesh::Status st : statuses) CHECK(st == stratmesh::Status::ok);
     CHECK(emitted.count == report.triangle_count);
-    CHECK(report.points_used == s.size());
-    CHECK(report.caps_closed == 2);
-    CHECK(capped == emitted.count + report.cap_triangles);
+    CHECK(report.points.used_count == s.size());
+    CHECK(report.caps.closed_count == 2);
+    CHECK(capped == emitted.count + report.caps.triangle_count);
 }
 
 TEST_CASE("find_parting allocates nothing: a fork found and labelled, no parting, refusals") {
@@ -402,17 +402,17 @@ TEST_CASE("find_parting allocates nothing: a fork found and labelled, no parting
         statuses[0] = stratmesh::find_parting({fork.xyz.data(), fork.size(), 0, stratmesh::Scalar::float64},
                                               z, work.data(), work.size(), &found, labels.data());
         statuses[1] = stratmesh::find_parting({tube.xyz.data(), tube.size(), 0, stratmesh::Scalar::float64},
-                                              x, work.data(), work.size(), &none);
+                                              x, work.data(), work.size(), &none, nullptr);
         statuses[2] = stratmesh::find_parting({nan_cloud.data(), tube.size(), 0, stratmesh::Scalar::float64},
-                                              x, work.data(), work.size(), &refused);
+                                              x, work.data(), work.size(), &refused, nullptr);
         statuses[3] = stratmesh::find_parting({fork.xyz.data(), fork.size(), 0, stratmesh::Scalar::float64},
-                                              z, work.data(), 1000, &short_of);
+                                              z, work.data(), 1000, &short_of, nullptr);
     });
     CHECK(n == 0);
     CHECK(statuses[0] == stratmesh::Status::ok);
-    CHECK(found.branches_above == 2);
+    CHECK(found.above_branch_count == 2);
     CHECK(statuses[1] == stratmesh::Status::ok);
-    CHECK(none.branches_above + none.branches_below == 0);
+    CHECK(none.above_branch_count + none.below_branch_count == 0);
     CHECK(statuses[2] == stratmesh::Status::invalid_point);
     CHECK(statuses[3] == stratmesh::Status::out_of_memory);
 }
@@ -427,7 +427,7 @@ TEST_CASE("join_branches allocates nothing: a fork's parts traced and planned, r
     stratmesh::Parting parting = {};
     REQUIRE(stratmesh::find_parting(cloud, z, work.data(), work.size(), &parting, labels.data()) ==
             stratmesh::Status::ok);
-    REQUIRE(parting.branches_above == 2);
+    REQUIRE(parting.above_branch_count == 2);
     std::vector<uint32_t> triangles;
     for (uint8_t label : {stratmesh::kInTrunk, stratmesh::kFirstAboveBranch,
                           static_cast<uint8_t>(stratmesh::kFirstAboveBranch + 1)}) {
@@ -464,7 +464,7 @@ TEST_CASE("join_branches allocates nothing: a fork's parts traced and planned, r
     });
     CHECK(n == 0);
     CHECK(statuses[0] == stratmesh::Status::ok);
-    CHECK(planned.branches_grafted == 2);  // the fork stands on a dome: grafted, holes and all
+    CHECK(planned.grafted_branch_count == 2);  // the fork stands on a dome: grafted, holes and all
     CHECK(statuses[1] == stratmesh::Status::out_of_memory);
 }
 
@@ -548,7 +548,7 @@ Outcome capture(no_heap::ReconstructCase& c, stratmesh::Status s) {
     o.count = c.count;
     o.tris.assign(c.tris.begin(), c.tris.begin() + static_cast<std::ptrdiff_t>(3 * c.count));
     stratmesh::Report r = c.report;
-    r.layers = nullptr;
+    r.layers.info = nullptr;
     r.detail = nullptr;
     o.report_bytes.resize(sizeof r);
     std::memcpy(o.report_bytes.data(), &r, sizeof r);
@@ -698,7 +698,7 @@ TEST_CASE("stack high-water mark of reconstruct and delaunay_2d stays below 16 K
     for (no_heap::ReconstructCase& c : rc) {
         size_t used = stack_used(call_reconstruct, &c);
         INFO(c.name);
-        CHECK(c.report.points_in == c.cloud().count);
+        CHECK(c.report.points.in_count == c.cloud().count);
         if (used > worst_r) worst_r = used;
     }
     std::vector<no_heap::DelaunayCase> dc = no_heap::delaunay_cases();

@@ -225,6 +225,7 @@ namespace stratmesh {
     /* argument checks: a caller error, detected before any work */                      \
     X(invalid_argument, "a null pointer with a non-zero count, a stride too small, or buffers that overlap") \
     X(too_many_points, "more points than 32-bit indices can address")                    \
+    X(not_compiled, "the options ask for a feature this build leaves out (STRATMESH_SMALL_CODE)") \
     /* the data */                                                                        \
     X(invalid_point, "a coordinate is NaN or infinite")                                   \
     X(too_few_points, "fewer than 3 distinct points")                                     \
@@ -507,6 +508,8 @@ struct PointCounts {
 
 // Report::layers.
 struct LayerCounts {
+    size_t planned_count;    // layers planned (cuts + 1, layer_count, or the automatic plan),
+                             // before too small, thin, open or folding ones are merged
     size_t used_count;       // layers of the output
     size_t parallel_count;   // of those, triangulated by Options::run_jobs' jobs (0 without
                              // a runner, or when the workspace was too small for the jobs)
@@ -6019,6 +6022,8 @@ struct CapCounts {
 // Report::detail for the caps, from reconstruct() and cap_ends() alike.
 const char* const kCapsTooLargeDetail =
     "the triangle array is too small for the caps; triangle_count says how many are needed";
+const char* const kNotCompiledDetail =
+    "the options ask for a feature this build leaves out (STRATMESH_SMALL_CODE)";
 const char* const kLoopLeftOpenDetail =
     "a boundary loop's projection across the axis is not a simple polygon (or every cap "
     "found for it would repeat an edge of the surface): it is left open";
@@ -7764,110 +7769,108 @@ inline void report_chain(const SurfaceChain& chain, size_t valid, Report& rep) {
         rep.detail = "the manifold safety net removed the triangles of some points";
 }
 
-// The whole reconstruction; `rep` arrives zeroed but for its layer array. Report::points.unused_count
-// is left to the caller, who derives it so the counts add up on every path.
-inline Status run_reconstruction(const Cloud& cloud, const Options& options, void* workspace,
-                                 size_t workspace_bytes, uint32_t* triangles,
-                                 size_t triangle_capacity, size_t* triangle_count,
-                                 Report& rep) {
-    LayerInfo* layer_infos = rep.layers.info;
-    size_t layer_capacity = rep.layers.info_capacity;
+// A cloud as a tube reads it: in place, the points left out (outliers, or the points of
+// other parts) marked in the reader's optional bitmap, and the sums of the points kept.
+struct TubeInput {
+    CloudReader reader;
+    size_t count;
+    CloudSums sums;
+};
 
-    Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
-                                                triangle_count, workspace, rep);
-    if (status != Status::ok) return status;
-    notify(options, Phase::validate, 0);
-    CloudReader reader = reader_of(cloud);
+// Whether this build holds every feature the flags ask for (STRATMESH_SMALL_CODE leaves
+// some out).
+inline bool flags_compiled(const Options& options) {
+    const uint32_t f = options.flags;
+    return (kDropOutliers || !(f & drop_outliers)) && (kSurfaceFlips || !(f & surface_flips)) &&
+           (kClosedEnds || !(f & open_ends));
+}
+
+// Reads a cloud that passed check_reconstruct_arguments: refuses or counts its NaN and
+// infinite points, leaves out its outliers (drop_outliers; the bitmap stays in `arena`)
+// and sums what is kept.
+inline Status read_cloud(const Cloud& cloud, const Options& options, Arena& arena, Report& rep,
+                         TubeInput& in) {
+    in.reader = reader_of(cloud);
+    in.count = cloud.count;
     // One pass serves the check for invalid points, the frame and the distinct points.
-    CloudSums sums = sum_cloud(reader, cloud.count);
-    status = reject_invalid_points(reader, cloud.count, sums, options, rep);
+    in.sums = sum_cloud(in.reader, cloud.count);
+    Status status = reject_invalid_points(in.reader, cloud.count, in.sums, options, rep);
     if (status != Status::ok) return status;
     status = validate_layer_options(options);
     if (status != Status::ok) return status;
-    Arena arena = Arena::over(workspace, workspace_bytes);
-    // Every exit from here records the peak workspace.
-    auto finish = [&](Status result) {
-        rep.workspace_used_bytes = arena.peak_from_buffer();
-        return result;
-    };
+    if (!flags_compiled(options)) {
+        rep.detail = kNotCompiledDetail;
+        return Status::not_compiled;
+    }
     if (options.flags & drop_outliers) {
-        if (!kDropOutliers) return Status::invalid_argument;
-        if (!find_outliers(reader, cloud.count, arena, rep)) return finish(Status::out_of_memory);
-        sums = sum_cloud(reader, cloud.count);  // without the outliers
+        if (!find_outliers(in.reader, cloud.count, arena, rep)) return Status::out_of_memory;
+        in.sums = sum_cloud(in.reader, cloud.count);  // without the outliers
     }
-    size_t valid = cloud.count - rep.points.rejected_count;
-    Frame frame;
-    status = choose_frame(reader, cloud.count, sums, options, frame);
-    if (status != Status::ok) return status;
-    report_frame(frame, rep);
-    if (sums.distinct < 3) {
-        rep.detail = "fewer than 3 distinct valid points";
-        return Status::too_few_points;
-    }
+    return Status::ok;
+}
 
-    double lo = DBL_MAX, hi = -DBL_MAX;
-    if (!kFastLoops || !height_range_from_extremes(frame, &lo, &hi))
-        height_range(reader, cloud.count, frame, &lo, &hi);
-    if (!(hi > lo)) {
-        rep.detail = "every point has the same height along the axis";
-        return Status::flat_cloud;
-    }
-
-    ReconstructMemory m;
-    size_t layer_limit = planned_layer_limit(cloud.count, options);
-    if (!plan_reconstruct(m, cloud.count, layer_limit, arena)) return finish(Status::out_of_memory);
+// Plans the layers of a tube along the frame's axis and groups its points by layer.
+inline Status plan_tube_layers(const TubeInput& in, const Options& options, const Frame& frame,
+                               double lo, double hi, Arena& arena, ReconstructMemory& m,
+                               LayerPlan& plan, Local** staged, Report& rep) {
+    const size_t valid = in.sums.valid;
+    const size_t layer_limit = planned_layer_limit(in.count, options);
+    if (!plan_reconstruct(m, in.count, layer_limit, arena)) return Status::out_of_memory;
     notify(options, Phase::layers, 0);
-    LayerPlan plan = {m.bounds, 0, (hi - lo) * kCutTolerance};
+    plan = {m.bounds, 0, (hi - lo) * kCutTolerance};
     if (automatic_layers(options)) {
-        size_t mark = arena.mark();
-        uint32_t bins = profile_bin_count(valid);
+        const size_t mark = arena.mark();
+        const uint32_t bins = profile_bin_count(valid);
         ProfileBin* profile = nullptr;
         BinRange* ranges = nullptr;
         double* cuts = nullptr;
         allocate_profile(arena, bins, &profile, &ranges, &cuts);
-        if (arena.failed) return finish(Status::out_of_memory);
-        plan_automatic_layers(reader, cloud.count, valid, frame, lo, hi, profile, ranges, cuts,
+        if (arena.failed) return Status::out_of_memory;
+        plan_automatic_layers(in.reader, in.count, valid, frame, lo, hi, profile, ranges, cuts,
                               bins, plan);
         arena.rewind(mark);
     } else {
-        plan_layers(options, lo, hi, cloud.count, frame, plan);
+        plan_layers(options, lo, hi, in.count, frame, plan);
     }
+    rep.layers.planned_count = plan.count;
     // Without a runner, the grouped points are also staged in the workspace's end room when
     // there is room: each layer is then loaded in sequence instead of gathered from the
     // whole cloud, for as long as the layers before it leave that room untouched. Either
     // way the same coordinates are loaded.
-    Local* staged = nullptr;
-    {
-        size_t mark = arena.mark();
-        uint32_t* layer = arena.alloc<uint32_t>(cloud.count);
-        if (arena.failed) return finish(Status::out_of_memory);
-        if (kStagePoints && !(kParallelLayers && options.run_jobs)) {
-            const size_t bytes = saturating_product(valid, sizeof(Local));
-            staged = static_cast<Local*>(arena.room_at_end(bytes));
-        }
-        group_by_layer(reader, cloud.count, frame, plan, layer, staged, m);
-        arena.rewind(mark);
-    }
+    *staged = nullptr;
+    const size_t mark = arena.mark();
+    uint32_t* layer = arena.alloc<uint32_t>(in.count);
+    if (arena.failed) return Status::out_of_memory;
+    if (kStagePoints && !(kParallelLayers && options.run_jobs))
+        *staged = static_cast<Local*>(arena.room_at_end(saturating_product(valid, sizeof(Local))));
+    group_by_layer(in.reader, in.count, frame, plan, layer, *staged, m);
+    arena.rewind(mark);
+    return Status::ok;
+}
 
+// Triangulates the planned layers one group after another, each stitched to the one below,
+// into `sink`; the layers used go to the report.
+inline Status triangulate_tube(const TubeInput& in, const Options& options, const Frame& frame,
+                               const LayerPlan& plan, Local* staged, Arena& arena,
+                               ReconstructMemory& m, TriangleSink& sink, Report& rep) {
     notify(options, Phase::triangulate, 0);
-    TriangleSink sink = {triangles, triangle_capacity, 0, 0};
     SurfaceChain& chain = m.chain;
     chain.frame = frame;
-    chain.reader = reader;
+    chain.reader = in.reader;
     chain.output_id = nullptr;
     const LayerQueue queue = {m.order, staged, m.layer_start, plan.bounds, plan.count, true};
     ParallelLayers parallel;
-    rep.layers.parallel_count = start_parallel_layers(options, reader, frame, queue, arena, parallel);
+    rep.layers.parallel_count = start_parallel_layers(options, in.reader, frame, queue, arena, parallel);
     for (uint32_t first = 0; first < plan.count;) {
         GroupResult group;
-        status = add_group(chain, queue, first, arena, sink, group,
-                           parallel.ready ? parallel.ahead_of(first) : nullptr);
+        const Status status = add_group(chain, queue, first, arena, sink, group,
+                                        parallel.ready ? parallel.ahead_of(first) : nullptr);
         if (status == Status::not_columnar) break;
-        if (status != Status::ok) return finish(status);
-        if (rep.layers.used_count < layer_capacity)
+        if (status != Status::ok) return status;
+        if (rep.layers.used_count < rep.layers.info_capacity)
             describe_layer(frame, group.cylinder, plan.bounds[first], plan.bounds[group.last + 1],
                            group.points - group.counts.duplicates, group.triangles, group.folds,
-                           layer_infos[rep.layers.used_count]);
+                           rep.layers.info[rep.layers.used_count]);
         ++rep.layers.used_count;
         first = group.last + 1;
         notify(options, Phase::triangulate, static_cast<double>(first) / plan.count);
@@ -7876,46 +7879,105 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     if (rep.layers.used_count == 0) {
         rep.detail = "no layer's points surround the axis: the cloud is not columnar around "
                      "it (try another axis)";
-        return finish(Status::not_columnar);
+        return Status::not_columnar;
     }
     notify(options, Phase::stitch, 1);
     if (sink.count == 0) {
         rep.detail = "every point lies on the boundary of its layer: too few points to span a "
                      "surface";
-        return finish(Status::too_few_points);
+        return Status::too_few_points;
     }
-    if (sink.count > triangle_capacity) {
-        *triangle_count = sink.count;
-        rep.triangle_count = sink.count;
-        rep.detail = "the triangle array is too small; triangle_count says how many are needed";
-        return finish(Status::triangle_capacity);
-    }
+    return Status::ok;
+}
 
+// Closes the tube's boundary loops with caps (close_ends) and fills the caps' report.
+inline Status cap_tube(const TubeInput& in, const Options& options, const Frame& frame,
+                       Arena& arena, uint32_t* triangles, size_t capacity, size_t& count,
+                       size_t* triangle_count, Report& rep) {
     notify(options, Phase::manifold, 0);
-    size_t count = sink.count;
+    if (!(options.flags & close_ends)) return Status::ok;
     CapCounts caps = {0, 0, 0, 0};
-    if (options.flags & close_ends) {
-        size_t needed = 0;
-        status = cap_boundary_loops(triangles, count, triangle_capacity, reader, cloud.count,
-                                    frame, arena, caps, &needed);
-        if (status == Status::triangle_capacity) {
-            *triangle_count = needed;
-            rep.triangle_count = needed;
-            rep.detail = kCapsTooLargeDetail;
-        }
-        if (status != Status::ok) return finish(status);
-    }
+    size_t needed = 0;
+    const Status status = cap_boundary_loops(triangles, count, capacity, in.reader, in.count,
+                                             frame, arena, caps, &needed);
     rep.caps.closed_count = caps.closed;
     rep.caps.open_count = caps.left_open;
     rep.caps.triangle_count = caps.triangles;
     rep.caps.wall_flip_count = caps.wall_flips;
+    if (status == Status::triangle_capacity) {
+        *triangle_count = needed;
+        rep.triangle_count = needed;
+        rep.detail = kCapsTooLargeDetail;
+    }
+    return status;
+}
+
+// One tube through the kept points of `in`: the frame, the layers, their triangulation and
+// stitching, the caps. `rep` holds the counts of read_cloud; Report::points.unused_count
+// is left to the caller.
+inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& arena,
+                        uint32_t* triangles, size_t triangle_capacity, size_t* triangle_count,
+                        Report& rep) {
+    Frame frame;
+    Status status = choose_frame(in.reader, in.count, in.sums, options, frame);
+    if (status != Status::ok) return status;
+    report_frame(frame, rep);
+    if (in.sums.distinct < 3) {
+        rep.detail = "fewer than 3 distinct valid points";
+        return Status::too_few_points;
+    }
+    double lo = DBL_MAX, hi = -DBL_MAX;
+    if (!kFastLoops || !height_range_from_extremes(frame, &lo, &hi))
+        height_range(in.reader, in.count, frame, &lo, &hi);
+    if (!(hi > lo)) {
+        rep.detail = "every point has the same height along the axis";
+        return Status::flat_cloud;
+    }
+    ReconstructMemory m;
+    LayerPlan plan;
+    Local* staged = nullptr;
+    status = plan_tube_layers(in, options, frame, lo, hi, arena, m, plan, &staged, rep);
+    if (status != Status::ok) return status;
+    TriangleSink sink = {triangles, triangle_capacity, 0, 0};
+    status = triangulate_tube(in, options, frame, plan, staged, arena, m, sink, rep);
+    if (status != Status::ok) return status;
+    if (sink.count > triangle_capacity) {
+        *triangle_count = sink.count;
+        rep.triangle_count = sink.count;
+        rep.detail = "the triangle array is too small; triangle_count says how many are needed";
+        return Status::triangle_capacity;
+    }
+    size_t count = sink.count;
+    status = cap_tube(in, options, frame, arena, triangles, triangle_capacity, count,
+                      triangle_count, rep);
+    if (status != Status::ok) return status;
     *triangle_count = count;
     rep.triangle_count = count;
     rep.diagnostics.fold_count = sink.folds;
-    report_chain(chain, valid, rep);
-    if (!rep.detail && caps.left_open > 0) rep.detail = kLoopLeftOpenDetail;
+    report_chain(m.chain, in.sums.valid, rep);
+    if (!rep.detail && rep.caps.open_count > 0) rep.detail = kLoopLeftOpenDetail;
     notify(options, Phase::done, 1);
-    return finish(Status::ok);
+    return Status::ok;
+}
+
+// reconstruct() of one tube; `rep` arrives zeroed but for its layer array.
+// Report::points.unused_count is left to the caller, who derives it so the counts add up on
+// every path.
+inline Status run_reconstruction(const Cloud& cloud, const Options& options, void* workspace,
+                                 size_t workspace_bytes, uint32_t* triangles,
+                                 size_t triangle_capacity, size_t* triangle_count,
+                                 Report& rep) {
+    Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
+                                                triangle_count, workspace, rep);
+    if (status != Status::ok) return status;
+    notify(options, Phase::validate, 0);
+    Arena arena = Arena::over(workspace, workspace_bytes);
+    TubeInput in;
+    status = read_cloud(cloud, options, arena, rep, in);
+    if (status == Status::ok)
+        status = mesh_tube(in, options, arena, triangles, triangle_capacity, triangle_count, rep);
+    rep.workspace_used_bytes = arena.peak_from_buffer();
+    return status;
 }
 
 }  // namespace detail
@@ -8094,6 +8156,7 @@ Status stream_open(const Options& options, void* workspace, size_t workspace_byt
         if (detail::any_overlap(ranges, 3)) return Status::invalid_argument;
     }
     if (options.axis == Axis::automatic) return Status::invalid_axis;
+    if (!detail::flags_compiled(options)) return Status::not_compiled;
     // The largest window this workspace holds.
     size_t low = 0, high = workspace_bytes / sizeof(detail::Vec3);
     if (high > detail::kMaxPoints - 1) high = detail::kMaxPoints - 1;
@@ -8477,6 +8540,10 @@ struct PartingSweep {
     }
 };
 
+// The widest run of empty sectors (of kSectors) around a branch's centre at the cut: a
+// quarter turn. An arc of a ring seen from its centroid leaves more than that open.
+const uint32_t kBranchArcSectors = kSectors / 4;
+
 // A piece that counts at a cut: its root and its points' sums within the two gaps above.
 struct BranchCandidate {
     uint32_t root;
@@ -8521,6 +8588,21 @@ inline uint32_t branches_at(PartingSweep& s, uint32_t added, uint32_t slab_start
             ++found[k].slice_points[slice];
         }
     }
+    // A branch's points within a gap of the cut go around its centre there: the arcs of a
+    // rim that sparse flanks break apart near an open end do not.
+    uint32_t held[kMaxBranches] = {};
+    for (uint32_t t = slab_start; t < added; ++t) {
+        if (!(s.level(t) - cut < s.gap)) continue;
+        const uint32_t r = s.root(t);
+        for (uint32_t k = 0; k < pieces; ++k) {
+            if (found[k].root != r) continue;
+            const Local l = s.position[s.added[t]];
+            const double n = found[k].slice_points[0];
+            held[k] |= 1u << sector_around(l.x - found[k].sum[0][0] / n, l.y - found[k].sum[0][1] / n);
+        }
+    }
+    for (uint32_t k = 0; k < pieces; ++k)
+        if (widest_gap(held[k]) > kBranchArcSectors) return 0;
     for (uint32_t k = 0; k < pieces; ++k) {
         const BranchCandidate& b = found[k];
         if (b.slice_points[1] == 0) continue;

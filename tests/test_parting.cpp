@@ -227,6 +227,39 @@ TEST_CASE("find_parting: no tube that does not fork parts, at any size or pose")
             }
 }
 
+TEST_CASE("find_parting: the arcs of a rim broken apart near an open end are no branches") {
+    // A grid tube (spacing 0.5, radius 10, 80 rows) whose lowest 20 rows have three empty
+    // channels 3 wide: below the cut there, single linkage makes three arcs of about 400
+    // points each, thick and tall enough to count, but none goes around a centre of its own.
+    std::vector<double> xyz;
+    const double radius = 10, spacing = 0.5, pi = 3.14159265358979323846;
+    const int around = static_cast<int>(2 * pi * radius / spacing);
+    for (int row = 0; row < 80; ++row)
+        for (int k = 0; k < around; ++k) {
+            const double angle = 2 * pi * k / around, arc = angle * radius;
+            const double channel = std::fmod(arc, 2 * pi * radius / 3);
+            if (row < 20 && channel < 3) continue;
+            xyz.insert(xyz.end(), {radius * std::cos(angle), radius * std::sin(angle), row * spacing});
+        }
+    const size_t n = xyz.size() / 3;
+    Options o = {};
+    o.axis = stratmesh::Axis::z;
+    const Cloud cloud = {xyz.data(), n, 0, Scalar::float64};
+    std::vector<uint8_t> label(n, 77);
+    const PartingRun run = find_parting_of(cloud, o, label.data());
+    REQUIRE(run.status == Status::ok);
+    REQUIRE(run.parting.gap > 0);
+    // The channels do split the band: brute-force single linkage below a cut inside it.
+    Shape s;
+    s.xyz = xyz;
+    const double z_axis[3] = {0, 0, 1};
+    const Pieces pieces = pieces_beyond(s, z_axis, 8, false, run.parting.gap, stratmesh::kSmallestBranch);
+    CHECK(pieces.sizes.size() == 3);
+    CHECK(run.parting.below_branch_count == 0);
+    CHECK(run.parting.above_branch_count == 0);
+    CHECK(std::count(label.begin(), label.end(), stratmesh::kInTrunk) == static_cast<std::ptrdiff_t>(n));
+}
+
 TEST_CASE("find_parting: the same answer for the points in any order, and read as strided float32") {
     const Shape s = shapes::forked_tube(12000, Pose::tilted);
     const PartingRun first = find_parting_of(cloud_of(s), axis_options(s));

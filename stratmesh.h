@@ -3000,10 +3000,9 @@ inline CloudSums sum_cloud(const CloudReader& cloud, size_t count) {
     return s;
 }
 
-// The frame: centroid origin, axis from the options (or PCA), e1/e2 completing it; `sums`
-// is sum_cloud(cloud, count).
-inline Status choose_frame(const CloudReader& cloud, size_t count, const CloudSums& sums,
-                           const Options& options, Frame& frame) {
+// The frame of the points summed in `sums`: centroid origin, axis from the options (an
+// explicit one: Axis::automatic is resolved before, see choose_axis), e1/e2 completing it.
+inline Status choose_frame(const CloudSums& sums, const Options& options, Frame& frame) {
     const size_t valid = sums.valid;
     const Vec3 sum = {sums.total[0], sums.total[1], sums.total[2]};
     const Vec3 small_sum = {sums.small_total[0], sums.small_total[1], sums.small_total[2]};
@@ -3047,18 +3046,6 @@ inline Status choose_frame(const CloudReader& cloud, size_t count, const CloudSu
         if (!is_finite(axis.x) || !is_finite(axis.y) || !is_finite(axis.z) || !normalize(axis))
             return Status::invalid_axis;
         break;
-    case Axis::automatic: {
-        double m[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-        for (size_t i = 0; i < count; ++i) {
-            if (!cloud.valid(i)) continue;
-            Vec3 d = frame.offset(cloud.point(i));
-            double c[3] = {d.x, d.y, d.z};
-            for (int r = 0; r < 3; ++r)
-                for (int s = 0; s < 3; ++s) m[r][s] += c[r] * c[s];
-        }
-        axis = principal_direction(m);
-        break;
-    }
     default: return Status::invalid_axis;
     }
     // e1: the coordinate axis least aligned with the stacking axis, made orthogonal.
@@ -7722,36 +7709,38 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options) {
     return point_count > SIZE_MAX / 2 ? 0 : 2 * point_count;
 }
 
-size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
-    if (point_count > detail::kMaxPoints - 1) return 0;
-    detail::Arena arena = detail::Arena::measuring();
+
+namespace detail {
+
+// The workspace bound of mesh_tube() (with read_cloud()) for point_count points.
+inline size_t tube_workspace_size(size_t point_count, const Options& options) {
+    if (point_count > kMaxPoints - 1) return 0;
+    Arena arena = Arena::measuring();
     // drop_outliers, as find_outliers allocates: the bitmap stays, the grid comes and goes
     // before the rest is allocated.
     size_t outlier_bytes = 0;
-    if (detail::kDropOutliers && (options.flags & drop_outliers)) {
-        detail::Arena grid = detail::Arena::measuring();
+    if (kDropOutliers && (options.flags & drop_outliers)) {
+        Arena grid = Arena::measuring();
         grid.alloc<unsigned char>(point_count / 8 + 1);
-        detail::allocate_cell_scratch(grid, point_count);
+        allocate_cell_scratch(grid, point_count);
         if (grid.failed) return 0;
         outlier_bytes = grid.required_bytes();
         arena.alloc<unsigned char>(point_count / 8 + 1);
     }
-    detail::ReconstructMemory m;
-    const size_t layer_limit = detail::planned_layer_limit(point_count, options);
-    detail::plan_reconstruct(m, point_count, layer_limit, arena);
-    size_t scratch = detail::reconstruct_scratch_size(point_count,
+    ReconstructMemory m;
+    const size_t layer_limit = planned_layer_limit(point_count, options);
+    plan_reconstruct(m, point_count, layer_limit, arena);
+    size_t scratch = reconstruct_scratch_size(point_count,
                                                       (options.flags & close_ends) != 0);
     // With a runner, the layers done ahead (at most one per kMinLayerPoints points, plus the
     // last) stay while the groups are formed.
     if (options.run_jobs &&
-        !detail::plan_parallel_workspace(point_count, layer_limit, arena, &scratch))
+        !plan_parallel_workspace(point_count, layer_limit, arena, &scratch))
         return 0;
     if (arena.failed || scratch == 0 || scratch > SIZE_MAX - arena.required_bytes()) return 0;
     const size_t bytes = arena.required_bytes() + scratch;
     return bytes > outlier_bytes ? bytes : outlier_bytes;
 }
-
-namespace detail {
 
 // The chain's counts into the report, with the reason when a valid point is not a vertex.
 inline void report_chain(const SurfaceChain& chain, size_t valid, Report& rep) {
@@ -7919,7 +7908,7 @@ inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& aren
                         uint32_t* triangles, size_t triangle_capacity, size_t* triangle_count,
                         Report& rep) {
     Frame frame;
-    Status status = choose_frame(in.reader, in.count, in.sums, options, frame);
+    Status status = choose_frame(in.sums, options, frame);
     if (status != Status::ok) return status;
     report_frame(frame, rep);
     if (in.sums.distinct < 3) {
@@ -7960,49 +7949,9 @@ inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& aren
     return Status::ok;
 }
 
-// reconstruct() of one tube; `rep` arrives zeroed but for its layer array.
-// Report::points.unused_count is left to the caller, who derives it so the counts add up on
-// every path.
-inline Status run_reconstruction(const Cloud& cloud, const Options& options, void* workspace,
-                                 size_t workspace_bytes, uint32_t* triangles,
-                                 size_t triangle_capacity, size_t* triangle_count,
-                                 Report& rep) {
-    Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
-                                                triangle_count, workspace, rep);
-    if (status != Status::ok) return status;
-    notify(options, Phase::validate, 0);
-    Arena arena = Arena::over(workspace, workspace_bytes);
-    TubeInput in;
-    status = read_cloud(cloud, options, arena, rep, in);
-    if (status == Status::ok)
-        status = mesh_tube(in, options, arena, triangles, triangle_capacity, triangle_count, rep);
-    rep.workspace_used_bytes = arena.peak_from_buffer();
-    return status;
-}
 
 }  // namespace detail
 
-Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
-                   size_t workspace_bytes, uint32_t* triangles, size_t triangle_capacity,
-                   size_t* triangle_count, Report* report) {
-    if (detail::reconstruct_buffers_overlap(cloud, workspace, workspace_bytes, triangles,
-                                            triangle_capacity, triangle_count, report))
-        return Status::invalid_argument;
-    Report local_report;
-    Report& rep = report ? *report : local_report;
-    LayerInfo* layers = report ? report->layers.info : nullptr;
-    size_t layer_capacity = layers ? report->layers.info_capacity : 0;
-    std::memset(&rep, 0, sizeof rep);
-    rep.layers.info = layers;
-    rep.layers.info_capacity = layer_capacity;
-    rep.points.in_count = cloud.count;
-    if (triangle_count) *triangle_count = 0;
-    Status status = detail::run_reconstruction(cloud, options, workspace, workspace_bytes,
-                                               triangles, triangle_capacity, triangle_count,
-                                               rep);
-    rep.points.unused_count = rep.points.in_count - rep.points.used_count - rep.points.duplicate_count - rep.points.rejected_count;
-    return status;
-}
 
 // >>stream ==================================================================================
 //
@@ -8187,7 +8136,7 @@ Status stream_open(const Options& options, void* workspace, size_t workspace_byt
     // The frame's axis is checked now, on no points.
     detail::Frame frame;
     detail::CloudReader none = {nullptr, 0, false, nullptr};
-    Status status = detail::choose_frame(none, 0, detail::sum_cloud(none, 0), options, frame);
+    Status status = detail::choose_frame(detail::sum_cloud(none, 0), options, frame);
     if (status != Status::ok) return status;
     detail::publish(*s);
     *stream = s;
@@ -8240,7 +8189,7 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     }
     detail::Frame frame = s.chain.frame;
     if (!s.has_frame) {
-        Status status = detail::choose_frame(reader, points.count, sums, s.options, frame);
+        Status status = detail::choose_frame(sums, s.options, frame);
         if (status != Status::ok) return status;
     }
     const double axis_origin = detail::dot(frame.origin, frame.axis);
@@ -8348,6 +8297,255 @@ Status stream_close(Stream* stream) {
     return status;
 }
 
+// >>axis ====================================================================================
+//
+// The automatic axis. The method needs the direction along which the cloud's sections are
+// loops around one centre line, and the direction of largest variance is often another: a
+// head is longest from front to back, a squat bone across. So each candidate, the three
+// principal directions of the cloud and then x, y and z (skipping any within about ten
+// degrees of one before it), meshes a sample of the cloud as one tube, and the candidate
+// whose sample surface is smallest wins: where the layers cannot follow the surface they
+// fold and bridge gaps with webs, and both add area. The sample is every k-th kept point
+// in input order, so the choice is deterministic.
+
+namespace detail {
+
+// Points meshed per candidate: enough to see an object's limbs and ends, few enough that
+// six candidates cost a small part of a large run.
+const size_t kAxisSample = 512;
+// A candidate whose direction is within about 10 degrees of an earlier one is not tried.
+const double kSameAxisCosine = 0.985;
+const uint32_t kMostAxisCandidates = 6;
+
+inline size_t axis_sample_size(size_t valid) { return valid < kAxisSample ? valid : kAxisSample; }
+
+// The three principal directions of a symmetric 3x3 matrix, largest variance first: power
+// iteration, then again on the matrix without the first direction's share.
+inline void principal_directions(const double m[3][3], Vec3 out[3]) {
+    out[0] = principal_direction(m);
+    const Vec3 v = out[0];
+    const double mv[3] = {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z,
+                          m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
+                          m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
+    const double lambda = mv[0] * v.x + mv[1] * v.y + mv[2] * v.z;
+    const double c[3] = {v.x, v.y, v.z};
+    double rest[3][3];
+    for (int r = 0; r < 3; ++r)
+        for (int s = 0; s < 3; ++s) rest[r][s] = m[r][s] - lambda * c[r] * c[s];
+    Vec3 second = principal_direction(rest);
+    second = second - scaled(v, dot(second, v));
+    if (!normalize(second)) {
+        // Any direction across the first.
+        second = abs_value(v.x) < 0.5 ? cross(v, Vec3{1, 0, 0}) : cross(v, Vec3{0, 1, 0});
+        normalize(second);
+    }
+    out[1] = second;
+    out[2] = cross(v, second);
+}
+
+// The candidates for the axis of a sample of `count` points, packed.
+inline uint32_t axis_candidates(const double* xyz, size_t count, Vec3* out) {
+    Vec3 mean = {0, 0, 0};
+    for (size_t i = 0; i < count; ++i)
+        mean = Vec3{mean.x + xyz[3 * i], mean.y + xyz[3 * i + 1], mean.z + xyz[3 * i + 2]};
+    mean = scaled(mean, 1.0 / static_cast<double>(count));
+    double m[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    for (size_t i = 0; i < count; ++i) {
+        const double d[3] = {xyz[3 * i] - mean.x, xyz[3 * i + 1] - mean.y, xyz[3 * i + 2] - mean.z};
+        for (int r = 0; r < 3; ++r)
+            for (int s = 0; s < 3; ++s) m[r][s] += d[r] * d[s];
+    }
+    Vec3 all[6];
+    principal_directions(m, all);
+    all[3] = Vec3{1, 0, 0};
+    all[4] = Vec3{0, 1, 0};
+    all[5] = Vec3{0, 0, 1};
+    uint32_t kept = 0;
+    for (const Vec3& a : all) {
+        bool repeat = false;
+        for (uint32_t k = 0; k < kept; ++k) repeat = repeat || abs_value(dot(a, out[k])) > kSameAxisCosine;
+        if (!repeat) out[kept++] = a;
+    }
+    return kept;
+}
+
+// What a candidate's sample surface measures: its area, plus the area of a triangle per
+// sample point left out (a layer that cannot follow the surface drops points instead of
+// folding).
+inline double sample_surface(const double* xyz, const uint32_t* tri, size_t count,
+                             size_t unused) {
+    double area = 0;
+    for (size_t t = 0; t < count; ++t) {
+        const double* a = xyz + 3 * tri[3 * t];
+        const double* b = xyz + 3 * tri[3 * t + 1];
+        const double* c = xyz + 3 * tri[3 * t + 2];
+        const Vec3 n = cross(Vec3{b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                             Vec3{c[0] - a[0], c[1] - a[1], c[2] - a[2]});
+        area += std::sqrt(dot(n, n)) / 2;
+    }
+    const double per_triangle = count > 0 ? area / static_cast<double>(count) : 0;
+    return area + 2 * per_triangle * static_cast<double>(unused);
+}
+
+// Workspace for choose_axis() on a cloud of `valid` kept points, given the flags.
+inline size_t axis_workspace_size(size_t valid, const Options& options);
+
+// Meshes the sample along one candidate; DBL_MAX if it cannot.
+inline double try_axis(const double* sample, size_t count, Vec3 axis, const Options& options,
+                       Arena& arena) {
+    Options trial = {};
+    trial.axis = Axis::direction;
+    trial.direction[0] = axis.x;
+    trial.direction[1] = axis.y;
+    trial.direction[2] = axis.z;
+    trial.flags = options.flags & open_ends;
+    trial.layer_count = 1;
+    const size_t mark = arena.mark();
+    uint32_t* tri = arena.alloc<uint32_t>(6 * count);
+    if (arena.failed) return DBL_MAX;
+    const Cloud cloud = {sample, count, 0, Scalar::float64};
+    TubeInput in = {reader_of(cloud), count, {}};
+    in.sums = sum_cloud(in.reader, count);
+    Report rep = {};
+    size_t triangles = 0;
+    const Status status = mesh_tube(in, trial, arena, tri, 2 * count, &triangles, rep);
+    arena.rewind(mark);
+    if (status != Status::ok) return DBL_MAX;
+    return sample_surface(sample, tri, triangles, in.sums.valid - rep.points.used_count -
+                                                      rep.points.duplicate_count);
+}
+
+// The axis for Axis::automatic: the candidate whose sample surface is smallest (see above).
+// False if the workspace is too small.
+inline bool choose_axis(const TubeInput& in, const Options& options, Arena& arena, Vec3& axis) {
+    const size_t count = axis_sample_size(in.sums.valid);
+    const size_t mark = arena.mark();
+    double* sample = arena.alloc<double>(3 * count);
+    if (arena.failed) return false;
+    const size_t step = in.sums.valid / count;
+    size_t taken = 0;
+    for (size_t i = 0, seen = 0; i < in.count && taken < count; ++i) {
+        if (!in.reader.valid(i)) continue;
+        if (seen++ % step != 0) continue;
+        const Vec3 p = in.reader.point(i);
+        sample[3 * taken] = p.x;
+        sample[3 * taken + 1] = p.y;
+        sample[3 * taken + 2] = p.z;
+        ++taken;
+    }
+    Vec3 candidates[kMostAxisCandidates];
+    const uint32_t tries = axis_candidates(sample, taken, candidates);
+    axis = candidates[0];
+    double best = DBL_MAX;
+    for (uint32_t k = 0; k < tries; ++k) {
+        const double score = try_axis(sample, taken, candidates[k], options, arena);
+        if (arena.failed) return false;
+        if (score < best) {
+            best = score;
+            axis = candidates[k];
+        }
+    }
+    arena.rewind(mark);
+    return true;
+}
+
+inline size_t axis_workspace_size(size_t valid, const Options& options) {
+    const size_t count = axis_sample_size(valid);
+    Options trial = {};
+    trial.flags = options.flags & open_ends;
+    trial.layer_count = 1;
+    const size_t tube = tube_workspace_size(count, trial);
+    if (tube == 0) return 0;
+    Arena arena = Arena::measuring();
+    arena.alloc<double>(3 * count);
+    arena.alloc<uint32_t>(6 * count);
+    return arena.failed ? 0 : arena.required_bytes() + tube;
+}
+
+}  // namespace detail
+
+namespace detail {
+
+// The options along the axis to use: Axis::automatic resolved by choose_axis().
+inline Status resolve_axis(const TubeInput& in, const Options& options, Arena& arena,
+                           Options& along, Report& rep) {
+    along = options;
+    if (options.axis != Axis::automatic) return Status::ok;
+    if (in.sums.distinct < 3) {  // no surface along any axis: mesh_tube says so
+        along.axis = Axis::z;
+        return Status::ok;
+    }
+    Vec3 axis;
+    if (!choose_axis(in, options, arena, axis)) {
+        rep.detail = "the workspace is smaller than reconstruct_workspace_size()";
+        return Status::out_of_memory;
+    }
+    along.axis = Axis::direction;
+    along.direction[0] = axis.x;
+    along.direction[1] = axis.y;
+    along.direction[2] = axis.z;
+    return Status::ok;
+}
+
+// reconstruct() of one tube; `rep` arrives zeroed but for its layer array.
+// Report::points.unused_count is left to the caller, who derives it so the counts add up on
+// every path.
+inline Status run_reconstruction(const Cloud& cloud, const Options& options, void* workspace,
+                                 size_t workspace_bytes, uint32_t* triangles,
+                                 size_t triangle_capacity, size_t* triangle_count,
+                                 Report& rep) {
+    Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
+                                                triangle_count, workspace, rep);
+    if (status != Status::ok) return status;
+    notify(options, Phase::validate, 0);
+    Arena arena = Arena::over(workspace, workspace_bytes);
+    TubeInput in;
+    Options along;
+    status = read_cloud(cloud, options, arena, rep, in);
+    if (status == Status::ok) status = resolve_axis(in, options, arena, along, rep);
+    if (status == Status::ok)
+        status = mesh_tube(in, along, arena, triangles, triangle_capacity, triangle_count, rep);
+    rep.workspace_used_bytes = arena.peak_from_buffer();
+    return status;
+}
+
+}  // namespace detail
+
+size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
+    const size_t tube = detail::tube_workspace_size(point_count, options);
+    if (tube == 0 || options.axis != Axis::automatic) return tube;
+    // The axis is chosen once the outliers are known, before the tube is planned.
+    detail::Arena arena = detail::Arena::measuring();
+    if (detail::kDropOutliers && (options.flags & drop_outliers))
+        arena.alloc<unsigned char>(point_count / 8 + 1);
+    const size_t axis = detail::axis_workspace_size(point_count, options);
+    if (axis == 0 || axis > SIZE_MAX - arena.required_bytes()) return 0;
+    const size_t choosing = arena.required_bytes() + axis;
+    return choosing > tube ? choosing : tube;
+}
+
+Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
+                   size_t workspace_bytes, uint32_t* triangles, size_t triangle_capacity,
+                   size_t* triangle_count, Report* report) {
+    if (detail::reconstruct_buffers_overlap(cloud, workspace, workspace_bytes, triangles,
+                                            triangle_capacity, triangle_count, report))
+        return Status::invalid_argument;
+    Report local_report;
+    Report& rep = report ? *report : local_report;
+    LayerInfo* layers = report ? report->layers.info : nullptr;
+    size_t layer_capacity = layers ? report->layers.info_capacity : 0;
+    std::memset(&rep, 0, sizeof rep);
+    rep.layers.info = layers;
+    rep.layers.info_capacity = layer_capacity;
+    rep.points.in_count = cloud.count;
+    if (triangle_count) *triangle_count = 0;
+    Status status = detail::run_reconstruction(cloud, options, workspace, workspace_bytes,
+                                               triangles, triangle_capacity, triangle_count,
+                                               rep);
+    rep.points.unused_count = rep.points.in_count - rep.points.used_count - rep.points.duplicate_count - rep.points.rejected_count;
+    return status;
+}
+
 #if !defined(STRATMESH_SMALL_CODE)
 // >>cap ends ================================================================================
 //
@@ -8361,7 +8559,10 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count) {
     detail::CapLoop loop;
     detail::allocate_cap_graph(graph, point_count, triangle_count, arena);
     detail::allocate_cap_loop(loop, point_count, arena);  // every point on a loop at most
-    return arena.failed ? 0 : arena.required_bytes();
+    // Axis::automatic is resolved first, as reconstruct() resolves it.
+    const size_t axis = detail::axis_workspace_size(point_count, Options{});
+    if (arena.failed || axis == 0) return 0;
+    return arena.required_bytes() > axis ? arena.required_bytes() : axis;
 }
 
 Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
@@ -8404,8 +8605,12 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
             checks.detail = "a triangle names a point outside the cloud, or an invalid one";
             return finish(Status::invalid_argument);
         }
+    detail::TubeInput in = {reader, cloud.count, sums};
+    Options along;
+    status = detail::resolve_axis(in, options, arena, along, checks);
+    if (status != Status::ok) return finish(status);
     detail::Frame frame;
-    status = detail::choose_frame(reader, cloud.count, sums, options, frame);
+    status = detail::choose_frame(sums, along, frame);
     if (status != Status::ok) return finish(status);
     status = detail::cap_boundary_loops(triangles, count, triangle_capacity, reader,
                                         cloud.count, frame, arena, caps, &needed);
@@ -8831,6 +9036,9 @@ size_t find_parting_workspace_size(size_t point_count, const Options& options) {
     detail::allocate_cell_scratch(arena, point_count);  // the outliers' and the scale's grid
     arena.alloc<detail::GridItem>(2 * detail::kDecileSample);
     arena.rewind(mark);
+    // Axis::automatic is resolved first, as reconstruct() resolves it.
+    arena.alloc<unsigned char>(detail::axis_workspace_size(point_count, options));
+    arena.rewind(mark);
     detail::PartingMemory m;
     detail::allocate_parting(m, point_count, arena);
     return arena.failed ? 0 : arena.required_bytes();
@@ -8867,8 +9075,12 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
         if (!find_outliers(reader, cloud.count, arena, rep)) return finish(out_of_workspace(rep));
         sums = sum_cloud(reader, cloud.count);
     }
+    const TubeInput in = {reader, cloud.count, sums};
+    Options along;
+    status = resolve_axis(in, options, arena, along, rep);
+    if (status != Status::ok) return finish(status);
     Frame frame;
-    status = choose_frame(reader, cloud.count, sums, options, frame);
+    status = choose_frame(sums, along, frame);
     if (status != Status::ok) return finish(status);
     parting->axis[0] = frame.axis.x;
     parting->axis[1] = frame.axis.y;
@@ -9551,7 +9763,7 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
     along.flags &= ~static_cast<uint32_t>(origin_given);
     for (int k = 0; k < 3; ++k) along.direction[k] = parting.axis[k];
     Frame frame;
-    status = choose_frame(reader, cloud.count, sums, along, frame);
+    status = choose_frame(sums, along, frame);
     if (status != Status::ok) return finish(status);
     const uint32_t sides[2] = {parting.above_branch_count < kMaxBranches ? parting.above_branch_count : kMaxBranches,
                                parting.below_branch_count < kMaxBranches ? parting.below_branch_count : kMaxBranches};

@@ -53,7 +53,7 @@ TEST_CASE("internals: the height range from a coordinate axis's extremes equals 
             }
             stratmesh::detail::Frame frame;
             const stratmesh::detail::CloudSums sums = stratmesh::detail::sum_cloud(reader, count);
-            REQUIRE(stratmesh::detail::choose_frame(reader, count, sums, options, frame) == Status::ok);
+            REQUIRE(stratmesh::detail::choose_frame(sums, options, frame) == Status::ok);
             double lo = DBL_MAX, hi = -DBL_MAX, pass_lo = DBL_MAX, pass_hi = -DBL_MAX;
             stratmesh::detail::height_range(reader, count, frame, &pass_lo, &pass_hi);
             INFO("trial " << trial << ", offset " << offset << ", size " << size);

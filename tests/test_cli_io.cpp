@@ -333,7 +333,7 @@ TEST_CASE("a vertex count of 4000000000 is caught before any allocation") {
     std::string lie = std::string("element vertex 4000000000\n") + kXyz;
     check_fails(little_ply_header(lie) + std::string(36, '\0'), {"declares 4000000000"});
     check_fails("ply\nformat ascii 1.0\n" + lie + "end_header\n1 2 3\n",
-                {"line 8", "ends inside element 'vertex' record 1 of 4000000000"});
+                {"line 8", "ends before element 'vertex' record 1 of 4000000000"});
 }
 
 TEST_CASE("element counts that overflow") {
@@ -373,7 +373,7 @@ TEST_CASE("a file that is only a header") {
     check_fails(little_ply_header(std::string("element vertex 3\n") + kXyz),
                 {"byte", "declares 3 records"});
     check_fails("ply\nformat ascii 1.0\nelement vertex 3\n" + std::string(kXyz) + "end_header\n",
-                {"ends inside element 'vertex' record 0 of 3"});
+                {"line 7", "ends before element 'vertex' record 0 of 3"});
 }
 
 TEST_CASE("garbage in text files names the line") {
@@ -598,7 +598,7 @@ TEST_CASE("point by point reading: what it cannot read, and errors that name the
         {"mesh.off", "OFF\n3 1 0\n1 2 3\n4 5 6\n7 8 9\n3 0 1 2\n", "OFF files cannot be read"},
         {"bad.xyz", "1 2 3\n4 5 6\n7 eight 9\n", "line 3: 'eight' is not a number"},
         {"ascii_short.ply", ascii.substr(0, ascii.size() - 30),
-         "the file ends inside element 'vertex' record 9 of 10"},
+         "the line ends before property 'z' of element 'vertex' record 9 of 10"},
         {"empty.xyz", "", "the file is empty"}};
     for (const auto& c : cases) {
         std::string name = c.name;

@@ -392,6 +392,10 @@ CommandAction parse_command_line(int argc, const char* const* argv, CommandLine&
     return Parser(argc, argv, line).run(error);
 }
 
+std::vector<NamedFile> named_files(const CommandLine& line) {
+    return {{"the input", line.input}, {"-o", line.output}, {"--report", line.report}};
+}
+
 const char* usage_text() { return kUsage; }
 
 const char* axis_name(stratmesh::Axis axis) {

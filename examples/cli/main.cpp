@@ -10,6 +10,7 @@
 #include "peak_memory.h"
 #include "progress.h"
 #include "report_json.h"
+#include "safe_output.h"
 #include "stratmesh.h"
 #include "stream_run.h"
 #include "summary.h"
@@ -135,6 +136,7 @@ bool read_input(const CommandLine& line, std::vector<double>& xyz, RunRecord& re
     record.read_seconds = seconds_since(start);
     record.input_format = cloud_format_name(info.format);
     record.input_encoding = info.encoding;
+    record.input_faces_ignored = info.faces_ignored;
     CloudFormat named = cloud_format_from_extension(line.input);
     if (!line.quiet && named != CloudFormat::automatic && named != info.format)
         std::fprintf(stderr, "stratmesh: note: %s holds %s, not %s; read as %s\n",
@@ -498,14 +500,23 @@ bool write_output(const CommandLine& line, const std::vector<double>& xyz,
     return true;
 }
 
+// The input's faces, which the cloud leaves out.
+void warn_faces_ignored(const CommandLine& line, const RunRecord& record) {
+    if (line.quiet || record.input_faces_ignored == 0) return;
+    std::fprintf(stderr, "stratmesh: warning: %llu faces in %s ignored\n",
+                 static_cast<unsigned long long>(record.input_faces_ignored), line.input.c_str());
+}
+
 // Prints the summary and writes the report of a run whose mesh is written.
 int finish_run(const CommandLine& line, RunRecord& record) {
     record.peak_rss_bytes = peak_resident_bytes();
+    warn_faces_ignored(line, record);
     if (!line.quiet) print_summary(stderr, record);
     return write_report(line, record) ? kExitOk : kExitFile;
 }
 
 int refuse(const CommandLine& line, RunRecord& record) {
+    warn_faces_ignored(line, record);
     explain_refusal(line, record);
     record.peak_rss_bytes = peak_resident_bytes();
     write_report(line, record);
@@ -530,6 +541,11 @@ int run_streamed(const CommandLine& line, RunRecord& record) {
 }
 
 int run(const CommandLine& line) {
+    std::string clash;
+    if (!check_distinct_files(named_files(line), clash)) {
+        std::fprintf(stderr, "stratmesh: %s\n", clash.c_str());
+        return kExitUsage;
+    }
     RunRecord record;
     record_command_line(line, record);
     if (line.stream) return run_streamed(line, record);
@@ -566,6 +582,7 @@ int run(const CommandLine& line) {
 } // namespace
 
 int main(int argc, char** argv) {
+    install_output_signal_handlers();
     CommandLine line;
     std::string error;
     switch (parse_command_line(argc, argv, line, error)) {

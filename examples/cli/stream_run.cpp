@@ -118,6 +118,7 @@ private:
             layer_.insert(layer_.end(), point, point + 3);
             ++points_read_;
         }
+        record_.input_faces_ignored = reader.faces_ignored();
         if (error.empty()) return StreamOutcome::done;
         error = line_.input + ": " + error;
         return StreamOutcome::file_error;

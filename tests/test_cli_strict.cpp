@@ -1,0 +1,209 @@
+// Tests of the tool's guarantees about files: output that never destroys data
+// (safe_output.h), readers that refuse a body disagreeing with its header and say where
+// (cloud_io.h), and a round trip through every input format and encoding the tool reads.
+#include <doctest/doctest.h>
+
+#include "args.h"
+#include "cloud_io.h"
+#include "safe_output.h"
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace stratmesh_cli;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct ScratchDir {
+    fs::path path;
+    ScratchDir() {
+        path = fs::temp_directory_path() /
+               ("stratmesh_cli_strict_" + std::to_string(std::random_device{}()) + "_" +
+                std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
+        fs::create_directories(path);
+    }
+    ~ScratchDir() {
+        std::error_code ignored;
+        fs::remove_all(path, ignored);
+    }
+    std::string file(const std::string& name) const { return (path / name).string(); }
+    size_t entries() const {
+        return static_cast<size_t>(
+            std::distance(fs::directory_iterator(path), fs::directory_iterator()));
+    }
+};
+
+void save(const std::string& path, const std::string& bytes) {
+    std::ofstream out(path, std::ios::binary);
+    out << bytes;
+}
+
+std::string load(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+bool contains(const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+}
+
+} // namespace
+
+// ==== output that never destroys data =====================================================
+
+TEST_CASE("two names of one file are refused, through symlinks and hard links") {
+    ScratchDir dir;
+    save(dir.file("scan.ply"), "points");
+    fs::create_symlink("scan.ply", dir.file("link.ply"));
+    fs::create_hard_link(dir.file("scan.ply"), dir.file("hard.ply"));
+    fs::create_directory(dir.file("sub"));
+    const std::string scan = dir.file("scan.ply");
+    const std::string around = dir.file("sub/../scan.ply");
+    const struct {
+        std::vector<NamedFile> files;
+        const char* message; // empty: distinct
+    } cases[] = {
+        {{{"the input", scan}, {"-o", scan}}, "-o '"},
+        {{{"the input", scan}, {"-o", dir.file("link.ply")}}, "-o '"},
+        {{{"the input", scan}, {"-o", dir.file("hard.ply")}}, "-o '"},
+        {{{"the input", scan}, {"-o", around}}, "-o '"},
+        {{{"the input", scan}, {"-o", dir.file("m.ply")}, {"--report", scan}}, "--report '"},
+        {{{"the input", scan}, {"-o", dir.file("m.ply")}, {"--report", dir.file("m.ply")}},
+         "is the same file as -o"},
+        // Neither exists yet: the same directory and name.
+        {{{"the input", scan}, {"-o", dir.file("new.ply")}, {"--report", dir.file("sub/../new.ply")}},
+         "is the same file as -o"},
+        {{{"the input", scan}, {"-o", dir.file("m.ply")}, {"--report", dir.file("r.json")}}, ""},
+        {{{"the input", scan}, {"-o", dir.file("m.ply")}, {"--report", ""}}, ""},
+        {{{"the input", scan}, {"-o", dir.file("sub/scan.ply")}}, ""},
+    };
+    for (const auto& c : cases) {
+        std::string error;
+        const bool distinct = check_distinct_files(c.files, error);
+        CAPTURE(error);
+        CHECK(distinct == (c.message[0] == 0));
+        if (!distinct) {
+            CHECK(contains(error, c.message));
+            CHECK(contains(error, "another path"));
+        }
+    }
+}
+
+TEST_CASE("the command line's files are the input, -o and --report") {
+    CommandLine line;
+    std::string error;
+    const char* argv[] = {"stratmesh", "in.ply", "-o", "out.ply", "--report", "r.json"};
+    REQUIRE(parse_command_line(6, argv, line, error) == CommandAction::run);
+    std::vector<NamedFile> files = named_files(line);
+    REQUIRE(files.size() == 3);
+    CHECK(files[0].path == "in.ply");
+    CHECK(files[1].option == "-o");
+    CHECK(files[2].path == "r.json");
+}
+
+TEST_CASE("an atomic file appears only when committed, keeping the old one until then") {
+    ScratchDir dir;
+    const std::string path = dir.file("m.ply");
+    save(path, "old");
+    fs::permissions(path, fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+    {
+        AtomicFile file;
+        std::string error;
+        REQUIRE(file.open(path, error));
+        std::fputs("new", file.file());
+        std::fflush(file.file());
+        CHECK(load(path) == "old");
+        CHECK(dir.entries() == 2);
+        REQUIRE(file.commit(0, error));
+    }
+    CHECK(load(path) == "new");
+    CHECK(dir.entries() == 1);
+    CHECK((fs::status(path).permissions() & fs::perms::all) ==
+          (fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read));
+}
+
+TEST_CASE("a failed write leaves the old file and no temporary") {
+    ScratchDir dir;
+    const std::string path = dir.file("m.ply");
+    save(path, "old");
+    SUBCASE("a write that failed (the disk full)") {
+        AtomicFile file;
+        std::string error;
+        REQUIRE(file.open(path, error));
+        std::fputs("partial", file.file());
+        CHECK_FALSE(file.commit(ENOSPC, error));
+        CHECK(error == path + ": cannot write: " + std::strerror(ENOSPC));
+    }
+    SUBCASE("abandoned (an error elsewhere)") {
+        AtomicFile file;
+        std::string error;
+        REQUIRE(file.open(path, error));
+        std::fputs("partial", file.file());
+    }
+    CHECK(load(path) == "old");
+    CHECK(dir.entries() == 1);
+}
+
+TEST_CASE("a symlinked destination is replaced at its target; a device is written directly") {
+    ScratchDir dir;
+    save(dir.file("real.ply"), "old");
+    fs::create_symlink("real.ply", dir.file("link.ply"));
+    AtomicFile file;
+    std::string error;
+    REQUIRE(file.open(dir.file("link.ply"), error));
+    std::fputs("new", file.file());
+    REQUIRE(file.commit(0, error));
+    CHECK(fs::is_symlink(dir.file("link.ply")));
+    CHECK(load(dir.file("real.ply")) == "new");
+    CHECK(dir.entries() == 2);
+#ifndef _WIN32
+    if (fs::exists("/dev/full")) {
+        AtomicFile full;
+        REQUIRE(full.open("/dev/full", error));
+        std::fputs("anything", full.file());
+        CHECK_FALSE(full.commit(0, error));
+        CHECK(contains(error, "/dev/full: cannot write"));
+        CHECK(fs::is_character_file("/dev/full"));
+    }
+#endif
+}
+
+TEST_CASE("a destination that cannot be created says so") {
+    ScratchDir dir;
+    AtomicFile file;
+    std::string error;
+    CHECK_FALSE(file.open(dir.file("no/such/dir/m.ply"), error));
+    CHECK(contains(error, "no/such/dir/m.ply: cannot create"));
+    CHECK_FALSE(file.open(dir.path.string(), error));
+    CHECK(contains(error, "cannot create"));
+    CHECK(dir.entries() == 0);
+}
+
+TEST_CASE("a scratch file beside the destination leaves no name behind") {
+    ScratchDir dir;
+    std::string error;
+    std::FILE* scratch = scratch_file_beside(dir.file("m.ply"), error);
+    REQUIRE(scratch);
+    CHECK(std::fputs("body", scratch) >= 0);
+    std::rewind(scratch);
+    char back[5] = {};
+    CHECK(std::fread(back, 1, 4, scratch) == 4);
+    CHECK(std::string(back) == "body");
+#ifndef _WIN32
+    CHECK(dir.entries() == 0);
+#endif
+    std::fclose(scratch);
+    CHECK(dir.entries() == 0);
+}

@@ -847,7 +847,8 @@ TEST_CASE("command line: every option") {
     CHECK(line.input == "in.xyz");
     CHECK(line.output == "out.stl");
     CHECK(line.axis == stratmesh::Axis::direction);
-    CHECK(line.direction[1] == -2);
+    // Normalised by the parser: (1, -2, 0.5) / sqrt(5.25).
+    CHECK(line.direction[1] == doctest::Approx(-2 / std::sqrt(5.25)).epsilon(1e-15));
     CHECK(line.cuts == std::vector<double>{3, -1.5, 100});
     CHECK(line.report == "r.json");
     CHECK((line.ascii && line.skip_invalid && line.quiet));

@@ -6,6 +6,7 @@
 // unchanged. See mesh_io.h.
 #include "args.h"
 #include "cloud_io.h"
+#include "frame_check.h"
 #include "mesh_io.h"
 #include "peak_memory.h"
 #include "progress.h"
@@ -143,6 +144,16 @@ bool read_input(const CommandLine& line, std::vector<double>& xyz, RunRecord& re
                      line.input.c_str(), cloud_format_name(info.format), cloud_format_name(named),
                      cloud_format_name(info.format));
     return true;
+}
+
+// False, with the message printed, if --origin is too far from the cloud for any frame.
+bool origin_in_reach(const CommandLine& line, const std::vector<double>& xyz) {
+    CloudBox box;
+    box.add(xyz.data(), xyz.size() / 3);
+    std::string error;
+    if (box.origin_in_reach(line.origin, error)) return true;
+    std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
+    return false;
 }
 
 // What reconstruct() produced: triangles indexing the input points.
@@ -469,11 +480,14 @@ void explain_refusal(const CommandLine& line, const RunRecord& record) {
                      "stratmesh: point %zu (counting from 0) has a NaN or infinite coordinate; "
                      "--skip-invalid skips such points\n",
                      record.report.first_invalid_point);
-    if (record.report.detail) std::fprintf(stderr, "stratmesh: %s\n", record.report.detail);
-    if (record.stream && record.status == stratmesh::Status::out_of_memory)
+    // Where the tool gives its own advice (--skip-invalid, the stream's budget, which are
+    // its options), the library's, in the library's terms, is left out.
+    const bool budget = record.stream && record.status == stratmesh::Status::out_of_memory;
+    if (record.report.detail && !budget && record.status != stratmesh::Status::invalid_point)
+        std::fprintf(stderr, "stratmesh: %s\n", record.report.detail);
+    if (budget)
         std::fprintf(stderr,
-                     "stratmesh: --stream-points %llu is too few for these layers: raise it or "
-                     "cut thinner layers\n",
+                     "stratmesh: --stream-points %llu is too few for these layers: raise it\n",
                      static_cast<unsigned long long>(record.stream_points));
 }
 
@@ -532,6 +546,9 @@ int run_streamed(const CommandLine& line, RunRecord& record) {
     case StreamOutcome::done: return finish_run(line, record);
     case StreamOutcome::refused: return refuse(line, record);
     case StreamOutcome::file_error: break;
+    case StreamOutcome::usage:
+        std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
+        return kExitUsage;
     case StreamOutcome::unsorted:
         std::fprintf(stderr, "stratmesh: %s: %s\n", line.input.c_str(), error.c_str());
         return kExitUnsorted;
@@ -552,6 +569,7 @@ int run(const CommandLine& line) {
     std::vector<double> xyz;
     Reconstruction result;
     if (!read_input(line, xyz, record)) return kExitFile;
+    if (line.origin_given && !origin_in_reach(line, xyz)) return kExitUsage;
     std::vector<uint8_t> labels;
     const bool automatic = !line.one_tube && !line.find_branches && !line.split_branches;
     if ((automatic || line.find_branches || line.split_branches) &&

@@ -12,7 +12,9 @@
 #include "cli/mini_json.h"
 #include "cli/mini_mesh.h"
 
+#include <cctype>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -401,16 +403,55 @@ TEST_CASE("empty and pointless files") {
     CHECK(contains(forced.error, "no 'v' line"));
 }
 
+// The number after "byte " in a message, or SIZE_MAX if there is none.
+size_t byte_named(const std::string& error) {
+    size_t at = error.find("byte ");
+    return at == std::string::npos ? SIZE_MAX : std::stoul(error.substr(at + 5));
+}
+
+bool names_line(const std::string& error) {
+    size_t at = error.find("line ");
+    return at != std::string::npos && at + 5 < error.size() && std::isdigit(error[at + 5]);
+}
+
 TEST_CASE("every truncation and many corruptions of valid files fail cleanly") {
     // Under the sanitizers this is a small deterministic fuzz run of all the readers.
     std::vector<double> xyz = test_points(6);
-    std::vector<std::string> files = {
-        busy_binary_ply(xyz, false),   double_binary_ply(xyz, true),
-        ascii_ply(xyz, "\n"),          "OFF\n3 1 0\n1 2 3\n4 5 6\n7 8 9\n3 0 1 2\n",
-        "v 1 2 3\nv 4 5 6\nf 1 2 3\n", "3\n1 2 3\n4 5 6\n7 8 9\n"};
+    struct File {
+        std::string bytes;
+        size_t points;  // what the whole file holds
+        bool binary;    // a PLY binary body: any truncation is an error at a byte offset
+        bool counted;   // a header counts the points: a truncation never gives fewer
+    };
+    const File files[] = {
+        {busy_binary_ply(xyz, false), 6, true, true},
+        {double_binary_ply(xyz, true), 6, true, true},
+        {ascii_ply(xyz, "\n"), 6, false, true},
+        {"OFF\n3 1 0\n1 2 3\n4 5 6\n7 8 9\n3 0 1 2\n", 3, false, true},
+        {"v 1 2 3\nv 4 5 6\nf 1 2 3\n", 2, false, false},
+        {"3\n1 2 3\n4 5 6\n7 8 9\n", 3, false, true}};
     std::mt19937 random(12345);
-    for (const std::string& file : files) {
-        for (size_t length = 0; length <= file.size(); ++length) read_text(file.substr(0, length));
+    for (const File& f : files) {
+        const std::string& file = f.bytes;
+        for (size_t length = 0; length < file.size(); ++length) {
+            CAPTURE(length);
+            ReadResult r = read_text(file.substr(0, length));
+            if (f.binary) {
+                // Ends before the body's last byte: an error, at a byte within what is
+                // there (or at a line of the header).
+                REQUIRE_FALSE(r.ok);
+                CHECK((byte_named(r.error) <= length || names_line(r.error) || length == 0));
+            } else if (r.ok) {
+                CHECK(r.xyz.size() / 3 <= f.points);
+                if (f.counted) CHECK(r.xyz.size() / 3 == f.points);
+            } else {
+                CHECK((names_line(r.error) || length == 0 ||
+                       contains(r.error, "no points found") || contains(r.error, "no vertices found")));
+            }
+        }
+        ReadResult whole = read_text(file);
+        REQUIRE_MESSAGE(whole.ok, whole.error);
+        CHECK(whole.xyz.size() / 3 == f.points);
         for (int round = 0; round < 300; ++round) {
             std::string bent = file;
             bent[random() % bent.size()] = static_cast<char>(random() & 0xff);

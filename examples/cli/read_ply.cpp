@@ -285,7 +285,7 @@ bool parse_header(std::string_view data, PlyHeader& header, std::string& error) 
             return false;
         }
     }
-    error = "the header never ends (no 'end_header' line)";
+    error = at_line(lines.line_number()) + "the header never ends (no 'end_header' line)";
     return false;
 }
 
@@ -835,7 +835,10 @@ std::unique_ptr<PointReader> open_ply_points(std::unique_ptr<FileWindow> file, s
     PlyHeader header;
     VertexLayout layout;
     if (!parse_header(file->peek(kMaxHeader), header, error)) return nullptr;
-    if (!find_vertex_layout(header, layout, error)) return nullptr;
+    if (!find_vertex_layout(header, layout, error)) {
+        error = at_line(header.data_line - 1) + error;
+        return nullptr;
+    }
     const PlyElement& vertex = header.elements[layout.element];
     if (header.encoding != PlyEncoding::ascii && fixed_record_size(vertex) == 0) {
         error = "the vertex element has list properties: a binary PLY file with them cannot "
@@ -858,7 +861,10 @@ bool read_ply(std::string_view data, std::vector<double>& xyz, std::string& erro
     PlyHeader header;
     VertexLayout layout;
     if (!parse_header(data, header, error)) return false;
-    if (!find_vertex_layout(header, layout, error)) return false;
+    if (!find_vertex_layout(header, layout, error)) {
+        error = at_line(header.data_line - 1) + error;
+        return false;
+    }
     encoding = encoding_name(header.encoding);
     faces = face_count(header);
     xyz.clear();

@@ -440,7 +440,9 @@ TEST_CASE("every truncation and many corruptions of valid files fail cleanly") {
                 // Ends before the body's last byte: an error, at a byte within what is
                 // there (or at a line of the header).
                 REQUIRE_FALSE(r.ok);
-                CHECK((byte_named(r.error) <= length || names_line(r.error) || length == 0));
+                // (The first bytes, "ply" without its line end, are no PLY file yet.)
+                CHECK((byte_named(r.error) <= length || names_line(r.error) || length == 0 ||
+                       contains(r.error, "no points found")));
             } else if (r.ok) {
                 CHECK(r.xyz.size() / 3 <= f.points);
                 if (f.counted) CHECK(r.xyz.size() / 3 == f.points);

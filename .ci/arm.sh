@@ -38,6 +38,11 @@ aarch64-linux-gnu-g++ -std=c++17 -O2 "${warn[@]}" -Wno-psabi -static -I. -Itests
 # also shows that leaving out the faster paths changes no byte.
 arm-linux-gnueabihf-g++ -std=c++17 -O2 "${warn[@]}" -Wno-psabi -static -DSTRATMESH_SMALL_CODE -I. -Itests "${src[@]}" -o "$out/digest-armhf"
 "$out/digest-native" > "$out/digest-native.txt"
+# The control: a call that does not return ok fails the digest.
+if "$out/digest-native" --control-bad-status > "$out/digest-control.txt"; then
+  echo "FAIL: the digest passes a call that did not return ok"; exit 1
+fi
+echo "the digest fails on a status that is not ok (control): ok"
 qemu-aarch64 "$out/digest-aarch64" > "$out/digest-aarch64.txt"
 qemu-arm "$out/digest-armhf" > "$out/digest-armhf.txt"
 cat "$out/digest-native.txt"
@@ -82,5 +87,12 @@ arm-none-eabi-g++ -mcpu=cortex-m7 -mfpu=fpv5-d16 -mfloat-abi=hard -mthumb -Os -s
   -fno-exceptions -fno-rtti -DSTRATMESH_SMALL_CODE -fcallgraph-info=su -I. -c stratmesh.cpp -o "$out/stack_m7.o" \
   -dumpdir "$out/"
 python3 examples/firmware/stack_bound.py --limit 16384 "$out"/*stack_m7*.ci
+# The control: a call graph without the entry points must fail, not pass unchecked.
+printf 'graph: { title: "none"\nnode: { title: "f" label: "f\\n8 bytes (static)" }\n}\n' \
+  > "$out/no_entry_points.ci"
+if python3 examples/firmware/stack_bound.py --limit 16384 "$out/no_entry_points.ci" >/dev/null; then
+  echo "FAIL: stack_bound.py passes a call graph without entry points"; exit 1
+fi
+echo "stack_bound.py fails on a call graph without entry points (control): ok"
 
 step "arm done"

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # CI fuzz stage: builds the libFuzzer harnesses (clang, ASan + UBSan) in build-fuzz and
-# runs each for about FUZZ_SECONDS (default 60) on a copy of its seed corpus. Exits
+# runs each for about FUZZ_SECONDS (default 45) on a copy of its seed corpus. Exits
 # non-zero on any crash, sanitizer report, broken invariant, leak, timeout or memory limit.
 # Installs nothing: needs clang++ and libFuzzer (Debian: clang-14, libclang-rt-14-dev).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-seconds=${FUZZ_SECONDS:-60}
+seconds=${FUZZ_SECONDS:-45}
 cxx=${FUZZ_CXX:-clang++}
 build=build-fuzz
 jobs=$(nproc 2>/dev/null || echo 2)
@@ -53,6 +53,7 @@ set_aside_stalls() {
 }
 
 status=0
+summary=()
 for harness in fuzz_predicates fuzz_delaunay fuzz_reconstruct fuzz_stream fuzz_join fuzz_cloud_reader; do
   work="$build/run/$harness"
   rm -rf "$work"
@@ -67,6 +68,11 @@ for harness in fuzz_predicates fuzz_delaunay fuzz_reconstruct fuzz_stream fuzz_j
     -report_slow_units=10 -rss_limit_mb=1024 -malloc_limit_mb=64 -max_len=65536 -print_final_stats=1 \
     -artifact_prefix="$work/artifacts/" >"$work/log" 2>&1 || rc=$?
   tail -n 30 "$work/log"
+  # Executions per second: libFuzzer's final stats (-print_final_stats=1).
+  units=$(sed -n 's/^stat::number_of_executed_units: *//p' "$work/log" | tail -n 1)
+  rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$work/log" | tail -n 1)
+  printf '%s: %s executions in about %ss, %s per second\n' "$harness" "${units:-?}" "$seconds" "${rate:-?}"
+  summary+=("$(printf '%-18s %8s exec/s' "$harness" "${rate:-?}")")
   set_aside_stalls "$harness" "$work/artifacts"
   if [ "$rc" = 70 ] && ls "$work/stalls"/timeout-* >/dev/null 2>&1 &&
      ! ls "$work/artifacts"/* >/dev/null 2>&1; then
@@ -81,4 +87,6 @@ for harness in fuzz_predicates fuzz_delaunay fuzz_reconstruct fuzz_stream fuzz_j
     status=1
   fi
 done
+printf '\n==== executions per second (%ss each)\n' "$seconds"
+printf '%s\n' "${summary[@]}"
 exit $status

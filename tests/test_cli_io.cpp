@@ -12,7 +12,9 @@
 #include "cli/mini_json.h"
 #include "cli/mini_mesh.h"
 
+#include <cctype>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -333,7 +335,7 @@ TEST_CASE("a vertex count of 4000000000 is caught before any allocation") {
     std::string lie = std::string("element vertex 4000000000\n") + kXyz;
     check_fails(little_ply_header(lie) + std::string(36, '\0'), {"declares 4000000000"});
     check_fails("ply\nformat ascii 1.0\n" + lie + "end_header\n1 2 3\n",
-                {"line 8", "ends inside element 'vertex' record 1 of 4000000000"});
+                {"line 8", "ends before element 'vertex' record 1 of 4000000000"});
 }
 
 TEST_CASE("element counts that overflow") {
@@ -373,7 +375,7 @@ TEST_CASE("a file that is only a header") {
     check_fails(little_ply_header(std::string("element vertex 3\n") + kXyz),
                 {"byte", "declares 3 records"});
     check_fails("ply\nformat ascii 1.0\nelement vertex 3\n" + std::string(kXyz) + "end_header\n",
-                {"ends inside element 'vertex' record 0 of 3"});
+                {"line 7", "ends before element 'vertex' record 0 of 3"});
 }
 
 TEST_CASE("garbage in text files names the line") {
@@ -401,16 +403,57 @@ TEST_CASE("empty and pointless files") {
     CHECK(contains(forced.error, "no 'v' line"));
 }
 
+// The number after "byte " in a message, or SIZE_MAX if there is none.
+size_t byte_named(const std::string& error) {
+    size_t at = error.find("byte ");
+    return at == std::string::npos ? SIZE_MAX : std::stoul(error.substr(at + 5));
+}
+
+bool names_line(const std::string& error) {
+    size_t at = error.find("line ");
+    return at != std::string::npos && at + 5 < error.size() && std::isdigit(error[at + 5]);
+}
+
 TEST_CASE("every truncation and many corruptions of valid files fail cleanly") {
     // Under the sanitizers this is a small deterministic fuzz run of all the readers.
     std::vector<double> xyz = test_points(6);
-    std::vector<std::string> files = {
-        busy_binary_ply(xyz, false),   double_binary_ply(xyz, true),
-        ascii_ply(xyz, "\n"),          "OFF\n3 1 0\n1 2 3\n4 5 6\n7 8 9\n3 0 1 2\n",
-        "v 1 2 3\nv 4 5 6\nf 1 2 3\n", "3\n1 2 3\n4 5 6\n7 8 9\n"};
+    struct File {
+        std::string bytes;
+        size_t points;  // what the whole file holds
+        bool binary;    // a PLY binary body: any truncation is an error at a byte offset
+        bool counted;   // a header counts the points: a truncation never gives fewer
+    };
+    const File files[] = {
+        {busy_binary_ply(xyz, false), 6, true, true},
+        {double_binary_ply(xyz, true), 6, true, true},
+        {ascii_ply(xyz, "\n"), 6, false, true},
+        {"OFF\n3 1 0\n1 2 3\n4 5 6\n7 8 9\n3 0 1 2\n", 3, false, true},
+        {"v 1 2 3\nv 4 5 6\nf 1 2 3\n", 2, false, false},
+        {"3\n1 2 3\n4 5 6\n7 8 9\n", 3, false, true}};
     std::mt19937 random(12345);
-    for (const std::string& file : files) {
-        for (size_t length = 0; length <= file.size(); ++length) read_text(file.substr(0, length));
+    for (const File& f : files) {
+        const std::string& file = f.bytes;
+        for (size_t length = 0; length < file.size(); ++length) {
+            CAPTURE(length);
+            ReadResult r = read_text(file.substr(0, length));
+            if (f.binary) {
+                // Ends before the body's last byte: an error, at a byte within what is
+                // there (or at a line of the header).
+                REQUIRE_FALSE(r.ok);
+                // (The first bytes, "ply" without its line end, are no PLY file yet.)
+                CHECK((byte_named(r.error) <= length || names_line(r.error) || length == 0 ||
+                       contains(r.error, "no points found")));
+            } else if (r.ok) {
+                CHECK(r.xyz.size() / 3 <= f.points);
+                if (f.counted) CHECK(r.xyz.size() / 3 == f.points);
+            } else {
+                CHECK((names_line(r.error) || length == 0 ||
+                       contains(r.error, "no points found") || contains(r.error, "no vertices found")));
+            }
+        }
+        ReadResult whole = read_text(file);
+        REQUIRE_MESSAGE(whole.ok, whole.error);
+        CHECK(whole.xyz.size() / 3 == f.points);
         for (int round = 0; round < 300; ++round) {
             std::string bent = file;
             bent[random() % bent.size()] = static_cast<char>(random() & 0xff);
@@ -598,7 +641,7 @@ TEST_CASE("point by point reading: what it cannot read, and errors that name the
         {"mesh.off", "OFF\n3 1 0\n1 2 3\n4 5 6\n7 8 9\n3 0 1 2\n", "OFF files cannot be read"},
         {"bad.xyz", "1 2 3\n4 5 6\n7 eight 9\n", "line 3: 'eight' is not a number"},
         {"ascii_short.ply", ascii.substr(0, ascii.size() - 30),
-         "the file ends inside element 'vertex' record 9 of 10"},
+         "the line ends before property 'z' of element 'vertex' record 9 of 10"},
         {"empty.xyz", "", "the file is empty"}};
     for (const auto& c : cases) {
         std::string name = c.name;
@@ -689,15 +732,18 @@ TEST_CASE("the stream writer, fed piece by piece, writes what write_mesh_file wr
     }
 }
 
-TEST_CASE("the stream writer removes its output when abandoned or unwritable") {
+TEST_CASE("the stream writer leaves nothing behind when abandoned or unwritable") {
     TempDir dir;
     std::string error;
     {
         MeshStreamWriter writer;
         REQUIRE(writer.open(dir.file("m.ply"), MeshFormat::ply, false, error));
-        CHECK(std::filesystem::exists(dir.file("m.ply")));
+        // Only the output's temporary is there: the scratch bodies are unnamed.
+        CHECK_FALSE(std::filesystem::exists(dir.file("m.ply")));
+        CHECK(std::distance(std::filesystem::directory_iterator(dir.path),
+                            std::filesystem::directory_iterator()) == 1);
     }
-    CHECK_FALSE(std::filesystem::exists(dir.file("m.ply")));
+    CHECK(std::filesystem::is_empty(dir.path));
     MeshStreamWriter writer;
     CHECK_FALSE(writer.open(dir.file("no/such/dir/m.ply"), MeshFormat::ply, false, error));
     CHECK(contains(error, "no/such/dir/m.ply: cannot create"));
@@ -844,7 +890,8 @@ TEST_CASE("command line: every option") {
     CHECK(line.input == "in.xyz");
     CHECK(line.output == "out.stl");
     CHECK(line.axis == stratmesh::Axis::direction);
-    CHECK(line.direction[1] == -2);
+    // Normalised by the parser: (1, -2, 0.5) / sqrt(5.25).
+    CHECK(line.direction[1] == doctest::Approx(-2 / std::sqrt(5.25)).epsilon(1e-15));
     CHECK(line.cuts == std::vector<double>{3, -1.5, 100});
     CHECK(line.report == "r.json");
     CHECK((line.ascii && line.skip_invalid && line.quiet));

@@ -730,7 +730,12 @@ TEST_CASE("buffers that share memory: invalid_argument, nothing written anywhere
 }
 
 TEST_CASE("more points than 32-bit indices: too_many_points, nothing read") {
-    if (sizeof(size_t) <= 4) return;
+    // 2^32 - 1 points: one more than indices can address, and still a size_t on 32-bit
+    // targets, where the sizes say no buffer can hold them.
+    const size_t beyond = size_t{0xFFFFFFFFu};
+    CHECK(stratmesh::delaunay_2d_workspace_size(beyond) == 0);
+    if (sizeof(size_t) <= 4) CHECK(stratmesh::delaunay_2d_max_triangles(beyond) == 0);
+    else CHECK(stratmesh::delaunay_2d_max_triangles(beyond) == 2 * beyond - 5);
     double xy[6] = {0, 0, 1, 0, 0, 1};
     unsigned char work[64];
     uint32_t tris[3];

@@ -10,17 +10,15 @@
 using stratmesh::Status;
 
 TEST_CASE("every status has a distinct message that starts with its name") {
+    // Every status, from the list that generates the enum: a new one is tested here too.
+#define STRATMESH_TEST_STATUS_ENTRY(name, message) {Status::name, #name},
     const std::pair<Status, const char*> named[] = {
-        {Status::ok, "ok"},
-        {Status::invalid_argument, "invalid_argument"},
-        {Status::too_many_points, "too_many_points"},
-        {Status::invalid_point, "invalid_point"},
-        {Status::too_few_points, "too_few_points"},
-        {Status::collinear, "collinear"},
-        {Status::out_of_memory, "out_of_memory"},
-        {Status::triangle_capacity, "triangle_capacity"},
-        {Status::internal_error, "internal_error"},
-    };
+        STRATMESH_STATUS_LIST(STRATMESH_TEST_STATUS_ENTRY)};
+#undef STRATMESH_TEST_STATUS_ENTRY
+    // The list starts at ok and counts up without gaps, as the enum's values do.
+    for (size_t k = 0; k < sizeof named / sizeof named[0]; ++k)
+        CHECK(static_cast<size_t>(named[k].first) == k);
+    CHECK(sizeof named / sizeof named[0] >= 14);
     std::set<std::string> seen;
     for (const auto& entry : named) {
         std::string message = stratmesh::status_string(entry.first);

@@ -1,5 +1,6 @@
 #include "args.h"
 
+#include "frame_check.h"
 #include "mesh_io.h"
 #include "text_scan.h"
 
@@ -37,7 +38,8 @@ const char kUsage[] =
     "Options:\n"
     "  -o, --output FILE     the mesh to write (required)\n"
     "  --axis x|y|z|X,Y,Z    the axis the layers are stacked along (default: automatic,\n"
-    "                        the cloud's principal direction)\n"
+    "                        the cloud's principal direction); a direction of any finite\n"
+    "                        non-zero length\n"
     "  --cuts H1,H2,...      cut the layers at these positions along the axis, measured\n"
     "                        as dot(point, unit axis): with --axis z, 68 is the plane z = 68\n"
     "  --layers N            N layers of equal height\n"
@@ -76,7 +78,8 @@ const char kUsage[] =
     "  --threads N           triangulate the layers on N threads (default: the machine's\n"
     "                        hardware threads); the output is the same bytes for any N\n"
     "  --origin X,Y,Z        the reference point of the unrolling frame (default: the\n"
-    "                        cloud's centroid; with --stream, the first valid point)\n"
+    "                        cloud's centroid; with --stream, the first valid point);\n"
+    "                        within 2^32 times the cloud's size of the cloud\n"
     "  --stream              read and reconstruct layer by layer in bounded memory; needs\n"
     "                        --axis x|y|z|X,Y,Z and --cuts or --layer-height, points\n"
     "                        sorted along the axis, input PLY, XYZ or OBJ, output PLY, OBJ\n"
@@ -148,7 +151,8 @@ bool parse_axis(std::string_view text, CommandLine& line, std::string& error) {
         error = "--axis: expected x, y, z or a direction X,Y,Z, not '" + std::string(text) + "'";
         return false;
     }
-    if (v[0] == 0 && v[1] == 0 && v[2] == 0) {
+    // Normalised here, so any finite non-zero length works (1e308,0,0 and 1e-320,0,0).
+    if (!normalise_direction(v.data())) {
         error = "--axis: the direction must not be zero";
         return false;
     }
@@ -390,6 +394,10 @@ private:
 CommandAction parse_command_line(int argc, const char* const* argv, CommandLine& line,
                                  std::string& error) {
     return Parser(argc, argv, line).run(error);
+}
+
+std::vector<NamedFile> named_files(const CommandLine& line) {
+    return {{"the input", line.input}, {"-o", line.output}, {"--report", line.report}};
 }
 
 const char* usage_text() { return kUsage; }

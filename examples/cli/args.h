@@ -2,6 +2,7 @@
 #ifndef STRATMESH_CLI_ARGS_H
 #define STRATMESH_CLI_ARGS_H
 
+#include "safe_output.h"
 #include "stratmesh.h"
 
 #include <cstdint>
@@ -46,6 +47,10 @@ enum class CommandAction { run, help, version, usage_error };
 // usage_error with the message in `error`.
 CommandAction parse_command_line(int argc, const char* const* argv, CommandLine& line,
                                  std::string& error);
+
+// The files the command line names, the input first, each with how the command line names
+// it: what check_distinct_files (safe_output.h) compares.
+std::vector<NamedFile> named_files(const CommandLine& line);
 
 // The --help text.
 const char* usage_text();

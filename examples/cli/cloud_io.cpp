@@ -44,13 +44,15 @@ CloudFormat detect_text_format(std::string_view text) {
     return CloudFormat::xyz;
 }
 
-bool dispatch(std::string_view text, CloudFormat format, std::vector<double>& xyz,
-              std::string& error, std::string& encoding) {
+bool dispatch(std::string_view data, CloudFormat format, std::vector<double>& xyz,
+              std::string& error, std::string& encoding, uint64_t& faces) {
     encoding = "text";
+    faces = 0;
+    const std::string_view text = skip_byte_order_mark(data);
     switch (format) {
-    case CloudFormat::ply: return read_ply(text, xyz, error, encoding);
-    case CloudFormat::off: return read_off(text, xyz, error);
-    case CloudFormat::obj: return read_obj(text, xyz, error);
+    case CloudFormat::ply: return read_ply(data, xyz, error, encoding, faces);
+    case CloudFormat::off: return read_off(text, xyz, error, faces);
+    case CloudFormat::obj: return read_obj(text, xyz, error, faces);
     case CloudFormat::xyz:
     case CloudFormat::automatic: break;
     }
@@ -89,7 +91,7 @@ CloudFormat cloud_format_from_extension(const std::string& path) {
 }
 
 CloudFormat detect_cloud_format(const char* data, size_t size) {
-    std::string_view text(data, data ? size : 0);
+    std::string_view text = skip_byte_order_mark(std::string_view(data, data ? size : 0));
     if (starts_with(text, "ply\n") || starts_with(text, "ply\r\n")) return CloudFormat::ply;
     return detect_text_format(text);
 }
@@ -102,10 +104,12 @@ bool read_cloud_from_memory(const char* data, size_t size, CloudFormat format,
     }
     if (format == CloudFormat::automatic) format = detect_cloud_format(data, size);
     std::string encoding;
-    bool ok = dispatch(std::string_view(data, size), format, xyz, error, encoding);
+    uint64_t faces = 0;
+    bool ok = dispatch(std::string_view(data, size), format, xyz, error, encoding, faces);
     if (info) {
         info->format = format;
         info->encoding = encoding;
+        info->faces_ignored = faces;
     }
     return ok;
 }
@@ -159,7 +163,8 @@ std::unique_ptr<PointReader> open_point_reader(const std::string& path, CloudInf
         error = "OFF files cannot be read point by point (--stream): convert the file to PLY "
                 "or XYZ";
     else if (info.format == CloudFormat::ply)
-        reader = open_ply_points(std::move(file), error, info.encoding, info.point_limit);
+        reader = open_ply_points(std::move(file), error, info.encoding, info.point_limit,
+                                 info.faces_ignored);
     else {
         // A point takes a line of at least three one-character numbers and two separators
         // ("1 2 3"), an OBJ vertex two characters more ("v 1 2 3"), and a line end but on
@@ -169,6 +174,8 @@ std::unique_ptr<PointReader> open_point_reader(const std::string& path, CloudInf
         const uintmax_t bytes = regular ? std::filesystem::file_size(path, failed) : 0;
         if (regular && !failed)
             info.point_limit = bytes / (info.format == CloudFormat::obj ? 8 : 6) + 1;
+        if (start.substr(0, kByteOrderMark.size()) == kByteOrderMark)
+            file->skip(kByteOrderMark.size());
         reader = open_text_points(std::move(file), info.format == CloudFormat::obj);
     }
     if (!reader) error = path + ": " + error;

@@ -1,8 +1,14 @@
 // Reading point clouds for the stratmesh tool.
 //
 // Formats: PLY (ascii, binary_little_endian, binary_big_endian), XYZ/PTS/TXT numeric
-// columns, OFF and OBJ (their vertices are the cloud; faces are ignored). Points come out
-// as doubles, x y z packed, in file order. Float data converts to double exactly.
+// columns, OFF and OBJ (their vertices are the cloud; faces are counted and skipped).
+// Points come out as doubles, x y z packed, in file order. Float data converts to double
+// exactly. A UTF-8 byte-order mark at the start of any of them is skipped.
+//
+// The readers are strict: a body that disagrees with its header (records more or fewer
+// than declared, tokens more or fewer than a record's properties, an element or a
+// property declared twice, a value outside its declared type, a number beyond the range
+// of a double) is an error, never a guess. docs/formats.md lists what each reader accepts.
 //
 // Every reader parses from a memory buffer and trusts nothing in it: counts are checked
 // against the bytes actually present before anything is reserved, vectors otherwise grow
@@ -39,6 +45,8 @@ struct CloudInfo {
     // text file's size over the shortest line a point can take); UINT64_MAX if unknown (a
     // pipe).
     uint64_t point_limit = UINT64_MAX;
+    // Faces in the file (OFF, OBJ, a PLY 'face' element), which the cloud leaves out.
+    uint64_t faces_ignored = 0;
 };
 
 // Parses a whole file image. `format` automatic detects it from the content; any other
@@ -66,6 +74,9 @@ public:
     // The next point; false at the end of the points (`error` left empty) or on an error
     // (`error` says what and where, like the whole-file readers).
     virtual bool next(double xyz[3], std::string& error) = 0;
+    // The faces the file holds, which the reader skips: all of them once next() has
+    // returned false without an error (a PLY header's count from the start).
+    virtual uint64_t faces_ignored() const { return 0; }
 };
 
 // Opens `path` for reading point by point, with the format detected from its first

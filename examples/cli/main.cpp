@@ -6,10 +6,12 @@
 // unchanged. See mesh_io.h.
 #include "args.h"
 #include "cloud_io.h"
+#include "frame_check.h"
 #include "mesh_io.h"
 #include "peak_memory.h"
 #include "progress.h"
 #include "report_json.h"
+#include "safe_output.h"
 #include "stratmesh.h"
 #include "stream_run.h"
 #include "summary.h"
@@ -135,12 +137,23 @@ bool read_input(const CommandLine& line, std::vector<double>& xyz, RunRecord& re
     record.read_seconds = seconds_since(start);
     record.input_format = cloud_format_name(info.format);
     record.input_encoding = info.encoding;
+    record.input_faces_ignored = info.faces_ignored;
     CloudFormat named = cloud_format_from_extension(line.input);
     if (!line.quiet && named != CloudFormat::automatic && named != info.format)
         std::fprintf(stderr, "stratmesh: note: %s holds %s, not %s; read as %s\n",
                      line.input.c_str(), cloud_format_name(info.format), cloud_format_name(named),
                      cloud_format_name(info.format));
     return true;
+}
+
+// False, with the message printed, if --origin is too far from the cloud for any frame.
+bool origin_in_reach(const CommandLine& line, const std::vector<double>& xyz) {
+    CloudBox box;
+    box.add(xyz.data(), xyz.size() / 3);
+    std::string error;
+    if (box.origin_in_reach(line.origin, error)) return true;
+    std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
+    return false;
 }
 
 // What reconstruct() produced: triangles indexing the input points.
@@ -467,11 +480,14 @@ void explain_refusal(const CommandLine& line, const RunRecord& record) {
                      "stratmesh: point %zu (counting from 0) has a NaN or infinite coordinate; "
                      "--skip-invalid skips such points\n",
                      record.report.points.first_invalid_index);
-    if (record.report.detail) std::fprintf(stderr, "stratmesh: %s\n", record.report.detail);
-    if (record.stream && record.status == stratmesh::Status::out_of_memory)
+    // Where the tool gives its own advice (--skip-invalid, the stream's budget, which are
+    // its options), the library's, in the library's terms, is left out.
+    const bool budget = record.stream && record.status == stratmesh::Status::out_of_memory;
+    if (record.report.detail && !budget && record.status != stratmesh::Status::invalid_point)
+        std::fprintf(stderr, "stratmesh: %s\n", record.report.detail);
+    if (budget)
         std::fprintf(stderr,
-                     "stratmesh: --stream-points %llu is too few for these layers: raise it or "
-                     "cut thinner layers\n",
+                     "stratmesh: --stream-points %llu is too few for these layers: raise it\n",
                      static_cast<unsigned long long>(record.stream_points));
 }
 
@@ -498,14 +514,23 @@ bool write_output(const CommandLine& line, const std::vector<double>& xyz,
     return true;
 }
 
+// The input's faces, which the cloud leaves out.
+void warn_faces_ignored(const CommandLine& line, const RunRecord& record) {
+    if (line.quiet || record.input_faces_ignored == 0) return;
+    std::fprintf(stderr, "stratmesh: warning: %llu faces in %s ignored\n",
+                 static_cast<unsigned long long>(record.input_faces_ignored), line.input.c_str());
+}
+
 // Prints the summary and writes the report of a run whose mesh is written.
 int finish_run(const CommandLine& line, RunRecord& record) {
     record.peak_rss_bytes = peak_resident_bytes();
+    warn_faces_ignored(line, record);
     if (!line.quiet) print_summary(stderr, record);
     return write_report(line, record) ? kExitOk : kExitFile;
 }
 
 int refuse(const CommandLine& line, RunRecord& record) {
+    warn_faces_ignored(line, record);
     explain_refusal(line, record);
     record.peak_rss_bytes = peak_resident_bytes();
     write_report(line, record);
@@ -521,6 +546,9 @@ int run_streamed(const CommandLine& line, RunRecord& record) {
     case StreamOutcome::done: return finish_run(line, record);
     case StreamOutcome::refused: return refuse(line, record);
     case StreamOutcome::file_error: break;
+    case StreamOutcome::usage:
+        std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
+        return kExitUsage;
     case StreamOutcome::unsorted:
         std::fprintf(stderr, "stratmesh: %s: %s\n", line.input.c_str(), error.c_str());
         return kExitUnsorted;
@@ -530,12 +558,18 @@ int run_streamed(const CommandLine& line, RunRecord& record) {
 }
 
 int run(const CommandLine& line) {
+    std::string clash;
+    if (!check_distinct_files(named_files(line), clash)) {
+        std::fprintf(stderr, "stratmesh: %s\n", clash.c_str());
+        return kExitUsage;
+    }
     RunRecord record;
     record_command_line(line, record);
     if (line.stream) return run_streamed(line, record);
     std::vector<double> xyz;
     Reconstruction result;
     if (!read_input(line, xyz, record)) return kExitFile;
+    if (line.origin_given && !origin_in_reach(line, xyz)) return kExitUsage;
     std::vector<uint8_t> labels;
     const bool automatic = !line.one_tube && !line.find_branches && !line.split_branches;
     if ((automatic || line.find_branches || line.split_branches) &&
@@ -566,6 +600,7 @@ int run(const CommandLine& line) {
 } // namespace
 
 int main(int argc, char** argv) {
+    install_output_signal_handlers();
     CommandLine line;
     std::string error;
     switch (parse_command_line(argc, argv, line, error)) {

@@ -1,6 +1,7 @@
 #include "mesh_io.h"
 
 #include "path_util.h"
+#include "safe_output.h"
 #include "stratmesh.h"
 
 #include <cerrno>
@@ -31,6 +32,12 @@ public:
             std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
             remember_failure();
         buffer_.clear();
+    }
+
+    // Writes out the buffer; the errno of the first write that failed, 0 if none.
+    int drain() {
+        flush();
+        return failure_;
     }
 
     // Flushes and closes; false (with errno's text in `error`) if anything failed.
@@ -341,22 +348,17 @@ bool write_mesh_file(const std::string& path, MeshFormat format, const MeshView&
         error = path + ": " + error;
         return false;
     }
-    std::FILE* file = std::fopen(path.c_str(), "wb");
-    if (!file) {
-        error = path + ": cannot create: " + std::strerror(errno);
-        return false;
-    }
-    BlockWriter writer(file);
+    AtomicFile file;
+    if (!file.open(path, error)) return false;
+    BlockWriter writer(file.file());
     write_body(writer, format, mesh, ascii);
-    if (writer.close(error)) return true;
-    error = path + ": cannot write: " + error;
-    std::remove(path.c_str());
-    return false;
+    return file.commit(writer.drain(), error);
 }
 
 MeshStreamWriter::MeshStreamWriter() = default;
 
-// A writer still open here is abandoned: its file is closed and the output removed.
+// A writer still open here is abandoned: its temporaries are removed, the destination left
+// as it was.
 MeshStreamWriter::~MeshStreamWriter() {
     std::string ignored;
     if (out_) finish(false, ignored);
@@ -367,20 +369,20 @@ bool MeshStreamWriter::open(const std::string& path, MeshFormat format, bool asc
     path_ = path;
     format_ = format;
     ascii_ = ascii && format == MeshFormat::ply;
-    std::FILE* file = std::fopen(path.c_str(), "wb");
-    std::FILE* vertices = format == MeshFormat::obj ? nullptr : std::tmpfile();
-    std::FILE* faces = format == MeshFormat::obj ? nullptr : std::tmpfile();
-    if (file) out_ = std::make_unique<BlockWriter>(file);
-    if (vertices) vertices_ = std::make_unique<BlockWriter>(vertices);
-    if (faces) faces_ = std::make_unique<BlockWriter>(faces);
-    bool temporaries = format == MeshFormat::obj || (vertices && faces);
-    if (file && temporaries) {
-        if (format == MeshFormat::obj) out_->buffer() += obj_header();
+    file_ = std::make_unique<AtomicFile>();
+    if (!file_->open(path, error)) return false;
+    out_ = std::make_unique<BlockWriter>(file_->file());
+    if (format == MeshFormat::obj) {
+        out_->buffer() += obj_header();
         return true;
     }
-    error = path + (file ? ": cannot create a temporary file: " : ": cannot create: ") +
-            std::strerror(errno);
-    finish(false, error);
+    std::FILE* vertices = scratch_file_beside(path, error);
+    std::FILE* faces = vertices ? scratch_file_beside(path, error) : nullptr;
+    if (vertices) vertices_ = std::make_unique<BlockWriter>(vertices);
+    if (faces) faces_ = std::make_unique<BlockWriter>(faces);
+    if (faces) return true;
+    std::string ignored;
+    finish(false, ignored);
     return false;
 }
 
@@ -444,13 +446,15 @@ bool MeshStreamWriter::finish(bool keep, std::string& error) {
     bool ok = keep && (format_ == MeshFormat::obj ||
                        (copy_body(*vertices_, single) && copy_body(*faces_, false)));
     if (keep && !ok) failure = "a temporary file cannot be read back";
-    for (std::unique_ptr<BlockWriter>* w : {&vertices_, &faces_, &out_}) {
+    for (std::unique_ptr<BlockWriter>* w : {&vertices_, &faces_}) {
         if (*w && !(*w)->close(failure)) ok = false;
         w->reset();
     }
-    if (ok) return true;
+    const int written = out_ ? out_->drain() : 0;
+    out_.reset();
+    if (ok) return file_->commit(written, error);
+    if (file_) file_->discard();
     if (keep) error = path_ + ": cannot write: " + failure;
-    std::remove(path_.c_str());
     return false;
 }
 

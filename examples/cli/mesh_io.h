@@ -40,17 +40,20 @@ struct MeshView {
 bool all_coordinates_are_floats(const double* xyz, size_t count);
 
 // Writes the mesh; `ascii` selects text PLY and text STL (OBJ and OFF are always text).
-// On failure the partial file is removed and `error` names the file and the cause.
+// Written whole or not at all (AtomicFile, safe_output.h): on failure a file already at
+// `path` is left as it was and `error` names the file and the cause.
 bool write_mesh_file(const std::string& path, MeshFormat format, const MeshView& mesh, bool ascii,
                      std::string& error);
 
+class AtomicFile;
 class BlockWriter;
 
 // Writes a mesh whose vertices and triangles arrive piece by piece (--stream), in bounded
 // memory, with the same vertex rule and the same bytes as write_mesh_file() given the
 // whole mesh (OBJ excepted: its vertex and face lines interleave as they arrive). OBJ goes
-// straight to the file; PLY and OFF, whose headers count what follows, collect the vertex
-// and face bodies in two temporary files and copy them after the header at finish().
+// straight to the output's temporary; PLY and OFF, whose headers count what follows,
+// collect the vertex and face bodies in two unnamed scratch files beside the output and
+// copy them after the header at finish(). The output is renamed into place only then.
 // STL, which repeats the corners' coordinates in every triangle, is not supported.
 class MeshStreamWriter {
 public:
@@ -71,6 +74,7 @@ private:
     std::string path_;
     MeshFormat format_ = MeshFormat::unknown;
     bool ascii_ = false;
+    std::unique_ptr<AtomicFile> file_;
     std::unique_ptr<BlockWriter> out_, vertices_, faces_;
     size_t vertex_count_ = 0, triangle_count_ = 0;
     bool all_floats_ = true;

@@ -1,10 +1,14 @@
 // PLY reader: ascii, binary_little_endian and binary_big_endian. Only the vertex element's
 // x, y and z are kept; every other property and element is stepped over, so normals,
-// colours, intensities and faces (before or after the vertices) do no harm.
+// colours, intensities and faces (before or after the vertices) do no harm. Stepped over
+// is still checked: the whole body must match the header (docs/formats.md), an ascii
+// record being one line of exactly its properties' values, each within its type.
 #include "cloud_readers.h"
 #include "file_window.h"
 #include "text_scan.h"
 
+#include <cfloat>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 
@@ -53,6 +57,31 @@ size_t type_size(PlyType type) {
 
 bool is_integral(PlyType type) { return type != PlyType::float32 && type != PlyType::float64; }
 
+// The type's name as the PLY specification spells it.
+const char* type_name(PlyType type) {
+    for (const TypeName& t : kTypeNames)
+        if (t.type == type) return t.name;
+    return "?";
+}
+
+// Whether a value read from text is one the type can hold: integers whole and within
+// their range; floats within float's range (NaN and infinities too, for the library to
+// judge); doubles anything (a literal beyond their range is already refused).
+bool type_holds(PlyType type, double v) {
+    double lowest = 0, highest = 0;
+    switch (type) {
+    case PlyType::int8: lowest = -128, highest = 127; break;
+    case PlyType::uint8: highest = 255; break;
+    case PlyType::int16: lowest = -32768, highest = 32767; break;
+    case PlyType::uint16: highest = 65535; break;
+    case PlyType::int32: lowest = -2147483648.0, highest = 2147483647.0; break;
+    case PlyType::uint32: highest = 4294967295.0; break;
+    case PlyType::float32: return !std::isfinite(v) || std::fabs(v) <= static_cast<double>(FLT_MAX);
+    case PlyType::float64: return true;
+    }
+    return v >= lowest && v <= highest && std::floor(v) == v;
+}
+
 struct PlyProperty {
     std::string name;
     PlyType type = PlyType::float32;     // the item type for a list
@@ -64,6 +93,7 @@ struct PlyElement {
     std::string name;
     uint64_t count = 0;
     std::vector<PlyProperty> properties;
+    size_t line = 0; // of its 'element' line
 };
 
 enum class PlyEncoding { none, ascii, little_endian, big_endian };
@@ -147,6 +177,13 @@ bool parse_element_line(const Words& words, PlyHeader& header, std::string& erro
     }
     PlyElement element;
     element.name = std::string(words.word[1]);
+    for (const PlyElement& before : header.elements) {
+        if (before.name == element.name) {
+            error = "a second element " + quote(element.name) + " (the first is on line " +
+                    std::to_string(before.line) + ")";
+            return false;
+        }
+    }
     CountParse parsed = parse_count(words.word[2], element.count);
     if (parsed != CountParse::ok) {
         error = "the count of element " + quote(element.name) + ", " + quote(words.word[2]) + ", " +
@@ -198,22 +235,36 @@ bool parse_property_line(const Words& words, PlyHeader& header, std::string& err
         }
         property.name = std::string(words.word[2]);
     }
-    header.elements.back().properties.push_back(std::move(property));
+    std::vector<PlyProperty>& properties = header.elements.back().properties;
+    for (const PlyProperty& before : properties) {
+        if (before.name == property.name) {
+            error = "a second property " + quote(property.name) + " in element " +
+                    quote(header.elements.back().name);
+            return false;
+        }
+    }
+    properties.push_back(std::move(property));
     return true;
 }
 
-bool parse_header_line(const Words& words, PlyHeader& header, std::string& error) {
+bool parse_header_line(const Words& words, size_t line, PlyHeader& header, std::string& error) {
     std::string_view keyword = words.word[0];
     if (keyword == "comment" || keyword == "obj_info") return true;
     if (keyword == "format") return parse_format_line(words, header, error);
-    if (keyword == "element") return parse_element_line(words, header, error);
+    if (keyword == "element") {
+        if (!parse_element_line(words, header, error)) return false;
+        header.elements.back().line = line;
+        return true;
+    }
     if (keyword == "property") return parse_property_line(words, header, error);
     error = "unknown header keyword " + quote(keyword);
     return false;
 }
 
+// `data` from the file's first byte, a byte-order mark included.
 bool parse_header(std::string_view data, PlyHeader& header, std::string& error) {
-    LineCursor lines(data);
+    const size_t start = data.size() - skip_byte_order_mark(data).size();
+    LineCursor lines(data.substr(start));
     std::string_view line;
     if (!lines.next(line) || line != "ply") {
         error = "line 1: not a PLY file (the first line is not 'ply')";
@@ -223,18 +274,18 @@ bool parse_header(std::string_view data, PlyHeader& header, std::string& error) 
         Words words = split_words(line);
         if (words.count == 0) continue;
         if (words.word[0] == "end_header") {
-            header.data_offset = lines.offset();
+            header.data_offset = start + lines.offset();
             header.data_line = lines.line_number() + 1;
             if (header.encoding != PlyEncoding::none) return true;
             error = at_line(lines.line_number()) + "the header has no 'format' line";
             return false;
         }
-        if (!parse_header_line(words, header, error)) {
+        if (!parse_header_line(words, lines.line_number(), header, error)) {
             error = at_line(lines.line_number()) + error;
             return false;
         }
     }
-    error = "the header never ends (no 'end_header' line)";
+    error = at_line(lines.line_number()) + "the header never ends (no 'end_header' line)";
     return false;
 }
 
@@ -423,68 +474,131 @@ bool read_binary_vertices(ByteReader& in, const PlyElement& element, const Verte
     return true;
 }
 
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+// After a binary body: nothing, or line ends and spaces (some writers end the file with a
+// newline). Anything else means the header does not describe the file.
+std::string trailing_bytes_message(uint64_t offset, uint64_t count, const PlyHeader& header) {
+    return at_byte(static_cast<size_t>(offset)) + std::to_string(count) +
+           " bytes follow the last element (" + quote(header.elements.back().name) +
+           "): the header does not describe the whole file";
+}
+
 bool read_binary_body(std::string_view data, const PlyHeader& header, const VertexLayout& layout,
                       std::vector<double>& xyz, std::string& error) {
     ByteReader in(data, header.data_offset, header.encoding == PlyEncoding::big_endian);
-    for (size_t e = 0; e < layout.element; ++e)
-        if (!skip_binary_element(in, header.elements[e], error)) return false;
-    return read_binary_vertices(in, header.elements[layout.element], layout, xyz, error);
-}
-
-// ---- ascii body --------------------------------------------------------------------------
-// The record readers take any token source: a TokenCursor over the whole file, or
-// FileTokens over a window of it (--stream).
-
-template <class Tokens>
-bool next_ascii_value(Tokens& in, const PlyElement& element, uint64_t record, double& value,
-                      std::string& error) {
-    std::string_view token;
-    if (!in.next(token)) {
-        error = at_line(in.line_number()) + "the file ends inside " + record_place(element, record);
-        return false;
+    for (size_t e = 0; e < header.elements.size(); ++e) {
+        bool ok = e == layout.element
+                      ? read_binary_vertices(in, header.elements[e], layout, xyz, error)
+                      : skip_binary_element(in, header.elements[e], error);
+        if (!ok) return false;
     }
-    if (parse_number(token, value)) return true;
-    error = at_line(in.line_number()) + quote(token) + " is not a number (" +
-            record_place(element, record) + ")";
-    return false;
-}
-
-template <class Tokens>
-bool next_ascii_list_length(Tokens& in, const PlyElement& element, uint64_t record,
-                            uint64_t& count, std::string& error) {
-    std::string_view token;
-    if (!in.next(token)) {
-        error = at_line(in.line_number()) + "the file ends inside " + record_place(element, record);
+    for (size_t at = in.offset(); at < data.size(); ++at) {
+        if (is_space(data[at])) continue;
+        error = trailing_bytes_message(in.offset(), in.remaining(), header);
         return false;
-    }
-    CountParse parsed = parse_count(token, count);
-    if (parsed == CountParse::ok) return true;
-    error = at_line(in.line_number()) + "list length " + quote(token) + " " +
-            count_problem(parsed) + " (" + record_place(element, record) + ")";
-    return false;
-}
-
-template <class Tokens>
-bool read_ascii_record(Tokens& in, const PlyElement& element,
-                       const std::vector<int>& coordinate_of, double* xyz, uint64_t record,
-                       std::string& error) {
-    for (size_t p = 0; p < element.properties.size(); ++p) {
-        double value = 0;
-        if (element.properties[p].is_list) {
-            uint64_t count = 0;
-            if (!next_ascii_list_length(in, element, record, count, error)) return false;
-            for (uint64_t i = 0; i < count; ++i)
-                if (!next_ascii_value(in, element, record, value, error)) return false;
-            continue;
-        }
-        if (!next_ascii_value(in, element, record, value, error)) return false;
-        if (coordinate_of[p] >= 0) xyz[coordinate_of[p]] = value;
     }
     return true;
 }
 
-template <class Tokens>
-bool read_ascii_element(Tokens& in, const PlyElement& element,
+// ---- ascii body --------------------------------------------------------------------------
+// A record is one line holding exactly its properties' values (a list: its length, then
+// that many items). The readers take any line source: BodyLines over the whole file, or
+// FileLines over a window of it (--stream).
+
+// The lines of an ascii body held in memory, numbered as in the file.
+class BodyLines {
+public:
+    BodyLines(std::string_view body, size_t first_line) : lines_(body), first_(first_line) {}
+    bool next(std::string_view& line) { return lines_.next(line); }
+    size_t line_number() const { return first_ + lines_.line_number() - 1; }
+
+private:
+    LineCursor lines_;
+    size_t first_;
+};
+
+std::string property_place(const PlyElement& element, const PlyProperty& property,
+                           uint64_t record) {
+    return "property " + quote(property.name) + " of " + record_place(element, record);
+}
+
+// The next value of a record's line, checked against `type`.
+bool next_ascii_value(std::string_view& rest, size_t line, const PlyElement& element,
+                      const PlyProperty& property, PlyType type, uint64_t record,
+                      double& value, std::string& error) {
+    std::string_view token;
+    if (!next_field(rest, token, false)) {
+        error = at_line(line) + "the line ends before " + property_place(element, property, record);
+        return false;
+    }
+    NumberParse parsed = scan_number(token, value);
+    if (parsed == NumberParse::ok && type_holds(type, value)) return true;
+    std::string problem = parsed == NumberParse::not_a_number   ? " is not a number"
+                          : parsed == NumberParse::out_of_range ? " is beyond the range of a double"
+                          : is_integral(type) && std::floor(value) != value
+                              ? std::string(" is not a whole number, as ") + type_name(type) +
+                                    " requires"
+                              : std::string(" is out of the range of ") + type_name(type);
+    error = at_line(line) + quote(token) + problem + " (" +
+            property_place(element, property, record) + ")";
+    return false;
+}
+
+template <class Lines>
+bool read_ascii_record(Lines& in, const PlyElement& element,
+                       const std::vector<int>& coordinate_of, double* xyz, uint64_t record,
+                       std::string& error) {
+    std::string_view line;
+    if (!in.next(line)) {
+        error = at_line(in.line_number()) + "the file ends before " + record_place(element, record);
+        return false;
+    }
+    const size_t number = in.line_number();
+    std::string_view rest = line, probe = line, token;
+    if (!next_field(probe, token, false)) {
+        error = at_line(number) + "an empty line where " + record_place(element, record) +
+                " should be";
+        return false;
+    }
+    size_t values = 0;
+    for (size_t p = 0; p < element.properties.size(); ++p) {
+        const PlyProperty& property = element.properties[p];
+        double value = 0;
+        if (!property.is_list) {
+            if (!next_ascii_value(rest, number, element, property, property.type, record, value,
+                                  error))
+                return false;
+            if (coordinate_of[p] >= 0) xyz[coordinate_of[p]] = value;
+            ++values;
+            continue;
+        }
+        if (!next_ascii_value(rest, number, element, property, property.count_type, record,
+                              value, error))
+            return false;
+        if (value < 0) {
+            error = at_line(number) + "list " + quote(property.name) + " has a negative length (" +
+                    record_place(element, record) + ")";
+            return false;
+        }
+        const uint64_t length = static_cast<uint64_t>(value);
+        for (uint64_t i = 0; i < length; ++i)
+            if (!next_ascii_value(rest, number, element, property, property.type, record, value,
+                                  error))
+                return false;
+        values += 1 + length;
+    }
+    size_t extra = 0;
+    while (next_field(rest, token, false)) ++extra;
+    if (extra == 0) return true;
+    error = at_line(number) + std::to_string(values + extra) + " values where " +
+            record_place(element, record) + " has " + std::to_string(values) +
+            ": the header does not describe the line";
+    return false;
+}
+
+template <class Lines>
+bool read_ascii_element(Lines& in, const PlyElement& element,
                         const std::vector<int>& coordinate_of, std::vector<double>* xyz,
                         std::string& error) {
     if (element.properties.empty()) return true;
@@ -496,46 +610,77 @@ bool read_ascii_element(Tokens& in, const PlyElement& element,
     return true;
 }
 
+// After the last record: only blank lines.
+template <class Lines>
+bool check_ascii_end(Lines& in, const PlyHeader& header, std::string& error) {
+    std::string_view line, token;
+    while (in.next(line)) {
+        if (!next_field(line, token, false)) continue;
+        uint64_t records = 0;
+        for (const PlyElement& element : header.elements) records += element.count;
+        error = at_line(in.line_number()) + "data after the last record (the header declares " +
+                std::to_string(records) + " records in " + std::to_string(header.elements.size()) +
+                (header.elements.size() == 1 ? " element" : " elements") + ")";
+        return false;
+    }
+    return true;
+}
+
 bool read_ascii_body(std::string_view data, const PlyHeader& header, const VertexLayout& layout,
                      std::vector<double>& xyz, std::string& error) {
-    TokenCursor in(data.substr(header.data_offset), header.data_line);
-    for (size_t e = 0; e < layout.element; ++e) {
+    BodyLines in(data.substr(header.data_offset), header.data_line);
+    for (size_t e = 0; e < header.elements.size(); ++e) {
         const PlyElement& element = header.elements[e];
-        std::vector<int> none(element.properties.size(), -1);
-        if (!read_ascii_element(in, element, none, nullptr, error)) return false;
+        bool ok = true;
+        if (e == layout.element) {
+            ok = read_ascii_element(in, element, layout.coordinate_of, &xyz, error);
+        } else {
+            std::vector<int> none(element.properties.size(), -1);
+            ok = read_ascii_element(in, element, none, nullptr, error);
+        }
+        if (!ok) return false;
     }
-    return read_ascii_element(in, header.elements[layout.element], layout.coordinate_of, &xyz,
-                              error);
+    return check_ascii_end(in, header, error);
+}
+
+uint64_t face_count(const PlyHeader& header) {
+    for (const PlyElement& element : header.elements)
+        if (element.name == "face") return element.count;
+    return 0;
 }
 
 // ---- streaming (--stream) ----------------------------------------------------------------
 
-// Tokens of a file read through a FileWindow: a TokenCursor over each run of whole lines.
-class FileTokens {
+// Lines of a file read through a FileWindow: a LineCursor over each run of whole lines.
+class FileLines {
 public:
-    explicit FileTokens(FileWindow& file) : file_(file), cursor_(std::string_view(), 1) {}
+    explicit FileLines(FileWindow& file) : file_(file), cursor_(std::string_view()) {}
 
-    bool next(std::string_view& token) {
-        std::string_view lines;
-        while (!cursor_.next(token)) {
-            if (!file_.next_lines(lines)) return false;
-            cursor_ = TokenCursor(lines, file_.lines_first_line());
+    bool next(std::string_view& line) {
+        std::string_view block;
+        while (!cursor_.next(line)) {
+            if (!file_.next_lines(block)) return false;
+            cursor_ = LineCursor(block);
         }
         return true;
     }
-    size_t line_number() const { return cursor_.line_number(); }
+    size_t line_number() const {
+        return cursor_.line_number() == 0 ? file_.lines_first_line()
+                                          : file_.lines_first_line() + cursor_.line_number() - 1;
+    }
 
 private:
     FileWindow& file_;
-    TokenCursor cursor_;
+    LineCursor cursor_;
 };
 
-// The vertex element's points, one record at a time.
+// The vertex element's points, one record at a time; at their end, the rest of the body
+// checked against the header.
 class PlyPoints : public PointReader {
 public:
     PlyPoints(std::unique_ptr<FileWindow> file, PlyHeader header, VertexLayout layout)
         : file_(std::move(file)), header_(std::move(header)), layout_(std::move(layout)),
-          tokens_(*file_) {}
+          lines_(*file_) {}
 
     // Steps over the elements before the vertices.
     bool skip_to_vertices(std::string& error) {
@@ -543,7 +688,7 @@ public:
             const PlyElement& element = header_.elements[e];
             if (header_.encoding == PlyEncoding::ascii) {
                 std::vector<int> none(element.properties.size(), -1);
-                if (!read_ascii_element(tokens_, element, none, nullptr, error)) return false;
+                if (!read_ascii_element(lines_, element, none, nullptr, error)) return false;
                 continue;
             }
             uint64_t size = fixed_record_size(element);
@@ -553,22 +698,23 @@ public:
                         "stepped over without reading it whole";
                 return false;
             }
-            if (element.count > UINT64_MAX / (size ? size : 1) ||
-                !file_->discard(element.count * size)) {
-                error = at_byte(file_->offset()) + "the file ends inside element " +
-                        quote(element.name);
-                return false;
-            }
+            if (!discard_records(element, size, error)) return false;
         }
         return true;
     }
 
     bool next(double xyz[3], std::string& error) override {
         const PlyElement& vertex = header_.elements[layout_.element];
-        if (record_ == vertex.count) return false;
+        if (record_ == vertex.count) {
+            if (!checked_rest_) {
+                checked_rest_ = true;
+                if (!check_rest(error)) return false;
+            }
+            return false;
+        }
         xyz[0] = xyz[1] = xyz[2] = 0;
         bool ok = header_.encoding == PlyEncoding::ascii
-                      ? read_ascii_record(tokens_, vertex, layout_.coordinate_of, xyz, record_,
+                      ? read_ascii_record(lines_, vertex, layout_.coordinate_of, xyz, record_,
                                           error)
                       : next_binary(vertex, xyz, error);
         std::string failure = file_->failure();
@@ -577,7 +723,87 @@ public:
         return ok && failure.empty();
     }
 
+    uint64_t faces_ignored() const override { return face_count(header_); }
+
 private:
+    bool discard_records(const PlyElement& element, uint64_t size, std::string& error) {
+        if (element.count <= UINT64_MAX / (size ? size : 1) && file_->discard(element.count * size))
+            return true;
+        error = at_byte(static_cast<size_t>(file_->offset())) + "the file ends inside element " +
+                quote(element.name);
+        return false;
+    }
+
+    // A binary record with lists, stepped over one property at a time.
+    bool discard_binary_record(const PlyElement& element, uint64_t record, std::string& error) {
+        const bool big = header_.encoding == PlyEncoding::big_endian;
+        for (const PlyProperty& property : element.properties) {
+            const size_t size = type_size(property.is_list ? property.count_type : property.type);
+            std::string_view bytes = file_->peek(size);
+            if (bytes.size() < size) {
+                error = at_byte(static_cast<size_t>(file_->offset() + bytes.size())) +
+                        "the file ends inside " + record_place(element, record);
+                return false;
+            }
+            if (!property.is_list) {
+                file_->skip(size);
+                continue;
+            }
+            const size_t at = static_cast<size_t>(file_->offset());
+            double length = 0;
+            ByteReader in(bytes, 0, big);
+            in.scalar(property.count_type, length);
+            file_->skip(size);
+            if (length < 0) {
+                error = at_byte(at) + "list " + quote(property.name) + " has a negative length (" +
+                        record_place(element, record) + ")";
+                return false;
+            }
+            if (!file_->discard(static_cast<uint64_t>(length) * type_size(property.type))) {
+                error = at_byte(static_cast<size_t>(file_->offset())) + "the file ends inside " +
+                        record_place(element, record);
+                return false;
+            }
+        }
+        return true;
+    }
+
+    // The elements after the vertices, then the end of the file.
+    bool check_rest(std::string& error) {
+        for (size_t e = layout_.element + 1; e < header_.elements.size(); ++e) {
+            const PlyElement& element = header_.elements[e];
+            if (header_.encoding == PlyEncoding::ascii) {
+                std::vector<int> none(element.properties.size(), -1);
+                if (!read_ascii_element(lines_, element, none, nullptr, error)) return false;
+                continue;
+            }
+            const uint64_t size = fixed_record_size(element);
+            if (size > 0 || element.properties.empty()) {
+                if (!discard_records(element, size, error)) return false;
+                continue;
+            }
+            for (uint64_t r = 0; r < element.count; ++r)
+                if (!discard_binary_record(element, r, error)) return false;
+        }
+        if (header_.encoding == PlyEncoding::ascii) return check_ascii_end(lines_, header_, error);
+        const uint64_t end = file_->offset();
+        uint64_t rest = 0;
+        bool clean = true;
+        for (std::string_view bytes = file_->peek(1 << 16); !bytes.empty();
+             bytes = file_->peek(1 << 16)) {
+            for (char c : bytes) clean = clean && is_space(c);
+            rest += bytes.size();
+            file_->skip(bytes.size());
+        }
+        if (!file_->failure().empty()) {
+            error = file_->failure();
+            return false;
+        }
+        if (clean) return true;
+        error = trailing_bytes_message(end, rest, header_);
+        return false;
+    }
+
     bool next_binary(const PlyElement& vertex, double xyz[3], std::string& error) {
         size_t size = static_cast<size_t>(fixed_record_size(vertex));
         std::string_view bytes = file_->peek(size);
@@ -594,20 +820,25 @@ private:
     std::unique_ptr<FileWindow> file_;
     PlyHeader header_;
     VertexLayout layout_;
-    FileTokens tokens_;
+    FileLines lines_;
     uint64_t record_ = 0;
+    bool checked_rest_ = false;
 };
 
 } // namespace
 
 std::unique_ptr<PointReader> open_ply_points(std::unique_ptr<FileWindow> file, std::string& error,
-                                             std::string& encoding, uint64_t& vertex_count) {
+                                             std::string& encoding, uint64_t& vertex_count,
+                                             uint64_t& faces) {
     // The header must lie within the first block: headers are a few hundred bytes.
     const size_t kMaxHeader = 1 << 20;
     PlyHeader header;
     VertexLayout layout;
     if (!parse_header(file->peek(kMaxHeader), header, error)) return nullptr;
-    if (!find_vertex_layout(header, layout, error)) return nullptr;
+    if (!find_vertex_layout(header, layout, error)) {
+        error = at_line(header.data_line - 1) + error;
+        return nullptr;
+    }
     const PlyElement& vertex = header.elements[layout.element];
     if (header.encoding != PlyEncoding::ascii && fixed_record_size(vertex) == 0) {
         error = "the vertex element has list properties: a binary PLY file with them cannot "
@@ -616,6 +847,7 @@ std::unique_ptr<PointReader> open_ply_points(std::unique_ptr<FileWindow> file, s
     }
     encoding = encoding_name(header.encoding);
     vertex_count = vertex.count;
+    faces = face_count(header);
     file->skip(header.data_offset);
     file->set_first_line(header.data_line);
     auto points =
@@ -625,12 +857,16 @@ std::unique_ptr<PointReader> open_ply_points(std::unique_ptr<FileWindow> file, s
 }
 
 bool read_ply(std::string_view data, std::vector<double>& xyz, std::string& error,
-              std::string& encoding) {
+              std::string& encoding, uint64_t& faces) {
     PlyHeader header;
     VertexLayout layout;
     if (!parse_header(data, header, error)) return false;
-    if (!find_vertex_layout(header, layout, error)) return false;
+    if (!find_vertex_layout(header, layout, error)) {
+        error = at_line(header.data_line - 1) + error;
+        return false;
+    }
     encoding = encoding_name(header.encoding);
+    faces = face_count(header);
     xyz.clear();
     if (header.encoding == PlyEncoding::ascii)
         return read_ascii_body(data, header, layout, xyz, error);

@@ -19,6 +19,7 @@ struct NumberRow {
     size_t fields = 0; // fields seen
     double first[3] = {0, 0, 0};
     std::string_view bad; // the first field that is not a number, if any
+    NumberParse bad_as = NumberParse::ok; // and why
     bool all_start_with_letters = true;
 };
 
@@ -27,8 +28,12 @@ NumberRow scan_numbers(std::string_view content, bool commas) {
     std::string_view field;
     while (next_field(content, field, commas)) {
         double value = 0;
-        bool numeric = parse_number(field, value);
-        if (!numeric && row.bad.empty()) row.bad = field;
+        NumberParse parsed = scan_number(field, value);
+        bool numeric = parsed == NumberParse::ok;
+        if (!numeric && row.bad.empty()) {
+            row.bad = field;
+            row.bad_as = parsed;
+        }
         if (numeric && row.fields < 3) row.first[row.fields] = value;
         row.all_start_with_letters = row.all_start_with_letters && !numeric && is_letter(field[0]);
         ++row.fields;
@@ -39,7 +44,9 @@ NumberRow scan_numbers(std::string_view content, bool commas) {
 // A point row: every field a number, at least three of them. False with a message if not.
 bool take_point(const NumberRow& row, size_t line, std::vector<double>& xyz, std::string& error) {
     if (!row.bad.empty()) {
-        error = at_line(line) + quote(row.bad) + " is not a number";
+        error = at_line(line) + quote(row.bad) +
+                (row.bad_as == NumberParse::out_of_range ? " is beyond the range of a double"
+                                                         : " is not a number");
         return false;
     }
     if (row.fields < 3) {
@@ -52,11 +59,10 @@ bool take_point(const NumberRow& row, size_t line, std::vector<double>& xyz, std
 }
 
 // A PTS count line: a single whole number.
-bool is_count_line(std::string_view content) {
+bool is_count_line(std::string_view content, uint64_t& count) {
     std::string_view field, rest = content;
     if (!next_field(rest, field, true)) return false;
     std::string_view extra;
-    uint64_t count = 0;
     return !next_field(rest, extra, true) && parse_count(field, count) == CountParse::ok;
 }
 
@@ -86,8 +92,37 @@ bool read_off_vertices(LineCursor& lines, uint64_t count, std::vector<double>& x
     return true;
 }
 
+// The face lines after an OFF file's vertices: each a vertex count k and k whole numbers
+// (colours may follow); nothing but blank and comment lines after the last.
+bool read_off_faces(LineCursor& lines, uint64_t count, std::string& error) {
+    std::string_view content, field;
+    for (uint64_t f = 0; f < count; ++f) {
+        if (!next_content_line(lines, content)) {
+            error = at_line(lines.line_number()) + "the file ends after " + std::to_string(f) +
+                    " of the " + std::to_string(count) + " faces the header announces";
+            return false;
+        }
+        uint64_t corners = 0, index = 0;
+        next_field(content, field, false);
+        CountParse parsed = parse_count(field, corners);
+        for (uint64_t k = 0; parsed == CountParse::ok && k < corners; ++k)
+            parsed = next_field(content, field, false) ? parse_count(field, index)
+                                                       : CountParse::not_a_number;
+        if (parsed != CountParse::ok) {
+            error = at_line(lines.line_number()) + "face " + std::to_string(f) +
+                    " is not a corner count followed by that many vertex indices";
+            return false;
+        }
+    }
+    if (!next_content_line(lines, content)) return true;
+    error = at_line(lines.line_number()) + "more lines than the header's vertices and " +
+            std::to_string(count) + " faces";
+    return false;
+}
+
 // The keyword line of an OFF file, and the vertex count (on that line or the next).
-bool read_off_header(LineCursor& lines, uint64_t& vertex_count, std::string& error) {
+bool read_off_header(LineCursor& lines, uint64_t& vertex_count, uint64_t& face_count,
+                     std::string& error) {
     std::string_view rest, keyword, count;
     if (!next_content_line(lines, rest) || !next_field(rest, keyword, false) ||
         !is_off_keyword(keyword)) {
@@ -109,14 +144,24 @@ bool read_off_header(LineCursor& lines, uint64_t& vertex_count, std::string& err
         return false;
     }
     CountParse parsed = parse_count(count, vertex_count);
+    if (parsed != CountParse::ok) {
+        error = at_line(lines.line_number()) + "the vertex count " + quote(count) + " " +
+                count_problem(parsed);
+        return false;
+    }
+    std::string_view faces;
+    parsed = next_field(rest, faces, false) ? parse_count(faces, face_count)
+                                            : CountParse::not_a_number;
     if (parsed == CountParse::ok) return true;
-    error = at_line(lines.line_number()) + "the vertex count " + quote(count) + " " +
-            count_problem(parsed);
+    error = at_line(lines.line_number()) + "the face count " + quote(faces) + " " +
+            count_problem(parsed) + " (the counts line is 'vertices faces edges')";
     return false;
 }
 
 // The lines of a column file (XYZ, PTS, TXT, CSV): a point per line, except blank and
-// comment lines, a first line of column names and a PTS count line.
+// comment lines and a first line of column names. A file whose first line with a number
+// is a single whole number is PTS: each such count line announces the points up to the
+// next one (scans joined one after another), and each must count them exactly.
 class ColumnRows {
 public:
     // Appends the line's point, if it has one; false with a message on a bad line.
@@ -127,19 +172,45 @@ public:
         if (row.fields == 0) return true;
         bool column_names = first_content_ && row.all_start_with_letters;
         first_content_ = false;
-        if (column_names || is_count_line(content)) return true;
+        if (column_names) return true;
+        bool first = first_number_;
+        first_number_ = false;
+        uint64_t count = 0;
+        if ((first || counted_) && is_count_line(content, count)) {
+            if (!finish(error)) return false;
+            counted_ = true;
+            count_ = count;
+            count_line_ = line_number;
+            points_ = 0;
+            return true;
+        }
+        ++points_;
         return take_point(row, line_number, xyz, error);
+    }
+
+    // At the end of the file: false with a message if a count line was wrong.
+    bool finish(std::string& error) const {
+        if (!counted_ || points_ == count_) return true;
+        error = at_line(count_line_) + "the count line announces " + std::to_string(count_) +
+                " points, " + std::to_string(points_) + " follow";
+        return false;
     }
 
 private:
     bool first_content_ = true;
+    bool first_number_ = true;
+    bool counted_ = false; // PTS: count lines start the blocks
+    uint64_t count_ = 0, points_ = 0;
+    size_t count_line_ = 0;
 };
 
-// Appends the point of an OBJ "v" line; other lines are ignored.
+// Appends the point of an OBJ "v" line and counts "f" lines; other lines are ignored.
 bool take_obj_line(std::string_view line, size_t line_number, std::vector<double>& xyz,
-                   std::string& error) {
+                   uint64_t& faces, std::string& error) {
     std::string_view rest = strip_comment(line, false), keyword;
-    if (!next_field(rest, keyword, false) || keyword != "v") return true;
+    if (!next_field(rest, keyword, false)) return true;
+    if (keyword == "f") ++faces;
+    if (keyword != "v") return true;
     return take_point(scan_numbers(rest, false), line_number, xyz, error);
 }
 
@@ -154,16 +225,19 @@ public:
         while (point_.empty()) {
             if (!next_line(line)) {
                 error = file_->failure();
+                if (error.empty() && !obj_) columns_.finish(error);
                 return false;
             }
             size_t number = file_->lines_first_line() + lines_.line_number() - 1;
-            bool ok = obj_ ? take_obj_line(line, number, point_, error)
+            bool ok = obj_ ? take_obj_line(line, number, point_, faces_, error)
                            : columns_.take(line, number, point_, error);
             if (!ok) return false;
         }
         for (size_t k = 0; k < 3; ++k) xyz[k] = point_[k];
         return true;
     }
+
+    uint64_t faces_ignored() const override { return faces_; }
 
 private:
     bool next_line(std::string_view& line) {
@@ -180,6 +254,7 @@ private:
     LineCursor lines_{std::string_view()};
     ColumnRows columns_;
     std::vector<double> point_;
+    uint64_t faces_ = 0;
 };
 
 } // namespace
@@ -202,25 +277,31 @@ bool read_xyz(std::string_view data, std::vector<double>& xyz, std::string& erro
     xyz.clear();
     while (lines.next(line))
         if (!rows.take(line, lines.line_number(), xyz, error)) return false;
+    if (!rows.finish(error)) return false;
     if (!xyz.empty()) return true;
     error = "no points found (no line with 3 numbers)";
     return false;
 }
 
-bool read_off(std::string_view data, std::vector<double>& xyz, std::string& error) {
+bool read_off(std::string_view data, std::vector<double>& xyz, std::string& error,
+              uint64_t& faces) {
     LineCursor lines(data);
     uint64_t vertex_count = 0;
     xyz.clear();
-    if (!read_off_header(lines, vertex_count, error)) return false;
-    return read_off_vertices(lines, vertex_count, xyz, error);
+    faces = 0;
+    return read_off_header(lines, vertex_count, faces, error) &&
+           read_off_vertices(lines, vertex_count, xyz, error) &&
+           read_off_faces(lines, faces, error);
 }
 
-bool read_obj(std::string_view data, std::vector<double>& xyz, std::string& error) {
+bool read_obj(std::string_view data, std::vector<double>& xyz, std::string& error,
+              uint64_t& faces) {
     LineCursor lines(data);
     std::string_view line;
     xyz.clear();
+    faces = 0;
     while (lines.next(line))
-        if (!take_obj_line(line, lines.line_number(), xyz, error)) return false;
+        if (!take_obj_line(line, lines.line_number(), xyz, faces, error)) return false;
     if (!xyz.empty()) return true;
     error = "no vertices found (no 'v' line)";
     return false;

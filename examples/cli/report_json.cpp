@@ -1,5 +1,7 @@
 #include "report_json.h"
 
+#include "safe_output.h"
+
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -167,6 +169,7 @@ void write_files(JsonWriter& j, const RunRecord& r) {
     j.text_field("path", r.input_path);
     j.text_field("format", r.input_format);
     j.text_field("encoding", r.input_encoding);
+    j.count_field("faces_ignored", r.input_faces_ignored);
     j.end_object();
     j.key("output");
     j.begin_object();
@@ -465,20 +468,10 @@ std::string run_record_json(const RunRecord& record) {
 }
 
 bool write_text_file(const std::string& path, const std::string& text, std::string& error) {
-    std::FILE* file = std::fopen(path.c_str(), "wb");
-    if (!file) {
-        error = path + ": cannot create: " + std::strerror(errno);
-        return false;
-    }
-    bool ok = std::fwrite(text.data(), 1, text.size(), file) == text.size();
-    int failure = errno;
-    if (std::fclose(file) != 0 && ok) {
-        ok = false;
-        failure = errno;
-    }
-    if (ok) return true;
-    error = path + ": cannot write: " + std::strerror(failure);
-    return false;
+    AtomicFile file;
+    if (!file.open(path, error)) return false;
+    const bool written = std::fwrite(text.data(), 1, text.size(), file.file()) == text.size();
+    return file.commit(written ? 0 : (errno != 0 ? errno : EIO), error);
 }
 
 } // namespace stratmesh_cli

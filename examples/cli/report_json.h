@@ -21,6 +21,7 @@ const char* phase_name(stratmesh::Phase phase);
 struct RunRecord {
     // Input and output.
     std::string input_path, input_format, input_encoding;
+    uint64_t input_faces_ignored = 0; // faces in the input, left out of the cloud
     std::string output_path, output_format;
     bool output_ascii = false;
     bool output_written = false;

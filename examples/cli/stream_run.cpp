@@ -1,6 +1,7 @@
 #include "stream_run.h"
 
 #include "cloud_io.h"
+#include "frame_check.h"
 #include "mesh_io.h"
 
 #include <algorithm>
@@ -92,6 +93,7 @@ public:
             return StreamOutcome::file_error;
         StreamOutcome outcome = read_and_push(*reader, error);
         if (outcome == StreamOutcome::done) outcome = close(error);
+        if (outcome == StreamOutcome::refused) count_refused_push();
         record_.take_report(report_, layers_);
         record_.read_seconds = seconds_since(start) - stream_seconds_ - write_seconds_;
         return outcome;
@@ -111,13 +113,14 @@ private:
                     error = backwards_message(height);
                     return StreamOutcome::unsorted;
                 }
-                if (height >= top_ && !push(top_)) return StreamOutcome::refused;
+                if (height >= top_ && !push(top_)) return stopped(error);
                 if (height >= top_ || !std::isfinite(highest_)) top_ = tops_.top_above(height);
                 highest_ = height;
             }
             layer_.insert(layer_.end(), point, point + 3);
             ++points_read_;
         }
+        record_.input_faces_ignored = reader.faces_ignored();
         if (error.empty()) return StreamOutcome::done;
         error = line_.input + ": " + error;
         return StreamOutcome::file_error;
@@ -154,15 +157,37 @@ private:
             runner.writer_.add_triangles(triangles, count);
     }
 
-    // Writes the layer's vertices (before any triangle can use them) and pushes it.
+    // The library's counts leave out the push it refused, whose points (the first invalid
+    // one among them, on invalid_point) were read all the same: they count as unused, so
+    // that the counts add up and first_invalid_index is one of the points counted.
+    void count_refused_push() {
+        if (pushed_ <= report_.points.in_count) return;
+        report_.points.unused_count += pushed_ - report_.points.in_count;
+        report_.points.in_count = pushed_;
+    }
+
+    // Why push() returned false: the library refused, or the --origin given is out of reach.
+    StreamOutcome stopped(std::string& error) const {
+        if (origin_error_.empty()) return StreamOutcome::refused;
+        error = origin_error_;
+        return StreamOutcome::usage;
+    }
+
+    // Writes the layer's vertices (before any triangle can use them) and pushes it. An
+    // --origin given is checked against the points read so far first (frame_check.h).
     bool push(double top) {
         if (layer_.empty()) return true;
+        if (line_.origin_given) {
+            box_.add(layer_.data(), layer_.size() / 3);
+            if (!box_.origin_in_reach(options_.origin, origin_error_)) return false;
+        }
         Clock::time_point start = Clock::now();
         writer_.add_vertices(layer_.data(), layer_.size() / 3);
         if (line_.cap) all_points_.insert(all_points_.end(), layer_.begin(), layer_.end());
         Clock::time_point pushed = Clock::now();
         write_seconds_ += std::chrono::duration<double>(pushed - start).count();
         stratmesh::Cloud cloud = {layer_.data(), layer_.size() / 3, 0, stratmesh::Scalar::float64};
+        pushed_ += cloud.count;
         record_.status = stratmesh::stream_push(stream_, cloud, top);
         stream_seconds_ += seconds_since(pushed);
         ++record_.stream_pushes;
@@ -174,7 +199,7 @@ private:
     StreamOutcome close(std::string& error) {
         // The last push's top only bounds its points.
         double last_top = std::isfinite(highest_) ? highest_ : 0;
-        if (points_read_ > 0 && !push(last_top)) return StreamOutcome::refused;
+        if (points_read_ > 0 && !push(last_top)) return stopped(error);
         if (!record_.batch_cuts.empty()) record_.batch_cuts.pop_back();
         Clock::time_point start = Clock::now();
         record_.status =
@@ -250,7 +275,10 @@ private:
     double top_ = LayerTops::kInfinity;
     double highest_ = -LayerTops::kInfinity; // the height of the last finite point
     size_t points_read_ = 0;
+    size_t pushed_ = 0; // points handed to stream_push, refused ones too
     double stream_seconds_ = 0, write_seconds_ = 0;
+    CloudBox box_;             // with --origin: the points pushed so far
+    std::string origin_error_; // why --origin is out of reach
 };
 
 } // namespace

@@ -16,7 +16,8 @@ enum class StreamOutcome {
     done,       // the mesh is written
     refused,    // the library refused the input: record.status says why
     file_error, // reading or writing failed: `error` says what and where
-    unsorted    // a point lies below the one before it along the axis: `error` says which
+    unsorted,   // a point lies below the one before it along the axis: `error` says which
+    usage       // the command line asks for what the cloud cannot give: `error` says what
 };
 
 // Runs the stream with `options` (axis, flags; the origin, unless given, is the first

@@ -1,6 +1,7 @@
 #include "text_scan.h"
 
 #include <charconv>
+#include <cmath>
 #include <cstdlib>
 
 namespace stratmesh_cli {
@@ -28,22 +29,6 @@ bool LineCursor::next(std::string_view& line) {
     return true;
 }
 
-bool TokenCursor::next(std::string_view& token) {
-    size_t line_of_last_token = line_;
-    while (pos_ < text_.size() && (is_blank(text_[pos_]) || text_[pos_] == '\n')) {
-        if (text_[pos_] == '\n') ++line_;
-        ++pos_;
-    }
-    if (pos_ >= text_.size()) {
-        line_ = line_of_last_token; // report the end on the last line with anything
-        return false;
-    }
-    size_t start = pos_;
-    while (pos_ < text_.size() && !is_blank(text_[pos_]) && text_[pos_] != '\n') ++pos_;
-    token = text_.substr(start, pos_ - start);
-    return true;
-}
-
 std::string_view strip_comment(std::string_view line, bool slashes) {
     size_t cut = line.find('#');
     if (slashes) {
@@ -67,22 +52,32 @@ bool next_field(std::string_view& rest, std::string_view& field, bool commas) {
     return true;
 }
 
-bool parse_number(std::string_view token, double& value) {
+NumberParse scan_number(std::string_view token, double& value) {
     // from_chars takes no leading '+'; allow one before a digit or a point.
     if (token.size() > 1 && token[0] == '+' && (is_digit(token[1]) || token[1] == '.'))
         token.remove_prefix(1);
-    if (token.empty()) return false;
+    if (token.empty()) return NumberParse::not_a_number;
     const char* first = token.data();
     const char* last = first + token.size();
     std::from_chars_result r = std::from_chars(first, last, value);
-    if (r.ec == std::errc::result_out_of_range && r.ptr == last) {
-        // Beyond a double's range (or subnormal, for some libraries): strtod rounds to
-        // infinity, zero or the subnormal. The tool never changes the C locale.
-        std::string copy(token);
-        value = std::strtod(copy.c_str(), nullptr);
-        return true;
-    }
-    return r.ec == std::errc() && r.ptr == last;
+    if (r.ptr != last) return NumberParse::not_a_number;
+    if (r.ec == std::errc()) return NumberParse::ok;
+    if (r.ec != std::errc::result_out_of_range) return NumberParse::not_a_number;
+    // from_chars leaves `value` alone out of range; strtod rounds to infinity on overflow
+    // and to zero or a subnormal on underflow. The tool never changes the C locale.
+    std::string copy(token);
+    value = std::strtod(copy.c_str(), nullptr);
+    return std::isinf(value) ? NumberParse::out_of_range : NumberParse::ok;
+}
+
+bool parse_number(std::string_view token, double& value) {
+    return scan_number(token, value) == NumberParse::ok;
+}
+
+std::string_view skip_byte_order_mark(std::string_view text) {
+    if (text.substr(0, kByteOrderMark.size()) == kByteOrderMark)
+        text.remove_prefix(kByteOrderMark.size());
+    return text;
 }
 
 CountParse parse_count(std::string_view token, uint64_t& value) {

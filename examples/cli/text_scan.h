@@ -29,21 +29,6 @@ private:
     size_t line_number_ = 0;
 };
 
-// Walks whitespace-separated tokens across lines, counting lines for error messages.
-class TokenCursor {
-public:
-    TokenCursor(std::string_view text, size_t first_line) : text_(text), line_(first_line) {}
-
-    bool next(std::string_view& token);
-    // The line of the token last returned (or where the text ended).
-    size_t line_number() const { return line_; }
-
-private:
-    std::string_view text_;
-    size_t pos_ = 0;
-    size_t line_;
-};
-
 // Cuts `line` at the first comment marker: '#' always, "//" when `slashes` is set.
 std::string_view strip_comment(std::string_view line, bool slashes);
 
@@ -51,9 +36,23 @@ std::string_view strip_comment(std::string_view line, bool slashes);
 // '\v', '\f', and also of ',' and ';' when `commas` is set. False when none is left.
 bool next_field(std::string_view& rest, std::string_view& field, bool commas);
 
+enum class NumberParse { ok, not_a_number, out_of_range };
+
 // The whole token as a double (decimal or scientific, optional sign, "nan", "inf").
-// Locale-independent. False if any character is left over.
+// Locale-independent. A finite literal beyond the largest double ("1e400", a number of
+// 400 digits) is out_of_range, never infinity; one below the smallest rounds to the
+// nearest double (a subnormal or zero), as any decimal rounds.
+NumberParse scan_number(std::string_view token, double& value);
+
+// scan_number() == ok.
 bool parse_number(std::string_view token, double& value);
+
+// The three bytes of a UTF-8 byte-order mark, which some editors write at the start of a
+// text file.
+constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
+
+// `text` without a leading byte-order mark.
+std::string_view skip_byte_order_mark(std::string_view text);
 
 enum class CountParse { ok, negative, not_a_number, too_large };
 

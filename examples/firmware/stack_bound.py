@@ -3,8 +3,9 @@
 
 Reads the .ci files (VCG graphs: one node per function with its frame size, one edge per
 call site), walks the call graph from each public entry point and prints the deepest path.
-Fails on recursion (a cycle), on a frame of dynamic size, or when an entry point's depth is
-above --limit. Calls out of the library (memcpy, sqrt, frexp, ...: leaf functions of the C
+Fails on recursion (a cycle), on a frame of dynamic size, when an entry point's depth is
+above --limit, or when no function of the graphs is an entry point (the wrong files, or a
+renamed function: nothing would have been checked). Calls out of the library (memcpy, sqrt, frexp, ...: leaf functions of the C
 library) and indirect calls (the caller's progress callback) are listed, not counted: add
 the C library's leaf frames and your callback's depth to the figure.
 
@@ -74,6 +75,9 @@ def main(argv):
     print("calls out of the library (not counted): " + ", ".join(external))
     for entry in ENTRY_POINTS:
         roots = [t for t in frames if re.search(r"(^|:)_ZN9stratmesh%d%sE" % (len(entry), entry), t)]
+        if not roots:
+            print("FAIL: no function in the call graphs is the entry point %s" % entry)
+            status = 1
         for root in roots:
             try:
                 total, path = depth(root)

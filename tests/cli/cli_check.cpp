@@ -153,6 +153,27 @@ std::string truncated_ply() {
     return text + std::string(10 * 12, '\x01');
 }
 
+// Hostile inputs too large to keep as files in tests/cli/hostile: an ascii PLY whose header
+// says 10 vertices over a body of 600, a coordinate of 100,000 digits, and the sorted
+// cylinder with its point 1500 NaN (for --stream's counts after a refusal).
+std::string ply_more_records_than_declared(const std::vector<double>& xyz) {
+    std::string text = "ply\nformat ascii 1.0\nelement vertex 10\nproperty double x\n"
+                       "property double y\nproperty double z\nend_header\n";
+    for (size_t i = 0; i < 600; ++i)
+        text += number_text(xyz[3 * i]) + " " + number_text(xyz[3 * i + 1]) + " " +
+                number_text(xyz[3 * i + 2]) + "\n";
+    return text;
+}
+
+std::string xyz_with_huge_integer() {
+    return "1 2 3\n4 5 6\n7 1" + std::string(100000, '0') + " 9\n";
+}
+
+std::string sorted_with_nan_at(std::vector<double> sorted, size_t index) {
+    for (size_t k = 0; k < 3; ++k) sorted[3 * index + k] = std::nan("");
+    return as_xyz(sorted, 0);
+}
+
 int make_inputs(const std::string& dir) {
     std::error_code ignored;
     std::filesystem::create_directories(dir, ignored);
@@ -175,7 +196,10 @@ int make_inputs(const std::string& dir) {
               write_file(dir + "/cylinder_obj.ply", as_obj(cylinder)) &&
               write_file(dir + "/sorted.xyz", as_xyz(sorted, 0)) &&
               write_file(dir + "/mesh.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 1\n3 0 1 2\n") &&
-              write_file(dir + "/sorted.ply", as_binary_ply(sorted));
+              write_file(dir + "/sorted.ply", as_binary_ply(sorted)) &&
+              write_file(dir + "/more_records.ply", ply_more_records_than_declared(cylinder)) &&
+              write_file(dir + "/huge_integer.xyz", xyz_with_huge_integer()) &&
+              write_file(dir + "/sorted_nan.xyz", sorted_with_nan_at(sorted, 1500));
     if (!ok) std::fprintf(stderr, "cannot write the inputs into %s\n", dir.c_str());
     return ok ? 0 : 1;
 }

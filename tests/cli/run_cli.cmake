@@ -6,6 +6,7 @@
 #   EXPECT_EXIT    the exit code it must return
 #   EXPECT_STDOUT  optional regular expression stdout must match
 #   EXPECT_STDERR  optional regular expression stderr must match
+#   REJECT_STDERR  optional regular expression stderr must not match
 #   CHECKS         optional commands to run afterwards in WORK_DIR, each must exit 0:
 #                  arguments separated by '|', commands by '||'
 file(REMOVE_RECURSE "${WORK_DIR}")
@@ -25,6 +26,10 @@ if(DEFINED EXPECT_STDOUT AND NOT out MATCHES "${EXPECT_STDOUT}")
 endif()
 if(DEFINED EXPECT_STDERR AND NOT err MATCHES "${EXPECT_STDERR}")
   message(FATAL_ERROR "stderr does not match '${EXPECT_STDERR}'")
+endif()
+
+if(DEFINED REJECT_STDERR AND err MATCHES "${REJECT_STDERR}")
+  message(FATAL_ERROR "stderr matches '${REJECT_STDERR}'")
 endif()
 
 if(DEFINED CHECKS AND NOT CHECKS STREQUAL "")

@@ -58,6 +58,7 @@ std::vector<double> quantized(const std::vector<double>& v) {
 }
 
 Fnv1a64 g_input, g_output, g_full_input, g_full;
+size_t g_not_ok = 0; // calls whose status was not ok: each fails the run
 
 // Adds one call's outcome to `output` (its status, triangle count, `counts` and triangles)
 // and prints a line: what ran, on what, and `shown` with its label.
@@ -68,6 +69,7 @@ void record(Fnv1a64& output, const char* call, const char* name, size_t points,
     output.u64(count);
     for (uint64_t c : counts) output.u64(c);
     for (size_t i = 0; i < 3 * count; ++i) output.u32(tris[i]);
+    if (s != stratmesh::Status::ok) ++g_not_ok;
     std::printf("%-11s %-34s %5zu points: %-12s %5zu triangles, %3zu %s\n", call, name, points,
                 s == stratmesh::Status::ok ? "ok" : "NOT OK", count, shown, label);
 }
@@ -172,6 +174,53 @@ void delaunay_case(const char* name, const std::vector<double>& raw) {
                 s == stratmesh::Status::ok ? "ok" : "NOT OK", info.triangle_count);
 }
 
+// find_parting, each part meshed apart (the trunk along z, each branch around its own
+// automatic axis), then join_branches: the joined triangles go into the digest.
+void join_case(const char* name, const std::vector<double>& raw, const stratmesh::Options& o) {
+    std::vector<double> xyz = quantized(raw);
+    for (double d : xyz) g_input.f64(d);
+    const size_t n = xyz.size() / 3;
+    const stratmesh::Cloud cloud = {xyz.data(), n, 0, stratmesh::Scalar::float64};
+    std::vector<unsigned char> work(stratmesh::find_parting_workspace_size(n, o));
+    stratmesh::Parting parting = {};
+    std::vector<uint8_t> label(n, 0);
+    stratmesh::Status s = stratmesh::find_parting(cloud, o, work.data(), work.size(), &parting,
+                                                  label.data());
+    std::vector<uint32_t> all;
+    for (unsigned part = 0; part < 256 && s == stratmesh::Status::ok; ++part) {
+        std::vector<double> points;
+        std::vector<uint32_t> index;
+        for (size_t i = 0; i < n; ++i) {
+            if (label[i] != part) continue;
+            index.push_back(static_cast<uint32_t>(i));
+            points.insert(points.end(), xyz.begin() + static_cast<std::ptrdiff_t>(3 * i),
+                          xyz.begin() + static_cast<std::ptrdiff_t>(3 * i + 3));
+        }
+        if (index.empty()) continue;
+        stratmesh::Options po = o;
+        if (part != stratmesh::kInTrunk) po.axis = stratmesh::Axis::automatic;
+        const stratmesh::Cloud c = {points.data(), index.size(), 0, stratmesh::Scalar::float64};
+        std::vector<unsigned char> space(stratmesh::reconstruct_workspace_size(c.count, po));
+        std::vector<uint32_t> t(3 * stratmesh::reconstruct_max_triangles(c.count, po));
+        size_t count = 0;
+        s = stratmesh::reconstruct(c, po, space.data(), space.size(), t.data(), t.size() / 3,
+                                   &count, nullptr);
+        for (size_t k = 0; k < 3 * count; ++k) all.push_back(index[t[k]]);
+    }
+    const size_t given = all.size() / 3;
+    size_t count = given;
+    stratmesh::JoinReport report = {};
+    if (s == stratmesh::Status::ok) {
+        std::vector<unsigned char> space(stratmesh::join_branches_workspace_size(n, given));
+        all.resize(3 * (given + stratmesh::join_branches_max_triangles(n)));
+        s = stratmesh::join_branches(cloud, o, parting, label.data(), space.data(), space.size(),
+                                     all.data(), all.size() / 3, &count, &report);
+    }
+    record(g_output, "join", name, n, s, all.data(), count,
+           {parting.above_branch_count, parting.below_branch_count, report.joined_side_count},
+           report.joined_side_count, "sides joined");
+}
+
 stratmesh::Options axis_z(uint32_t layers = 0, double height = 0) {
     stratmesh::Options o = {};
     o.axis = stratmesh::Axis::z;
@@ -182,8 +231,12 @@ stratmesh::Options axis_z(uint32_t layers = 0, double height = 0) {
 
 }  // namespace
 
-int main() {
+// With --control-bad-status, a case that cannot succeed is added: the run must then fail,
+// which shows that a bad status does fail it (.ci/arm.sh).
+int main(int argc, char** argv) {
     using shapes::Pose;
+    if (argc > 1 && std::strcmp(argv[1], "--control-bad-status") == 0)
+        reconstruct_case("two points (control: too_few_points)", {0, 0, 0, 1, 1, 1}, axis_z());
     std::vector<double> cyl = shapes::cylinder(3000, Pose::z).xyz;
     reconstruct_case("cylinder, automatic layers", cyl, axis_z());
     reconstruct_case("cylinder, 1 layer", cyl, axis_z(1));
@@ -279,6 +332,22 @@ int main() {
     std::vector<double> dups(random.begin(), random.begin() + 1000);
     dups.insert(dups.end(), random.begin(), random.begin() + 500);
     delaunay_case("500 random points, 250 repeated", dups);
+    // A trunk of radius 10 up to z = 60 and two prongs of radius 3 on its wall above it:
+    // golden-angle spirals.
+    std::vector<double> pronged;
+    const double golden = shapes::kPi * (3 - std::sqrt(5.0));
+    const struct {
+        size_t count;
+        double cx, radius, z0, z1;
+    } spirals[] = {{4200, 0, 10, 0, 60}, {850, -7, 3, 60, 100}, {850, 7, 3, 60, 100}};
+    for (const auto& sp : spirals)
+        for (size_t i = 0; i < sp.count; ++i) {
+            const double t = static_cast<double>(i);
+            pronged.insert(pronged.end(),
+                           {sp.cx + sp.radius * std::cos(golden * t), sp.radius * std::sin(golden * t),
+                            sp.z0 + (sp.z1 - sp.z0) * (t + 0.5) / static_cast<double>(sp.count)});
+        }
+    join_case("pronged tube, 4 trunk layers", pronged, axis_z(4));
 
     std::printf("input  %016llx\n", static_cast<unsigned long long>(g_input.h));
     std::printf("digest %016llx\n", static_cast<unsigned long long>(g_output.h));
@@ -288,5 +357,7 @@ int main() {
 #else
     std::printf("full   not built (STRATMESH_SMALL_CODE)\n");
 #endif
-    return 0;
+    if (g_not_ok == 0) return 0;
+    std::printf("FAIL: %zu calls did not return ok\n", g_not_ok);
+    return 1;
 }

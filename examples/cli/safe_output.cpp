@@ -1,0 +1,240 @@
+#include "safe_output.h"
+
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+
+#ifndef _WIN32
+#include <unistd.h>
+#endif
+
+namespace stratmesh_cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// ---- the temporaries a signal handler removes --------------------------------------------
+// Plain arrays: the handler may only touch memory that is complete whenever it runs.
+
+constexpr int kSlots = 8;
+constexpr size_t kPathBytes = 4096;
+char g_temporary[kSlots][kPathBytes];
+volatile std::sig_atomic_t g_in_use[kSlots];
+
+int remember_temporary(const std::string& path) {
+    if (path.size() >= kPathBytes) return -1;
+    for (int s = 0; s < kSlots; ++s) {
+        if (g_in_use[s]) continue;
+        std::memcpy(g_temporary[s], path.c_str(), path.size() + 1);
+        g_in_use[s] = 1;
+        return s;
+    }
+    return -1;
+}
+
+void forget_temporary(int& slot) {
+    if (slot >= 0) g_in_use[slot] = 0;
+    slot = -1;
+}
+
+extern "C" void remove_temporaries_and_die(int signal_number) {
+    for (int s = 0; s < kSlots; ++s)
+#ifndef _WIN32
+        if (g_in_use[s]) unlink(g_temporary[s]);
+#else
+        if (g_in_use[s]) std::remove(g_temporary[s]);
+#endif
+    std::signal(signal_number, SIG_DFL);
+    std::raise(signal_number);
+}
+
+// ---- names -------------------------------------------------------------------------------
+
+// Six letters that differ between calls and between processes; a clash only costs a retry
+// (the temporary is created exclusively).
+std::string unique_suffix() {
+    static uint64_t counter = 0;
+    uint64_t x = static_cast<uint64_t>(
+                     std::chrono::steady_clock::now().time_since_epoch().count()) ^
+                 (++counter * 0x9E3779B97F4A7C15ull) ^
+                 static_cast<uint64_t>(reinterpret_cast<uintptr_t>(&counter));
+#ifndef _WIN32
+    x ^= static_cast<uint64_t>(getpid()) << 32;
+#endif
+    std::string suffix;
+    for (int k = 0; k < 6; ++k) {
+        x ^= x >> 29;
+        x *= 0xBF58476D1CE4E5B9ull;
+        x ^= x >> 32;
+        suffix += "abcdefghijklmnopqrstuvwxyz0123456789"[x % 36];
+    }
+    return suffix;
+}
+
+// Creates a new file, exclusively, named after `target` in its directory: a hidden name
+// (".NAME.stratmesh-XXXXXX") that no reader takes for the finished file. The name goes into
+// `temporary` and into the signal handler's table (`slot`) before the file exists.
+std::FILE* create_beside(const std::string& target, const char* mode, std::string& temporary,
+                         int& slot) {
+    const fs::path where(target);
+    fs::path directory = where.parent_path();
+    if (directory.empty()) directory = ".";
+    const std::string name = where.filename().string();
+    for (int attempt = 0; attempt < 100; ++attempt) {
+        temporary = (directory / ("." + name + ".stratmesh-" + unique_suffix())).string();
+        slot = remember_temporary(temporary);
+        std::FILE* file = std::fopen(temporary.c_str(), mode);
+        if (file) return file;
+        const int failure = errno;
+        forget_temporary(slot);
+        if (failure != EEXIST) {
+            errno = failure;
+            return nullptr;
+        }
+    }
+    errno = EEXIST;
+    return nullptr;
+}
+
+// Whether two paths name the same file, or would once created.
+bool same_file(const std::string& a, const std::string& b) {
+    std::error_code ea, eb;
+    const bool a_exists = fs::exists(a, ea), b_exists = fs::exists(b, eb);
+    if (a_exists && b_exists) {
+        std::error_code e;
+        return fs::equivalent(a, b, e) && !e;
+    }
+    if (a_exists || b_exists) return false;
+    const fs::path pa(a), pb(b);
+    if (pa.filename() != pb.filename()) return false;
+    fs::path da = pa.parent_path(), db = pb.parent_path();
+    if (da.empty()) da = ".";
+    if (db.empty()) db = ".";
+    std::error_code e;
+    return fs::equivalent(da, db, e) && !e;
+}
+
+} // namespace
+
+bool check_distinct_files(const std::vector<NamedFile>& files, std::string& error) {
+    for (size_t j = 1; j < files.size(); ++j) {
+        for (size_t i = 0; i < j; ++i) {
+            if (files[i].path.empty() || files[j].path.empty() ||
+                !same_file(files[i].path, files[j].path))
+                continue;
+            error = files[j].option + " '" + files[j].path + "' is the same file as " +
+                    files[i].option + " '" + files[i].path + "': give " + files[j].option +
+                    " another path";
+            return false;
+        }
+    }
+    return true;
+}
+
+AtomicFile::~AtomicFile() { discard(); }
+
+bool AtomicFile::open(const std::string& path, std::string& error) {
+    discard();
+    path_ = target_ = path;
+    std::error_code e;
+    const fs::file_status status = fs::status(path, e);
+    int failure = 0;
+    if (fs::is_directory(status)) {
+        failure = EISDIR;
+    } else if (fs::exists(status) && !fs::is_regular_file(status)) {
+        file_ = std::fopen(path.c_str(), "wb");
+        if (!file_) failure = errno;
+    } else {
+        if (fs::exists(status)) {
+            const fs::path resolved = fs::canonical(path, e);
+            if (!e) target_ = resolved.string();
+#ifndef _WIN32
+            // Renaming would replace a file that may not be written.
+            if (access(target_.c_str(), W_OK) != 0) failure = errno;
+#endif
+        }
+        if (failure == 0) file_ = create_beside(target_, "wbx", temporary_, slot_);
+        if (!file_ && failure == 0) failure = errno;
+    }
+    if (file_) return true;
+    error = path + ": cannot create: " + std::strerror(failure);
+    temporary_.clear();
+    return false;
+}
+
+bool AtomicFile::commit(int failure, std::string& error) {
+    if (!file_) {
+        error = path_ + ": cannot write: the file is not open";
+        return false;
+    }
+    if (std::fflush(file_) != 0 && failure == 0) failure = errno;
+#ifndef _WIN32
+    // On the disk before the rename: after a power cut the name holds the old file or the
+    // new one, never an empty one (some file systems commit a rename before the data).
+    if (!temporary_.empty() && failure == 0 && fsync(fileno(file_)) != 0) failure = errno;
+#endif
+    if (std::fclose(file_) != 0 && failure == 0) failure = errno;
+    file_ = nullptr;
+    if (failure == 0 && !temporary_.empty()) {
+        std::error_code e;
+        const fs::file_status old = fs::status(target_, e);
+        if (fs::is_regular_file(old)) fs::permissions(temporary_, old.permissions(), e);
+        e.clear();
+        fs::rename(temporary_, target_, e);
+        if (e) failure = e.value();
+        if (!e) {
+            temporary_.clear();
+            forget_temporary(slot_);
+        }
+    }
+    if (failure == 0) return true;
+    error = path_ + ": cannot write: " + std::strerror(failure);
+    discard();
+    return false;
+}
+
+void AtomicFile::discard() {
+    if (file_) std::fclose(file_);
+    file_ = nullptr;
+    if (!temporary_.empty()) std::remove(temporary_.c_str());
+    temporary_.clear();
+    forget_temporary(slot_);
+}
+
+std::FILE* scratch_file_beside(const std::string& path, std::string& error) {
+    std::error_code e;
+    const fs::file_status status = fs::status(path, e);
+    std::FILE* file = nullptr;
+#ifndef _WIN32
+    if (!fs::exists(status) || fs::is_regular_file(status)) {
+        // Beside the destination: on its file system, not on a /tmp that may be smaller.
+        std::string temporary;
+        int slot = -1;
+        const fs::path resolved = fs::exists(status) ? fs::canonical(path, e) : fs::path(path);
+        file = create_beside(e ? path : resolved.string(), "wb+x", temporary, slot);
+        if (file) unlink(temporary.c_str());
+        forget_temporary(slot);
+    } else
+#endif
+    {
+        // A device or a pipe has no directory of its own to write in.
+        file = std::tmpfile();
+    }
+    if (!file) error = path + ": cannot create a temporary file beside it: " + std::strerror(errno);
+    return file;
+}
+
+void install_output_signal_handlers() {
+    for (int signal_number : {SIGINT, SIGTERM})
+        std::signal(signal_number, remove_temporaries_and_die);
+#ifndef _WIN32
+    std::signal(SIGHUP, remove_temporaries_and_die);
+    std::signal(SIGXFSZ, SIG_IGN);
+#endif
+}
+
+} // namespace stratmesh_cli

@@ -1,0 +1,120 @@
+# Output that never destroys data, end to end.
+#
+#   TOOL      the stratmesh tool
+#   INPUTS    the directory make-inputs filled
+#   TINY      a 4-point PLY (its mesh about 300 bytes, its report over 2 KB)
+#   WORK_DIR  emptied and used as the working directory
+#
+# 1. Each pair of the input, -o and --report naming one file (the same path, or a symlink
+#    to it) is refused with exit 2 and a message naming both options, and every file in the
+#    directory keeps its bytes.
+# 2. A write that fails leaves the old output and no temporary: -o through a symlink to
+#    /dev/full (a device, written directly and left a device), and a file size limit
+#    (ulimit -f, which binds root too) on the mesh, on the report and on --stream's
+#    output. The controls: the same runs without the failure write the files.
+file(REMOVE_RECURSE "${WORK_DIR}")
+file(MAKE_DIRECTORY "${WORK_DIR}")
+file(COPY "${INPUTS}/sorted.ply" DESTINATION "${WORK_DIR}")
+file(CREATE_LINK sorted.ply "${WORK_DIR}/link.ply" SYMBOLIC)
+file(WRITE "${WORK_DIR}/old.ply" "the old mesh")
+file(WRITE "${WORK_DIR}/old.json" "the old report")
+file(COPY "${TINY}" DESTINATION "${WORK_DIR}")
+get_filename_component(tiny "${TINY}" NAME)
+file(CREATE_LINK old.ply "${WORK_DIR}/old_link.ply" SYMBOLIC)
+
+function(fail message)
+  message(FATAL_ERROR "${message}")
+endfunction()
+
+# The directory's names and their contents' hashes, to compare before and after a run.
+function(snapshot out)
+  file(GLOB names RELATIVE "${WORK_DIR}" "${WORK_DIR}/*" "${WORK_DIR}/.*")
+  list(SORT names)
+  set(state "")
+  foreach(name IN LISTS names)
+    if(IS_SYMLINK "${WORK_DIR}/${name}")
+      file(READ_SYMLINK "${WORK_DIR}/${name}" target)
+      string(APPEND state "${name}->${target};")
+    else()
+      file(SHA256 "${WORK_DIR}/${name}" hash)
+      string(APPEND state "${name}=${hash};")
+    endif()
+  endforeach()
+  set(${out} "${state}" PARENT_SCOPE)
+endfunction()
+
+# run(EXIT regex args...): the tool in WORK_DIR must exit with EXIT and print `regex`.
+function(run expected_exit regex)
+  execute_process(COMMAND ${ARGN} WORKING_DIRECTORY "${WORK_DIR}"
+    RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  message(STATUS "${ARGN}\n-- exit ${code}: ${err}")
+  if(NOT "${code}" STREQUAL "${expected_exit}")
+    fail("exit ${code}, expected ${expected_exit}: ${ARGN}\n${err}")
+  endif()
+  if(NOT err MATCHES "${regex}")
+    fail("stderr does not match '${regex}': ${ARGN}\n${err}")
+  endif()
+endfunction()
+
+# 1. Two names of one file.
+set(clashes
+  "sorted.ply -o sorted.ply|-o 'sorted.ply' is the same file as the input 'sorted.ply'"
+  "sorted.ply -o link.ply|-o 'link.ply' is the same file as the input 'sorted.ply'"
+  "link.ply -o sorted.ply|-o 'sorted.ply' is the same file as the input 'link.ply'"
+  "sorted.ply -o m.ply --report sorted.ply|--report 'sorted.ply' is the same file as the input"
+  "sorted.ply -o m.ply --report link.ply|--report 'link.ply' is the same file as the input"
+  "sorted.ply -o m.ply --report m.ply|--report 'm.ply' is the same file as -o 'm.ply'"
+  "sorted.ply -o old.ply --report old_link.ply|--report 'old_link.ply' is the same file as -o"
+  "sorted.ply -o m.ply --report ./m.ply --stream --axis z --cuts 50|--report './m.ply' is the same file as -o")
+foreach(clash IN LISTS clashes)
+  string(REPLACE "|" ";" fields "${clash}")
+  list(GET fields 0 args)
+  list(GET fields 1 regex)
+  separate_arguments(args UNIX_COMMAND "${args}")
+  snapshot(before)
+  run(2 "${regex}.*: give .* another path" "${TOOL}" ${args})
+  snapshot(after)
+  if(NOT before STREQUAL after)
+    fail("the files changed:\n${before}\n${after}")
+  endif()
+endforeach()
+
+# 2. Failed writes.
+snapshot(before)
+if(EXISTS /dev/full)
+  file(CREATE_LINK /dev/full "${WORK_DIR}/full.ply" SYMBOLIC)
+  run(3 "full.ply: cannot write: No space left on device" "${TOOL}" sorted.ply -o full.ply -q)
+  run(3 "full.ply: cannot write: No space left on device"
+    "${TOOL}" sorted.ply -o full.ply -q --stream --axis z --cuts 50)
+  file(REMOVE "${WORK_DIR}/full.ply")
+  if(NOT IS_SYMLINK /dev/full AND NOT IS_DIRECTORY /dev/full)
+    execute_process(COMMAND test -c /dev/full RESULT_VARIABLE not_a_device)
+    if(not_a_device)
+      fail("/dev/full is no longer a device")
+    endif()
+  endif()
+endif()
+# A limit of 64 blocks of 512 bytes: the sorted cylinder's mesh takes about 120 KB.
+set(limited sh -c "ulimit -f 64 && exec \"$@\"" limited "${TOOL}")
+run(3 "old.ply: cannot write: File too large" ${limited} sorted.ply -o old.ply -q)
+run(3 "old.ply: cannot write: File too large" ${limited} sorted.ply -o old.ply -q --ascii)
+run(3 "old.ply: cannot write: File too large"
+  ${limited} sorted.ply -o old.ply -q --stream --axis z --cuts 50)
+# The tiny mesh fits in 1 block, its report does not.
+set(limited_1 sh -c "ulimit -f 1 && exec \"$@\"" limited "${TOOL}")
+run(3 "old.json: cannot write: File too large" ${limited_1} ${tiny} -o tiny.ply -q --report old.json)
+file(REMOVE "${WORK_DIR}/tiny.ply")
+snapshot(after)
+if(NOT before STREQUAL after)
+  fail("a failed write changed the files or left a temporary:\n${before}\n${after}")
+endif()
+# The control: without the limit the same runs write the mesh and the report.
+run(0 "" "${TOOL}" sorted.ply -o old.ply -q --report r.json)
+file(SIZE "${WORK_DIR}/old.ply" mesh_bytes)
+if(mesh_bytes LESS 1000 OR NOT EXISTS "${WORK_DIR}/r.json")
+  fail("the control run did not replace old.ply (${mesh_bytes} bytes) or write r.json")
+endif()
+file(GLOB left "${WORK_DIR}/.*stratmesh*")
+if(left)
+  fail("temporaries left behind: ${left}")
+endif()

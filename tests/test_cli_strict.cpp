@@ -1,0 +1,405 @@
+// Tests of the tool's guarantees about files: output that never destroys data
+// (safe_output.h), readers that refuse a body disagreeing with its header and say where
+// (cloud_io.h), and a round trip through every input format and encoding the tool reads.
+#include <doctest/doctest.h>
+
+#include "args.h"
+#include "cloud_io.h"
+#include "frame_check.h"
+#include "safe_output.h"
+
+#include <cerrno>
+#include <cstdint>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace stratmesh_cli;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct ScratchDir {
+    fs::path path;
+    ScratchDir() {
+        path = fs::temp_directory_path() /
+               ("stratmesh_cli_strict_" + std::to_string(std::random_device{}()) + "_" +
+                std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
+        fs::create_directories(path);
+    }
+    ~ScratchDir() {
+        std::error_code ignored;
+        fs::remove_all(path, ignored);
+    }
+    std::string file(const std::string& name) const { return (path / name).string(); }
+    size_t entries() const {
+        return static_cast<size_t>(
+            std::distance(fs::directory_iterator(path), fs::directory_iterator()));
+    }
+};
+
+void save(const std::string& path, const std::string& bytes) {
+    std::ofstream out(path, std::ios::binary);
+    out << bytes;
+}
+
+std::string load(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+bool contains(const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+}
+
+} // namespace
+
+// ==== output that never destroys data =====================================================
+
+TEST_CASE("two names of one file are refused, through symlinks and hard links") {
+    ScratchDir dir;
+    save(dir.file("scan.ply"), "points");
+    fs::create_symlink("scan.ply", dir.file("link.ply"));
+    fs::create_hard_link(dir.file("scan.ply"), dir.file("hard.ply"));
+    fs::create_directory(dir.file("sub"));
+    const std::string scan = dir.file("scan.ply");
+    const std::string around = dir.file("sub/../scan.ply");
+    const struct {
+        std::vector<NamedFile> files;
+        const char* message; // empty: distinct
+    } cases[] = {
+        {{{"the input", scan}, {"-o", scan}}, "-o '"},
+        {{{"the input", scan}, {"-o", dir.file("link.ply")}}, "-o '"},
+        {{{"the input", scan}, {"-o", dir.file("hard.ply")}}, "-o '"},
+        {{{"the input", scan}, {"-o", around}}, "-o '"},
+        {{{"the input", scan}, {"-o", dir.file("m.ply")}, {"--report", scan}}, "--report '"},
+        {{{"the input", scan}, {"-o", dir.file("m.ply")}, {"--report", dir.file("m.ply")}},
+         "is the same file as -o"},
+        // Neither exists yet: the same directory and name.
+        {{{"the input", scan}, {"-o", dir.file("new.ply")}, {"--report", dir.file("sub/../new.ply")}},
+         "is the same file as -o"},
+        {{{"the input", scan}, {"-o", dir.file("m.ply")}, {"--report", dir.file("r.json")}}, ""},
+        {{{"the input", scan}, {"-o", dir.file("m.ply")}, {"--report", ""}}, ""},
+        {{{"the input", scan}, {"-o", dir.file("sub/scan.ply")}}, ""},
+    };
+    for (const auto& c : cases) {
+        std::string error;
+        const bool distinct = check_distinct_files(c.files, error);
+        CAPTURE(error);
+        CHECK(distinct == (c.message[0] == 0));
+        if (!distinct) {
+            CHECK(contains(error, c.message));
+            CHECK(contains(error, "another path"));
+        }
+    }
+}
+
+TEST_CASE("the command line's files are the input, -o and --report") {
+    CommandLine line;
+    std::string error;
+    const char* argv[] = {"stratmesh", "in.ply", "-o", "out.ply", "--report", "r.json"};
+    REQUIRE(parse_command_line(6, argv, line, error) == CommandAction::run);
+    std::vector<NamedFile> files = named_files(line);
+    REQUIRE(files.size() == 3);
+    CHECK(files[0].path == "in.ply");
+    CHECK(files[1].option == "-o");
+    CHECK(files[2].path == "r.json");
+}
+
+TEST_CASE("an atomic file appears only when committed, keeping the old one until then") {
+    ScratchDir dir;
+    const std::string path = dir.file("m.ply");
+    save(path, "old");
+    fs::permissions(path, fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+    {
+        AtomicFile file;
+        std::string error;
+        REQUIRE(file.open(path, error));
+        std::fputs("new", file.file());
+        std::fflush(file.file());
+        CHECK(load(path) == "old");
+        CHECK(dir.entries() == 2);
+        REQUIRE(file.commit(0, error));
+    }
+    CHECK(load(path) == "new");
+    CHECK(dir.entries() == 1);
+    CHECK((fs::status(path).permissions() & fs::perms::all) ==
+          (fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read));
+}
+
+TEST_CASE("a failed write leaves the old file and no temporary") {
+    ScratchDir dir;
+    const std::string path = dir.file("m.ply");
+    save(path, "old");
+    SUBCASE("a write that failed (the disk full)") {
+        AtomicFile file;
+        std::string error;
+        REQUIRE(file.open(path, error));
+        std::fputs("partial", file.file());
+        CHECK_FALSE(file.commit(ENOSPC, error));
+        CHECK(error == path + ": cannot write: " + std::strerror(ENOSPC));
+    }
+    SUBCASE("abandoned (an error elsewhere)") {
+        AtomicFile file;
+        std::string error;
+        REQUIRE(file.open(path, error));
+        std::fputs("partial", file.file());
+    }
+    CHECK(load(path) == "old");
+    CHECK(dir.entries() == 1);
+}
+
+TEST_CASE("a symlinked destination is replaced at its target; a device is written directly") {
+    ScratchDir dir;
+    save(dir.file("real.ply"), "old");
+    fs::create_symlink("real.ply", dir.file("link.ply"));
+    AtomicFile file;
+    std::string error;
+    REQUIRE(file.open(dir.file("link.ply"), error));
+    std::fputs("new", file.file());
+    REQUIRE(file.commit(0, error));
+    CHECK(fs::is_symlink(dir.file("link.ply")));
+    CHECK(load(dir.file("real.ply")) == "new");
+    CHECK(dir.entries() == 2);
+#ifndef _WIN32
+    if (fs::exists("/dev/full")) {
+        AtomicFile full;
+        REQUIRE(full.open("/dev/full", error));
+        std::fputs("anything", full.file());
+        CHECK_FALSE(full.commit(0, error));
+        CHECK(contains(error, "/dev/full: cannot write"));
+        CHECK(fs::is_character_file("/dev/full"));
+    }
+#endif
+}
+
+TEST_CASE("a destination that cannot be created says so") {
+    ScratchDir dir;
+    AtomicFile file;
+    std::string error;
+    CHECK_FALSE(file.open(dir.file("no/such/dir/m.ply"), error));
+    CHECK(contains(error, "no/such/dir/m.ply: cannot create"));
+    CHECK_FALSE(file.open(dir.path.string(), error));
+    CHECK(contains(error, "cannot create"));
+    CHECK(dir.entries() == 0);
+}
+
+TEST_CASE("a scratch file beside the destination leaves no name behind") {
+    ScratchDir dir;
+    std::string error;
+    std::FILE* scratch = scratch_file_beside(dir.file("m.ply"), error);
+    REQUIRE(scratch);
+    CHECK(std::fputs("body", scratch) >= 0);
+    std::rewind(scratch);
+    char back[5] = {};
+    CHECK(std::fread(back, 1, 4, scratch) == 4);
+    CHECK(std::string(back) == "body");
+#ifndef _WIN32
+    CHECK(dir.entries() == 0);
+#endif
+    std::fclose(scratch);
+    CHECK(dir.entries() == 0);
+}
+
+// ==== the frame the command line asks for =================================================
+
+TEST_CASE("a direction of any finite non-zero length normalises without overflow") {
+    const double cases[][3] = {{1e308, 0, 0},          {1e-320, 0, 0},     {1e308, 1e308, 1e308},
+                               {-4.9e-324, 4.9e-324, 0}, {3, -4, 0},       {1e308, 1e-320, -1}};
+    for (const auto& c : cases) {
+        double v[3] = {c[0], c[1], c[2]};
+        REQUIRE(normalise_direction(v));
+        const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        CHECK(length == doctest::Approx(1).epsilon(1e-15));
+        // A component far below the largest may vanish; the others keep their signs.
+        for (size_t k = 0; k < 3; ++k)
+            if (v[k] != 0) CHECK((v[k] > 0) == (c[k] > 0));
+    }
+    double v[3] = {3, -4, 0};
+    REQUIRE(normalise_direction(v));
+    CHECK(v[0] == doctest::Approx(0.6));
+    CHECK(v[1] == doctest::Approx(-0.8));
+    double zero[3] = {0, 0, -0.0};
+    CHECK_FALSE(normalise_direction(zero));
+    double inf[3] = {INFINITY, 0, 0};
+    CHECK_FALSE(normalise_direction(inf));
+}
+
+TEST_CASE("an origin too far from the cloud is refused, naming --origin") {
+    const double cloud[] = {0, 0, 0, 100, 0, 0, 0, 50, 10};
+    CloudBox box;
+    std::string error;
+    const double none[3] = {1e300, 0, 0};
+    CHECK(box.origin_in_reach(none, error)); // nothing seen yet
+    box.add(cloud, 3);
+    const double near[3] = {50, 25, -1e9};
+    CHECK(box.origin_in_reach(near, error));
+    const double edge[3] = {100 + 100 * kOriginReach, 0, 0};
+    CHECK(box.origin_in_reach(edge, error));
+    const double beyond[3] = {100 + 101 * kOriginReach, 0, 0};
+    CHECK_FALSE(box.origin_in_reach(beyond, error));
+    CHECK(contains(error, "--origin"));
+    const double far[3] = {-1e300, 0, 0};
+    CHECK_FALSE(box.origin_in_reach(far, error));
+    CHECK(contains(error, "lies 1e+300 from the cloud, which spans 100"));
+    const double skipped[] = {NAN, 1e300, 0};
+    box.add(skipped, 1); // not finite: not part of the box
+    CHECK_FALSE(box.origin_in_reach(far, error));
+}
+
+// ==== round trip through every format and encoding ========================================
+
+namespace {
+
+// Coordinates every format holds exactly: small integers for the integer types, floats for
+// float, any double for double and for text written with %.17g.
+enum class Kind { int8, int16, int32, float32, float64 };
+
+std::vector<double> round_trip_points(Kind kind, size_t count) {
+    std::mt19937_64 random(20240611 + static_cast<unsigned>(kind));
+    std::vector<double> xyz;
+    for (size_t i = 0; i < 3 * count; ++i) {
+        const double u = std::ldexp(static_cast<double>(random() >> 11), -53) * 2 - 1;
+        switch (kind) {
+        case Kind::int8: xyz.push_back(std::floor(u * 127)); break;
+        case Kind::int16: xyz.push_back(std::floor(u * 32767)); break;
+        case Kind::int32: xyz.push_back(std::floor(u * 2147483647.0)); break;
+        case Kind::float32: xyz.push_back(static_cast<double>(static_cast<float>(std::ldexp(u, static_cast<int>(i % 40) - 20)))); break;
+        case Kind::float64: xyz.push_back(std::ldexp(u, static_cast<int>(i % 600) - 300)); break;
+        }
+    }
+    return xyz;
+}
+
+std::string text_number(double v) {
+    char text[40];
+    std::snprintf(text, sizeof text, "%.17g", v);
+    return text;
+}
+
+void append_bytes(std::string& out, const void* p, size_t n, bool big_endian) {
+    const unsigned char* b = static_cast<const unsigned char*>(p);
+    const uint16_t probe = 1;
+    const bool host_little = *reinterpret_cast<const unsigned char*>(&probe) == 1;
+    for (size_t i = 0; i < n; ++i) out += static_cast<char>(b[host_little == big_endian ? n - 1 - i : i]);
+}
+
+void append_binary(std::string& out, double v, Kind kind, bool big_endian) {
+    switch (kind) {
+    case Kind::int8: { const int8_t x = static_cast<int8_t>(v); append_bytes(out, &x, 1, big_endian); break; }
+    case Kind::int16: { const int16_t x = static_cast<int16_t>(v); append_bytes(out, &x, 2, big_endian); break; }
+    case Kind::int32: { const int32_t x = static_cast<int32_t>(v); append_bytes(out, &x, 4, big_endian); break; }
+    case Kind::float32: { const float x = static_cast<float>(v); append_bytes(out, &x, 4, big_endian); break; }
+    case Kind::float64: append_bytes(out, &v, 8, big_endian); break;
+    }
+}
+
+const char* ply_type(Kind kind) {
+    const char* names[] = {"char", "short", "int", "float", "double"};
+    return names[static_cast<int>(kind)];
+}
+
+// The cloud as a PLY file with a face element after the vertices (checked, left out).
+std::string as_ply(const std::vector<double>& xyz, Kind kind, const char* encoding) {
+    const size_t n = xyz.size() / 3;
+    std::string out = std::string("ply\nformat ") + encoding + " 1.0\nelement vertex " +
+                      std::to_string(n) + "\n";
+    for (const char* axis : {"x", "y", "z"}) out += std::string("property ") + ply_type(kind) + " " + axis + "\n";
+    out += "property uchar red\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    const bool ascii = std::string(encoding) == "ascii";
+    const bool big = std::string(encoding) == "binary_big_endian";
+    for (size_t i = 0; i < n; ++i) {
+        for (size_t k = 0; k < 3; ++k) {
+            if (ascii) out += (k ? " " : "") + text_number(xyz[3 * i + k]);
+            else append_binary(out, xyz[3 * i + k], kind, big);
+        }
+        if (ascii) out += " 200\n";
+        else out += static_cast<char>(200);
+    }
+    if (ascii) return out + "3 0 1 2\n";
+    out += static_cast<char>(3);
+    for (int32_t corner : {0, 1, 2}) append_bytes(out, &corner, 4, big);
+    return out;
+}
+
+std::string as_text(const std::vector<double>& xyz, const std::string& head, const char* prefix,
+                    const char* separator, const std::string& tail) {
+    std::string out = head;
+    for (size_t i = 0; i < xyz.size() / 3; ++i) {
+        out += prefix;
+        for (size_t k = 0; k < 3; ++k) out += (k ? separator : "") + text_number(xyz[3 * i + k]);
+        out += "\n";
+    }
+    return out + tail;
+}
+
+} // namespace
+
+TEST_CASE("every format and encoding reads back the points written, bit for bit") {
+    const size_t n = 50;
+    const Kind kinds[] = {Kind::int8, Kind::int16, Kind::int32, Kind::float32, Kind::float64};
+    std::vector<std::pair<std::string, std::string>> files; // name, bytes
+    std::vector<std::vector<double>> expected;
+    for (Kind kind : kinds) {
+        const std::vector<double> xyz = round_trip_points(kind, n);
+        for (const char* encoding : {"ascii", "binary_little_endian", "binary_big_endian"}) {
+            files.push_back({std::string("PLY ") + encoding + " " + ply_type(kind), as_ply(xyz, kind, encoding)});
+            expected.push_back(xyz);
+        }
+    }
+    const std::vector<double> xyz = round_trip_points(Kind::float64, n);
+    const std::string count = std::to_string(n);
+    const std::pair<std::string, std::string> text_files[] = {
+        {"XYZ", as_text(xyz, "", "", " ", "")},
+        {"CSV", as_text(xyz, "x,y,z\n", "", ",", "")},
+        {"PTS", as_text(xyz, count + "\n", "", " ", "")},
+        {"OFF", as_text(xyz, "OFF\n" + count + " 1 0\n", "", " ", "3 0 1 2\n")},
+        {"OBJ", as_text(xyz, "o cloud\n", "v ", " ", "f 1 2 3\n")}};
+    for (const auto& f : text_files) {
+        files.push_back(f);
+        expected.push_back(xyz);
+    }
+    ScratchDir dir;
+    for (size_t i = 0; i < files.size(); ++i) {
+        CAPTURE(files[i].first);
+        for (bool streamed : {false, true}) {
+            CAPTURE(streamed);
+            if (streamed && files[i].first == "OFF") continue; // not readable point by point
+            std::vector<double> got;
+            std::string error;
+            CloudInfo info;
+            bool ok = false;
+            uint64_t faces_seen = 0;
+            if (!streamed) {
+                ok = read_cloud_from_memory(files[i].second.data(), files[i].second.size(),
+                                            CloudFormat::automatic, got, error, &info);
+                faces_seen = info.faces_ignored;
+            } else {
+                const std::string path = dir.file("cloud_" + std::to_string(i));
+                save(path, files[i].second);
+                std::unique_ptr<PointReader> reader = open_point_reader(path, info, error);
+                REQUIRE_MESSAGE(reader, error);
+                double p[3];
+                while (reader->next(p, error)) got.insert(got.end(), p, p + 3);
+                ok = error.empty();
+                faces_seen = reader->faces_ignored();
+            }
+            REQUIRE_MESSAGE(ok, error);
+            REQUIRE(got.size() == expected[i].size());
+            CHECK(std::memcmp(got.data(), expected[i].data(), got.size() * sizeof(double)) == 0);
+            const bool faces = files[i].first.rfind("PLY", 0) == 0 || files[i].first == "OFF" ||
+                               files[i].first == "OBJ";
+            CHECK(faces_seen == (faces ? 1u : 0u));
+        }
+    }
+}

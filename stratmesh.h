@@ -408,6 +408,13 @@ enum Flags : uint32_t {
     // across (README, Known limitations). A build with STRATMESH_SMALL_CODE, which has no
     // closed ends, ignores it.
     open_ends = 1u << 5,
+    // reconstruct() meshes the cloud as one tube without looking for where it parts into
+    // branches (see PartCounts): the search's time saved, the paper's single column.
+    one_tube = 1u << 6,
+    // reconstruct() keeps the trunk and branches meshed apart even where a side could not
+    // be joined or points past a cut belong to no branch (left apart or unused, as
+    // Report::parts says), instead of meshing the cloud as one tube then.
+    keep_parts = 1u << 7,
 };
 
 // Phases reported to Options::progress, in the order they run. Each layer is stitched to
@@ -491,6 +498,87 @@ struct LayerInfo {
     uint32_t closed_ends;    // ClosedEnd bits: which of the layer's ends closes the surface
 };
 
+// ==== Where the cloud parts ================================================================
+
+// The most branches a side can hold: each counts with a twentieth of the side's points.
+const uint32_t kMaxBranches = 20;
+// The fewest points a branch holds.
+const uint32_t kSmallestBranch = 64;
+// The gap, in median nearest-neighbour distances.
+const double kPartingGap = 4.0;
+
+struct Parting {
+    double gap;               // the linking distance, in the cloud's units; 0 if the cloud
+                              // has no scale (too many points without a neighbour in the
+                              // grid, as drop_outliers measures it): nothing is found then
+    double axis[3];           // unit axis used, as Report::axis
+    // The lowest cut, as dot(point, axis), above which the points part into
+    // above_branch_count branches (0: no cut where they do; `above` is then 0).
+    double above;
+    uint32_t above_branch_count;
+    // The highest cut below which the points part into below_branch_count branches.
+    double below;
+    uint32_t below_branch_count;
+    // The branches' point counts, largest first (above_branch_count and below_branch_count of them).
+    uint32_t above_point_counts[kMaxBranches];
+    uint32_t below_point_counts[kMaxBranches];
+    size_t workspace_used_bytes;    // peak workspace bytes, from the start of the buffer
+    const char* detail;       // a static sentence on why, when the call failed or, with
+                              // ok, searched nothing (a cloud without a scale, gap 0; one
+                              // too crowded to search: see kPartingChecksPerPoint in the
+                              // implementation)
+};
+
+// Labels of find_parting()'s branch_of: a point in no branch (the trunk, a NaN point, every
+// point where the cloud does not part), in the k-th branch above the cut (k from 0, largest
+// first: kFirstAboveBranch + k) or below it (kFirstBelowBranch + k), or beyond a cut but in
+// no branch (a piece left aside: apart from the cut, or too small to count and more than a
+// gap from it). A piece beyond the cut that is no branch but starts within a gap of it
+// (the top of a crown between horns, cut just below) is the trunk's: kInTrunk.
+const uint8_t kInTrunk = 0;
+const uint8_t kFirstAboveBranch = 1;
+const uint8_t kFirstBelowBranch = 1 + kMaxBranches;
+const uint8_t kBeyondBranches = 255;
+
+// How reconstruct() met a cloud that parts into branches (PartCounts::outcome).
+enum class PartsOutcome : uint32_t {
+    one_tube = 0,  // one tube through every point: nothing parts, or the one_tube flag
+    joined,        // the trunk and its branches meshed apart and joined into one surface
+    kept_apart,    // with keep_parts: meshed apart, kept though not all joined
+    undone,        // meshed apart, but a side could not be joined, a part was refused or
+                   // points belong to no part: meshed as one tube instead
+};
+
+// One part meshed apart (PartCounts::info).
+struct PartInfo {
+    uint32_t label;          // its points' branch label: kInTrunk, kFirstAboveBranch + k,
+                             // kFirstBelowBranch + k
+    Status status;           // its reconstruction's status (not ok: its points unused)
+    size_t point_count;
+    size_t layer_count;
+    size_t triangle_count;
+    size_t fold_count;
+    size_t merged_end_layer_count;  // the trunk's layers merged into a closed end under its
+                                    // branches (see reconstruct())
+};
+
+// Report::parts.
+struct PartCounts {
+    PartsOutcome outcome;
+    Parting parting;         // where the cloud parts along Report::axis (all zero with the
+                             // one_tube flag)
+    size_t part_count;       // parts meshed apart: the trunk and its branches (0: one tube)
+    size_t joined_side_count;     // sides whose branches were joined (see join_branches())
+    size_t apart_side_count;      // sides left apart
+    size_t grafted_branch_count;  // branches grafted onto the trunk's closed end
+    size_t junction_triangle_count;  // triangles the junctions added
+    size_t removed_triangle_count;   // trunk triangles the grafts took out
+    // Optional per-part details: the caller points `info` at an array of `info_capacity`
+    // entries; the first min(part_count, info_capacity) are filled, the trunk first.
+    PartInfo* info;
+    size_t info_capacity;
+};
+
 // Report::points. in_count = used_count + duplicate_count + rejected_count + unused_count,
 // on every status.
 struct PointCounts {
@@ -545,6 +633,7 @@ struct Report {
     PointCounts points;
     LayerCounts layers;
     CapCounts caps;
+    PartCounts parts;
     Diagnostics diagnostics;
     const char* detail;      // a static sentence on why, when something failed or was dropped
     // The workspace bytes this call used at its peak, counted from the start of the
@@ -770,49 +859,11 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
 // the bundled bust, nor the femur, whose condyles part for only a gap below their notch,
 // as a bump would.
 
-// The most branches a side can hold: each counts with a twentieth of the side's points.
-const uint32_t kMaxBranches = 20;
-// The fewest points a branch holds.
-const uint32_t kSmallestBranch = 64;
-// The gap, in median nearest-neighbour distances.
-const double kPartingGap = 4.0;
-
-struct Parting {
-    double gap;               // the linking distance, in the cloud's units; 0 if the cloud
-                              // has no scale (too many points without a neighbour in the
-                              // grid, as drop_outliers measures it): nothing is found then
-    double axis[3];           // unit axis used, as Report::axis
-    // The lowest cut, as dot(point, axis), above which the points part into
-    // above_branch_count branches (0: no cut where they do; `above` is then 0).
-    double above;
-    uint32_t above_branch_count;
-    // The highest cut below which the points part into below_branch_count branches.
-    double below;
-    uint32_t below_branch_count;
-    // The branches' point counts, largest first (above_branch_count and below_branch_count of them).
-    uint32_t above_point_counts[kMaxBranches];
-    uint32_t below_point_counts[kMaxBranches];
-    size_t workspace_used_bytes;    // peak workspace bytes, from the start of the buffer
-    const char* detail;       // a static sentence on why, when the call failed or, with
-                              // ok, searched nothing (a cloud without a scale, gap 0; one
-                              // too crowded to search: see kPartingChecksPerPoint in the
-                              // implementation)
-};
 
 // Bytes of workspace find_parting() needs for point_count points (about 100 a point);
 // 0 if that is beyond what this platform can address.
 size_t find_parting_workspace_size(size_t point_count, const Options& options);
 
-// Labels of find_parting()'s branch_of: a point in no branch (the trunk, a NaN point, every
-// point where the cloud does not part), in the k-th branch above the cut (k from 0, largest
-// first: kFirstAboveBranch + k) or below it (kFirstBelowBranch + k), or beyond a cut but in
-// no branch (a piece left aside: apart from the cut, or too small to count and more than a
-// gap from it). A piece beyond the cut that is no branch but starts within a gap of it
-// (the top of a crown between horns, cut just below) is the trunk's: kInTrunk.
-const uint8_t kInTrunk = 0;
-const uint8_t kFirstAboveBranch = 1;
-const uint8_t kFirstBelowBranch = 1 + kMaxBranches;
-const uint8_t kBeyondBranches = 255;
 
 // Finds where the cloud parts into branches (see above). options: axis, direction, and
 // the flags skip_invalid_points and drop_outliers (outliers are left out first); the rest
@@ -989,6 +1040,7 @@ const uint32_t kCapSearchCorners = 0;
 const bool kCapFinFlips = false;
 const bool kDropOutliers = false;
 const bool kSurfaceFlips = false;
+const bool kFindParts = false;
 const bool kLocalUnpeel = false;
 const bool kPeelFoldedEnds = false;
 const bool kFoldMerge = false;
@@ -1019,6 +1071,7 @@ const bool kCapFinFlips = true;
 const bool kDropOutliers = true;
 // Layers are flipped on the surface (see "flips on the surface" in >>layer triangulation).
 const bool kSurfaceFlips = true;
+const bool kFindParts = true;
 // A band that folds between peeled loops gets back only the peeled triangles around its
 // folds (see add_group); without it, all of them.
 const bool kLocalUnpeel = true;
@@ -2759,10 +2812,10 @@ inline CellBlock block_around(const GridItem* items, size_t count, size_t member
 // on every k-th point in cell order, at most about kDecileSample of them: a decile needs
 // no more.
 inline double nearest_distance_decile(const CloudReader& reader, const CellScratch& g,
-                                      size_t count, double side) {
+                                      size_t count, double side, size_t most_sampled) {
     const GridItem* items = g.items;
     for (size_t i = 0; i < count; ++i) g.sorted[i] = reader.point(items[i].index);
-    const size_t step = count > kDecileSample ? count / kDecileSample : 1;
+    const size_t step = count > most_sampled ? count / most_sampled : 1;
     size_t histogram[kNearestBins] = {}, sampled = 0;
     for (size_t first = 0; first < count;) {
         size_t last = first;
@@ -2824,7 +2877,7 @@ inline CloudBox box_of(const CloudReader& reader, size_t count) {
 // grid serves. A box wider than the double range (points near +-1e308) gives an infinite
 // side, which is refused: such a cloud has no scale.
 inline double nearest_spacing(const CloudReader& reader, size_t count, const CloudBox& box,
-                              CellScratch& g) {
+                              CellScratch& g, size_t most_sampled) {
     const Vec3 half = scaled(box.high - box.low, 0.5);
     double side = 4 * std::sqrt(dot(half, half)) / std::sqrt(static_cast<double>(box.valid));
     double nearest = 0;
@@ -2838,7 +2891,7 @@ inline double nearest_spacing(const CloudReader& reader, size_t count, const Clo
             side *= shrink > 0.0625 ? shrink : 0.0625;
             continue;
         }
-        nearest = nearest_distance_decile(reader, g, n, side);
+        nearest = nearest_distance_decile(reader, g, n, side, most_sampled);
         side *= 4;
     }
     return nearest;
@@ -2853,7 +2906,7 @@ inline size_t drop_outliers_of(CloudReader& reader, size_t count, unsigned char*
     for (uint32_t round = 0; round < kOutlierRounds; ++round) {
         const CloudBox box = box_of(reader, count);
         if (box.valid < 2 * kOutlierNeighbours) break;
-        const double nearest = nearest_spacing(reader, count, box, g);
+        const double nearest = nearest_spacing(reader, count, box, g, kDecileSample);
         if (!(nearest > 0)) break;
         const size_t n = sort_into_cells(reader, count, box.low, kOutlierReach * nearest, g);
         const GridItem* items = g.items;
@@ -3176,7 +3229,9 @@ inline void plan_layers(const Options& options, double lo, double hi, size_t poi
 //     count-weighted mean of its bins' centroids, give or take three standard errors of
 //     the bin's centroid, so sampling noise alone never cuts) and it is at most kMaxTurns
 //     mean radii
-//     tall (taller layers unroll with distorted aspect);
+//     tall (taller layers unroll with distorted aspect), and it holds at most
+//     kMostLayerPoints points (so that a large cloud comes in layers that a job runner can
+//     triangulate side by side, the same layers whatever the runner);
 //   - a layer that is not is cut in two at the bin boundary where the surface changes
 //     least: the smallest sum of centroid drift and radius change between the two bins
 //     (relative to the radius), plus a penalty where the bins are denser than average, so
@@ -3188,6 +3243,7 @@ inline void plan_layers(const Options& options, double lo, double hi, size_t poi
 
 const uint32_t kProfileSectors = 8;
 const double kCentreDrift = 0.75;
+const size_t kMostLayerPoints = size_t{1} << 17;
 const size_t kPointsPerProfileBin = 256;
 const double kDensityWeight = 0.5;
 
@@ -3285,6 +3341,7 @@ inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_
     cy /= static_cast<double>(points);
     radius /= static_cast<double>(points);
     if (bin_height * (range.end - range.first) > kMaxTurns * radius) return false;
+    if (points > kMostLayerPoints) return false;
     for (uint32_t b = range.first; b < range.end; ++b) {
         // Too few points to say, or an arc rather than a ring (the slanted end of a scan):
         // such a bin's centroid says nothing about where the centre line must run.
@@ -7545,8 +7602,10 @@ inline bool reconstruct_buffers_overlap(const Cloud& cloud, void* workspace,
         byte_range(triangle_count, sizeof(size_t)),
         byte_range(report, sizeof(Report)),
         byte_range(report ? report->layers.info : nullptr,
-                   report ? saturating_product(report->layers.info_capacity, sizeof(LayerInfo)) : 0)};
-    return any_overlap(buffers, 6);
+                   report ? saturating_product(report->layers.info_capacity, sizeof(LayerInfo)) : 0),
+        byte_range(report ? report->parts.info : nullptr,
+                   report ? saturating_product(report->parts.info_capacity, sizeof(PartInfo)) : 0)};
+    return any_overlap(buffers, 7);
 }
 
 inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangles,
@@ -7704,10 +7763,6 @@ inline void describe_layer(const Frame& frame, const Cylinder& cyl, double botto
 
 }  // namespace detail
 
-size_t reconstruct_max_triangles(size_t point_count, const Options& options) {
-    (void)options;
-    return point_count > SIZE_MAX / 2 ? 0 : 2 * point_count;
-}
 
 
 namespace detail {
@@ -8487,64 +8542,7 @@ inline Status resolve_axis(const TubeInput& in, const Options& options, Arena& a
     return Status::ok;
 }
 
-// reconstruct() of one tube; `rep` arrives zeroed but for its layer array.
-// Report::points.unused_count is left to the caller, who derives it so the counts add up on
-// every path.
-inline Status run_reconstruction(const Cloud& cloud, const Options& options, void* workspace,
-                                 size_t workspace_bytes, uint32_t* triangles,
-                                 size_t triangle_capacity, size_t* triangle_count,
-                                 Report& rep) {
-    Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
-                                                triangle_count, workspace, rep);
-    if (status != Status::ok) return status;
-    notify(options, Phase::validate, 0);
-    Arena arena = Arena::over(workspace, workspace_bytes);
-    TubeInput in;
-    Options along;
-    status = read_cloud(cloud, options, arena, rep, in);
-    if (status == Status::ok) status = resolve_axis(in, options, arena, along, rep);
-    if (status == Status::ok)
-        status = mesh_tube(in, along, arena, triangles, triangle_capacity, triangle_count, rep);
-    rep.workspace_used_bytes = arena.peak_from_buffer();
-    return status;
-}
-
 }  // namespace detail
-
-size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
-    const size_t tube = detail::tube_workspace_size(point_count, options);
-    if (tube == 0 || options.axis != Axis::automatic) return tube;
-    // The axis is chosen once the outliers are known, before the tube is planned.
-    detail::Arena arena = detail::Arena::measuring();
-    if (detail::kDropOutliers && (options.flags & drop_outliers))
-        arena.alloc<unsigned char>(point_count / 8 + 1);
-    const size_t axis = detail::axis_workspace_size(point_count, options);
-    if (axis == 0 || axis > SIZE_MAX - arena.required_bytes()) return 0;
-    const size_t choosing = arena.required_bytes() + axis;
-    return choosing > tube ? choosing : tube;
-}
-
-Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
-                   size_t workspace_bytes, uint32_t* triangles, size_t triangle_capacity,
-                   size_t* triangle_count, Report* report) {
-    if (detail::reconstruct_buffers_overlap(cloud, workspace, workspace_bytes, triangles,
-                                            triangle_capacity, triangle_count, report))
-        return Status::invalid_argument;
-    Report local_report;
-    Report& rep = report ? *report : local_report;
-    LayerInfo* layers = report ? report->layers.info : nullptr;
-    size_t layer_capacity = layers ? report->layers.info_capacity : 0;
-    std::memset(&rep, 0, sizeof rep);
-    rep.layers.info = layers;
-    rep.layers.info_capacity = layer_capacity;
-    rep.points.in_count = cloud.count;
-    if (triangle_count) *triangle_count = 0;
-    Status status = detail::run_reconstruction(cloud, options, workspace, workspace_bytes,
-                                               triangles, triangle_capacity, triangle_count,
-                                               rep);
-    rep.points.unused_count = rep.points.in_count - rep.points.used_count - rep.points.duplicate_count - rep.points.rejected_count;
-    return status;
-}
 
 #if !defined(STRATMESH_SMALL_CODE)
 // >>cap ends ================================================================================
@@ -8640,6 +8638,9 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
 namespace detail {
 
 const uint32_t kStepsPerGap = 2;
+// The points the scale (the median distance to the nearest neighbour) is measured on:
+// enough for the median within a few percent.
+const size_t kScaleSample = 2048;
 // The blocks of the grid cells met last, by a hash of the cell: a step's points share
 // cells, and each block costs 18 searches to find.
 const uint32_t kBlockCacheSize = 2048;
@@ -8983,7 +8984,7 @@ inline void split_into_steps(const Local* position, size_t n, double lo, double 
 }
 
 // The median distance from a point to its nearest distinct neighbour, on every k-th point
-// in cell order, at most kDecileSample of them; 0 where more than half find none. The
+// in cell order, at most kScaleSample of them; 0 where more than half find none. The
 // cells are those of side `decile` (nearest_spacing's), within which nine points in ten
 // find theirs; a point looks at kNearestCandidates points at most, its own cell first.
 // Exact where nearest_spacing is not: that one is rounded up to a half-octave, too coarse
@@ -8994,7 +8995,7 @@ inline double median_nearest_distance(const CloudReader& reader, size_t count, c
     const size_t n = sort_into_cells(reader, count, box.low, decile, g);
     const GridItem* items = g.items;
     for (size_t i = 0; i < n; ++i) g.sorted[i] = reader.point(items[i].index);
-    const size_t step = (n + kDecileSample - 1) / kDecileSample;  // at most kDecileSample
+    const size_t step = (n + kScaleSample - 1) / kScaleSample;  // at most kScaleSample
     size_t sampled = 0;
     uint64_t any = 0, every = ~uint64_t{0};
     for (size_t i = 0; i < n; i += step) {
@@ -9034,7 +9035,7 @@ size_t find_parting_workspace_size(size_t point_count, const Options& options) {
     if (options.flags & drop_outliers) arena.alloc<unsigned char>(point_count / 8 + 1);
     const size_t mark = arena.mark();
     detail::allocate_cell_scratch(arena, point_count);  // the outliers' and the scale's grid
-    arena.alloc<detail::GridItem>(2 * detail::kDecileSample);
+    arena.alloc<detail::GridItem>(2 * detail::kScaleSample);
     arena.rewind(mark);
     // Axis::automatic is resolved first, as reconstruct() resolves it.
     arena.alloc<unsigned char>(detail::axis_workspace_size(point_count, options));
@@ -9092,13 +9093,13 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
     const size_t mark = arena.mark();
     CellScratch scale_grid = allocate_cell_scratch(arena, cloud.count);
     if (arena.failed) return finish(out_of_workspace(rep));
-    GridItem* sample = arena.alloc<GridItem>(2 * kDecileSample);
+    GridItem* sample = arena.alloc<GridItem>(2 * kScaleSample);
     if (arena.failed) return finish(out_of_workspace(rep));
     const CloudBox box = box_of(reader, cloud.count);
-    const double decile = nearest_spacing(reader, cloud.count, box, scale_grid);
+    const double decile = nearest_spacing(reader, cloud.count, box, scale_grid, kScaleSample);
     const double spacing = decile > 0 ? median_nearest_distance(reader, cloud.count, box, decile,
                                                                 scale_grid, sample,
-                                                                sample + kDecileSample)
+                                                                sample + kScaleSample)
                                       : 0;
     arena.rewind(mark);
     PartingMemory m;
@@ -9855,7 +9856,466 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
     *triangle_count = kept + r.added_triangle_count;
     return finish(Status::ok);
 }
+
+// >>parts ===================================================================================
+//
+// reconstruct()'s default where the cloud parts into branches (PartCounts). One tube wraps
+// branches and the gaps between them, so where find_parting() finds a cut, the trunk (the
+// points labelled kInTrunk) is meshed along the cloud's axis, each branch as a tube of its
+// own around its own automatic axis, and join_branches() zips them into one surface (caps
+// last, with close_ends, once joined). That is kept only when it is whole: every part
+// meshed, every side joined, every point in a part; otherwise, unless keep_parts, the cloud
+// is meshed as one tube after all (PartsOutcome::undone). A part is meshed in place: the
+// points of the other parts join the outliers in the reader's bitmap, so its triangles
+// index the cloud directly and its frame is the one a copy of its points would get.
+//
+// The search costs about the reconstruction's time again on a cloud that does not part,
+// so a cloud of more than kPartingSample points is searched on a sample first (every k-th
+// kept point) and in full only where the sample parts: a branch of fewer than about
+// kSmallestBranch * n / kPartingSample points can go unseen.
+
+namespace detail {
+
+const size_t kPartingSample = 8192;
+// The trunk's end layer under branches standing on its closed end is merged with the
+// layers next to it until it is this many of their largest radius tall: a closed end
+// projects from a pole one radius in from the end, but at most three quarters of the way
+// into its layer (kPoleDepth), and a thinner end layer puts the pole so near the end that
+// the branches' stumps fold over the crown and their grafts cross the trunk beside them.
+const double kPoleLayerRadii = 4.0 / 3.0;
+
+// The trunk's layers, as many as a tube of `count` points can have (each holds at least
+// kMinLayerPoints but the last).
+inline size_t most_layers(size_t count) { return count / kMinLayerPoints + 2; }
+
+struct PartsMemory {
+    uint8_t* labels;          // find_parting's branch_of for the whole cloud
+    unsigned char* mask;      // the points left out of the part being meshed
+    LayerInfo* layers;        // the trunk's
+    double* cuts;             // the trunk's, merged at its ends (see cuts_for_tall_ends)
+    size_t layer_capacity;
+};
+
+inline bool allocate_parts(PartsMemory& m, size_t count, Arena& arena) {
+    m.labels = arena.alloc<uint8_t>(count);
+    m.mask = arena.alloc<unsigned char>(count / 8 + 1);
+    m.layer_capacity = most_layers(count);
+    m.layers = arena.alloc<LayerInfo>(m.layer_capacity);
+    m.cuts = arena.alloc<double>(m.layer_capacity);
+    return !arena.failed;
+}
+
+// The reader of the part labelled `label`: every other point left out with the outliers.
+inline TubeInput part_input(const TubeInput& whole, const PartsMemory& m, uint8_t label) {
+    const size_t bytes = whole.count / 8 + 1;
+    std::memset(m.mask, 0, bytes);
+    for (size_t i = 0; i < whole.count; ++i)
+        if (m.labels[i] != label) m.mask[i >> 3] |= static_cast<unsigned char>(1u << (i & 7));
+    if (whole.reader.dropped)
+        for (size_t b = 0; b < bytes; ++b) m.mask[b] |= whole.reader.dropped[b];
+    TubeInput in = whole;
+    in.reader.dropped = m.mask;
+    in.sums = sum_cloud(in.reader, in.count);
+    return in;
+}
+
+// Where branches stand on a closed end of the trunk (its end layer at a side that parts
+// is closed, as a skull's crown under horns), the cuts that merge that end layer with the
+// layers next to it until it is kPoleLayerRadii times the largest of their radii tall;
+// false where no end needs it. *merged counts the layers merged away.
+inline bool cuts_for_tall_ends(const PartsMemory& m, size_t n, const Parting& parting,
+                               size_t* cut_count, size_t* merged) {
+    if (n < 2) return false;
+    const LayerInfo* layers = m.layers;
+    size_t first = 0, last = n - 1;  // the layers kept whole: [first, last]
+    if (parting.above_branch_count > 0 && (layers[n - 1].closed_ends & closed_top)) {
+        double radius = layers[last].radius;
+        while (last > 0 && layers[n - 1].top - layers[last].bottom < kPoleLayerRadii * radius) {
+            --last;
+            radius = radius > layers[last].radius ? radius : layers[last].radius;
+        }
+    }
+    if (parting.below_branch_count > 0 && (layers[0].closed_ends & closed_bottom)) {
+        double radius = layers[first].radius;
+        while (first < last && layers[first].top - layers[0].bottom < kPoleLayerRadii * radius) {
+            ++first;
+            radius = radius > layers[first].radius ? radius : layers[first].radius;
+        }
+    }
+    if (first == 0 && last == n - 1) return false;
+    *cut_count = 0;
+    for (size_t k = first; k < last; ++k) m.cuts[(*cut_count)++] = layers[k].top;
+    *merged = n - 1 - *cut_count;
+    return true;
+}
+
+// A part's counts into the whole's report.
+inline void add_part_counts(const Report& part, Report& rep) {
+    rep.points.used_count += part.points.used_count;
+    rep.points.duplicate_count += part.points.duplicate_count;
+    rep.diagnostics.fold_count += part.diagnostics.fold_count;
+    rep.diagnostics.illegal_removed_count += part.diagnostics.illegal_removed_count;
+    rep.diagnostics.diagonal_swap_count += part.diagnostics.diagonal_swap_count;
+}
+
+inline void record_part(Report& rep, uint8_t label, Status status, const TubeInput& in,
+                        const Report& part, size_t triangles, size_t merged) {
+    PartCounts& p = rep.parts;
+    if (p.part_count < p.info_capacity)
+        p.info[p.part_count] = {label, status, in.sums.valid, part.layers.used_count,
+                                status == Status::ok ? triangles : 0,
+                                part.diagnostics.fold_count, merged};
+    ++p.part_count;
+}
+
+// Finds where the cloud parts, on a sample first when it is large (see above); the labels
+// are filled where it parts. False if the workspace is too small.
+inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const Options& along,
+                           const PartsMemory& m, Arena& arena, Parting& parting) {
+    Options search = along;
+    search.flags &= skip_invalid_points | drop_outliers;
+    if (whole.sums.valid > kPartingSample) {
+        const size_t mark = arena.mark();
+        const size_t step = whole.sums.valid / kPartingSample;
+        double* sample = arena.alloc<double>(3 * kPartingSample);
+        if (!sample) return false;
+        size_t taken = 0;
+        for (size_t i = 0, seen = 0; i < whole.count && taken < kPartingSample; ++i) {
+            if (!whole.reader.valid(i) || seen++ % step != 0) continue;
+            const Vec3 p = whole.reader.point(i);
+            sample[3 * taken] = p.x;
+            sample[3 * taken + 1] = p.y;
+            sample[3 * taken + 2] = p.z;
+            ++taken;
+        }
+        Options on_sample = search;
+        on_sample.flags &= ~static_cast<uint32_t>(skip_invalid_points | drop_outliers);
+        const size_t bytes = find_parting_workspace_size(taken, on_sample);
+        void* work = arena.alloc<unsigned char>(bytes);
+        if (!work) return false;
+        const Status status = find_parting({sample, taken, 0, Scalar::float64}, on_sample, work,
+                                           bytes, &parting, nullptr);
+        arena.rewind(mark);
+        if (status != Status::ok || parting.above_branch_count + parting.below_branch_count == 0)
+            return true;
+    }
+    const size_t mark = arena.mark();
+    const size_t bytes = find_parting_workspace_size(cloud.count, search);
+    void* work = arena.alloc<unsigned char>(bytes);
+    if (!work) return false;
+    const Status status = find_parting(cloud, search, work, bytes, &parting, m.labels);
+    arena.rewind(mark);
+    if (status != Status::ok) parting.above_branch_count = parting.below_branch_count = 0;
+    return true;
+}
+
+// The trunk along the cloud's axis, its end layers under branches merged where they stand
+// on a closed end; its triangles start the output.
+inline Status mesh_trunk(const TubeInput& trunk, const Options& along, const Parting& parting,
+                         const PartsMemory& m, Arena& arena, uint32_t* triangles,
+                         size_t capacity, size_t* count, Report& part, size_t* merged) {
+    Options o = along;
+    o.flags &= ~static_cast<uint32_t>(close_ends);
+    part.layers.info = m.layers;
+    part.layers.info_capacity = m.layer_capacity;
+    const size_t mark = arena.mark();
+    Status status = mesh_tube(trunk, o, arena, triangles, capacity, count, part);
+    arena.rewind(mark);
+    size_t cut_count = 0;
+    *merged = 0;
+    if (status != Status::ok || part.layers.used_count > m.layer_capacity ||
+        !cuts_for_tall_ends(m, part.layers.used_count, parting, &cut_count, merged))
+        return status;
+    // Again along the same axis, through the layers' own cuts but those merged.
+    o.axis = Axis::direction;
+    for (int k = 0; k < 3; ++k) o.direction[k] = part.axis[k];
+    o.cuts = m.cuts;
+    o.cut_count = cut_count;
+    o.layer_count = cut_count == 0 ? 1 : 0;
+    o.layer_height = 0;
+    part = Report{};
+    part.layers.info = m.layers;
+    part.layers.info_capacity = m.layer_capacity;
+    status = mesh_tube(trunk, o, arena, triangles, capacity, count, part);
+    arena.rewind(mark);
+    return status;
+}
+
+// Meshes the parts into the output and joins them (then caps them, with close_ends).
+// Returns ok with rep.parts.outcome joined or kept_apart, or ok with outcome undone (the
+// output is then to be made again as one tube); other statuses are errors.
+inline Status mesh_parts(const Cloud& cloud, const TubeInput& whole, const Options& along,
+                         const PartsMemory& m, Arena& arena, uint32_t* triangles,
+                         size_t capacity, size_t* triangle_count, Report& rep) {
+    const Parting& parting = rep.parts.parting;
+    bool whole_split = true;
+    Report trunk_report = {};
+    const TubeInput trunk = part_input(whole, m, kInTrunk);
+    size_t count = 0, merged = 0;
+    Status status = mesh_trunk(trunk, along, parting, m, arena, triangles, capacity, &count,
+                               trunk_report, &merged);
+    record_part(rep, kInTrunk, status, trunk, trunk_report, count, merged);
+    if (status != Status::ok) {
+        rep.parts.outcome = PartsOutcome::undone;
+        return status == Status::out_of_memory ? status : Status::ok;
+    }
+    add_part_counts(trunk_report, rep);
+    for (int k = 0; k < 3; ++k) {
+        rep.axis[k] = trunk_report.axis[k];
+        rep.axis_origin[k] = trunk_report.axis_origin[k];
+    }
+    rep.layers.used_count = trunk_report.layers.used_count;
+    rep.layers.planned_count = trunk_report.layers.planned_count;
+    rep.layers.parallel_count = trunk_report.layers.parallel_count;
+    for (size_t k = 0; k < rep.layers.used_count && k < rep.layers.info_capacity &&
+                       k < m.layer_capacity; ++k)
+        rep.layers.info[k] = m.layers[k];
+    Options branch_options = along;
+    branch_options.axis = Axis::automatic;
+    branch_options.cuts = nullptr;
+    branch_options.cut_count = 0;
+    branch_options.layer_count = 0;
+    branch_options.layer_height = 0;
+    branch_options.progress = nullptr;
+    branch_options.flags &= ~static_cast<uint32_t>(origin_given | close_ends);
+    const uint32_t branches = parting.above_branch_count + parting.below_branch_count;
+    for (uint32_t b = 0; b < branches; ++b) {
+        const bool above = b < parting.above_branch_count;
+        const uint8_t label = static_cast<uint8_t>(
+            above ? kFirstAboveBranch + b : kFirstBelowBranch + (b - parting.above_branch_count));
+        const TubeInput branch = part_input(whole, m, label);
+        if (branch.sums.valid == 0) continue;  // the side above took its points
+        Report part = {};
+        Options own;
+        size_t added = 0;
+        const size_t mark = arena.mark();
+        status = resolve_axis(branch, branch_options, arena, own, part);
+        if (status == Status::ok)
+            status = mesh_tube(branch, own, arena, triangles + 3 * count, capacity - count,
+                               &added, part);
+        arena.rewind(mark);
+        record_part(rep, label, status, branch, part, added, 0);
+        if (status == Status::out_of_memory) return status;
+        if (status != Status::ok) {  // its points stay unused
+            whole_split = false;
+            if (!rep.detail) rep.detail = part.detail;
+            continue;
+        }
+        add_part_counts(part, rep);
+        count += added;
+    }
+    for (size_t i = 0; i < whole.count && whole_split; ++i)
+        whole_split = m.labels[i] != kBeyondBranches;
+    // The junctions.
+    JoinReport join = {};
+    const size_t join_bytes = join_branches_workspace_size(cloud.count, count);
+    const size_t mark = arena.mark();
+    void* work = arena.alloc<unsigned char>(join_bytes);
+    if (!work) return Status::out_of_memory;
+    Options joining = {};
+    joining.flags = along.flags & skip_invalid_points;
+    size_t joined = count;
+    status = join_branches(cloud, joining, parting, m.labels, work, join_bytes, triangles,
+                           capacity, &joined, &join);
+    arena.rewind(mark);
+    if (status == Status::ok) count = joined;
+    rep.parts.joined_side_count = join.joined_side_count;
+    rep.parts.apart_side_count = join.apart_side_count;
+    rep.parts.grafted_branch_count = join.grafted_branch_count;
+    rep.parts.junction_triangle_count = join.added_triangle_count;
+    rep.parts.removed_triangle_count = join.removed_triangle_count;
+    if (!rep.detail) rep.detail = join.detail;
+    whole_split = whole_split && status == Status::ok && join.apart_side_count == 0;
+    if (!whole_split && !(along.flags & keep_parts)) {
+        rep.parts.outcome = PartsOutcome::undone;
+        return Status::ok;
+    }
+    rep.parts.outcome = whole_split ? PartsOutcome::joined : PartsOutcome::kept_apart;
+    if (along.flags & close_ends) {
+        const size_t cap_bytes = cap_ends_workspace_size(cloud.count, count);
+        void* capping = arena.alloc<unsigned char>(cap_bytes);
+        if (!capping) return Status::out_of_memory;
+        Options capped = along;
+        capped.flags &= skip_invalid_points | origin_given;
+        Report caps = {};
+        status = cap_ends(cloud, capped, capping, cap_bytes, triangles, capacity, &count, &caps);
+        arena.rewind(mark);
+        if (status != Status::ok) return status;
+        rep.caps = caps.caps;
+    }
+    *triangle_count = count;
+    rep.triangle_count = count;
+    return Status::ok;
+}
+
+// reconstruct() with the search for branches: `in` is read and `along` has its axis.
+inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in, const Options& along,
+                                  Arena& arena, uint32_t* triangles, size_t capacity,
+                                  size_t* triangle_count, Report& rep) {
+    if (in.sums.distinct >= 3) {
+        const size_t mark = arena.mark();
+        PartsMemory m;
+        if (!allocate_parts(m, cloud.count, arena)) return Status::out_of_memory;
+        if (!search_parting(cloud, in, along, m, arena, rep.parts.parting))
+            return Status::out_of_memory;
+        const Parting& p = rep.parts.parting;
+        // A trunk of fewer points than a branch is no trunk: the cloud is apart all along
+        // (separate objects), and is meshed as one tube.
+        size_t trunk_points = 0;
+        if (p.above_branch_count + p.below_branch_count > 0)
+            for (size_t i = 0; i < cloud.count; ++i) trunk_points += m.labels[i] == kInTrunk;
+        if (trunk_points >= kSmallestBranch) {
+            const Report before = rep;
+            const Status status =
+                mesh_parts(cloud, in, along, m, arena, triangles, capacity, triangle_count, rep);
+            if (status != Status::ok || rep.parts.outcome != PartsOutcome::undone) return status;
+            // Not kept: the counts start again, the parts' record stays.
+            const PartCounts parts = rep.parts;
+            rep = before;
+            rep.parts = parts;
+        }
+        arena.rewind(mark);
+    }
+    return mesh_tube(in, along, arena, triangles, capacity, triangle_count, rep);
+}
+
+// The workspace reconstruct_default() takes on top of read_cloud()'s.
+inline size_t parts_workspace_size(size_t count, const Options& options) {
+    Arena arena = Arena::measuring();
+    PartsMemory m;
+    allocate_parts(m, count, arena);
+    Options plain = options;  // a part's points are read through the mask
+    plain.flags &= ~static_cast<uint32_t>(drop_outliers | close_ends);
+    Options search = options;
+    search.flags &= skip_invalid_points | drop_outliers;
+    const size_t triangles = reconstruct_max_triangles(count, options);
+    const size_t sample = count > kPartingSample
+                              ? saturating_product(3 * sizeof(double), kPartingSample) + Arena::kAlign +
+                                    find_parting_workspace_size(kPartingSample, plain)
+                              : 0;
+    Options branch = plain;  // its own automatic axis and layers
+    branch.cuts = nullptr;
+    branch.cut_count = 0;
+    branch.layer_count = 0;
+    branch.layer_height = 0;
+    const size_t steps[] = {sample, find_parting_workspace_size(count, search),
+                            tube_workspace_size(count, plain), axis_workspace_size(count, branch),
+                            tube_workspace_size(count, branch),
+                            join_branches_workspace_size(count, triangles),
+                            cap_ends_workspace_size(count, triangles)};
+    size_t most = sample;
+    for (size_t k = 1; k < sizeof steps / sizeof steps[0]; ++k) {
+        if (steps[k] == 0) return 0;  // beyond what this platform can address
+        most = steps[k] > most ? steps[k] : most;
+    }
+    if (arena.failed || most > SIZE_MAX - arena.required_bytes() - Arena::kAlign) return 0;
+    return arena.required_bytes() + Arena::kAlign + most;
+}
+
+}  // namespace detail
 #endif
+
+// >>reconstruct entry ======================================================================
+//
+// reconstruct() in its steps: check the arguments, read the cloud, choose the axis, then
+// one tube or the parts (where the build has them and the one_tube flag is not given).
+
+namespace detail {
+
+// Whether reconstruct() looks for branches with these options.
+inline bool searches_parts(const Options& options) {
+    return kFindParts && !(options.flags & one_tube);
+}
+
+inline Status mesh_cloud(const Cloud& cloud, const TubeInput& in, const Options& along,
+                         Arena& arena, uint32_t* triangles, size_t capacity,
+                         size_t* triangle_count, Report& rep) {
+#if !defined(STRATMESH_SMALL_CODE)
+    if (searches_parts(along))
+        return reconstruct_default(cloud, in, along, arena, triangles, capacity, triangle_count,
+                                   rep);
+#else
+    (void)cloud;
+#endif
+    return mesh_tube(in, along, arena, triangles, capacity, triangle_count, rep);
+}
+
+// reconstruct()'s body; `rep` arrives zeroed but for its caller's arrays.
+// Report::points.unused_count is left to the caller, who derives it so the counts add up on
+// every path.
+inline Status run_reconstruction(const Cloud& cloud, const Options& options, void* workspace,
+                                 size_t workspace_bytes, uint32_t* triangles,
+                                 size_t triangle_capacity, size_t* triangle_count,
+                                 Report& rep) {
+    Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
+                                                triangle_count, workspace, rep);
+    if (status != Status::ok) return status;
+    notify(options, Phase::validate, 0);
+    Arena arena = Arena::over(workspace, workspace_bytes);
+    TubeInput in;
+    Options along;
+    status = read_cloud(cloud, options, arena, rep, in);
+    if (status == Status::ok) status = resolve_axis(in, options, arena, along, rep);
+    if (status == Status::ok)
+        status = mesh_cloud(cloud, in, along, arena, triangles, triangle_capacity,
+                            triangle_count, rep);
+    rep.workspace_used_bytes = arena.peak_from_buffer();
+    return status;
+}
+
+}  // namespace detail
+
+size_t reconstruct_max_triangles(size_t point_count, const Options& options) {
+    // A manifold surface through V vertices, open or closed, has at most 2V triangles; the
+    // junctions of branches add at most four per branch beyond that.
+    const size_t junctions = detail::searches_parts(options) ? 8 * size_t{kMaxBranches} : 0;
+    return point_count > (SIZE_MAX - junctions) / 2 ? 0 : 2 * point_count + junctions;
+}
+
+size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
+    size_t most = detail::tube_workspace_size(point_count, options);
+    if (most == 0) return 0;
+    // The axis is chosen, and the parts meshed, once the outliers are known.
+    detail::Arena arena = detail::Arena::measuring();
+    if (detail::kDropOutliers && (options.flags & drop_outliers))
+        arena.alloc<unsigned char>(point_count / 8 + 1);
+    const size_t read = arena.required_bytes();
+    size_t steps[2] = {0, 0};
+    if (options.axis == Axis::automatic) steps[0] = detail::axis_workspace_size(point_count, options);
+#if !defined(STRATMESH_SMALL_CODE)
+    if (detail::searches_parts(options)) steps[1] = detail::parts_workspace_size(point_count, options);
+#endif
+    for (size_t bytes : steps) {
+        if (bytes > SIZE_MAX - read) return 0;
+        most = read + bytes > most ? read + bytes : most;
+    }
+    return most;
+}
+
+Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
+                   size_t workspace_bytes, uint32_t* triangles, size_t triangle_capacity,
+                   size_t* triangle_count, Report* report) {
+    if (detail::reconstruct_buffers_overlap(cloud, workspace, workspace_bytes, triangles,
+                                            triangle_capacity, triangle_count, report))
+        return Status::invalid_argument;
+    Report local_report;
+    Report& rep = report ? *report : local_report;
+    const LayerCounts layers = report ? report->layers : LayerCounts{};
+    const PartCounts parts = report ? report->parts : PartCounts{};
+    std::memset(&rep, 0, sizeof rep);
+    rep.layers.info = layers.info;
+    rep.layers.info_capacity = layers.info ? layers.info_capacity : 0;
+    rep.parts.info = parts.info;
+    rep.parts.info_capacity = parts.info ? parts.info_capacity : 0;
+    rep.points.in_count = cloud.count;
+    if (triangle_count) *triangle_count = 0;
+    Status status = detail::run_reconstruction(cloud, options, workspace, workspace_bytes,
+                                               triangles, triangle_capacity, triangle_count,
+                                               rep);
+    rep.points.unused_count = rep.points.in_count - rep.points.used_count -
+                              rep.points.duplicate_count - rep.points.rejected_count;
+    return status;
+}
 
 }  // namespace stratmesh
 

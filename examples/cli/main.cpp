@@ -105,7 +105,9 @@ stratmesh::Options make_options(const CommandLine& line, ProgressMonitor& monito
                     (line.cap ? stratmesh::close_ends : 0u) |
                     (line.drop_outliers ? stratmesh::drop_outliers : 0u) |
                     (line.surface_flips ? stratmesh::surface_flips : 0u) |
-                    (line.open_ends ? stratmesh::open_ends : 0u);
+                    (line.open_ends ? stratmesh::open_ends : 0u) |
+                    (line.one_tube || line.find_branches ? stratmesh::one_tube : 0u) |
+                    (line.split_branches ? stratmesh::keep_parts : 0u);
     options.progress = &ProgressMonitor::callback;
     options.progress_user = &monitor;
     if (line.origin_given) {
@@ -187,7 +189,8 @@ void record_outcome(stratmesh::Report report, std::vector<stratmesh::LayerInfo>&
 // triangle buffer sizes go to *workspace_bytes and *triangle_buffer_bytes. False if the
 // buffers cannot be allocated.
 bool run_reconstruct(const std::vector<double>& xyz, const stratmesh::Options& options,
-                     std::vector<stratmesh::LayerInfo>& layers, Reconstruction& result,
+                     std::vector<stratmesh::LayerInfo>& layers,
+                     std::vector<stratmesh::PartInfo>& parts, Reconstruction& result,
                      stratmesh::Status& status, stratmesh::Report& report,
                      size_t* workspace_bytes, size_t* triangle_buffer_bytes) {
     const size_t count = xyz.size() / 3;
@@ -199,6 +202,8 @@ bool run_reconstruct(const std::vector<double>& xyz, const stratmesh::Options& o
     report = {};
     report.layers.info = layers.data();
     report.layers.info_capacity = layers.size();
+    report.parts.info = parts.data();
+    report.parts.info_capacity = parts.size();
     const stratmesh::Cloud cloud = {xyz.data(), count, 0, stratmesh::Scalar::float64};
     status = stratmesh::reconstruct(cloud, options, workspace.get(), *workspace_bytes,
                                     result.triangles.get(), max_triangles,
@@ -215,232 +220,21 @@ bool reconstruct_points(const std::vector<double>& xyz, const CommandLine& line,
     ThreadJobs jobs;
     stratmesh::Options options = make_options(line, monitor, jobs);
     std::vector<stratmesh::LayerInfo> layers(layer_capacity(line, count));
+    std::vector<stratmesh::PartInfo> parts(1 + 2 * stratmesh::kMaxBranches);
     stratmesh::Report report;
     monitor.begin();
-    if (!run_reconstruct(xyz, options, layers, result, record.status, report,
+    if (!run_reconstruct(xyz, options, layers, parts, result, record.status, report,
                          &record.workspace_bytes, &record.triangle_buffer_bytes))
         return false;
     monitor.end();
     record_outcome(report, layers, monitor, record);
+    record.take_parts(report.parts, parts);
     return true;
 }
 
-// The points of `xyz` whose label is `label`, packed, and their indices.
-std::vector<double> points_labelled(const std::vector<double>& xyz,
-                                    const std::vector<uint8_t>& labels, uint8_t label,
-                                    std::vector<uint32_t>& indices) {
-    std::vector<double> part;
-    indices.clear();
-    for (size_t i = 0; i < labels.size(); ++i) {
-        if (labels[i] != label) continue;
-        indices.push_back(static_cast<uint32_t>(i));
-        part.insert(part.end(), xyz.begin() + static_cast<std::ptrdiff_t>(3 * i),
-                    xyz.begin() + static_cast<std::ptrdiff_t>(3 * i + 3));
-    }
-    return part;
-}
-
-// Appends a part's triangles to `all`, its indices back into the whole cloud.
-void append_part(const Reconstruction& part, const std::vector<uint32_t>& indices,
-                 std::vector<uint32_t>& all) {
-    for (size_t k = 0; k < 3 * part.triangle_count; ++k)
-        all.push_back(indices[part.triangles.get()[k]]);
-}
-
-// Joins the parts' triangles in `all` at each side that parts (join_branches); where a
-// side cannot be joined its parts stay apart, as the record says. False if buffers cannot
-// be allocated.
-bool join_parts(const std::vector<double>& xyz, const CommandLine& line,
-                const std::vector<uint8_t>& labels, std::vector<uint32_t>& all,
-                RunRecord& record) {
-    ProgressMonitor silent(false, stderr);
-    ThreadJobs jobs;
-    const stratmesh::Options options = make_options(line, silent, jobs);
-    const size_t count = xyz.size() / 3, given = all.size() / 3;
-    const size_t bytes = stratmesh::join_branches_workspace_size(count, given);
-    std::unique_ptr<unsigned char, FreeDeleter> workspace = allocate<unsigned char>(bytes);
-    if (!workspace) {
-        std::fprintf(stderr, "stratmesh: cannot allocate %zu bytes to join the branches\n", bytes);
-        return false;
-    }
-    const Clock::time_point start = Clock::now();
-    all.resize(3 * (given + stratmesh::join_branches_max_triangles(count)));
-    size_t joined = given;
-    const stratmesh::Cloud cloud = {xyz.data(), count, 0, stratmesh::Scalar::float64};
-    record.junction_status =
-        stratmesh::join_branches(cloud, options, record.parting, labels.data(), workspace.get(),
-                                 bytes, all.data(), all.size() / 3, &joined, &record.junction);
-    record.junction_run = true;
-    all.resize(3 * (record.junction_status == stratmesh::Status::ok ? joined : given));
-    record.reconstruct_seconds += seconds_since(start);
-    return true;
-}
-
-// Caps the joined parts' boundary loops (cap_ends), its counts into the record's report.
-// False if buffers cannot be allocated.
-bool cap_parts(const std::vector<double>& xyz, const CommandLine& line,
-               std::vector<uint32_t>& all, RunRecord& record) {
-    ProgressMonitor silent(false, stderr);
-    ThreadJobs jobs;
-    const stratmesh::Options options = make_options(line, silent, jobs);
-    const size_t count = xyz.size() / 3, given = all.size() / 3;
-    const size_t bytes = stratmesh::cap_ends_workspace_size(count, given);
-    std::unique_ptr<unsigned char, FreeDeleter> workspace = allocate<unsigned char>(bytes);
-    if (!workspace) {
-        std::fprintf(stderr, "stratmesh: cannot allocate %zu bytes to cap the ends\n", bytes);
-        return false;
-    }
-    const Clock::time_point start = Clock::now();
-    // A vertex-manifold surface passes each vertex at most once along its boundary loops,
-    // so the caps add fewer triangles than there are points.
-    all.resize(3 * (given + count));
-    size_t capped = given;
-    const stratmesh::Cloud cloud = {xyz.data(), count, 0, stratmesh::Scalar::float64};
-    stratmesh::Report caps = {};
-    const stratmesh::Status status =
-        stratmesh::cap_ends(cloud, options, workspace.get(), bytes, all.data(), all.size() / 3,
-                            &capped, &caps);
-    all.resize(3 * (status == stratmesh::Status::ok ? capped : given));
-    stratmesh::Report& whole = record.report;
-    whole.caps.closed_count = caps.caps.closed_count;
-    whole.caps.open_count = caps.caps.open_count;
-    whole.caps.triangle_count = caps.caps.triangle_count;
-    whole.caps.wall_flip_count = caps.caps.wall_flip_count;
-    record.reconstruct_seconds += seconds_since(start);
-    return true;
-}
-
-// A closed end projects from a pole one radius in from the end, but at most three quarters
-// of the way into its layer (stratmesh's kPoleDepth, find_closed_ends): so an end layer
-// at least this many radii tall has its pole a full radius in.
-const double kPoleLayerRadii = 4.0 / 3.0;
-
-// Where branches stand on a closed end of the trunk (the end layer at a side that parts is
-// closed, as under horns on a skull), the cuts that merge that end layer with the layers
-// next to it until it is kPoleLayerRadii times the largest of their radii tall; false
-// where no end needs it. A thinner end layer projects from a pole too near the end: the
-// branches' stumps in it fold over the crown, and their grafts cross the trunk beside
-// them (the bust with horns in 4 to 16 trunk layers: 24 to 117 self-intersecting pairs,
-// or a graft refused; merged, none; README, "Where the cloud parts"). The trunk's layers
-// are the record's. *merged counts the layers merged away.
-bool cuts_for_tall_ends(const RunRecord& record, std::vector<double>& cuts, size_t* merged) {
-    const std::vector<stratmesh::LayerInfo>& layers = record.layers;
-    const size_t n = layers.size();
-    if (n < 2 || record.report.layers.used_count != n) return false;
-    size_t first = 0, last = n - 1;  // the layers kept whole: [first, last]
-    if (record.parting.above_branch_count > 0 && (layers[n - 1].closed_ends & stratmesh::closed_top)) {
-        double radius = layers[last].radius;
-        while (last > 0 && layers[n - 1].top - layers[last].bottom < kPoleLayerRadii * radius) {
-            --last;
-            radius = std::max(radius, layers[last].radius);
-        }
-    }
-    if (record.parting.below_branch_count > 0 && (layers[0].closed_ends & stratmesh::closed_bottom)) {
-        double radius = layers[first].radius;
-        while (first < last && layers[first].top - layers[0].bottom < kPoleLayerRadii * radius) {
-            ++first;
-            radius = std::max(radius, layers[first].radius);
-        }
-    }
-    if (first == 0 && last == n - 1) return false;
-    cuts.clear();
-    for (size_t k = first; k < last; ++k) cuts.push_back(layers[k].top);
-    *merged = n - 1 - cuts.size();
-    return true;
-}
-
-// Where the cloud parts (by default or with --split-branches): the trunk (the points
-// labelled kInTrunk) with the options given, through reconstruct_points (its report becomes
-// the record's, with the whole cloud's counts and the branches' time), then each branch
-// around its own automatic axis and layers, every part's triangles into `result` with the
-// whole cloud's indices; with --cap the joined parts are capped.
-// False if buffers cannot be allocated.
-bool reconstruct_split(const std::vector<double>& xyz, const CommandLine& given,
-                       const std::vector<uint8_t>& labels, Reconstruction& result,
-                       RunRecord& record) {
-    // With --cap the parts are capped once joined: capped apart, they could not be.
-    CommandLine line = given;
-    line.cap = false;
-    std::vector<uint32_t> indices;
-    const std::vector<double> trunk = points_labelled(xyz, labels, stratmesh::kInTrunk, indices);
-    Reconstruction part;
-    if (!reconstruct_points(trunk, line, part, record)) return false;
-    std::vector<double> cuts;
-    size_t merged = 0;
-    if (record.status == stratmesh::Status::ok && cuts_for_tall_ends(record, cuts, &merged)) {
-        // Again along the same axis, through the layers' own cuts but those merged.
-        CommandLine tall = line;
-        tall.axis = stratmesh::Axis::direction;
-        for (size_t k = 0; k < 3; ++k) tall.direction[k] = record.report.axis[k];
-        tall.cuts = cuts;
-        tall.layer_count = cuts.empty() ? 1 : 0;
-        tall.layer_height = 0;
-        const double first_seconds = record.reconstruct_seconds;
-        if (!reconstruct_points(trunk, tall, part, record)) return false;
-        record.reconstruct_seconds += first_seconds;
-    }
-    record.split.push_back({"trunk", indices.size(), record.status, record.report.layers.used_count,
-                            part.triangle_count, record.report.diagnostics.fold_count, merged});
-    if (record.status != stratmesh::Status::ok) return true;
-    std::vector<uint32_t> all;
-    append_part(part, indices, all);
-    stratmesh::Report& whole = record.report;
-    const stratmesh::Parting& p = record.parting;
-    for (uint32_t b = 0; b < p.above_branch_count + p.below_branch_count; ++b) {
-        const bool above = b < p.above_branch_count;
-        const uint32_t k = above ? b : b - p.above_branch_count;
-        const uint8_t label = static_cast<uint8_t>(
-            (above ? stratmesh::kFirstAboveBranch : stratmesh::kFirstBelowBranch) + k);
-        const std::vector<double> branch = points_labelled(xyz, labels, label, indices);
-        if (indices.empty()) continue;  // the side above took its points
-        ProgressMonitor silent(false, stderr);
-        ThreadJobs jobs;
-        stratmesh::Options options = make_options(line, silent, jobs);
-        options.axis = stratmesh::Axis::automatic;
-        options.cuts = nullptr;
-        options.cut_count = 0;
-        options.layer_count = 0;
-        options.layer_height = 0;
-        options.flags &= ~static_cast<uint32_t>(stratmesh::origin_given);
-        std::vector<stratmesh::LayerInfo> no_layers;
-        stratmesh::Status status;
-        stratmesh::Report report;
-        size_t workspace_bytes = 0, triangle_bytes = 0;
-        const Clock::time_point start = Clock::now();
-        if (!run_reconstruct(branch, options, no_layers, part, status, report, &workspace_bytes,
-                             &triangle_bytes))
-            return false;
-        record.reconstruct_seconds += seconds_since(start);
-        record.split.push_back({std::string(above ? "branch above " : "branch below ") +
-                                    std::to_string(k + 1),
-                                indices.size(), status, report.layers.used_count,
-                                status == stratmesh::Status::ok ? part.triangle_count : 0,
-                                report.diagnostics.fold_count});
-        if (status != stratmesh::Status::ok) continue;  // its points stay unused
-        append_part(part, indices, all);
-        whole.points.used_count += report.points.used_count;
-        whole.points.duplicate_count += report.points.duplicate_count;
-        whole.points.rejected_count += report.points.rejected_count;
-        whole.points.outlier_count += report.points.outlier_count;
-        whole.diagnostics.illegal_removed_count += report.diagnostics.illegal_removed_count;
-        whole.diagnostics.fold_count += report.diagnostics.fold_count;
-    }
-    whole.points.in_count = labels.size();
-    whole.points.unused_count = whole.points.in_count - whole.points.used_count - whole.points.duplicate_count - whole.points.rejected_count;
-    if (!join_parts(xyz, line, labels, all, record)) return false;
-    if (given.cap && !cap_parts(xyz, given, all, record)) return false;
-    whole.triangle_count = all.size() / 3;
-    result.triangle_count = all.size() / 3;
-    result.triangles = allocate<uint32_t>(all.size());
-    if (!result.triangles) return false;
-    std::copy(all.begin(), all.end(), result.triangles.get());
-    return true;
-}
-
-// Where the cloud parts, into the record, and each point's branch into `labels` (unless
-// --branches only asks where). False if the buffer cannot be allocated.
-bool find_branches(const std::vector<double>& xyz, const CommandLine& line,
-                   std::vector<uint8_t>& labels, RunRecord& record) {
+// With --branches: where the cloud parts, into the record (the mesh is then one tube).
+// False if the buffer cannot be allocated.
+bool find_branches(const std::vector<double>& xyz, const CommandLine& line, RunRecord& record) {
     ProgressMonitor silent(false, stderr);
     ThreadJobs jobs;
     const stratmesh::Options options = make_options(line, silent, jobs);
@@ -453,23 +247,11 @@ bool find_branches(const std::vector<double>& xyz, const CommandLine& line,
     }
     const stratmesh::Cloud cloud = {xyz.data(), count, 0, stratmesh::Scalar::float64};
     Clock::time_point start = Clock::now();
-    if (!line.find_branches) labels.assign(count, stratmesh::kInTrunk);
     record.parting_status =
-        stratmesh::find_parting(cloud, options, workspace.get(), bytes, &record.parting,
-                                labels.empty() ? nullptr : labels.data());
+        stratmesh::find_parting(cloud, options, workspace.get(), bytes, &record.parting, nullptr);
     record.branches_seconds = seconds_since(start);
     record.parting_run = true;
     return true;
-}
-
-// Whether the split meshed every part and joined every side, with every point in a part.
-bool split_complete(const std::vector<uint8_t>& labels, const RunRecord& record) {
-    if (record.status != stratmesh::Status::ok || !record.junction_run ||
-        record.junction_status != stratmesh::Status::ok || record.junction.apart_side_count > 0)
-        return false;
-    for (const RunRecord::SplitPart& part : record.split)
-        if (part.status != stratmesh::Status::ok) return false;
-    return std::find(labels.begin(), labels.end(), stratmesh::kBeyondBranches) == labels.end();
 }
 
 void explain_refusal(const CommandLine& line, const RunRecord& record) {
@@ -570,28 +352,8 @@ int run(const CommandLine& line) {
     Reconstruction result;
     if (!read_input(line, xyz, record)) return kExitFile;
     if (line.origin_given && !origin_in_reach(line, xyz)) return kExitUsage;
-    std::vector<uint8_t> labels;
-    const bool automatic = !line.one_tube && !line.find_branches && !line.split_branches;
-    if ((automatic || line.find_branches || line.split_branches) &&
-        !find_branches(xyz, line, labels, record))
-        return kExitRefused;
-    // A trunk of fewer points than a branch is no trunk: the cloud is apart all along
-    // (separate objects), and is meshed as one tube.
-    const bool split = (automatic || line.split_branches) &&
-                       record.parting_status == stratmesh::Status::ok &&
-                       record.parting.above_branch_count + record.parting.below_branch_count > 0 &&
-                       std::count(labels.begin(), labels.end(), stratmesh::kInTrunk) >=
-                           static_cast<std::ptrdiff_t>(stratmesh::kSmallestBranch);
-    if (!(split ? reconstruct_split(xyz, line, labels, result, record)
-                : reconstruct_points(xyz, line, result, record)))
-        return kExitRefused;
-    if (split && automatic && !split_complete(labels, record)) {
-        // Parts left apart or points left out would be worse than the one tube's wrap.
-        const double split_seconds = record.reconstruct_seconds;
-        record.split_undone = true;
-        if (!reconstruct_points(xyz, line, result, record)) return kExitRefused;
-        record.reconstruct_seconds += split_seconds;
-    }
+    if (line.find_branches && !find_branches(xyz, line, record)) return kExitRefused;
+    if (!reconstruct_points(xyz, line, result, record)) return kExitRefused;
     if (record.status != stratmesh::Status::ok) return refuse(line, record);
     if (!write_output(line, xyz, result, record)) return kExitFile;
     return finish_run(line, record);

@@ -2,6 +2,7 @@
 
 #include "safe_output.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -414,6 +415,33 @@ RunRecord::RunRecord() {
     const double unknown = std::numeric_limits<double>::quiet_NaN();
     read_seconds = reconstruct_seconds = write_seconds = branches_seconds = unknown;
     for (double& s : phase_seconds) s = unknown;
+}
+
+void RunRecord::take_parts(const stratmesh::PartCounts& parts,
+                           const std::vector<stratmesh::PartInfo>& filled) {
+    if (!one_tube && !find_branches) {
+        parting_run = true;
+        parting = parts.parting;
+    }
+    split_undone = parts.outcome == stratmesh::PartsOutcome::undone;
+    const size_t count = std::min(parts.part_count, filled.size());
+    for (size_t k = 0; k < count; ++k) {
+        const stratmesh::PartInfo& info = filled[k];
+        std::string name = "trunk";
+        if (info.label >= stratmesh::kFirstBelowBranch)
+            name = "branch below " + std::to_string(info.label - stratmesh::kFirstBelowBranch + 1);
+        else if (info.label >= stratmesh::kFirstAboveBranch)
+            name = "branch above " + std::to_string(info.label - stratmesh::kFirstAboveBranch + 1);
+        split.push_back({name, info.point_count, info.status, info.layer_count,
+                         info.triangle_count, info.fold_count, info.merged_end_layer_count});
+    }
+    // The junctions were made once the trunk was meshed.
+    junction_run = count > 0 && filled[0].status == stratmesh::Status::ok;
+    junction.joined_side_count = static_cast<uint32_t>(parts.joined_side_count);
+    junction.apart_side_count = static_cast<uint32_t>(parts.apart_side_count);
+    junction.grafted_branch_count = static_cast<uint32_t>(parts.grafted_branch_count);
+    junction.added_triangle_count = parts.junction_triangle_count;
+    junction.removed_triangle_count = parts.removed_triangle_count;
 }
 
 void RunRecord::take_report(stratmesh::Report outcome,

@@ -83,9 +83,13 @@ struct RunRecord {
 
     RunRecord();
 
-    // Records the library's report; the first `outcome.layer_count` (at most) entries of
-    // `filled`, which outcome.layers pointed at, move into `layers`.
+    // Records the library's report; the first `outcome.layers.used_count` (at most) entries
+    // of `filled`, which outcome.layers.info pointed at, move into `layers`.
     void take_report(stratmesh::Report outcome, std::vector<stratmesh::LayerInfo>& filled);
+    // Records where the cloud parted and how its parts were meshed and joined, from the
+    // library's report and the part details it filled.
+    void take_parts(const stratmesh::PartCounts& parts,
+                    const std::vector<stratmesh::PartInfo>& filled);
 };
 
 // The record as a JSON document (UTF-8, numbers round-trip exactly, NaN/Inf as null).

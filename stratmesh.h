@@ -2807,40 +2807,57 @@ inline CellBlock block_around(const GridItem* items, size_t count, size_t member
     return b;
 }
 
+// The samples of the scale measures are taken by a hash of the coordinates, about one
+// point in `step`, so that they do not depend on the order of the points.
+inline uint32_t sample_step(size_t count, size_t most) {
+    const size_t step = count > most ? (count + most - 1) / most : 1;
+    return step < UINT32_MAX ? static_cast<uint32_t>(step) : UINT32_MAX;
+}
+
+inline bool sampled_point(Vec3 p, uint32_t step) {
+    double z = p.z + 0.0;
+    uint64_t bz;
+    std::memcpy(&bz, &z, sizeof bz);
+    const uint32_t h = mix32(coordinate_hash(p.x, p.y) ^ static_cast<uint32_t>(bz) ^
+                             mix32(static_cast<uint32_t>(bz >> 32)));
+    return step == 1 || h % step == 0;
+}
+
 // The distance that nine points in ten do not exceed to their nearest distinct point, as
 // the top of its half-octave; 0 when more than a tenth find none within a cell. Measured
-// on every k-th point in cell order, at most about kDecileSample of them: a decile needs
-// no more.
+// on about `most_sampled` points (see sample_step): a decile needs no more.
 inline double nearest_distance_decile(const CloudReader& reader, const CellScratch& g,
                                       size_t count, double side, size_t most_sampled) {
     const GridItem* items = g.items;
     for (size_t i = 0; i < count; ++i) g.sorted[i] = reader.point(items[i].index);
-    const size_t step = count > most_sampled ? count / most_sampled : 1;
+    const uint32_t step = sample_step(count, most_sampled);
     size_t histogram[kNearestBins] = {}, sampled = 0;
     for (size_t first = 0; first < count;) {
         size_t last = first;
         while (last < count && items[last].cell == items[first].cell) ++last;
-        const size_t sample = (first + step - 1) / step * step;  // the cell's first k-th point
-        if (sample < last) {
-            const CellBlock block = block_around(items, count, first);
-            for (size_t i = sample; i < last; i += step, ++sampled) {
-                const Vec3 p = g.sorted[i];
-                double nearest = side * side;
-                uint32_t seen = 0;
-                for (uint32_t k = 0; k < block.count && seen < kNearestCandidates; ++k)
-                    for (size_t j = block.begin[k]; j < block.end[k] && seen < kNearestCandidates; ++j) {
-                        const Vec3 d = g.sorted[j] - p;
-                        const double q = dot(d, d);
-                        ++seen;
-                        if (q > 0 && q < nearest) nearest = q;  // not itself, nor a duplicate
-                    }
-                int e = 0;
-                std::frexp(nearest / (side * side), &e);  // in [2^(e-1), 2^e): e <= 0 if found
-                const uint32_t bin = e > 0 ? kNearestBins - 1
-                                    : static_cast<uint32_t>(-e) < kNearestBins - 2 ? static_cast<uint32_t>(-e)
-                                                                                   : kNearestBins - 2;
-                ++histogram[bin];
-            }
+        bool has_block = false;
+        CellBlock block;
+        for (size_t i = first; i < last; ++i) {
+            const Vec3 p = g.sorted[i];
+            if (!sampled_point(p, step)) continue;
+            if (!has_block) block = block_around(items, count, first);
+            has_block = true;
+            ++sampled;
+            double nearest = side * side;
+            uint32_t seen = 0;
+            for (uint32_t k = 0; k < block.count && seen < kNearestCandidates; ++k)
+                for (size_t j = block.begin[k]; j < block.end[k] && seen < kNearestCandidates; ++j) {
+                    const Vec3 d = g.sorted[j] - p;
+                    const double q = dot(d, d);
+                    ++seen;
+                    if (q > 0 && q < nearest) nearest = q;  // not itself, nor a duplicate
+                }
+            int e = 0;
+            std::frexp(nearest / (side * side), &e);  // in [2^(e-1), 2^e): e <= 0 if found
+            const uint32_t bin = e > 0 ? kNearestBins - 1
+                                : static_cast<uint32_t>(-e) < kNearestBins - 2 ? static_cast<uint32_t>(-e)
+                                                                               : kNearestBins - 2;
+            ++histogram[bin];
         }
         first = last;
     }
@@ -8995,12 +9012,13 @@ inline double median_nearest_distance(const CloudReader& reader, size_t count, c
     const size_t n = sort_into_cells(reader, count, box.low, decile, g);
     const GridItem* items = g.items;
     for (size_t i = 0; i < n; ++i) g.sorted[i] = reader.point(items[i].index);
-    const size_t step = (n + kScaleSample - 1) / kScaleSample;  // at most kScaleSample
+    const uint32_t step = sample_step(n, kScaleSample / 2);
     size_t sampled = 0;
     uint64_t any = 0, every = ~uint64_t{0};
-    for (size_t i = 0; i < n; i += step) {
-        const CellBlock block = block_around(items, n, i);
+    for (size_t i = 0; i < n && sampled < kScaleSample; ++i) {
         const Vec3 p = g.sorted[i];
+        if (!sampled_point(p, step)) continue;
+        const CellBlock block = block_around(items, n, i);
         double nearest = DBL_MAX;
         uint32_t seen = 0;
         for (uint32_t k = 0; k < block.count && seen < kNearestCandidates; ++k)

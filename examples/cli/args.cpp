@@ -53,13 +53,11 @@ const char kUsage[] =
     "  --drop-outliers       leave out points far from the rest of the cloud (stray\n"
     "                        returns, specks of fewer than 8 points); they stay in the\n"
     "                        output, unused, counted as rejected (outliers)\n"
-    "  --unrolled-delaunay   leave each layer Delaunay on its unrolled annulus, as in the\n"
-    "                        paper, instead of flipping its edges afterwards on the\n"
-    "                        surface in 3D, by the empty-circle rule and toward where the\n"
-    "                        surface curves least (stratmesh's surface_flips, on by\n"
-    "                        default here: closer to the true surface, most where the\n"
-    "                        unrolling squeezes it; about 2.5 times the library's time on\n"
-    "                        a smooth tube)\n"
+    "  --surface-flips       after each layer is triangulated on its unrolled annulus (the\n"
+    "                        paper's method), flip its edges on the surface in 3D, by the\n"
+    "                        empty-circle rule and toward where the surface curves least\n"
+    "                        (stratmesh's surface_flips): closer to the true surface where\n"
+    "                        the unrolling squeezes it, for about 2.5 times the time\n"
     "  --open-ends           take no end of the cloud for a closed one (a dome, a base,\n"
     "                        otherwise meshed across from a pole): both are unrolled on\n"
     "                        the cylinder like the rest; for a cloud cut out of a larger\n"
@@ -235,7 +233,7 @@ bool apply_flag(std::string_view name, CommandLine& line) {
     if (name == "--skip-invalid") line.skip_invalid = true;
     if (name == "--cap") line.cap = true;
     if (name == "--drop-outliers") line.drop_outliers = true;
-    if (name == "--unrolled-delaunay") line.surface_flips = false;
+    if (name == "--surface-flips") line.surface_flips = true;
     if (name == "--open-ends") line.open_ends = true;
     if (name == "--branches") line.find_branches = true;
     if (name == "--split-branches") line.split_branches = true;
@@ -250,7 +248,7 @@ const char* const kValuedOptions[] = {"--output",  "--report",        "--axis",
                                       "--threads", "--stream-points", "--origin"};
 const char* const kFlags[] = {"--ascii", "--skip-invalid", "--cap",     "--quiet",
                               "--help",  "--version",      "--stream", "--drop-outliers",
-                              "--unrolled-delaunay", "--open-ends", "--branches",
+                              "--surface-flips", "--open-ends", "--branches",
                               "--split-branches", "--one-tube"};
 
 // What --stream cannot do, or an empty string.

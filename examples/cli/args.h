@@ -24,7 +24,7 @@ struct CommandLine {
     bool skip_invalid = false;
     bool cap = false;              // --cap: close the ends (stratmesh::close_ends)
     bool drop_outliers = false;    // --drop-outliers (stratmesh::drop_outliers)
-    bool surface_flips = true;     // off with --unrolled-delaunay (stratmesh::surface_flips)
+    bool surface_flips = false;    // --surface-flips (stratmesh::surface_flips)
     bool open_ends = false;        // --open-ends (stratmesh::open_ends)
     // Where the cloud parts into branches (stratmesh::find_parting). Without any of these
     // three the tool looks, meshes the parts apart and joins them, and keeps that only if

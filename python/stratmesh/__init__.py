@@ -14,7 +14,7 @@ from ._error import Error
 
 Error.__module__ = __name__  # shown as stratmesh.Error, where users catch it
 
-__all__ = ["Error", "FLAGS", "STATUSES", "Stream", "cap_ends", "reconstruct"]
+__all__ = ["Error", "FLAGS", "STATUSES", "Stream", "cap_ends", "reconstruct", "stream_workspace_size"]
 __version__ = _core.__version__
 
 #: The library's Flags bits by name; flags=(...) accepts any of them.
@@ -116,6 +116,12 @@ def cap_ends(points, triangles, *, axis="z", origin=None, skip_invalid=False, fl
     """
     options = _options(axis, origin=origin, flags=flags, skip_invalid_points=skip_invalid)
     return _core.cap_ends(points, triangles, options, copy)
+
+
+def stream_workspace_size(max_points, *, axis="z", surface_flips=False, open_ends=False):
+    """Bytes of workspace a Stream holding at most max_points points at once allocates."""
+    options = _options(axis, surface_flips=surface_flips, open_ends=open_ends)
+    return _core.stream_workspace_size(int(max_points), options)
 
 
 class Stream:

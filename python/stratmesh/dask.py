@@ -138,29 +138,28 @@ def layer_of(points, plan):
 
 
 def _split(part, offset, plan):
-    """One partition cut into the pieces each range needs: its own layers and one more on
-    each side (the layers that the bands at its edges join to)."""
+    """One partition cut into the pieces each range needs, as (points, global indices): its
+    own layers and one more on each side (the layers that the bands at its edges join to)."""
     part = np.asarray(part)
     layer = layer_of(part, plan)
-    index = np.arange(offset, offset + len(part), dtype=np.int64)
+    index = np.arange(offset, offset + len(part), dtype=plan.index_dtype)
     pieces = []
     for lo, hi in zip(plan.bounds[:-1], plan.bounds[1:]):
         take = (layer >= lo - 1) & (layer <= hi)
-        pieces.append((part[take], index[take], layer[take]))
+        pieces.append((part[take], index[take]))
     return pieces
 
 
-def _stream_span(points, layer, plan, max_points):
-    """Pushes the points (sorted by layer, stable) one layer at a time; returns the
-    triangles with indices into points, and the stream's report."""
+def _stream_span(points, starts, first, plan, max_points):
+    """Pushes layers first, first + 1, ... (layer first + i is points[starts[i]:starts[i+1]])
+    into one stream; returns the triangles with indices into points, and its report."""
     stream = Stream(axis=plan.axis, max_points=max_points, origin=plan.origin,
                     layer_info=plan.layer_count, **plan.options)
-    first, last = int(layer[0]), int(layer[-1])
-    starts = np.searchsorted(layer, np.arange(first, last + 2))
     out = []
-    for j in range(first, last + 1):
+    for i in range(len(starts) - 1):
+        j = first + i
         top = plan.cuts[j] if j < len(plan.cuts) else plan.height_max
-        out.append(stream.push(points[starts[j - first]:starts[j - first + 1]], top))
+        out.append(stream.push(points[starts[i]:starts[i + 1]], top))
     out.append(stream.close())
     return np.concatenate(out), stream.report
 
@@ -189,27 +188,28 @@ def _mesh_range(k, plan, *pieces):
     """Meshes range k's layers; keeps each triangle whose highest layer is in the range, so
     the band between two ranges is the upper one's. Returns global indices."""
     lo, hi = plan.bounds[k], plan.bounds[k + 1]
+    first, last = max(lo - 1, 0), min(hi, plan.layer_count - 1)
     points = np.concatenate([p[0] for p in pieces])
     index = np.concatenate([p[1] for p in pieces])
-    layer = np.concatenate([p[2] for p in pieces])
-    empty = np.empty((0, 3), dtype=plan.index_dtype)
-    if len(points) == 0:
-        return empty
+    layer = layer_of(points, plan)
     # Stable: within a layer the points keep the global order, as one stream would get them.
     order = np.argsort(layer, kind="stable")
-    points, index, layer = points[order], index[order], layer[order]
-    largest = int(np.bincount(layer - layer[0]).max())
+    points, index = points[order], index[order]
+    sizes = np.bincount(layer - first, minlength=last - first + 1)
+    starts = np.concatenate([[0], np.cumsum(sizes)])
+    held = min(len(points), 3 * int(sizes.max()))
     try:
-        local, report = _stream_span(points, layer, plan, min(len(points), 3 * largest))
+        local, report = _stream_span(points, starts, first, plan, held)
     except Error as e:
         if e.status != "out_of_memory":
             raise
         # Merged pushes held more than three layers' worth: hold the whole span.
-        local, report = _stream_span(points, layer, plan, len(points))
-    _check_edges(report, lo, hi, int(layer[0]), int(layer[-1]), plan)
-    owner = layer[local].max(axis=1)
-    kept = local[(owner >= lo) & (owner < hi)]
-    return index[kept].astype(plan.index_dtype) if len(kept) else empty
+        local, report = _stream_span(points, starts, first, plan, len(points))
+    _check_edges(report, lo, hi, first, last, plan)
+    # The points are in layer order, so a triangle's highest layer is its highest index's.
+    top = local.max(axis=1)
+    kept = local[(top >= starts[lo - first]) & (top < starts[hi - first])]
+    return index[kept]
 
 
 def mesh(points, plan):

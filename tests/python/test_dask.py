@@ -70,13 +70,17 @@ def test_without_the_layer_beyond_each_edge_the_union_differs(monkeypatch):
     split = smd._split
 
     def split_short(part, offset, plan):
-        pieces = split(part, offset, plan)
-        return [(p[layer <= hi - 1], i[layer <= hi - 1], layer[layer <= hi - 1])
-                for (p, i, layer), hi in zip(pieces, plan.bounds[1:])]
+        short = []
+        for (p, i), hi in zip(split(part, offset, plan), plan.bounds[1:]):
+            below = smd.layer_of(p, plan) < hi
+            short.append((p[below], i[below]))
+        return short
 
     with dask.config.set(scheduler="sync"):
         plan = smd.plan(parts, axis="z", layers=16, ranges=4, surface_flips=True)
         monkeypatch.setattr(smd, "_split", split_short)
+        # An empty layer beyond the edge fails the edge check first; the triangles are the point.
+        monkeypatch.setattr(smd, "_check_edges", lambda *args: None)
         short = smd.mesh(parts, plan).compute()
     expected = one_stream(cloud, plan)
     assert not np.array_equal(canonical(short), canonical(expected))

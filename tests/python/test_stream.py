@@ -59,6 +59,8 @@ def test_the_stream_holds_only_a_few_layers():
     for j in range(len(CUTS) + 1):
         small.push(cloud[layer == j], CUTS[j] if j < len(CUTS) else 7.0)
     small.close()
+    # The header's figure: about 190 bytes per point held.
+    assert 150 < stratmesh.stream_workspace_size(10**6) / 10**6 < 250
 
 
 def test_refused_pushes_leave_the_stream_usable():

@@ -6,7 +6,8 @@ stream and one reconstruct() in this process, and the quantities docs/dask.md's 
 
 The cloud is a bumpy tube (r = 1 + 0.25 sin(5 theta) cos(z), height 2 pi, random order)
 saved as --partitions .npy files, which the workers read themselves. Each worker is one
-process with one thread, and meshes --ranges-per-worker ranges of whole layers. The time of a cluster run is plan() (a pass over the files) plus
+process with one thread, and meshes --ranges-per-worker ranges of whole layers. The time
+of a cluster run is plan() (a pass over the files) plus
 mesh(...).compute(), the triangles gathered here; the cluster's start is not counted.
 Prints one JSON line per run.
 """

@@ -98,7 +98,8 @@ py::object report_object(const stratmesh::Report& r, stratmesh::Status status) {
         py::arg("status") = status_name(status),
         py::arg("triangle_count") = r.triangle_count,
         py::arg("axis") = py::make_tuple(r.axis[0], r.axis[1], r.axis[2]),
-        py::arg("axis_origin") = py::make_tuple(r.axis_origin[0], r.axis_origin[1], r.axis_origin[2]),
+        py::arg("axis_origin") =
+            py::make_tuple(r.axis_origin[0], r.axis_origin[1], r.axis_origin[2]),
         py::arg("points") = ns(
             py::arg("in_count") = r.points.in_count, py::arg("used_count") = r.points.used_count,
             py::arg("duplicate_count") = r.points.duplicate_count,
@@ -112,7 +113,8 @@ py::object report_object(const stratmesh::Report& r, stratmesh::Status status) {
             py::arg("used_count") = r.layers.used_count,
             py::arg("parallel_count") = r.layers.parallel_count, py::arg("info") = layers),
         py::arg("caps") = ns(
-            py::arg("closed_count") = r.caps.closed_count, py::arg("open_count") = r.caps.open_count,
+            py::arg("closed_count") = r.caps.closed_count,
+            py::arg("open_count") = r.caps.open_count,
             py::arg("triangle_count") = r.caps.triangle_count,
             py::arg("wall_flip_count") = r.caps.wall_flip_count),
         py::arg("diagnostics") = ns(
@@ -298,7 +300,8 @@ py::tuple cap_ends(py::handle object, py::handle triangles_in, const py::dict& o
     Points points = as_points(object, copy);
     OptionSet set;
     read_options(option_dict, set);
-    auto given = py::array_t<uint32_t, py::array::c_style | py::array::forcecast>::ensure(triangles_in);
+    using Indices = py::array_t<uint32_t, py::array::c_style | py::array::forcecast>;
+    Indices given = Indices::ensure(triangles_in);
     if (!given || given.ndim() != 2 || given.shape(1) != 3)
         raise_argument("triangles must be an (m, 3) array of indices");
     const size_t n = points.cloud.count;
@@ -327,12 +330,13 @@ class Stream {
 public:
     Stream(const py::dict& option_dict, size_t max_points, size_t layer_info)
         : layers_(layer_info) {
-        read_options(option_dict, set_);
-        bytes_ = stratmesh::stream_workspace_size(max_points, set_.options);
-        workspace_ = allocate_workspace(bytes_, max_points);
+        OptionSet set;
+        read_options(option_dict, set);
+        const size_t bytes = stratmesh::stream_workspace_size(max_points, set.options);
+        workspace_ = allocate_workspace(bytes, max_points);
         report_.layers.info = layers_.data();
         report_.layers.info_capacity = layers_.size();
-        stratmesh::Status status = stratmesh::stream_open(set_.options, workspace_.get(), bytes_,
+        stratmesh::Status status = stratmesh::stream_open(set.options, workspace_.get(), bytes,
                                                           emit, this, &report_, &stream_);
         if (status != stratmesh::Status::ok)
             raise_error(status, report_.detail, report_object(report_, status));
@@ -378,9 +382,7 @@ private:
                                      out->data(), owner);
     }
 
-    OptionSet set_;
     std::vector<stratmesh::LayerInfo> layers_;
-    size_t bytes_ = 0;
     std::unique_ptr<unsigned char[]> workspace_;
     stratmesh::Report report_ = {};
     stratmesh::Stream* stream_ = nullptr;

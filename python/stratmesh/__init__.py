@@ -14,7 +14,8 @@ from ._error import Error
 
 Error.__module__ = __name__  # shown as stratmesh.Error, where users catch it
 
-__all__ = ["Error", "FLAGS", "STATUSES", "Stream", "cap_ends", "reconstruct", "stream_workspace_size"]
+__all__ = ["Error", "FLAGS", "STATUSES", "Stream", "cap_ends", "reconstruct",
+           "stream_workspace_size"]
 __version__ = _core.__version__
 
 #: The library's Flags bits by name; flags=(...) accepts any of them.

@@ -20,6 +20,8 @@ import numpy as np
 from . import STATUSES, Error, Stream
 
 _UNIT = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+_CLOSED_BOTTOM, _CLOSED_TOP = 1, 2  # the header's ClosedEnd bits in LayerInfo::closed_ends
+_LEAST_HELD = 16                    # a stream's workspace holds at least this many points
 
 
 @dataclass(frozen=True)
@@ -126,7 +128,8 @@ def plan(points, *, axis, layer_height=None, layers=None, ranges=None, skip_inva
         raise Error("invalid_argument", STATUSES["invalid_argument"], "ranges must be 1 or more")
     bounds = tuple(int(b) for b in np.linspace(0, layers, ranges + 1).round())
     return Plan(axis=axis, unit=tuple(unit), origin=origin, cuts=cuts,
-                height_min=float(low), height_max=float(high), bounds=bounds, offsets=tuple(int(o) for o in np.cumsum([0] + counts)),
+                height_min=float(low), height_max=float(high), bounds=bounds,
+                offsets=tuple(int(o) for o in np.cumsum([0] + counts)),
                 options={"skip_invalid": skip_invalid, "surface_flips": surface_flips,
                          "open_ends": open_ends})
 
@@ -179,7 +182,8 @@ def _check_edges(report, lo, hi, first, last, plan):
                         f"the layer below height {plan.cuts[c]} merged with its neighbour at "
                         "a range's edge: choose a larger layer_height or fewer ranges")
     info = report.layers.info
-    if (first < lo and info[0].closed_ends & 1) or (last > hi - 1 and info[-1].closed_ends & 2):
+    if ((first < lo and info[0].closed_ends & _CLOSED_BOTTOM)
+            or (last > hi - 1 and info[-1].closed_ends & _CLOSED_TOP)):
         raise Error("not_columnar", STATUSES["not_columnar"],
                     "a range's edge was taken for a closed end: mesh with open_ends=True")
 
@@ -197,14 +201,14 @@ def _mesh_range(k, plan, *pieces):
     points, index = points[order], index[order]
     sizes = np.bincount(layer - first, minlength=last - first + 1)
     starts = np.concatenate([[0], np.cumsum(sizes)])
-    held = min(len(points), 3 * int(sizes.max()))
+    held = max(_LEAST_HELD, min(len(points), 3 * int(sizes.max())))
     try:
         local, report = _stream_span(points, starts, first, plan, held)
     except Error as e:
         if e.status != "out_of_memory":
             raise
         # Merged pushes held more than three layers' worth: hold the whole span.
-        local, report = _stream_span(points, starts, first, plan, len(points))
+        local, report = _stream_span(points, starts, first, plan, max(_LEAST_HELD, len(points)))
     _check_edges(report, lo, hi, first, last, plan)
     # The points are in layer order, so a triangle's highest layer is its highest index's.
     top = local.max(axis=1)

@@ -34,6 +34,6 @@ def assert_manifold(triangles):
     assert uses.max() <= 2, "an edge of three triangles or more"
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def tube():
     return bumpy_tube(60_000)

@@ -12,5 +12,10 @@ class Error(ValueError):
     def __init__(self, status, message, detail=None, report=None):
         super().__init__(f"{status}: {detail or message}")
         self.status = status
+        self.message = message
         self.detail = detail
         self.report = report
+
+    def __reduce__(self):
+        # Rebuilt from all its fields when pickled, as a Dask worker's error reaching the client.
+        return type(self), (self.status, self.message, self.detail, self.report)

@@ -86,13 +86,14 @@ def test_without_the_layer_beyond_each_edge_the_union_differs(monkeypatch):
     assert not np.array_equal(canonical(short), canonical(expected))
 
 
-def test_layers_too_thin_to_stand_alone_at_an_edge_are_refused():
+def test_layers_too_thin_to_stand_alone_at_an_edge_are_refused(client):
+    # Raised on a worker, the error reaches the client whole.
     cloud = bumpy_tube(60_000, seed=5)
-    with dask.config.set(scheduler="sync"):
-        plan = smd.plan([cloud], axis="z", layers=400, ranges=4)
-        with pytest.raises(stratmesh.Error) as e:
-            smd.mesh([cloud], plan).compute()
+    plan = smd.plan([cloud], axis="z", layers=400, ranges=4)
+    with pytest.raises(stratmesh.Error) as e:
+        smd.mesh([cloud], plan).compute()
     assert e.value.status == "invalid_layers"
+    assert "merged" in e.value.detail
 
 
 def test_plan_refusals():

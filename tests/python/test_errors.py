@@ -1,3 +1,5 @@
+import pickle
+
 import numpy as np
 import pytest
 
@@ -55,3 +57,13 @@ def test_bad_options():
 def test_every_status_has_a_message():
     assert "ok" in stratmesh.STATUSES and "invalid_point" in stratmesh.STATUSES
     assert all(stratmesh.STATUSES.values())
+
+
+def test_an_error_survives_pickling():
+    cloud = CLOUD.copy()
+    cloud[7, 0] = np.inf
+    error = refused("invalid_point", cloud, axis="z")
+    copy = pickle.loads(pickle.dumps(error))
+    assert type(copy) is stratmesh.Error
+    assert (copy.status, copy.detail, str(copy)) == (error.status, error.detail, str(error))
+    assert copy.report.points.first_invalid_index == 7

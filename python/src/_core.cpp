@@ -244,16 +244,52 @@ uint32_t* allocate_triangles(size_t capacity) {
     return static_cast<uint32_t*>(data);
 }
 
-std::unique_ptr<unsigned char[]> allocate_workspace(size_t bytes, size_t points) {
+// A *_workspace_size() of 0 means no workspace can serve that many points.
+void check_workspace_size(size_t bytes, size_t points) {
     if (bytes == 0 && points > 0)
         raise_error(stratmesh::Status::too_many_points, "no workspace can serve that many points",
                     py::none());
+}
+
+std::unique_ptr<unsigned char[]> allocate_workspace(size_t bytes, size_t points) {
+    check_workspace_size(bytes, points);
     // Not value-initialised: the library needs no zeroed memory, and zeroing costs a pass.
     return std::unique_ptr<unsigned char[]>(new unsigned char[std::max<size_t>(bytes, 1)]);
 }
 
+// A workspace kept between reconstruct() calls, so that its pages, touched once, cost
+// nothing the next time. Grows to the largest call's need; serves one call at a time.
+class Workspace {
+public:
+    size_t size() const { return size_; }
+
+    // The workspace for a call of `bytes`, held until the Lease ends.
+    class Lease {
+    public:
+        Lease(Workspace& w, size_t bytes, size_t points) : w_(w) {
+            if (w.busy_) raise_argument("the workspace is in use by another call");
+            check_workspace_size(bytes, points);
+            if (bytes > w.size_) {
+                w.data_ = allocate_workspace(bytes, points);
+                w.size_ = bytes;
+            }
+            w.busy_ = true;
+        }
+        ~Lease() { w_.busy_ = false; }
+        unsigned char* get() const { return w_.data_.get(); }
+
+    private:
+        Workspace& w_;
+    };
+
+private:
+    std::unique_ptr<unsigned char[]> data_;
+    size_t size_ = 0;
+    bool busy_ = false;
+};
+
 py::tuple reconstruct(py::handle object, const py::dict& option_dict, py::object progress,
-                      bool copy) {
+                      bool copy, py::object kept) {
     Points points = as_points(object, copy);
     OptionSet set;
     read_options(option_dict, set);
@@ -270,7 +306,6 @@ py::tuple reconstruct(py::handle object, const py::dict& option_dict, py::object
     const size_t n = points.cloud.count;
     const size_t bytes = stratmesh::reconstruct_workspace_size(n, options);
     const size_t capacity = stratmesh::reconstruct_max_triangles(n, options);
-    std::unique_ptr<unsigned char[]> workspace = allocate_workspace(bytes, n);
     // Every layer holds 16 distinct points or more, so this many entries hold every layer;
     // left uninitialised, the pages the library does not fill are never touched.
     const size_t layer_capacity = n / 16 + 1;
@@ -281,7 +316,13 @@ py::tuple reconstruct(py::handle object, const py::dict& option_dict, py::object
     report.layers.info_capacity = layer_capacity;
     size_t count = 0;
     stratmesh::Status status;
-    {
+    if (kept.is_none()) {
+        std::unique_ptr<unsigned char[]> workspace = allocate_workspace(bytes, n);
+        py::gil_scoped_release release;
+        status = stratmesh::reconstruct(points.cloud, options, workspace.get(), bytes,
+                                        triangles.get(), capacity, &count, &report);
+    } else {
+        Workspace::Lease workspace(kept.cast<Workspace&>(), bytes, n);
         py::gil_scoped_release release;
         status = stratmesh::reconstruct(points.cloud, options, workspace.get(), bytes,
                                         triangles.get(), capacity, &count, &report);
@@ -406,7 +447,10 @@ PYBIND11_MODULE(_core, m) {
 #undef STRATMESH_PY_ENTRY
     m.attr("STATUSES") = statuses;
     m.def("reconstruct", &reconstruct, py::arg("points"), py::arg("options"),
-          py::arg("progress"), py::arg("copy"));
+          py::arg("progress"), py::arg("copy"), py::arg("workspace"));
+    py::class_<Workspace>(m, "Workspace")
+        .def(py::init<>())
+        .def_property_readonly("size", &Workspace::size);
     m.def("cap_ends", &cap_ends, py::arg("points"), py::arg("triangles"), py::arg("options"),
           py::arg("copy"));
     m.def("stream_workspace_size", [](size_t max_points, const py::dict& option_dict) {

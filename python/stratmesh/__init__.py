@@ -14,7 +14,7 @@ from ._error import Error
 
 Error.__module__ = __name__  # shown as stratmesh.Error, where users catch it
 
-__all__ = ["Error", "FLAGS", "STATUSES", "Stream", "cap_ends", "reconstruct",
+__all__ = ["Error", "FLAGS", "STATUSES", "Stream", "Workspace", "cap_ends", "reconstruct",
            "stream_workspace_size"]
 __version__ = _core.__version__
 
@@ -22,6 +22,11 @@ __version__ = _core.__version__
 FLAGS = dict(_core.FLAGS)
 #: Every status name with its one-line explanation.
 STATUSES = dict(_core.STATUSES)
+
+#: A workspace that reconstruct(..., workspace=w) keeps between calls: its memory, touched
+#: once, costs no page faults the next time. It grows to the largest call's need (w.size
+#: bytes) and is freed with the object; one call uses it at a time.
+Workspace = _core.Workspace
 
 _AXES = {"auto": 0, "x": 1, "y": 2, "z": 3}
 _DIRECTION = 4
@@ -78,7 +83,7 @@ def _options(axis="auto", cuts=None, layers=0, layer_height=0.0, origin=None, th
 
 def reconstruct(points, *, axis="auto", cuts=None, layers=0, layer_height=0.0, cap=False,
                 skip_invalid=False, drop_outliers=False, surface_flips=False, open_ends=False,
-                origin=None, threads=1, progress=None, flags=(), copy=True):
+                origin=None, threads=1, progress=None, flags=(), copy=True, workspace=None):
     """Meshes a columnar cloud; returns (triangles, report).
 
     points         (n, 3) float32 or float64. Read in place when each point's x, y, z are
@@ -95,6 +100,7 @@ def reconstruct(points, *, axis="auto", cuts=None, layers=0, layer_height=0.0, c
                    triangles are the same bytes for any number.
     progress       callable(phase, fraction), called with the GIL held.
     flags          more flags by name, any key of stratmesh.FLAGS.
+    workspace      a stratmesh.Workspace to reuse; by default each call allocates its own.
 
     triangles is an (m, 3) uint32 array of indices into points; report a namespace with
     status, triangle_count, axis, axis_origin and the groups points, layers, caps,
@@ -104,7 +110,7 @@ def reconstruct(points, *, axis="auto", cuts=None, layers=0, layer_height=0.0, c
                        close_ends=cap, skip_invalid_points=skip_invalid,
                        drop_outliers=drop_outliers, surface_flips=surface_flips,
                        open_ends=open_ends)
-    return _core.reconstruct(points, options, progress, copy)
+    return _core.reconstruct(points, options, progress, copy, workspace)
 
 
 def cap_ends(points, triangles, *, axis="z", origin=None, skip_invalid=False, flags=(),

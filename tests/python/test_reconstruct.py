@@ -136,3 +136,17 @@ def test_a_float32_cloud_meshes_like_its_float64_values():
     a, _ = stratmesh.reconstruct(cloud, axis="z", layers=5)
     b, _ = stratmesh.reconstruct(cloud.astype(np.float64), axis="z", layers=5)
     assert np.array_equal(a, b)
+
+
+def test_a_kept_workspace_grows_and_gives_the_same_triangles(tube):
+    workspace = stratmesh.Workspace()
+    assert workspace.size == 0
+    small, _ = stratmesh.reconstruct(tube[:20_000], axis="z", layers=4, workspace=workspace)
+    first = workspace.size
+    assert first > 0
+    big, _ = stratmesh.reconstruct(tube, axis="z", layers=8, workspace=workspace)
+    assert workspace.size > first
+    again, _ = stratmesh.reconstruct(tube[:20_000], axis="z", layers=4, workspace=workspace)
+    assert workspace.size > first
+    assert np.array_equal(small, again)
+    assert np.array_equal(big, stratmesh.reconstruct(tube, axis="z", layers=8)[0])

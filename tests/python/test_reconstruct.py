@@ -1,3 +1,6 @@
+import threading
+import time
+
 import numpy as np
 import pytest
 
@@ -150,3 +153,27 @@ def test_a_kept_workspace_grows_and_gives_the_same_triangles(tube):
     assert workspace.size > first
     assert np.array_equal(small, again)
     assert np.array_equal(big, stratmesh.reconstruct(tube, axis="z", layers=8)[0])
+
+
+def test_the_gil_is_released_while_the_library_runs():
+    # Were the GIL held through the call, this thread would stall for all of it.
+    cloud = bumpy_tube(400_000)
+    done = threading.Event()
+    elapsed = []
+
+    def mesh():
+        start = time.perf_counter()
+        stratmesh.reconstruct(cloud, axis="z", layers=8)
+        elapsed.append(time.perf_counter() - start)
+        done.set()
+
+    worker = threading.Thread(target=mesh)
+    last = time.perf_counter()
+    longest = 0.0
+    worker.start()
+    while not done.is_set():
+        now = time.perf_counter()
+        longest = max(longest, now - last)
+        last = now
+    worker.join()
+    assert longest < 0.5 * elapsed[0]

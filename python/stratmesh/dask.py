@@ -76,10 +76,6 @@ def _partitions(points):
             else dask.delayed(p) for p in points]
 
 
-def _heights(part, unit):
-    return np.asarray(part, dtype=np.float64) @ unit
-
-
 def _summary(part, unit, skip_invalid):
     """Count, height range and coordinate sum of one partition (of its finite points)."""
     part = np.asarray(part, dtype=np.float64)
@@ -137,7 +133,8 @@ def plan(points, *, axis, layer_height=None, layers=None, ranges=None, skip_inva
 def layer_of(points, plan):
     """Each point's layer: the number of cuts at or below it (a point on a cut is above it).
     NaN heights land past the last layer and are pushed with it (the stream skips them)."""
-    return np.searchsorted(plan.cuts, _heights(points, np.array(plan.unit)), side="right")
+    heights = np.asarray(points, dtype=np.float64) @ np.array(plan.unit)
+    return np.searchsorted(plan.cuts, heights, side="right")
 
 
 def _split(part, offset, plan):

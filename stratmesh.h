@@ -234,6 +234,7 @@ namespace stratmesh {
     X(invalid_layers, "a cut, the layer count or the layer height is NaN, infinite or negative") \
     X(flat_cloud, "the cloud has no extent along the axis")                               \
     X(not_columnar, "the points do not surround the axis in any layer")                   \
+    X(degenerate, "the surface through the points has no area: they lie on a line up to rounding, or a few lie so far from the rest that the rest collapse") \
     X(out_of_order, "a streamed layer is out of axis order: its top is below the previous one, or a point lies outside its heights") \
     /* memory */                                                                          \
     X(out_of_memory, "the workspace is smaller than its *_workspace_size() bound")         \
@@ -2893,6 +2894,29 @@ inline CloudBox box_of(const CloudReader& reader, size_t count) {
 // exceed to their nearest distinct point, on grids of cells of about 4 points; 0 where no
 // grid serves. A box wider than the double range (points near +-1e308) gives an infinite
 // side, which is refused: such a cloud has no scale.
+// Where one cell of the grid (items sorted by cell) holds more than half the points: the
+// cell side that spreads its points as nearest_spacing spreads the whole cloud's first
+// (from its points' own box); 0 otherwise, or if they are all at one place.
+inline double crowded_cell_side(const CloudReader& reader, const GridItem* items, size_t n) {
+    for (size_t first = 0; first < n;) {
+        size_t last = first;
+        while (last < n && items[last].cell == items[first].cell) ++last;
+        if (2 * (last - first) > n) {
+            Vec3 low = reader.point(items[first].index), high = low;
+            for (size_t i = first + 1; i < last; ++i) {
+                const Vec3 p = reader.point(items[i].index);
+                low = {p.x < low.x ? p.x : low.x, p.y < low.y ? p.y : low.y, p.z < low.z ? p.z : low.z};
+                high = {p.x > high.x ? p.x : high.x, p.y > high.y ? p.y : high.y,
+                        p.z > high.z ? p.z : high.z};
+            }
+            const Vec3 half = scaled(high, 0.5) - scaled(low, 0.5);
+            return 4 * std::sqrt(dot(half, half)) / std::sqrt(static_cast<double>(last - first));
+        }
+        first = last;
+    }
+    return 0;
+}
+
 inline double nearest_spacing(const CloudReader& reader, size_t count, const CloudBox& box,
                               CellScratch& g, size_t most_sampled) {
     const Vec3 half = scaled(box.high - box.low, 0.5);
@@ -2906,6 +2930,10 @@ inline double nearest_spacing(const CloudReader& reader, size_t count, const Clo
         if (n > kCrowdedCell * occupied) {  // as on a surface: cells of 4 points on average
             const double shrink = std::sqrt(4 * static_cast<double>(occupied) / static_cast<double>(n));
             side *= shrink > 0.0625 ? shrink : 0.0625;
+            // Most points in one cell, far smaller than the whole (a speck far away set the
+            // box): the cells follow that cell's own points instead.
+            const double crowd = crowded_cell_side(reader, g.items, n);
+            if (crowd > 0 && crowd < side) side = crowd;
             continue;
         }
         nearest = nearest_distance_decile(reader, g, n, side, most_sampled);
@@ -7301,6 +7329,13 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
     group.alloc<uint64_t>(triangles);
     for (int k = 0; k < 4; ++k) group.alloc<uint32_t>(triangles);
 
+    // Counting the repeats of the vertices again (repeats_of_vertices).
+    Arena repeats = Arena::measuring();
+    repeats.alloc<unsigned char>(count / 8 + 1);
+    size_t slots = 1;
+    while (slots < 2 * count + 2) slots *= 2;
+    repeats.alloc<uint32_t>(slots);
+
     // Planning the layers: the automatic layers' profile, then each point's layer while the
     // points are grouped.
     Arena planning = Arena::measuring();
@@ -7320,8 +7355,9 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
         allocate_cap_loop(loop, count, caps);
     }
 
-    if (group.failed || planning.failed || caps.failed) return 0;  // beyond size_t
+    if (group.failed || planning.failed || caps.failed || repeats.failed) return 0;  // beyond size_t
     size_t most = group.high_water;
+    if (repeats.high_water > most) most = repeats.high_water;
     if (planning.high_water > most) most = planning.high_water;
     if (caps.high_water > most) most = caps.high_water;
     return most;
@@ -7830,6 +7866,48 @@ inline void report_chain(const SurfaceChain& chain, size_t valid, Report& rep) {
         rep.detail = "the manifold safety net removed the triangles of some points";
 }
 
+// The repeats of the output's vertices among the points that are not vertices: what
+// Report::points.duplicate_count counts. The layers count a repeat as they triangulate it;
+// where a point then ends with no triangle (the safety net removed them, or the layer left
+// it out), its repeats are unused too, so where some points are not vertices they are
+// counted again from the output, with a hash table of the vertices' coordinates in the
+// workspace. Returns SIZE_MAX if the workspace is too small.
+inline size_t repeats_of_vertices(const CloudReader& reader, size_t count,
+                                  const uint32_t* triangles, size_t triangle_count,
+                                  Arena& arena) {
+    const size_t mark = arena.mark();
+    unsigned char* used = arena.alloc<unsigned char>(count / 8 + 1);
+    size_t slots = 1;
+    while (slots < 2 * count + 2) slots *= 2;
+    uint32_t* table = arena.alloc<uint32_t>(slots);
+    if (arena.failed) return SIZE_MAX;
+    std::memset(used, 0, count / 8 + 1);
+    std::memset(table, 0xFF, slots * sizeof(uint32_t));
+    auto slot_of = [&](Vec3 p) { return coordinate_hash(p.x, p.y + p.z * 0.5) & (slots - 1); };
+    auto same = [](Vec3 a, Vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; };
+    for (size_t k = 0; k < 3 * triangle_count; ++k) {
+        const uint32_t v = triangles[k];
+        if ((used[v >> 3] >> (v & 7)) & 1) continue;
+        used[v >> 3] |= static_cast<unsigned char>(1u << (v & 7));
+        const Vec3 p = reader.point(v);
+        size_t s = slot_of(p);
+        while (table[s] != kNoIndex) s = (s + 1) & (slots - 1);
+        table[s] = v;
+    }
+    size_t repeats = 0;
+    for (size_t i = 0; i < count; ++i) {
+        if (((used[i >> 3] >> (i & 7)) & 1) || !reader.valid(i)) continue;
+        const Vec3 p = reader.point(i);
+        for (size_t s = slot_of(p); table[s] != kNoIndex; s = (s + 1) & (slots - 1))
+            if (same(reader.point(table[s]), p)) {
+                ++repeats;
+                break;
+            }
+    }
+    arena.rewind(mark);
+    return repeats;
+}
+
 // A cloud as a tube reads it: in place, the points left out (outliers, or the points of
 // other parts) marked in the reader's optional bitmap, and the sums of the points kept.
 struct TubeInput {
@@ -7951,6 +8029,35 @@ inline Status triangulate_tube(const TubeInput& in, const Options& options, cons
     return Status::ok;
 }
 
+// A surface this much smaller than the square of the cloud's extent has no area: its
+// points lie on a line up to rounding, or a few points far away set the extent and the rest
+// collapse in the frame (a speck at 1e30 beside a tube of size 1). Its triangles would be
+// slivers of no area, so the cloud is refused instead (Status::degenerate).
+const double kLeastArea = 0x1p-40;
+// The triangles whose areas estimate the surface's: enough to see area where there is some.
+const size_t kAreaSample = 1024;
+
+const char* const kNoAreaDetail =
+    "the surface through the points has no area: they lie on a line up to rounding, or a few "
+    "points far from the rest set the cloud's extent (drop_outliers leaves such points out)";
+
+// Whether the triangles, every k-th of them, have next to no area in the frame (where the
+// cloud's extent is about 1).
+inline bool has_no_area(const CloudReader& reader, const Frame& frame, const uint32_t* tri,
+                        size_t count) {
+    const size_t step = count > kAreaSample ? count / kAreaSample : 1;
+    double area = 0;
+    size_t seen = 0;
+    for (size_t t = 0; t < count; t += step, ++seen) {
+        const Local a = frame.local(reader.point(tri[3 * t]));
+        const Local b = frame.local(reader.point(tri[3 * t + 1]));
+        const Local c = frame.local(reader.point(tri[3 * t + 2]));
+        const Vec3 n = normal_of(a, b, c);
+        area += std::sqrt(dot(n, n)) / 2;
+    }
+    return seen > 0 && area * (static_cast<double>(count) / static_cast<double>(seen)) < kLeastArea;
+}
+
 // Closes the tube's boundary loops with caps (close_ends) and fills the caps' report.
 inline Status cap_tube(const TubeInput& in, const Options& options, const Frame& frame,
                        Arena& arena, uint32_t* triangles, size_t capacity, size_t& count,
@@ -8008,6 +8115,10 @@ inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& aren
         rep.detail = "the triangle array is too small; triangle_count says how many are needed";
         return Status::triangle_capacity;
     }
+    if (has_no_area(in.reader, frame, triangles, sink.count)) {
+        rep.detail = kNoAreaDetail;
+        return Status::degenerate;
+    }
     size_t count = sink.count;
     status = cap_tube(in, options, frame, arena, triangles, triangle_capacity, count,
                       triangle_count, rep);
@@ -8015,6 +8126,11 @@ inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& aren
     *triangle_count = count;
     rep.triangle_count = count;
     rep.diagnostics.fold_count = sink.folds;
+    if (in.sums.valid - m.chain.duplicates > m.chain.used) {  // some points are not vertices
+        const size_t repeats = repeats_of_vertices(in.reader, in.count, triangles, count, arena);
+        if (repeats == SIZE_MAX) return Status::out_of_memory;
+        m.chain.duplicates = repeats;
+    }
     report_chain(m.chain, in.sums.valid, rep);
     if (!rep.detail && rep.caps.open_count > 0) rep.detail = kLoopLeftOpenDetail;
     notify(options, Phase::done, 1);
@@ -8415,18 +8531,38 @@ inline void principal_directions(const double m[3][3], Vec3 out[3]) {
     out[2] = cross(v, second);
 }
 
-// The candidates for the axis of a sample of `count` points, packed.
-inline uint32_t axis_candidates(const double* xyz, size_t count, Vec3* out) {
+// The scatter matrix of `count` points, packed, about their mean.
+inline void scatter_of(const double* xyz, size_t count, double m[3][3]) {
     Vec3 mean = {0, 0, 0};
     for (size_t i = 0; i < count; ++i)
         mean = Vec3{mean.x + xyz[3 * i], mean.y + xyz[3 * i + 1], mean.z + xyz[3 * i + 2]};
     mean = scaled(mean, 1.0 / static_cast<double>(count));
-    double m[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    for (int r = 0; r < 3; ++r)
+        for (int s = 0; s < 3; ++s) m[r][s] = 0;
     for (size_t i = 0; i < count; ++i) {
         const double d[3] = {xyz[3 * i] - mean.x, xyz[3 * i + 1] - mean.y, xyz[3 * i + 2] - mean.z};
         for (int r = 0; r < 3; ++r)
             for (int s = 0; s < 3; ++s) m[r][s] += d[r] * d[s];
     }
+}
+
+// The variance of the scatter matrix along the unit direction v.
+inline double variance_along(const double m[3][3], Vec3 v) {
+    const double c[3] = {v.x, v.y, v.z};
+    double sum = 0;
+    for (int r = 0; r < 3; ++r)
+        for (int s = 0; s < 3; ++s) sum += c[r] * m[r][s] * c[s];
+    return sum;
+}
+
+// A sample whose second principal variance is this small a share of the first lies on a
+// line up to rounding: no surface passes through it (Status::degenerate).
+const double kLineVariance = 0x1p-80;
+
+// The candidates for the axis of a sample of `count` points, packed.
+inline uint32_t axis_candidates(const double* xyz, size_t count, Vec3* out) {
+    double m[3][3];
+    scatter_of(xyz, count, m);
     Vec3 all[6];
     principal_directions(m, all);
     all[3] = Vec3{1, 0, 0};
@@ -8487,24 +8623,33 @@ inline double try_axis(const double* sample, size_t count, Vec3 axis, const Opti
                                                       rep.points.duplicate_count);
 }
 
-// The axis for Axis::automatic: the candidate whose sample surface is smallest (see above).
-// False if the workspace is too small.
-inline bool choose_axis(const TubeInput& in, const Options& options, Arena& arena, Vec3& axis) {
+// Every k-th kept point of `in`, packed, at most axis_sample_size() of them, in `arena`;
+// null if the workspace is too small. *taken receives their count.
+inline double* axis_sample(const TubeInput& in, Arena& arena, size_t* taken) {
     const size_t count = axis_sample_size(in.sums.valid);
-    const size_t mark = arena.mark();
     double* sample = arena.alloc<double>(3 * count);
-    if (arena.failed) return false;
+    if (!sample) return nullptr;
     const size_t step = in.sums.valid / count;
-    size_t taken = 0;
-    for (size_t i = 0, seen = 0; i < in.count && taken < count; ++i) {
+    *taken = 0;
+    for (size_t i = 0, seen = 0; i < in.count && *taken < count; ++i) {
         if (!in.reader.valid(i)) continue;
         if (seen++ % step != 0) continue;
         const Vec3 p = in.reader.point(i);
-        sample[3 * taken] = p.x;
-        sample[3 * taken + 1] = p.y;
-        sample[3 * taken + 2] = p.z;
-        ++taken;
+        sample[3 * *taken] = p.x;
+        sample[3 * *taken + 1] = p.y;
+        sample[3 * *taken + 2] = p.z;
+        ++*taken;
     }
+    return sample;
+}
+
+// The axis for Axis::automatic: the candidate whose sample surface is smallest (see above).
+// False if the workspace is too small.
+inline bool choose_axis(const TubeInput& in, const Options& options, Arena& arena, Vec3& axis) {
+    const size_t mark = arena.mark();
+    size_t taken = 0;
+    const double* sample = axis_sample(in, arena, &taken);
+    if (!sample) return false;
     Vec3 candidates[kMostAxisCandidates];
     const uint32_t tries = axis_candidates(sample, taken, candidates);
     axis = candidates[0];
@@ -8537,6 +8682,21 @@ inline size_t axis_workspace_size(size_t valid, const Options& options) {
 }  // namespace detail
 
 namespace detail {
+
+// Whether the kept points of `in` lie on a line up to rounding (see kLineVariance), judged
+// on a sample. False also if the workspace is too small for the sample.
+inline bool on_a_line(const TubeInput& in, Arena& arena) {
+    const size_t mark = arena.mark();
+    size_t taken = 0;
+    const double* sample = axis_sample(in, arena, &taken);
+    arena.rewind(mark);
+    if (!sample) return false;
+    double m[3][3];
+    scatter_of(sample, taken, m);
+    Vec3 directions[3];
+    principal_directions(m, directions);
+    return !(variance_along(m, directions[1]) > kLineVariance * variance_along(m, directions[0]));
+}
 
 // The options along the axis to use: Axis::automatic resolved by choose_axis().
 inline Status resolve_axis(const TubeInput& in, const Options& options, Arena& arena,
@@ -10273,6 +10433,12 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     TubeInput in;
     Options along;
     status = read_cloud(cloud, options, arena, rep, in);
+    // A cloud on a line up to rounding is refused whatever the axis: a line has no surface,
+    // and along it a layer would only seem not to surround its axis.
+    if (status == Status::ok && in.sums.distinct >= 3 && on_a_line(in, arena)) {
+        rep.detail = kNoAreaDetail;
+        status = Status::degenerate;
+    }
     if (status == Status::ok) status = resolve_axis(in, options, arena, along, rep);
     if (status == Status::ok)
         status = mesh_cloud(cloud, in, along, arena, triangles, triangle_capacity,

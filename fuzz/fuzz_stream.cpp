@@ -308,17 +308,22 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     options.cut_count = cuts.size();
     auto run_batch = [&](uint32_t flags) {
         stratmesh::Options o = options;
-        o.flags |= flags;
+        o.flags |= flags | stratmesh::one_tube;  // the stream meshes one tube
         std::vector<unsigned char> batch_work(stratmesh::reconstruct_workspace_size(m, o));
         std::vector<uint32_t> batch(3 * stratmesh::reconstruct_max_triangles(m, o) + 3);
         size_t batch_count = 0;
         Status b = stratmesh::reconstruct(whole, o, batch_work.data(), batch_work.size(), batch.data(),
                                           batch.size() / 3, &batch_count, nullptr);
+        // A cloud whose surface has no area is refused by reconstruct(), which knows the
+        // whole cloud's extent; the stream's triangles have left before it is known.
+        if (b == Status::degenerate) return std::vector<uint32_t>();
         STRATMESH_FUZZ_CHECK(b == Status::ok, "reconstruct fails where the stream succeeded");
         batch.resize(3 * batch_count);
         return batch;
     };
-    STRATMESH_FUZZ_CHECK(run_batch(0) == t, "the stream's triangles differ from reconstruct()'s on the same layers");
+    const std::vector<uint32_t> batch = run_batch(0);
+    if (batch.empty() && !t.empty()) return 0;  // refused as degenerate (see run_batch)
+    STRATMESH_FUZZ_CHECK(batch == t, "the stream's triangles differ from reconstruct()'s on the same layers");
     if (soup) return 0;
     // With close_ends, cap_ends' output whole: the caps, and the wall's edges flipped under fins.
     capped.resize(3 * capped_count);

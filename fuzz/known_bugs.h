@@ -8,7 +8,9 @@
 //
 // Fixed, kept as regression corpus files: A (NaN from the predicates on all-subnormal
 // points), C (undefined behaviour in reconstruct for coordinates beyond 2^511 or
-// subnormal), D (wrong incircle signs for points a few ulps apart near 2^-218), G (reconstruct
+// subnormal), D (wrong incircle signs for points a few ulps apart near 2^-218), E (repeats
+// of a vertex counted as unused where the layer or the safety net left another point
+// without a triangle; the duplicates are counted again from the output then), G (reconstruct
 // made a repeated point a vertex instead of its lowest twin for a cloud with one far
 // outlier: the annulus coordinates spread beyond the predicates' exact range), H (undefined
 // behaviour, a NaN cast to an integer, for a cloud whose coordinates span more than the
@@ -25,13 +27,6 @@
 //    spreads above 320 bits (orient2d's filter in fuzz_predicates.cpp: above 800).
 //    Reproducer: bug-B-incircle-wrong-sign-span-618-bits (fuzz_predicates); the 434-bit one
 //    passes since the rescaling limits changed, but is equally outside the contract.
-// E: Report::duplicates misses repeats of a point that is a vertex, counting them as unused
-//    (Report documents that only repeats of an unused point count as unused). The first
-//    reproducer, bug-E-report-duplicates-counted-as-unused, no longer reproduces and is
-//    replayed strictly as a regression test; bug-E-repeats-of-a-vertex-counted-as-unused
-//    (fuzz_reconstruct: 280 repeats of a vertex, 2 counted as duplicates) still fails
-//    strictly. By default the check is the loose inequality duplicates <= repeats <=
-//    duplicates + unused; strictly, duplicates equals the repeats of vertices.
 #ifndef STRATMESH_FUZZ_KNOWN_BUGS_H
 #define STRATMESH_FUZZ_KNOWN_BUGS_H
 

@@ -1790,6 +1790,45 @@ TEST_CASE("folding layers: a thin layer that folds across a notch is joined with
 #endif
 }
 
+TEST_CASE("clouds whose surface would have no area are refused, not meshed into slivers") {
+    SUBCASE("points on a line up to rounding: degenerate, whatever the axis") {
+        std::vector<double> xyz;
+        for (int i = 0; i < 2000; ++i) xyz.insert(xyz.end(), {0.01 * i, 0.02 * i, 0.03 * i});
+        for (stratmesh::Axis axis : {stratmesh::Axis::automatic, stratmesh::Axis::x, stratmesh::Axis::z}) {
+            Options o = {};
+            o.axis = axis;
+            const Run run = reconstruct_guarded(Cloud{xyz.data(), 2000, 0, Scalar::float64}, o);
+            CHECK(run.status == Status::degenerate);
+            CHECK(run.count == 0);
+            CHECK(run.report.detail != nullptr);
+            CHECK(run.report.points.in_count == run.report.points.used_count + run.report.points.duplicate_count +
+                                                    run.report.points.rejected_count + run.report.points.unused_count);
+        }
+    }
+    SUBCASE("a tube and a speck at 1e30: refused; without the speck, or with it nearer, a tube") {
+        const Shape tube = shapes::bumpy_tube(kSmall, Pose::z);
+        for (double far : {1e30, 1e3}) {
+            std::vector<double> xyz = tube.xyz;
+            xyz.insert(xyz.end(), {0, 0, far});
+            const Cloud cloud = {xyz.data(), tube.size() + 1, 0, Scalar::float64};
+            const Run run = reconstruct_guarded(cloud, Options{});
+            CAPTURE(far);
+            if (far > 1e20) {
+                CHECK((run.status == Status::degenerate || run.status == Status::not_columnar));
+                CHECK(run.count == 0);
+            } else {
+                CHECK(run.status == Status::ok);
+            }
+            Options dropping = {};
+            dropping.flags = stratmesh::drop_outliers;
+            const Run dropped = reconstruct_guarded(cloud, dropping);
+            REQUIRE(dropped.status == Status::ok);
+            CHECK(dropped.report.points.outlier_count == 1);
+            CHECK(dropped.report.points.used_count == tube.size());
+        }
+    }
+}
+
 TEST_CASE("clouds that do not surround the axis: not_columnar, or ok with a manifold annulus") {
     SUBCASE("half-cylinder: ok, one manifold annulus through every point") {
         for (uint32_t layers : {1u, 6u}) {
@@ -1827,13 +1866,13 @@ TEST_CASE("clouds that do not surround the axis: not_columnar, or ok with a mani
             CHECK(run.report.detail != nullptr);
         }
     }
-    SUBCASE("points on the axis: not_columnar") {
+    SUBCASE("points on the axis: degenerate (a line has no surface)") {
         std::vector<double> xyz;
         for (size_t i = 0; i < 20; ++i) xyz.insert(xyz.end(), {1.0, 2.0, static_cast<double>(i)});
         Options o = {};
         o.axis = Axis::z;
         Run run = reconstruct_guarded(Cloud{xyz.data(), 20, 0, Scalar::float64}, o);
-        CHECK(run.status == Status::not_columnar);
+        CHECK(run.status == Status::degenerate);
     }
 }
 
@@ -2368,7 +2407,7 @@ TEST_CASE("malformed clouds: the documented status, counts that add up, nothing 
         CHECK(counts_add_up(three.report));
         CHECK((three.report.detail == nullptr || std::string(three.report.detail) != few));
     }
-    SUBCASE("all points on one line beside the axis, or across it: no surface") {
+    SUBCASE("all points on one line beside the axis, or across it: degenerate") {
         // Small integers times powers of two: exactly on their lines whatever the compiler
         // contracts (a fused multiply-add would move 0.01 * i - 1 off the line).
         std::vector<double> beside, across;
@@ -2379,7 +2418,7 @@ TEST_CASE("malformed clouds: the documented status, counts that add up, nothing 
         }
         for (const std::vector<double>* line : {&beside, &across}) {
             Run run = reconstruct_guarded(Cloud{line->data(), 200, 0, Scalar::float64}, along_z);
-            CHECK((run.status == Status::not_columnar || run.status == Status::too_few_points));
+            CHECK(run.status == Status::degenerate);
             check_refused(run, run.status);
             CHECK(run.report.points.unused_count == 200);
         }

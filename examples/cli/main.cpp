@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -254,6 +255,41 @@ bool find_branches(const std::vector<double>& xyz, const CommandLine& line, RunR
     return true;
 }
 
+// A point this many times farther from the middle of the cloud than nine points in ten
+// sets the cloud's extent on its own.
+const double kFarPointRatio = 1e6;
+
+// Where a cloud was refused for its shape: the point that lies farthest from the middle of
+// the cloud (the median of each coordinate), named when it lies kFarPointRatio times
+// farther than nine points in ten.
+void name_far_point(const std::vector<double>& xyz) {
+    const size_t n = xyz.size() / 3;
+    if (n < 10) return;
+    double middle[3];
+    std::vector<double> values(n);
+    for (size_t k = 0; k < 3; ++k) {
+        for (size_t i = 0; i < n; ++i) values[i] = xyz[3 * i + k];
+        std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(n / 2),
+                         values.end());
+        middle[k] = values[n / 2];
+    }
+    size_t farthest = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double d = 0;
+        for (size_t k = 0; k < 3; ++k) d += (xyz[3 * i + k] - middle[k]) * (xyz[3 * i + k] - middle[k]);
+        values[i] = std::isfinite(d) ? std::sqrt(d) : 0;
+        if (values[i] > values[farthest]) farthest = i;
+    }
+    const double far = values[farthest];
+    const auto decile = values.begin() + static_cast<std::ptrdiff_t>(9 * n / 10);
+    std::nth_element(values.begin(), decile, values.end());
+    if (!(far > kFarPointRatio * *decile)) return;
+    std::fprintf(stderr,
+                 "stratmesh: point %zu (counting from 0) lies %g from the middle of the cloud, "
+                 "where 9 points in 10 lie within %g: --drop-outliers leaves such points out\n",
+                 farthest, far, *decile);
+}
+
 void explain_refusal(const CommandLine& line, const RunRecord& record) {
     std::fprintf(stderr, "stratmesh: cannot reconstruct %s: %s\n", line.input.c_str(),
                  stratmesh::status_string(record.status));
@@ -311,9 +347,12 @@ int finish_run(const CommandLine& line, RunRecord& record) {
     return write_report(line, record) ? kExitOk : kExitFile;
 }
 
-int refuse(const CommandLine& line, RunRecord& record) {
+int refuse(const CommandLine& line, RunRecord& record, const std::vector<double>& xyz) {
     warn_faces_ignored(line, record);
     explain_refusal(line, record);
+    if (record.status == stratmesh::Status::not_columnar ||
+        record.status == stratmesh::Status::degenerate)
+        name_far_point(xyz);
     record.peak_rss_bytes = peak_resident_bytes();
     write_report(line, record);
     return kExitRefused;
@@ -326,7 +365,7 @@ int run_streamed(const CommandLine& line, RunRecord& record) {
     StreamOutcome outcome = run_stream(line, make_options(line, silent, jobs), record, error);
     switch (outcome) {
     case StreamOutcome::done: return finish_run(line, record);
-    case StreamOutcome::refused: return refuse(line, record);
+    case StreamOutcome::refused: return refuse(line, record, {});
     case StreamOutcome::file_error: break;
     case StreamOutcome::usage:
         std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
@@ -354,7 +393,7 @@ int run(const CommandLine& line) {
     if (line.origin_given && !origin_in_reach(line, xyz)) return kExitUsage;
     if (line.find_branches && !find_branches(xyz, line, record)) return kExitRefused;
     if (!reconstruct_points(xyz, line, result, record)) return kExitRefused;
-    if (record.status != stratmesh::Status::ok) return refuse(line, record);
+    if (record.status != stratmesh::Status::ok) return refuse(line, record, xyz);
     if (!write_output(line, xyz, result, record)) return kExitFile;
     return finish_run(line, record);
 }

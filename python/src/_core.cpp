@@ -52,6 +52,8 @@ const FlagName kFlags[] = {
     {"drop_outliers", stratmesh::drop_outliers},
     {"surface_flips", stratmesh::surface_flips},
     {"open_ends", stratmesh::open_ends},
+    {"one_tube", stratmesh::one_tube},
+    {"keep_parts", stratmesh::keep_parts},
 };
 
 const char* phase_name(stratmesh::Phase phase) {

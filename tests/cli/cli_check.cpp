@@ -58,6 +58,22 @@ std::vector<double> cylinder_points(size_t count) {
     return xyz;
 }
 
+// Points 0.01 i, 0.02 i, 0.03 i: on one line but for rounding.
+std::vector<double> line_points(size_t count) {
+    std::vector<double> xyz;
+    for (size_t i = 0; i < count; ++i) {
+        const double t = static_cast<double>(i);
+        xyz.insert(xyz.end(), {0.01 * t, 0.02 * t, 0.03 * t});
+    }
+    return xyz;
+}
+
+// The cloud with one more point at z = 1e30, which sets its extent on its own.
+std::vector<double> with_far_point(std::vector<double> xyz) {
+    xyz.insert(xyz.end(), {0, 0, 1e30});
+    return xyz;
+}
+
 // Two parallel cylinders of radius 10, 50 apart, height 100: one tube around both folds
 // wherever it is centred.
 std::vector<double> twin_tube_points(size_t count) {
@@ -199,7 +215,9 @@ int make_inputs(const std::string& dir) {
               write_file(dir + "/sorted.ply", as_binary_ply(sorted)) &&
               write_file(dir + "/more_records.ply", ply_more_records_than_declared(cylinder)) &&
               write_file(dir + "/huge_integer.xyz", xyz_with_huge_integer()) &&
-              write_file(dir + "/sorted_nan.xyz", sorted_with_nan_at(sorted, 1500));
+              write_file(dir + "/sorted_nan.xyz", sorted_with_nan_at(sorted, 1500)) &&
+              write_file(dir + "/line.xyz", as_xyz(line_points(2000), 0, "on a line up to rounding")) &&
+              write_file(dir + "/far_speck.xyz", as_xyz(with_far_point(cylinder), 0, "a point at 1e30"));
     if (!ok) std::fprintf(stderr, "cannot write the inputs into %s\n", dir.c_str());
     return ok ? 0 : 1;
 }

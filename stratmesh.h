@@ -1042,6 +1042,8 @@ const bool kCapFinFlips = false;
 const bool kDropOutliers = false;
 const bool kSurfaceFlips = false;
 const bool kFindParts = false;
+const bool kAxisTrials = false;
+const bool kDegenerateCheck = false;
 const bool kLocalUnpeel = false;
 const bool kPeelFoldedEnds = false;
 const bool kFoldMerge = false;
@@ -1073,6 +1075,8 @@ const bool kDropOutliers = true;
 // Layers are flipped on the surface (see "flips on the surface" in >>layer triangulation).
 const bool kSurfaceFlips = true;
 const bool kFindParts = true;
+const bool kAxisTrials = true;
+const bool kDegenerateCheck = true;
 // A band that folds between peeled loops gets back only the peeled triangles around its
 // folds (see add_group); without it, all of them.
 const bool kLocalUnpeel = true;
@@ -7329,12 +7333,8 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
     group.alloc<uint64_t>(triangles);
     for (int k = 0; k < 4; ++k) group.alloc<uint32_t>(triangles);
 
-    // Counting the repeats of the vertices again (repeats_of_vertices).
-    Arena repeats = Arena::measuring();
-    repeats.alloc<unsigned char>(count / 8 + 1);
-    size_t slots = 1;
-    while (slots < 2 * count + 2) slots *= 2;
-    repeats.alloc<uint32_t>(slots);
+    // (Counting the repeats of the vertices again, repeats_of_vertices takes a bit and at
+    // most 16 bytes a point, less than a group's points take above: covered.)
 
     // Planning the layers: the automatic layers' profile, then each point's layer while the
     // points are grouped.
@@ -7355,9 +7355,8 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
         allocate_cap_loop(loop, count, caps);
     }
 
-    if (group.failed || planning.failed || caps.failed || repeats.failed) return 0;  // beyond size_t
+    if (group.failed || planning.failed || caps.failed) return 0;  // beyond size_t
     size_t most = group.high_water;
-    if (repeats.high_water > most) most = repeats.high_water;
     if (planning.high_water > most) most = planning.high_water;
     if (caps.high_water > most) most = caps.high_water;
     return most;
@@ -7656,8 +7655,8 @@ inline bool reconstruct_buffers_overlap(const Cloud& cloud, void* workspace,
         byte_range(report, sizeof(Report)),
         byte_range(report ? report->layers.info : nullptr,
                    report ? saturating_product(report->layers.info_capacity, sizeof(LayerInfo)) : 0),
-        byte_range(report ? report->parts.info : nullptr,
-                   report ? saturating_product(report->parts.info_capacity, sizeof(PartInfo)) : 0)};
+        byte_range(kFindParts && report ? report->parts.info : nullptr,
+                   kFindParts && report ? saturating_product(report->parts.info_capacity, sizeof(PartInfo)) : 0)};
     return any_overlap(buffers, 7);
 }
 
@@ -7941,7 +7940,7 @@ inline Status read_cloud(const Cloud& cloud, const Options& options, Arena& aren
         rep.detail = kNotCompiledDetail;
         return Status::not_compiled;
     }
-    if (options.flags & drop_outliers) {
+    if (kDropOutliers && (options.flags & drop_outliers)) {
         if (!find_outliers(in.reader, cloud.count, arena, rep)) return Status::out_of_memory;
         in.sums = sum_cloud(in.reader, cloud.count);  // without the outliers
     }
@@ -8049,10 +8048,9 @@ inline bool has_no_area(const CloudReader& reader, const Frame& frame, const uin
     double area = 0;
     size_t seen = 0;
     for (size_t t = 0; t < count; t += step, ++seen) {
-        const Local a = frame.local(reader.point(tri[3 * t]));
-        const Local b = frame.local(reader.point(tri[3 * t + 1]));
-        const Local c = frame.local(reader.point(tri[3 * t + 2]));
-        const Vec3 n = normal_of(a, b, c);
+        const Vec3 a = scaled(reader.point(tri[3 * t]), frame.scale);
+        const Vec3 n = cross(scaled(reader.point(tri[3 * t + 1]), frame.scale) - a,
+                             scaled(reader.point(tri[3 * t + 2]), frame.scale) - a);
         area += std::sqrt(dot(n, n)) / 2;
     }
     return seen > 0 && area * (static_cast<double>(count) / static_cast<double>(seen)) < kLeastArea;
@@ -8115,7 +8113,7 @@ inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& aren
         rep.detail = "the triangle array is too small; triangle_count says how many are needed";
         return Status::triangle_capacity;
     }
-    if (has_no_area(in.reader, frame, triangles, sink.count)) {
+    if (kDegenerateCheck && has_no_area(in.reader, frame, triangles, sink.count)) {
         rep.detail = kNoAreaDetail;
         return Status::degenerate;
     }
@@ -8555,8 +8553,9 @@ inline double variance_along(const double m[3][3], Vec3 v) {
     return sum;
 }
 
-// A sample whose second principal variance is this small a share of the first lies on a
-// line up to rounding: no surface passes through it (Status::degenerate).
+// A sample whose variance across its principal direction is this small a share of the
+// variance along it lies on a line up to rounding: no surface passes through it
+// (Status::degenerate).
 const double kLineVariance = 0x1p-80;
 
 // The candidates for the axis of a sample of `count` points, packed.
@@ -8693,9 +8692,8 @@ inline bool on_a_line(const TubeInput& in, Arena& arena) {
     if (!sample) return false;
     double m[3][3];
     scatter_of(sample, taken, m);
-    Vec3 directions[3];
-    principal_directions(m, directions);
-    return !(variance_along(m, directions[1]) > kLineVariance * variance_along(m, directions[0]));
+    const double along = variance_along(m, principal_direction(m));
+    return !(m[0][0] + m[1][1] + m[2][2] - along > kLineVariance * along);
 }
 
 // The options along the axis to use: Axis::automatic resolved by choose_axis().
@@ -8703,6 +8701,10 @@ inline Status resolve_axis(const TubeInput& in, const Options& options, Arena& a
                            Options& along, Report& rep) {
     along = options;
     if (options.axis != Axis::automatic) return Status::ok;
+    if (!kAxisTrials) {
+        rep.detail = kNotCompiledDetail;
+        return Status::not_compiled;
+    }
     if (in.sums.distinct < 3) {  // no surface along any axis: mesh_tube says so
         along.axis = Axis::z;
         return Status::ok;
@@ -10435,7 +10437,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     status = read_cloud(cloud, options, arena, rep, in);
     // A cloud on a line up to rounding is refused whatever the axis: a line has no surface,
     // and along it a layer would only seem not to surround its axis.
-    if (status == Status::ok && in.sums.distinct >= 3 && on_a_line(in, arena)) {
+    if (status == Status::ok && kDegenerateCheck && in.sums.distinct >= 3 && on_a_line(in, arena)) {
         rep.detail = kNoAreaDetail;
         status = Status::degenerate;
     }
@@ -10465,7 +10467,8 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
         arena.alloc<unsigned char>(point_count / 8 + 1);
     const size_t read = arena.required_bytes();
     size_t steps[2] = {0, 0};
-    if (options.axis == Axis::automatic) steps[0] = detail::axis_workspace_size(point_count, options);
+    if (detail::kAxisTrials && options.axis == Axis::automatic)
+        steps[0] = detail::axis_workspace_size(point_count, options);
 #if !defined(STRATMESH_SMALL_CODE)
     if (detail::searches_parts(options)) steps[1] = detail::parts_workspace_size(point_count, options);
 #endif
@@ -10489,8 +10492,10 @@ Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
     std::memset(&rep, 0, sizeof rep);
     rep.layers.info = layers.info;
     rep.layers.info_capacity = layers.info ? layers.info_capacity : 0;
-    rep.parts.info = parts.info;
-    rep.parts.info_capacity = parts.info ? parts.info_capacity : 0;
+    if (detail::kFindParts) {
+        rep.parts.info = parts.info;
+        rep.parts.info_capacity = parts.info ? parts.info_capacity : 0;
+    }
     rep.points.in_count = cloud.count;
     if (triangle_count) *triangle_count = 0;
     Status status = detail::run_reconstruction(cloud, options, workspace, workspace_bytes,

@@ -81,6 +81,16 @@ const char* phase_name(stratmesh::Phase phase) {
     raise_error(stratmesh::Status::invalid_argument, detail.c_str(), py::none());
 }
 
+const char* parts_outcome_name(stratmesh::PartsOutcome outcome) {
+    switch (outcome) {
+        case stratmesh::PartsOutcome::one_tube: return "one_tube";
+        case stratmesh::PartsOutcome::joined: return "joined";
+        case stratmesh::PartsOutcome::kept_apart: return "kept_apart";
+        case stratmesh::PartsOutcome::undone: return "undone";
+    }
+    return "unknown";
+}
+
 // The report as nested namespaces (report.points.used_count, ...): one place to extend
 // when the header's Report grows a group.
 py::object report_object(const stratmesh::Report& r, stratmesh::Status status) {
@@ -119,6 +129,19 @@ py::object report_object(const stratmesh::Report& r, stratmesh::Status status) {
             py::arg("open_count") = r.caps.open_count,
             py::arg("triangle_count") = r.caps.triangle_count,
             py::arg("wall_flip_count") = r.caps.wall_flip_count),
+        py::arg("parts") = ns(
+            py::arg("outcome") = parts_outcome_name(r.parts.outcome),
+            py::arg("part_count") = r.parts.part_count,
+            py::arg("joined_side_count") = r.parts.joined_side_count,
+            py::arg("apart_side_count") = r.parts.apart_side_count,
+            py::arg("grafted_branch_count") = r.parts.grafted_branch_count,
+            py::arg("junction_triangle_count") = r.parts.junction_triangle_count,
+            py::arg("removed_triangle_count") = r.parts.removed_triangle_count,
+            py::arg("gap") = r.parts.parting.gap,
+            py::arg("above") = r.parts.parting.above,
+            py::arg("above_branch_count") = r.parts.parting.above_branch_count,
+            py::arg("below") = r.parts.parting.below,
+            py::arg("below_branch_count") = r.parts.parting.below_branch_count),
         py::arg("diagnostics") = ns(
             py::arg("fold_count") = r.diagnostics.fold_count,
             py::arg("illegal_removed_count") = r.diagnostics.illegal_removed_count,

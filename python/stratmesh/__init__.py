@@ -83,7 +83,8 @@ def _options(axis="auto", cuts=None, layers=0, layer_height=0.0, origin=None, th
 
 def reconstruct(points, *, axis="auto", cuts=None, layers=0, layer_height=0.0, cap=False,
                 skip_invalid=False, drop_outliers=False, surface_flips=False, open_ends=False,
-                origin=None, threads=1, progress=None, flags=(), copy=True, workspace=None):
+                one_tube=False, keep_parts=False, origin=None, threads=1, progress=None,
+                flags=(), copy=True, workspace=None):
     """Meshes a columnar cloud; returns (triangles, report).
 
     points         (n, 3) float32 or float64. Read in place when each point's x, y, z are
@@ -93,7 +94,7 @@ def reconstruct(points, *, axis="auto", cuts=None, layers=0, layer_height=0.0, c
     cuts           heights along the axis where layers start; else layers equal layers;
                    else layers of about layer_height; else the library's automatic layers.
     cap            close the tube's ends (the close_ends flag).
-    skip_invalid, drop_outliers, surface_flips, open_ends
+    skip_invalid, drop_outliers, surface_flips, open_ends, one_tube, keep_parts
                    the flags of the same names (skip_invalid: skip_invalid_points).
     origin         the frame's reference point (sets origin_given).
     threads        the layers are triangulated on this many threads (0: one per core); the
@@ -103,13 +104,13 @@ def reconstruct(points, *, axis="auto", cuts=None, layers=0, layer_height=0.0, c
     workspace      a stratmesh.Workspace to reuse; by default each call allocates its own.
 
     triangles is an (m, 3) uint32 array of indices into points; report a namespace with
-    status, triangle_count, axis, axis_origin and the groups points, layers, caps,
+    status, triangle_count, axis, axis_origin and the groups points, layers, caps, parts,
     diagnostics, then detail and workspace_used_bytes. A failure raises stratmesh.Error.
     """
     options = _options(axis, cuts, layers, layer_height, origin, threads, flags,
                        close_ends=cap, skip_invalid_points=skip_invalid,
                        drop_outliers=drop_outliers, surface_flips=surface_flips,
-                       open_ends=open_ends)
+                       open_ends=open_ends, one_tube=one_tube, keep_parts=keep_parts)
     return _core.reconstruct(points, options, progress, copy, workspace)
 
 

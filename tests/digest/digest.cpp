@@ -174,53 +174,6 @@ void delaunay_case(const char* name, const std::vector<double>& raw) {
                 s == stratmesh::Status::ok ? "ok" : "NOT OK", info.triangle_count);
 }
 
-// find_parting, each part meshed apart (the trunk along z, each branch around its own
-// automatic axis), then join_branches: the joined triangles go into the digest.
-void join_case(const char* name, const std::vector<double>& raw, const stratmesh::Options& o) {
-    std::vector<double> xyz = quantized(raw);
-    for (double d : xyz) g_input.f64(d);
-    const size_t n = xyz.size() / 3;
-    const stratmesh::Cloud cloud = {xyz.data(), n, 0, stratmesh::Scalar::float64};
-    std::vector<unsigned char> work(stratmesh::find_parting_workspace_size(n, o));
-    stratmesh::Parting parting = {};
-    std::vector<uint8_t> label(n, 0);
-    stratmesh::Status s = stratmesh::find_parting(cloud, o, work.data(), work.size(), &parting,
-                                                  label.data());
-    std::vector<uint32_t> all;
-    for (unsigned part = 0; part < 256 && s == stratmesh::Status::ok; ++part) {
-        std::vector<double> points;
-        std::vector<uint32_t> index;
-        for (size_t i = 0; i < n; ++i) {
-            if (label[i] != part) continue;
-            index.push_back(static_cast<uint32_t>(i));
-            points.insert(points.end(), xyz.begin() + static_cast<std::ptrdiff_t>(3 * i),
-                          xyz.begin() + static_cast<std::ptrdiff_t>(3 * i + 3));
-        }
-        if (index.empty()) continue;
-        stratmesh::Options po = o;
-        if (part != stratmesh::kInTrunk) po.axis = stratmesh::Axis::automatic;
-        const stratmesh::Cloud c = {points.data(), index.size(), 0, stratmesh::Scalar::float64};
-        std::vector<unsigned char> space(stratmesh::reconstruct_workspace_size(c.count, po));
-        std::vector<uint32_t> t(3 * stratmesh::reconstruct_max_triangles(c.count, po));
-        size_t count = 0;
-        s = stratmesh::reconstruct(c, po, space.data(), space.size(), t.data(), t.size() / 3,
-                                   &count, nullptr);
-        for (size_t k = 0; k < 3 * count; ++k) all.push_back(index[t[k]]);
-    }
-    const size_t given = all.size() / 3;
-    size_t count = given;
-    stratmesh::JoinReport report = {};
-    if (s == stratmesh::Status::ok) {
-        std::vector<unsigned char> space(stratmesh::join_branches_workspace_size(n, given));
-        all.resize(3 * (given + stratmesh::join_branches_max_triangles(n)));
-        s = stratmesh::join_branches(cloud, o, parting, label.data(), space.data(), space.size(),
-                                     all.data(), all.size() / 3, &count, &report);
-    }
-    record(g_output, "join", name, n, s, all.data(), count,
-           {parting.above_branch_count, parting.below_branch_count, report.joined_side_count},
-           report.joined_side_count, "sides joined");
-}
-
 stratmesh::Options axis_z(uint32_t layers = 0, double height = 0) {
     stratmesh::Options o = {};
     o.axis = stratmesh::Axis::z;
@@ -251,9 +204,6 @@ int main(int argc, char** argv) {
     cuts.cuts = cut_positions;
     cuts.cut_count = 4;
     reconstruct_case("vase, 4 cuts", vase, cuts);
-    stratmesh::Options automatic_axis = {};
-    automatic_axis.layer_count = 3;
-    reconstruct_case("vase tilted, automatic axis", shapes::vase(2000, Pose::tilted).xyz, automatic_axis);
     std::vector<double> grid = shapes::scan_grid(2000, Pose::z).xyz;
     reconstruct_case("scan grid, 1 layer", grid, axis_z(1));
     reconstruct_case("scan grid, 5 layers", grid, axis_z(5));
@@ -276,6 +226,11 @@ int main(int argc, char** argv) {
     const std::vector<uint32_t> streamed = stream_case("bumpy tube, 3 pushes", bumpy, 3, pushed);
 
 #if !defined(STRATMESH_SMALL_CODE)
+    // The automatic axis: each candidate meshes a sample (the small build asks for an axis).
+    stratmesh::Options automatic_axis = {};
+    automatic_axis.layer_count = 3;
+    reconstruct_case("vase tilted, automatic axis", shapes::vase(2000, Pose::tilted).xyz,
+                     automatic_axis, g_full_input, g_full);
     reconstruct_case("capsule (closed ends), automatic", shapes::capsule(3000, Pose::z).xyz,
                      axis_z(), g_full_input, g_full);
     reconstruct_case("slanted tube (crescent), 6 layers", shapes::slanted_tube(3000, Pose::z).xyz,
@@ -295,6 +250,24 @@ int main(int argc, char** argv) {
     stratmesh::Options outliers = axis_z(4);
     outliers.flags = stratmesh::drop_outliers;
     reconstruct_case("bumpy tube + strays, drop_outliers", strays, outliers, g_full_input,
+                     g_full);
+    // A trunk of radius 10 up to z = 60 and two prongs of radius 3 on its wall above it:
+    // golden-angle spirals.
+    std::vector<double> pronged;
+    const double golden = shapes::kPi * (3 - std::sqrt(5.0));
+    const struct {
+        size_t count;
+        double cx, radius, z0, z1;
+    } spirals[] = {{4200, 0, 10, 0, 60}, {850, -7, 3, 60, 100}, {850, 7, 3, 60, 100}};
+    for (const auto& sp : spirals)
+        for (size_t i = 0; i < sp.count; ++i) {
+            const double t = static_cast<double>(i);
+            pronged.insert(pronged.end(),
+                           {sp.cx + sp.radius * std::cos(golden * t), sp.radius * std::sin(golden * t),
+                            sp.z0 + (sp.z1 - sp.z0) * (t + 0.5) / static_cast<double>(sp.count)});
+        }
+    // reconstruct() finds the parting, meshes the trunk and the prongs apart and joins them.
+    reconstruct_case("pronged tube, 4 trunk layers, joined", pronged, axis_z(4), g_full_input,
                      g_full);
     cap_ends_case("bumpy tube, 3 pushes, capped", pushed, streamed);
     stratmesh::Options flipped = axis_z(3);
@@ -332,22 +305,6 @@ int main(int argc, char** argv) {
     std::vector<double> dups(random.begin(), random.begin() + 1000);
     dups.insert(dups.end(), random.begin(), random.begin() + 500);
     delaunay_case("500 random points, 250 repeated", dups);
-    // A trunk of radius 10 up to z = 60 and two prongs of radius 3 on its wall above it:
-    // golden-angle spirals.
-    std::vector<double> pronged;
-    const double golden = shapes::kPi * (3 - std::sqrt(5.0));
-    const struct {
-        size_t count;
-        double cx, radius, z0, z1;
-    } spirals[] = {{4200, 0, 10, 0, 60}, {850, -7, 3, 60, 100}, {850, 7, 3, 60, 100}};
-    for (const auto& sp : spirals)
-        for (size_t i = 0; i < sp.count; ++i) {
-            const double t = static_cast<double>(i);
-            pronged.insert(pronged.end(),
-                           {sp.cx + sp.radius * std::cos(golden * t), sp.radius * std::sin(golden * t),
-                            sp.z0 + (sp.z1 - sp.z0) * (t + 0.5) / static_cast<double>(sp.count)});
-        }
-    join_case("pronged tube, 4 trunk layers", pronged, axis_z(4));
 
     std::printf("input  %016llx\n", static_cast<unsigned long long>(g_input.h));
     std::printf("digest %016llx\n", static_cast<unsigned long long>(g_output.h));

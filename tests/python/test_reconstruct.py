@@ -177,3 +177,28 @@ def test_the_gil_is_released_while_the_library_runs():
         last = now
     worker.join()
     assert longest < 0.5 * elapsed[0]
+
+
+def forked_tube():
+    """A trunk of radius 10 up to z = 60 and two prongs of radius 3 on its wall above it."""
+    golden = np.pi * (3 - np.sqrt(5.0))
+    parts = []
+    for count, cx, radius, z0, z1 in ((4200, 0, 10, 0, 60), (850, -7, 3, 60, 100), (850, 7, 3, 60, 100)):
+        t = np.arange(count, dtype=np.float64)
+        parts.append(np.stack([cx + radius * np.cos(golden * t), radius * np.sin(golden * t),
+                               z0 + (z1 - z0) * (t + 0.5) / count], axis=1))
+    return np.concatenate(parts)
+
+
+def test_a_forked_cloud_is_meshed_in_parts_joined_into_one_surface():
+    points = forked_tube()
+    triangles, report = stratmesh.reconstruct(points, axis="z", layers=4)
+    assert report.parts.outcome == "joined"
+    assert report.parts.part_count == 3
+    assert report.parts.above_branch_count == 2
+    assert report.parts.joined_side_count == 1
+    assert report.points.used_count == len(points)
+    assert_manifold(triangles)
+    _, one = stratmesh.reconstruct(points, axis="z", layers=4, one_tube=True)
+    assert one.parts.outcome == "one_tube"
+    assert one.parts.part_count == 0

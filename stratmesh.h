@@ -8554,9 +8554,10 @@ inline double variance_along(const double m[3][3], Vec3 v) {
 }
 
 // A sample whose variance across its principal direction is this small a share of the
-// variance along it lies on a line up to rounding: no surface passes through it
-// (Status::degenerate).
-const double kLineVariance = 0x1p-80;
+// variance along it (a width a millionth of its length) lies on a line up to rounding: no
+// surface passes through it (Status::degenerate). Well above the rounding of the variances'
+// difference.
+const double kLineVariance = 0x1p-40;
 
 // The candidates for the axis of a sample of `count` points, packed.
 inline uint32_t axis_candidates(const double* xyz, size_t count, Vec3* out) {

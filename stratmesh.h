@@ -2994,8 +2994,9 @@ struct Frame {
     // Layers are flipped on the surface (the surface_flips flag; see "flips on the surface"
     // in >>layer triangulation).
     bool surface_flips;
-    // No end is taken for a closed one (the open_ends flag; false without kClosedEnds).
-    bool open_ends;
+    // The surface's ends (kLowPole, kHighPole) never taken for a closed one: both with the
+    // open_ends flag, the end of a branch at its cut (see mesh_parts); 0 without kClosedEnds.
+    uint32_t cut_ends;
     // The valid points' lowest and highest coordinates (set by choose_frame with kFastLoops).
     Vec3 low, high;
     // (p - origin) * scale, without overflow.
@@ -3158,7 +3159,7 @@ inline Status choose_frame(const CloudSums& sums, const Options& options, Frame&
     if (!normalize(e1)) return Status::invalid_axis;
     frame.axis = axis;
     frame.surface_flips = kSurfaceFlips && (options.flags & surface_flips);
-    frame.open_ends = kClosedEnds && (options.flags & open_ends);
+    frame.cut_ends = kClosedEnds && (options.flags & open_ends) ? closed_bottom | closed_top : 0u;
     frame.e1 = e1;
     frame.e2 = cross(axis, e1);
     return Status::ok;
@@ -4043,7 +4044,7 @@ struct LoadedLayer {
     Cylinder cyl;
     bool surface_flips;   // Frame::surface_flips
     uint32_t ends;        // kLowPole, kHighPole: the surface's ends (see find_closed_ends)
-    bool open_ends;       // Frame::open_ends
+    uint32_t cut_ends;    // Frame::cut_ends
 };
 
 // `staged` (optional): the same points in frame coordinates, in the arena's end room
@@ -4056,7 +4057,7 @@ inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint3
     layer.ends = 0;
     layer.count = count;
     if (kSurfaceFlips) layer.surface_flips = frame.surface_flips;
-    layer.open_ends = kClosedEnds && frame.open_ends;
+    layer.cut_ends = frame.cut_ends;
     layer.points = arena.alloc<Local>(count);
     if (arena.failed) return false;
     if (intact)
@@ -4118,7 +4119,8 @@ inline void find_closed_ends(LoadedLayer& layer, uint32_t ends) {
     Cylinder& c = layer.cyl;
     const Local* points = layer.points;
     const size_t n = layer.count;
-    if (!kClosedEnds || !ends || n == 0 || layer.open_ends) return;
+    ends &= ~layer.cut_ends;
+    if (!kClosedEnds || !ends || n == 0) return;
     double lo = points[0].h, hi = lo;
     for (size_t i = 1; i < n; ++i) {
         lo = points[i].h < lo ? points[i].h : lo;
@@ -7094,7 +7096,7 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
                                   ahead->ends == ends;
         LoadedLayer layer = {ids, n, nullptr, triangulated ? ahead->cylinder : Cylinder{},
                              kSurfaceFlips && c.frame.surface_flips, ends,
-                             kClosedEnds && c.frame.open_ends};
+                             c.frame.cut_ends};
         const Local* staged = q.staged ? q.staged + q.start[first] : nullptr;
         if (!triangulated && !load_layer(c.reader, c.frame, ids, staged, n, h0, h1, arena, layer))
             return Status::out_of_memory;
@@ -7913,6 +7915,7 @@ struct TubeInput {
     CloudReader reader;
     size_t count;
     CloudSums sums;
+    uint32_t cut_ends;  // ends that are cuts, never closed (Frame::cut_ends), besides open_ends
 };
 
 // Whether this build holds every feature the flags ask for (STRATMESH_SMALL_CODE leaves
@@ -8087,6 +8090,7 @@ inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& aren
     Frame frame;
     Status status = choose_frame(in.sums, options, frame);
     if (status != Status::ok) return status;
+    if (kClosedEnds) frame.cut_ends |= in.cut_ends;
     report_frame(frame, rep);
     if (in.sums.distinct < 3) {
         rep.detail = "fewer than 3 distinct valid points";
@@ -8487,23 +8491,31 @@ Status stream_close(Stream* stream) {
 //
 // The automatic axis. The method needs the direction along which the cloud's sections are
 // loops around one centre line, and the direction of largest variance is often another: a
-// head is longest from front to back, a squat bone across. So each candidate, the three
-// principal directions of the cloud and then x, y and z (skipping any within about ten
-// degrees of one before it), meshes a sample of the cloud as one tube, and the candidate
-// whose sample surface is smallest wins: where the layers cannot follow the surface they
-// fold and bridge gaps with webs, and both add area. The sample is every k-th kept point
-// in input order, so the choice is deterministic.
+// head is longest from front to back, a squat bone across. The candidates are the three
+// principal directions of the cloud (from a sample of kAxisShapeSample points) and then x,
+// y and z (skipping any within about ten degrees of one before it). A smaller sample is
+// meshed as one tube along the first: where the surface runs along it (its triangles'
+// normals lie across it, as on a tube or a limb), it is the axis. Otherwise each candidate
+// meshes the sample and the one whose surface is smallest wins: where the layers cannot
+// follow the surface they fold and bridge gaps with webs, and both add area. The samples
+// are every k-th kept point in input order, so the choice is deterministic.
 
 namespace detail {
 
 // Points meshed per candidate: enough to see an object's limbs and ends, few enough that
 // six candidates cost a small part of a large run.
 const size_t kAxisSample = 512;
+// Points the principal directions are measured on: enough for a tube's axis within a
+// fraction of a degree.
+const size_t kAxisShapeSample = 16384;
+// The share of the sample surface's normals along the first candidate (the mean squared
+// cosine, weighted by area) below which the surface runs along it: about 0.04 on a tube,
+// 0.16 to 0.5 on heads, bones and hands.
+const double kAlongSurface = 0.1;
 // A candidate whose direction is within about 10 degrees of an earlier one is not tried.
 const double kSameAxisCosine = 0.985;
 const uint32_t kMostAxisCandidates = 6;
 
-inline size_t axis_sample_size(size_t valid) { return valid < kAxisSample ? valid : kAxisSample; }
 
 // The three principal directions of a symmetric 3x3 matrix, largest variance first: power
 // iteration, then again on the matrix without the first direction's share.
@@ -8595,12 +8607,32 @@ inline double sample_surface(const double* xyz, const uint32_t* tri, size_t coun
     return area + 2 * per_triangle * static_cast<double>(unused);
 }
 
+// The mean squared cosine between the triangles' normals and the unit axis, weighted by
+// their areas: 0 where the surface runs along the axis, 1 where it lies across it.
+inline double normals_along(const double* xyz, const uint32_t* tri, size_t count, Vec3 axis) {
+    double along = 0, area = 0;
+    for (size_t t = 0; t < count; ++t) {
+        const double* a = xyz + 3 * tri[3 * t];
+        const double* b = xyz + 3 * tri[3 * t + 1];
+        const double* c = xyz + 3 * tri[3 * t + 2];
+        const Vec3 n = cross(Vec3{b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                             Vec3{c[0] - a[0], c[1] - a[1], c[2] - a[2]});
+        const double length = std::sqrt(dot(n, n));
+        if (length == 0) continue;
+        const double cosine = dot(n, axis) / length;
+        along += cosine * cosine * length;
+        area += length;
+    }
+    return area > 0 ? along / area : 1;
+}
+
 // Workspace for choose_axis() on a cloud of `valid` kept points, given the flags.
 inline size_t axis_workspace_size(size_t valid, const Options& options);
 
 // Meshes the sample along one candidate; DBL_MAX if it cannot.
+// *along (optional) receives the share of the sample surface's normals along the axis.
 inline double try_axis(const double* sample, size_t count, Vec3 axis, const Options& options,
-                       Arena& arena) {
+                       Arena& arena, double* along) {
     Options trial = {};
     trial.axis = Axis::direction;
     trial.direction[0] = axis.x;
@@ -8612,33 +8644,42 @@ inline double try_axis(const double* sample, size_t count, Vec3 axis, const Opti
     uint32_t* tri = arena.alloc<uint32_t>(6 * count);
     if (arena.failed) return DBL_MAX;
     const Cloud cloud = {sample, count, 0, Scalar::float64};
-    TubeInput in = {reader_of(cloud), count, {}};
+    TubeInput in = {reader_of(cloud), count, {}, 0};
     in.sums = sum_cloud(in.reader, count);
     Report rep = {};
     size_t triangles = 0;
     const Status status = mesh_tube(in, trial, arena, tri, 2 * count, &triangles, rep);
     arena.rewind(mark);
     if (status != Status::ok) return DBL_MAX;
+    if (along) *along = normals_along(sample, tri, triangles, axis);
     return sample_surface(sample, tri, triangles, in.sums.valid - rep.points.used_count -
                                                       rep.points.duplicate_count);
 }
 
-// Every k-th kept point of `in`, packed, at most axis_sample_size() of them, in `arena`;
-// null if the workspace is too small. *taken receives their count.
-inline double* axis_sample(const TubeInput& in, Arena& arena, size_t* taken) {
-    const size_t count = axis_sample_size(in.sums.valid);
+// Every k-th kept point of `in`, packed, at most `most` of them (and about that many), in
+// `arena`; null if the workspace is too small. *taken receives their count. Where every
+// point is kept, the sample is read by index, without a pass over the cloud.
+inline double* sample_points(const TubeInput& in, size_t most, Arena& arena, size_t* taken) {
+    const size_t count = in.sums.valid < most ? in.sums.valid : most;
     double* sample = arena.alloc<double>(3 * count);
-    if (!sample) return nullptr;
-    const size_t step = in.sums.valid / count;
     *taken = 0;
-    for (size_t i = 0, seen = 0; i < in.count && *taken < count; ++i) {
-        if (!in.reader.valid(i)) continue;
-        if (seen++ % step != 0) continue;
+    if (!sample || count == 0) return sample;
+    // The k-th of `count` is kept point number k * valid / count (64 bits: no overflow).
+    const uint64_t valid = in.sums.valid;
+    auto put = [&](size_t i) {
         const Vec3 p = in.reader.point(i);
         sample[3 * *taken] = p.x;
         sample[3 * *taken + 1] = p.y;
         sample[3 * *taken + 2] = p.z;
         ++*taken;
+    };
+    if (in.sums.valid == in.count && !in.reader.dropped) {
+        for (uint64_t k = 0; k < count; ++k) put(static_cast<size_t>(k * valid / count));
+        return sample;
+    }
+    for (size_t i = 0, seen = 0; i < in.count && *taken < count; ++i) {
+        if (!in.reader.valid(i)) continue;
+        if (seen++ == *taken * valid / count) put(i);
     }
     return sample;
 }
@@ -8648,33 +8689,37 @@ inline double* axis_sample(const TubeInput& in, Arena& arena, size_t* taken) {
 inline bool choose_axis(const TubeInput& in, const Options& options, Arena& arena, Vec3& axis) {
     const size_t mark = arena.mark();
     size_t taken = 0;
-    const double* sample = axis_sample(in, arena, &taken);
-    if (!sample) return false;
+    const double* shape = sample_points(in, kAxisShapeSample, arena, &taken);
+    if (!shape) return false;
     Vec3 candidates[kMostAxisCandidates];
-    const uint32_t tries = axis_candidates(sample, taken, candidates);
+    const uint32_t tries = axis_candidates(shape, taken, candidates);
+    arena.rewind(mark);
+    const double* sample = sample_points(in, kAxisSample, arena, &taken);
+    if (!sample) return false;
     axis = candidates[0];
-    double best = DBL_MAX;
-    for (uint32_t k = 0; k < tries; ++k) {
-        const double score = try_axis(sample, taken, candidates[k], options, arena);
-        if (arena.failed) return false;
+    double along = 1;
+    double best = try_axis(sample, taken, candidates[0], options, arena, &along);
+    for (uint32_t k = 1; k < tries && !(along < kAlongSurface); ++k) {
+        const double score = try_axis(sample, taken, candidates[k], options, arena, nullptr);
         if (score < best) {
             best = score;
             axis = candidates[k];
         }
     }
     arena.rewind(mark);
-    return true;
+    return !arena.failed;
 }
 
 inline size_t axis_workspace_size(size_t valid, const Options& options) {
-    const size_t count = axis_sample_size(valid);
+    const size_t count = valid < kAxisSample ? valid : kAxisSample;
     Options trial = {};
     trial.flags = options.flags & open_ends;
     trial.layer_count = 1;
     const size_t tube = tube_workspace_size(count, trial);
     if (tube == 0) return 0;
+    const size_t shape = valid < kAxisShapeSample ? valid : kAxisShapeSample;
     Arena arena = Arena::measuring();
-    arena.alloc<double>(3 * count);
+    arena.alloc<double>(3 * (shape > count ? shape : count));
     arena.alloc<uint32_t>(6 * count);
     return arena.failed ? 0 : arena.required_bytes() + tube;
 }
@@ -8688,7 +8733,7 @@ namespace detail {
 inline bool on_a_line(const TubeInput& in, Arena& arena) {
     const size_t mark = arena.mark();
     size_t taken = 0;
-    const double* sample = axis_sample(in, arena, &taken);
+    const double* sample = sample_points(in, kAxisSample, arena, &taken);
     arena.rewind(mark);
     if (!sample) return false;
     double m[3][3];
@@ -8783,7 +8828,7 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
             checks.detail = "a triangle names a point outside the cloud, or an invalid one";
             return finish(Status::invalid_argument);
         }
-    detail::TubeInput in = {reader, cloud.count, sums};
+    detail::TubeInput in = {reader, cloud.count, sums, 0};
     Options along;
     status = detail::resolve_axis(in, options, arena, along, checks);
     if (status != Status::ok) return finish(status);
@@ -8838,9 +8883,9 @@ struct CachedBlock {
 
 // The size from which a piece of a side of `points` points counts: kSmallestBranch, and a
 // twentieth of the side.
-inline uint32_t counting_size(size_t points) {
+inline uint32_t counting_size(size_t points, uint32_t smallest) {
     const size_t twentieth = (points + 19) / 20;
-    return twentieth > kSmallestBranch ? static_cast<uint32_t>(twentieth) : kSmallestBranch;
+    return twentieth > smallest ? static_cast<uint32_t>(twentieth) : smallest;
 }
 
 // The sweep's state. Pieces are named by the order in which their root was added. A
@@ -8867,6 +8912,7 @@ struct PartingSweep {
     unsigned char* is_listed; // order -> whether it is in `listed`
     size_t listed_count;
     uint32_t counting;        // counting_size(points added so far)
+    uint32_t smallest;        // the fewest points a branch holds (kSmallestBranch)
     uint64_t checks_left;     // see kPartingChecksPerPoint
     bool crowded;             // the checks ran out: the sweep stopped
 
@@ -8904,7 +8950,7 @@ struct PartingSweep {
         size[t] = 1;
         lowest[t] = highest[t] = level(t);
         is_listed[t] = 0;
-        counting = counting_size(t + 1);
+        counting = counting_size(t + 1, smallest);
         const uint64_t cell = cells[j].cell;
         CachedBlock& cached = blocks[(cell * 0x9E3779B97F4A7C15u) >> 53];  // 11 bits
         if (cached.cell != cell) cached = {cell, block_around(cells, count, j, fingers)};
@@ -8947,7 +8993,7 @@ inline uint32_t branches_at(PartingSweep& s, uint32_t added, uint32_t slab_start
     uint32_t pieces = 0;
     bool bump = false;
     size_t kept = 0;
-    const uint32_t counting = counting_size(added);
+    const uint32_t counting = counting_size(added, s.smallest);
     for (size_t k = 0; k < s.listed_count; ++k) {
         const uint32_t r = s.listed[k];
         if (s.parent[r] != r || s.size[r] < counting) {  // merged since, or too small now
@@ -9041,7 +9087,7 @@ inline SideParting sweep_for_parting(PartingSweep& s, const PartingSteps& p, boo
                                      uint32_t stop) {
     s.sign = from_top ? 1 : -1;
     s.listed_count = 0;
-    s.counting = kSmallestBranch;
+    s.counting = s.smallest;
     for (uint32_t k = 0; k < kBlockCacheSize; ++k) s.blocks[k].cell = kNoCell;
     for (size_t j = 0; j < s.count; ++j) s.order_of[j] = kNotAdded;
     for (size_t& f : s.fingers) f = 0;
@@ -9226,9 +9272,13 @@ size_t find_parting_workspace_size(size_t point_count, const Options& options) {
     return arena.failed ? 0 : arena.required_bytes();
 }
 
-Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
-                    size_t workspace_bytes, Parting* parting, uint8_t* branch_of) {
-    using namespace detail;
+namespace detail {
+
+// find_parting() with the fewest points a branch holds given: a sample of the cloud is
+// searched with fewer (see search_parting).
+inline Status find_parting_with(const Cloud& cloud, const Options& options, void* workspace,
+                                size_t workspace_bytes, Parting* parting, uint8_t* branch_of,
+                                uint32_t smallest) {
     if (!parting) return Status::invalid_argument;
     // Checked before anything is written (a count beyond the limit is refused below).
     const bool countable = cloud.count <= kMaxPoints - 1;
@@ -9257,7 +9307,7 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
         if (!find_outliers(reader, cloud.count, arena, rep)) return finish(out_of_workspace(rep));
         sums = sum_cloud(reader, cloud.count);
     }
-    const TubeInput in = {reader, cloud.count, sums};
+    const TubeInput in = {reader, cloud.count, sums, 0};
     Options along;
     status = resolve_axis(in, options, arena, along, rep);
     if (status != Status::ok) return finish(status);
@@ -9306,6 +9356,7 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
     parting->gap = gap;
     PartingSweep& s = m.sweep;
     s.crowded = false;
+    s.smallest = smallest;
     s.gap = gap * frame.scale;
     s.count = grid_in_frame(reader, cloud.count, frame, low, s.gap, m);
     s.cells = m.items;
@@ -9333,6 +9384,14 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
     if (branch_of && below.branches)
         label_branches(s, m.steps, false, below.cut_index, kFirstBelowBranch, branch_of);
     return finish(Status::ok);
+}
+
+}  // namespace detail
+
+Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
+                    size_t workspace_bytes, Parting* parting, uint8_t* branch_of) {
+    return detail::find_parting_with(cloud, options, workspace, workspace_bytes, parting,
+                                     branch_of, kSmallestBranch);
 }
 
 // >>join branches ===========================================================================
@@ -10057,7 +10116,11 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
 
 namespace detail {
 
-const size_t kPartingSample = 8192;
+const size_t kPartingSample = 4096;
+// On the sample a branch counts from this share of kSmallestBranch points: fewer than on
+// the whole cloud, so that a branch the whole cloud would count is seen in the sample too
+// (a horn of one point in a hundred); the search in full then decides.
+const uint32_t kSampleBranchShare = 4;
 // The trunk's end layer under branches standing on its closed end is merged with the
 // layers next to it until it is this many of their largest radius tall: a closed end
 // projects from a pole one radius in from the end, but at most three quarters of the way
@@ -10157,25 +10220,17 @@ inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const Opt
     search.flags &= skip_invalid_points | drop_outliers;
     if (whole.sums.valid > kPartingSample) {
         const size_t mark = arena.mark();
-        const size_t step = whole.sums.valid / kPartingSample;
-        double* sample = arena.alloc<double>(3 * kPartingSample);
-        if (!sample) return false;
         size_t taken = 0;
-        for (size_t i = 0, seen = 0; i < whole.count && taken < kPartingSample; ++i) {
-            if (!whole.reader.valid(i) || seen++ % step != 0) continue;
-            const Vec3 p = whole.reader.point(i);
-            sample[3 * taken] = p.x;
-            sample[3 * taken + 1] = p.y;
-            sample[3 * taken + 2] = p.z;
-            ++taken;
-        }
+        const double* sample = sample_points(whole, kPartingSample, arena, &taken);
+        if (!sample) return false;
         Options on_sample = search;
         on_sample.flags &= ~static_cast<uint32_t>(skip_invalid_points | drop_outliers);
         const size_t bytes = find_parting_workspace_size(taken, on_sample);
         void* work = arena.alloc<unsigned char>(bytes);
         if (!work) return false;
-        const Status status = find_parting({sample, taken, 0, Scalar::float64}, on_sample, work,
-                                           bytes, &parting, nullptr);
+        const Status status =
+            find_parting_with({sample, taken, 0, Scalar::float64}, on_sample, work, bytes,
+                              &parting, nullptr, kSmallestBranch / kSampleBranchShare);
         arena.rewind(mark);
         if (status != Status::ok || parting.above_branch_count + parting.below_branch_count == 0)
             return true;
@@ -10271,8 +10326,15 @@ inline Status mesh_parts(const Cloud& cloud, const TubeInput& whole, const Optio
         size_t added = 0;
         const size_t mark = arena.mark();
         status = resolve_axis(branch, branch_options, arena, own, part);
+        // The branch's end at the cut is a cut, not a closed end: its low end along its own
+        // axis if that runs away from the trunk.
+        const Vec3 trunk_axis = {rep.axis[0], rep.axis[1], rep.axis[2]};
+        const Vec3 own_axis = {own.direction[0], own.direction[1], own.direction[2]};
+        const bool away = (dot(own_axis, trunk_axis) > 0) == above;
+        TubeInput cut = branch;
+        cut.cut_ends = away ? kLowPole : kHighPole;
         if (status == Status::ok)
-            status = mesh_tube(branch, own, arena, triangles + 3 * count, capacity - count,
+            status = mesh_tube(cut, own, arena, triangles + 3 * count, capacity - count,
                                &added, part);
         arena.rewind(mark);
         record_part(rep, label, status, branch, part, added, 0);
@@ -10433,7 +10495,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     if (status != Status::ok) return status;
     notify(options, Phase::validate, 0);
     Arena arena = Arena::over(workspace, workspace_bytes);
-    TubeInput in;
+    TubeInput in = {};
     Options along;
     status = read_cloud(cloud, options, arena, rep, in);
     // A cloud on a line up to rounding is refused whatever the axis: a line has no surface,

@@ -1790,6 +1790,33 @@ TEST_CASE("folding layers: a thin layer that folds across a notch is joined with
 #endif
 }
 
+TEST_CASE("the automatic axis serves the method: the shapes' own axis, as close as the explicit one") {
+    // A head longer front to back than tall, and tubes and a vase, upright and tilted: the
+    // automatic axis lies within 10 degrees of the shape's, and the mesh is within 10% of the
+    // explicit axis's mean distance from the true surface (plus a hundredth of a spacing).
+    const Shape shapes_tried[] = {shapes::long_head(8000, Pose::z), shapes::long_head(8000, Pose::tilted),
+                                  shapes::bumpy_tube(8000, Pose::tilted), shapes::vase(8000, Pose::x)};
+    for (const Shape& s : shapes_tried) {
+        CAPTURE(s.name);
+        CAPTURE(shapes::pose_name(s.pose));
+        const Run automatic = reconstruct_guarded(cloud_of(s), Options{});
+        const Run explicit_axis = reconstruct_guarded(cloud_of(s), axis_options(s));
+        REQUIRE(automatic.status == Status::ok);
+        REQUIRE(explicit_axis.status == Status::ok);
+        double axis[3];
+        s.axis_direction(axis);
+        const double cosine = std::fabs(automatic.report.axis[0] * axis[0] + automatic.report.axis[1] * axis[1] +
+                                        automatic.report.axis[2] * axis[2]);
+        CHECK(cosine > std::cos(10 * 3.14159265358979323846 / 180));
+        const double chosen = mean_centroid_deviation(s, automatic.triangles);
+        const double given = mean_centroid_deviation(s, explicit_axis.triangles);
+        MESSAGE(s.name << " " << shapes::pose_name(s.pose) << ": mean distance " << chosen / s.spacing
+                       << " spacings automatic, " << given / s.spacing << " along the shape's axis");
+        CHECK(chosen <= 1.1 * given + 0.01 * s.spacing);
+        CHECK(automatic.report.points.unused_count == 0);
+    }
+}
+
 TEST_CASE("clouds whose surface would have no area are refused, not meshed into slivers") {
     SUBCASE("points on a line up to rounding: degenerate, whatever the axis") {
         std::vector<double> xyz;

@@ -291,6 +291,18 @@ inline Shape thin_tube(size_t n, Pose pose, double radius, uint64_t seed = 21) {
 inline Shape head(size_t n, Pose pose, uint64_t seed = 17) {
     return radial_random("head", pose, head_radius, 0, 2.4, n, seed);
 }
+// A head on a neck, longer from front to back (x) than tall (z): a neck of radius 0.35 up
+// to z = 0.5, then a head about 2.6 long, 1.2 wide and 1.5 tall. Its largest variance is
+// front to back; the method needs z.
+inline double long_head_radius(double theta, double z) {
+    const double head = 0.35 + 0.55 * detail::smoothstep((z - 0.5) / 0.4) -
+                        0.35 * detail::smoothstep((z - 1.6) / 0.4);
+    const double neck = 1 - detail::smoothstep((z - 0.5) / 0.4);
+    return head * (1 + (1 - neck) * 0.45 * std::cos(2 * theta));
+}
+inline Shape long_head(size_t n, Pose pose, uint64_t seed = 24) {
+    return radial_random("long head", pose, long_head_radius, 0, 2.0, n, seed);
+}
 // A cylinder with theta in [0, pi] only: it does not surround its axis.
 inline Shape half_cylinder(size_t n, Pose pose, uint64_t seed = 18) {
     return radial_random("half cylinder", pose, cylinder_radius, -3, 3, n, seed, 0, 0, kPi);

@@ -9,6 +9,7 @@
 #include "cloud_io.h"
 #include "mesh_io.h"
 #include "report_json.h"
+#include "text_scan.h"
 
 #include "cli/mini_json.h"
 #include "cli/mini_mesh.h"
@@ -454,6 +455,26 @@ TEST_CASE("XYZ columns: spaces, tabs, commas, comments, blank lines, extra colum
     REQUIRE_MESSAGE(r.ok, r.error);
     CHECK(r.info.format == CloudFormat::xyz);
     CHECK(r.xyz == xyz);
+}
+
+TEST_CASE("fields part at blanks, and at commas and semicolons when asked, no other byte") {
+    for (int byte = 0; byte < 256; ++byte) {
+        const char c = static_cast<char>(byte);
+        CAPTURE(byte);
+        const bool blank = c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+        for (bool commas : {false, true}) {
+            const bool separates = blank || (commas && (c == ',' || c == ';'));
+            const std::string line = std::string("12") + c + "34";
+            std::string_view rest = line;
+            std::string_view field;
+            std::vector<std::string> fields;
+            while (next_field(rest, field, commas)) fields.emplace_back(field);
+            if (separates)
+                CHECK(fields == std::vector<std::string>{"12", "34"});
+            else
+                CHECK(fields == std::vector<std::string>{line});
+        }
+    }
 }
 
 TEST_CASE("PTS with a count line, and a leading plus sign") {

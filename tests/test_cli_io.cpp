@@ -1017,6 +1017,87 @@ TEST_CASE("STL output: triangle corners to float precision, unit normals facing 
     }
 }
 
+namespace {
+
+// A mesh large enough that every writer fills its block many times: points with awkward
+// doubles (or their floats), two triangles per point, every vertex used.
+WrittenMesh large_mesh(size_t points, bool float_exact) {
+    WrittenMesh m;
+    m.xyz = test_points(points);
+    m.xyz[0] = -0.0;
+    m.xyz[4] = 3e38;
+    if (float_exact) m.xyz = rounded_to_float(m.xyz);
+    if (!float_exact) m.xyz[8] = 1e300; // beyond float: the binary PLY holds doubles
+    for (size_t i = 0; i < 2 * points; ++i) {
+        const uint32_t a = static_cast<uint32_t>(i / 2);
+        m.tris.insert(m.tris.end(), {a, static_cast<uint32_t>((a + 1 + i % 7) % points),
+                                     static_cast<uint32_t>((a + 5 + 3 * (i % 11)) % points)});
+    }
+    return m;
+}
+
+} // namespace
+
+TEST_CASE("large meshes: every format reads back bit for bit, the stream writer's bytes too") {
+    TempDir dir;
+    for (bool float_exact : {false, true}) {
+        const WrittenMesh m = large_mesh(60000, float_exact);
+        const std::pair<const char*, bool> outputs[] = {
+            {"m.ply", false}, {"m.ply", true}, {"m.obj", false}, {"m.off", false}};
+        for (const auto& out : outputs) {
+            const std::string name = out.first;
+            CAPTURE(name);
+            CAPTURE(out.second);
+            CAPTURE(float_exact);
+            const std::string path = dir.file("whole_" + name);
+            const mini_mesh::Mesh back = write_and_read(m, path, out.second);
+            CHECK(back.tris == m.tris);
+            std::vector<double> xyz;
+            std::string error;
+            REQUIRE_MESSAGE(read_cloud_file(path, xyz, error), error);
+            CHECK(same_bits(xyz, m.xyz));
+            if (name == "m.obj") continue; // the stream interleaves OBJ's lines
+            const std::string pieces = dir.file("pieces_" + name);
+            MeshStreamWriter writer;
+            REQUIRE_MESSAGE(writer.open(pieces, mesh_format_from_extension(pieces), out.second,
+                                        error),
+                            error);
+            const size_t half = m.xyz.size() / 6;
+            writer.add_vertices(m.xyz.data(), half);
+            writer.add_vertices(m.xyz.data() + 3 * half, m.xyz.size() / 3 - half);
+            writer.add_triangles(m.tris.data(), m.tris.size() / 3);
+            REQUIRE_MESSAGE(writer.finish(true, error), error);
+            std::string whole_bytes, piece_bytes;
+            REQUIRE(mini_mesh::load(path, whole_bytes));
+            REQUIRE(mini_mesh::load(pieces, piece_bytes));
+            CHECK(whole_bytes == piece_bytes);
+        }
+    }
+}
+
+TEST_CASE("large meshes: STL corners are the vertices' floats, triangle by triangle") {
+    TempDir dir;
+    const WrittenMesh m = large_mesh(30000, false);
+    // Binary STL clamps a finite double beyond float's range to the largest float; text
+    // STL holds the double itself.
+    auto as_float = [](double v, bool ascii) {
+        const double largest = static_cast<double>(std::numeric_limits<float>::max());
+        if (!ascii && std::isfinite(v) && std::fabs(v) > largest) v = v < 0 ? -largest : largest;
+        return static_cast<float>(v);
+    };
+    for (bool ascii : {false, true}) {
+        CAPTURE(ascii);
+        const mini_mesh::Mesh back = write_and_read(m, dir.file("m.stl"), ascii);
+        REQUIRE(back.xyz.size() == 3 * m.tris.size());
+        size_t wrong = 0;
+        for (size_t c = 0; c < m.tris.size(); ++c)
+            for (size_t k = 0; k < 3; ++k)
+                wrong += static_cast<float>(back.xyz[3 * c + k]) !=
+                         as_float(m.xyz[3 * m.tris[c] + k], ascii);
+        CHECK(wrong == 0);
+    }
+}
+
 TEST_CASE("the tool reads back what it writes, exactly") {
     TempDir dir;
     WrittenMesh m = small_mesh(false);

@@ -15,6 +15,7 @@ namespace {
 // Below this, malloc: a mapping of its own would cost more than the faults it saves.
 constexpr size_t kMapFrom = size_t{1} << 20;
 constexpr size_t kHugePage = size_t{2} << 20;
+constexpr size_t kSmallPage = 4096;
 
 bool mapped(size_t bytes) {
 #ifdef __linux__
@@ -25,12 +26,12 @@ bool mapped(size_t bytes) {
 #endif
 }
 
-// Whole huge pages, so that the last one is a huge page too.
+// Whole huge pages, so that the last one can be a huge page too.
 size_t mapped_length(size_t bytes) { return (bytes + kHugePage - 1) / kHugePage * kHugePage; }
 
 } // namespace
 
-void* allocate_big(size_t bytes) {
+void* allocate_big(size_t bytes, Pages pages) {
     if (bytes == 0) bytes = 1;
 #ifdef __linux__
     if (mapped(bytes)) {
@@ -45,10 +46,14 @@ void* allocate_big(size_t bytes) {
         if (head > 0) munmap(raw, head);
         if (tail > 0) munmap(reinterpret_cast<char*>(aligned) + length, tail);
         void* memory = reinterpret_cast<void*>(aligned);
-        madvise(memory, length, MADV_HUGEPAGE);
+        if (pages == Pages::huge)
+            madvise(memory, length, MADV_HUGEPAGE);
+        else
+            prefault_pages(memory, bytes);
         return memory;
     }
 #endif
+    (void)pages;
     return std::malloc(bytes);
 }
 
@@ -64,14 +69,13 @@ void free_big(void* memory, size_t bytes) {
     std::free(memory);
 }
 
-void advise_huge_pages(void* memory, size_t bytes) {
-#ifdef __linux__
+void prefault_pages(void* memory, size_t bytes) {
+#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
     const uintptr_t start = reinterpret_cast<uintptr_t>(memory);
-    if (bytes < kHugePage || start > UINTPTR_MAX - bytes) return;
-    const uintptr_t first = (start + kHugePage - 1) / kHugePage * kHugePage;
-    const uintptr_t last = (start + bytes) / kHugePage * kHugePage;
-    if (first < last)
-        madvise(reinterpret_cast<void*>(first), static_cast<size_t>(last - first), MADV_HUGEPAGE);
+    if (bytes < kMapFrom || start > UINTPTR_MAX - bytes) return;
+    const uintptr_t first = start / kSmallPage * kSmallPage;
+    madvise(reinterpret_cast<void*>(first), static_cast<size_t>(start + bytes - first),
+            MADV_POPULATE_WRITE);
 #else
     (void)memory;
     (void)bytes;
@@ -79,7 +83,7 @@ void advise_huge_pages(void* memory, size_t bytes) {
 }
 
 bool BigBuffer::reallocate(size_t bytes, size_t keep) {
-    char* fresh = static_cast<char*>(allocate_big(bytes));
+    char* fresh = static_cast<char*>(allocate_big(bytes, Pages::prefaulted));
     if (!fresh) return false;
     if (keep > bytes) keep = bytes;
     if (keep > size_) keep = size_;

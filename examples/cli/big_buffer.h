@@ -1,12 +1,18 @@
-// Large buffers for the tool: the file image, the library's workspace, the triangles.
+// Large buffers for the tool: the file image, the points, the library's workspace, the
+// triangles.
 //
-// A fresh buffer of many megabytes costs one page fault per 4 KiB page on first touch,
-// and on a virtual machine a fault costs microseconds: the 170 MB workspace of a
-// million-point cloud took about 0.1 s of faults. On Linux, allocate_big() maps the
-// buffer itself, aligned to 2 MiB and marked for transparent huge pages (madvise mode), so
-// the kernel fills it 2 MiB at a time: a fault per 512 pages. The pages are still touched
-// first by whoever writes them (only what is used is paid for, by the thread that uses
-// it). Elsewhere, and for small buffers, it is malloc.
+// A fresh buffer of many megabytes costs a page fault per 4 KiB page on first touch, about
+// 2.5 microseconds each on the 2-core VM of docs/benchmarks.md: 60 ms for a 100 MB
+// workspace. Two ways around it, each for its own use (Linux; elsewhere, and below a
+// megabyte, plain malloc):
+// - Pages::huge maps the buffer aligned to 2 MiB and marked for transparent huge pages
+//   (madvise mode), so the kernel fills it 2 MiB at a time, on first touch, only where it
+//   is used. Fast where the kernel has such pages at hand; on a VM that hands its free
+//   memory back to the host (free page reporting) a fresh huge page can cost more than its
+//   512 small ones: measure before using it.
+// - Pages::prefaulted maps small pages and faults them all in at once (MAP_POPULATE),
+//   about a quarter cheaper than one fault per page: for a buffer about to be written
+//   whole, such as a file image.
 #ifndef STRATMESH_CLI_BIG_BUFFER_H
 #define STRATMESH_CLI_BIG_BUFFER_H
 
@@ -14,18 +20,20 @@
 
 namespace stratmesh_cli {
 
-// Uninitialised memory of `bytes` bytes (at least one), aligned for any type, or null.
-void* allocate_big(size_t bytes);
+enum class Pages { huge, prefaulted };
 
-// Frees what allocate_big(bytes) returned; `bytes` must be the same. Null is ignored.
+// Uninitialised memory of `bytes` bytes (at least one), aligned for any type, or null.
+void* allocate_big(size_t bytes, Pages pages = Pages::huge);
+
+// Frees what allocate_big(bytes, ...) returned; `bytes` must be the same. Null is ignored.
 void free_big(void* memory, size_t bytes);
 
-// Asks for huge pages on the whole 2 MiB blocks inside [memory, memory + bytes), memory
-// that another allocator gave (a std::vector's storage). Only a hint: nothing on other
-// systems, or if the kernel refuses.
-void advise_huge_pages(void* memory, size_t bytes);
+// Faults in the pages of [memory, memory + bytes) in one call, for memory that another
+// allocator gave (a std::vector's storage) and that is about to be written whole. Its
+// content is kept. Only a hint: nothing on other systems or older kernels.
+void prefault_pages(void* memory, size_t bytes);
 
-// An owner of an allocate_big() buffer.
+// An owner of an allocate_big(..., Pages::prefaulted) buffer, for a file image.
 class BigBuffer {
 public:
     BigBuffer() = default;

@@ -58,9 +58,9 @@ bool read_cloud_from_memory(const char* data, size_t size, CloudFormat format,
                             std::vector<double>& xyz, std::string& error,
                             CloudInfo* info = nullptr);
 
-// Reads a whole file into `bytes` (allocate_big(), so a large file is read into huge
-// pages), its length into `size`: one request for a regular file whose size does not change,
-// a buffer doubling as the bytes arrive otherwise.
+// Reads a whole file into `bytes` (its pages faulted in at once, big_buffer.h), its length
+// into `size`: one request for a regular file whose size does not change, a buffer doubling
+// as the bytes arrive otherwise.
 bool read_file_bytes(const std::string& path, BigBuffer& bytes, size_t& size, std::string& error);
 
 // read_file_bytes + read_cloud_from_memory with the format detected from the content (the

@@ -535,7 +535,7 @@ void read_fixed_vertices(ByteReader& in, const PlyElement& element, const Vertex
     }
     const size_t count = static_cast<size_t>(element.count);
     xyz.reserve(xyz.size() + 3 * count);
-    advise_huge_pages(xyz.data(), xyz.capacity() * sizeof(double));
+    prefault_pages(xyz.data() + xyz.size(), 3 * count * sizeof(double));
     // A batch's records and points stay in the first-level caches.
     constexpr size_t kBatch = 1024;
     double staged[3 * kBatch];

@@ -488,6 +488,41 @@ TEST_CASE("fields part at blanks, and at commas and semicolons when asked, no ot
     }
 }
 
+TEST_CASE("numbers read in one pass are the fields and numbers of the two-step scan") {
+    const char* pieces[] = {"1",    "-2.5e3", "+4",  ".5",   "-.5",    "1e400", "-1e-400", "nan",
+                            "-inf", "inf",    "1e",  "1.5x", "0x10",   "abc",   "5+3",     "+",
+                            "-",    "1,2",    "3;4", "1e5",  "7.25E-2", "00012", "1..2",   "\xff"};
+    const char* separators[] = {" ", "\t", ",", ";", "  ", ", ", "\r", ""};
+    std::mt19937 random(99);
+    for (int round = 0; round < 5000; ++round) {
+        std::string line;
+        const int count = static_cast<int>(random() % 6);
+        for (int k = 0; k < count; ++k) {
+            line += separators[random() % 8];
+            line += pieces[random() % 24];
+        }
+        line += separators[random() % 8];
+        CAPTURE(line);
+        for (bool commas : {false, true}) {
+            std::string_view two = line, one = line, field_two, field_one;
+            for (;;) {
+                double value_two = -7, value_one = -7;
+                NumberParse parsed_one = NumberParse::ok;
+                const bool more_two = next_field(two, field_two, commas);
+                const bool more_one = next_number(one, field_one, value_one, parsed_one, commas);
+                REQUIRE(more_two == more_one);
+                if (!more_two) break;
+                const NumberParse parsed_two = scan_number(field_two, value_two);
+                CHECK(field_one == field_two);
+                CHECK(parsed_one == parsed_two);
+                if (parsed_two == NumberParse::ok)
+                    CHECK(std::memcmp(&value_one, &value_two, sizeof(double)) == 0);
+                CHECK(one.data() == two.data());
+            }
+        }
+    }
+}
+
 TEST_CASE("PTS with a count line, and a leading plus sign") {
     ReadResult r = read_text("3\n1 2 3 -50 255 255 255\n+4 5e0 6 10 1 2 3\n.5 -0 7\n");
     REQUIRE_MESSAGE(r.ok, r.error);

@@ -621,11 +621,11 @@ bool next_ascii_value(std::string_view& rest, size_t line, const PlyElement& ele
                       const PlyProperty& property, PlyType type, uint64_t record,
                       double& value, std::string& error) {
     std::string_view token;
-    if (!next_field(rest, token, false)) {
+    NumberParse parsed = NumberParse::ok;
+    if (!next_number(rest, token, value, parsed, false)) {
         error = at_line(line) + "the line ends before " + property_place(element, property, record);
         return false;
     }
-    NumberParse parsed = scan_number(token, value);
     if (parsed == NumberParse::ok && type_holds(type, value)) return true;
     std::string problem = parsed == NumberParse::not_a_number   ? " is not a number"
                           : parsed == NumberParse::out_of_range ? " is beyond the range of a double"

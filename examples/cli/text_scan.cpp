@@ -87,6 +87,27 @@ bool parse_number(std::string_view token, double& value) {
     return scan_number(token, value) == NumberParse::ok;
 }
 
+bool next_number(std::string_view& rest, std::string_view& field, double& value,
+                 NumberParse& parsed, bool commas) {
+    const unsigned char classes = commas ? kBlank | kComma : kBlank;
+    size_t start = 0;
+    while (start < rest.size() && is_field_separator(rest[start], classes)) ++start;
+    const char* first = rest.data() + start;
+    const char* last = rest.data() + rest.size();
+    std::from_chars_result r = std::from_chars(first, last, value);
+    if (r.ec == std::errc() && r.ptr > first &&
+        (r.ptr == last || is_field_separator(*r.ptr, classes))) {
+        field = std::string_view(first, static_cast<size_t>(r.ptr - first));
+        rest.remove_prefix(static_cast<size_t>(r.ptr - rest.data()));
+        parsed = NumberParse::ok;
+        return true;
+    }
+    // Anything else (a sign, a range error, no number, text after it) as the two calls do.
+    if (!next_field(rest, field, commas)) return false;
+    parsed = scan_number(field, value);
+    return true;
+}
+
 std::string_view skip_byte_order_mark(std::string_view text) {
     if (text.substr(0, kByteOrderMark.size()) == kByteOrderMark)
         text.remove_prefix(kByteOrderMark.size());

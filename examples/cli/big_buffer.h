@@ -10,9 +10,9 @@
 //   is used. Fast where the kernel has such pages at hand; on a VM that hands its free
 //   memory back to the host (free page reporting) a fresh huge page can cost more than its
 //   512 small ones: measure before using it.
-// - Pages::prefaulted maps small pages and faults them all in at once (MAP_POPULATE),
-//   about a quarter cheaper than one fault per page: for a buffer about to be written
-//   whole, such as a file image.
+// - Pages::prefaulted maps small pages and faults them all in at once
+//   (MADV_POPULATE_WRITE), about a quarter cheaper than one fault per page: for a buffer
+//   about to be written whole, such as a file image.
 #ifndef STRATMESH_CLI_BIG_BUFFER_H
 #define STRATMESH_CLI_BIG_BUFFER_H
 

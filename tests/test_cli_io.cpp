@@ -5,9 +5,11 @@
 #include <doctest/doctest.h>
 
 #include "args.h"
+#include "big_buffer.h"
 #include "cloud_io.h"
 #include "mesh_io.h"
 #include "report_json.h"
+#include "text_scan.h"
 
 #include "cli/mini_json.h"
 #include "cli/mini_mesh.h"
@@ -24,7 +26,12 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
+
+#ifndef _WIN32
+#include <sys/stat.h>
+#endif
 
 using namespace stratmesh_cli;
 
@@ -216,6 +223,217 @@ TEST_CASE("binary PLY with integer coordinates") {
     CHECK(r.xyz == std::vector<double>{-300, 70000, 255, 5, -1, 0});
 }
 
+namespace {
+
+// A PLY type's name and its values: the first few are the type's extremes and oddities,
+// the rest random bit patterns (for floats these include NaNs, infinities, subnormals).
+struct TypedColumn {
+    const char* name;
+    size_t size;
+    std::vector<std::string> raw;  // each value's bytes, little-endian
+    std::vector<double> expected;  // each value as a double
+};
+
+template <class T> TypedColumn typed_column(const char* name, size_t count, uint64_t seed) {
+    using Limits = std::numeric_limits<T>;
+    std::vector<T> values = {Limits::lowest(), Limits::max(), T(0), T(1)};
+    if (!Limits::is_integer) {
+        values.push_back(-T(0));
+        values.push_back(Limits::denorm_min());
+        values.push_back(-Limits::infinity());
+        values.push_back(Limits::quiet_NaN());
+    }
+    std::mt19937_64 random(seed);
+    while (values.size() < count) {
+        const uint64_t bits = random();
+        T value;
+        std::memcpy(&value, &bits, sizeof value);
+        values.push_back(value);
+    }
+    TypedColumn column{name, sizeof(T), {}, {}};
+    for (size_t i = 0; i < count; ++i) {
+        Bytes little{false, ""};
+        little.put(values[i]);
+        column.raw.push_back(little.data);
+        column.expected.push_back(static_cast<double>(values[i]));
+    }
+    return column;
+}
+
+std::vector<TypedColumn> every_typed_column(size_t count) {
+    return {typed_column<int8_t>("char", count, 1),     typed_column<uint8_t>("uint8", count, 2),
+            typed_column<int16_t>("short", count, 3),   typed_column<uint16_t>("ushort", count, 4),
+            typed_column<int32_t>("int32", count, 5),   typed_column<uint32_t>("uint", count, 6),
+            typed_column<float>("float", count, 7),     typed_column<double>("float64", count, 8)};
+}
+
+// Binary PLY whose vertices hold x, y, z from three columns (`count` points: values i,
+// count + i, 2 count + i of each), between other properties; with `list`, also a list
+// property, which makes the records variable in size (the per-record path).
+std::string typed_binary_ply(const TypedColumn* xyz[3], size_t count, bool big_endian,
+                             bool list) {
+    std::string header = std::string("ply\nformat ") +
+                         (big_endian ? "binary_big_endian" : "binary_little_endian") +
+                         " 1.0\nelement face 2\nproperty uchar flags\nproperty double area\n"
+                         "element vertex " + std::to_string(count) + "\nproperty uchar red\n" +
+                         "property " + xyz[0]->name + " x\nproperty short label\n" +
+                         (list ? "property list uchar int extra\n" : "") +
+                         "property " + xyz[1]->name + " y\nproperty " + xyz[2]->name +
+                         " z\nproperty double w\nend_header\n";
+    Bytes b{big_endian, header};
+    for (int f = 0; f < 2; ++f) b.put<uint8_t>(7).put<double>(0.5);
+    auto raw = [&](const TypedColumn& column, size_t i) {
+        std::string bytes = column.raw[i];
+        if (big_endian) bytes.assign(bytes.rbegin(), bytes.rend());
+        b.data += bytes;
+    };
+    for (size_t i = 0; i < count; ++i) {
+        b.put<uint8_t>(200);
+        raw(*xyz[0], i);
+        b.put<int16_t>(-3);
+        if (list) {
+            b.put<uint8_t>(static_cast<uint8_t>(i % 3));
+            for (size_t k = 0; k < i % 3; ++k) b.put<int32_t>(-1);
+        }
+        raw(*xyz[1], count + i);
+        raw(*xyz[2], 2 * count + i);
+        b.put<double>(1.25);
+    }
+    return b.data;
+}
+
+std::vector<double> typed_expected(const TypedColumn* xyz[3], size_t count) {
+    std::vector<double> out;
+    for (size_t i = 0; i < count; ++i)
+        for (size_t k = 0; k < 3; ++k) out.push_back(xyz[k]->expected[k * count + i]);
+    return out;
+}
+
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+} // namespace
+
+TEST_CASE("binary PLY: fixed-size records of every scalar type and byte order read as written") {
+    // More points than one conversion batch holds, and a last batch that is partial.
+    const size_t n = 2500;
+    const std::vector<TypedColumn> columns = every_typed_column(3 * n);
+    std::vector<std::vector<const TypedColumn*>> layouts;
+    for (const TypedColumn& c : columns) layouts.push_back({&c, &c, &c});
+    layouts.push_back({&columns[0], &columns[7], &columns[3]}); // char, double, ushort
+    layouts.push_back({&columns[6], &columns[5], &columns[2]}); // float, uint, short
+    for (const auto& layout : layouts) {
+        const TypedColumn* xyz[3] = {layout[0], layout[1], layout[2]};
+        const std::vector<double> expected = typed_expected(xyz, n);
+        for (bool big : {false, true}) {
+            CAPTURE(xyz[0]->name);
+            CAPTURE(xyz[1]->name);
+            CAPTURE(xyz[2]->name);
+            CAPTURE(big);
+            ReadResult fixed = read_text(typed_binary_ply(xyz, n, big, false));
+            ReadResult listed = read_text(typed_binary_ply(xyz, n, big, true));
+            REQUIRE_MESSAGE(fixed.ok, fixed.error);
+            REQUIRE_MESSAGE(listed.ok, listed.error);
+            CHECK(same_bits(fixed.xyz, expected));
+            CHECK(same_bits(listed.xyz, expected));
+        }
+    }
+}
+
+TEST_CASE("binary PLY: fixed-size records cut short fail at the vertices' first byte") {
+    const size_t n = 40;
+    const std::vector<TypedColumn> columns = every_typed_column(3 * n);
+    for (const TypedColumn& c : columns) {
+        const TypedColumn* xyz[3] = {&c, &c, &c};
+        for (bool big : {false, true}) {
+            CAPTURE(c.name);
+            CAPTURE(big);
+            const std::string whole = typed_binary_ply(xyz, n, big, false);
+            // The header, then two face records of 9 bytes before the vertices.
+            const size_t vertices_at = whole.find("end_header\n") + 11 + 2 * 9;
+            const size_t record = 1 + 2 + 8 + 3 * c.size;
+            REQUIRE(whole.size() == vertices_at + n * record);
+            for (size_t cut : {size_t{1}, record - 1, record + 1, n * record - 1}) {
+                CAPTURE(cut);
+                ReadResult r = read_text(whole.substr(0, whole.size() - cut));
+                CHECK_FALSE(r.ok);
+                CHECK_MESSAGE(contains(r.error, "byte " + std::to_string(vertices_at) +
+                                                    ": element 'vertex' declares " +
+                                                    std::to_string(n) + " records of " +
+                                                    std::to_string(record) + " bytes, but only " +
+                                                    std::to_string(n * record - cut) +
+                                                    " bytes follow"),
+                              r.error);
+            }
+        }
+    }
+}
+
+TEST_CASE("big buffers: any size, writable to the last byte, reallocated keeping the start") {
+    for (size_t bytes : {size_t{0}, size_t{1}, size_t{4096}, (size_t{3} << 20) + 5}) {
+        CAPTURE(bytes);
+        auto* memory = static_cast<unsigned char*>(allocate_big(bytes));
+        REQUIRE(memory != nullptr);
+        const size_t usable = bytes > 0 ? bytes : 1;
+        for (size_t i = 0; i < usable; i += 4093) memory[i] = static_cast<unsigned char>(i);
+        memory[usable - 1] = 0xab;
+        CHECK(memory[usable - 1] == 0xab);
+        free_big(memory, bytes);
+    }
+    BigBuffer buffer;
+    REQUIRE(buffer.reallocate(100, 0));
+    std::memcpy(buffer.data(), "stratmesh", 9);
+    REQUIRE(buffer.reallocate(5u << 20, 9));
+    CHECK(std::string(buffer.data(), 9) == "stratmesh");
+    REQUIRE(buffer.reallocate(4, 9));
+    CHECK(std::string(buffer.data(), 4) == "stra");
+    for (Pages pages : {Pages::huge, Pages::prefaulted}) {
+        const size_t bytes = (size_t{5} << 20) + 3;
+        auto* memory = static_cast<unsigned char*>(allocate_big(bytes, pages));
+        REQUIRE(memory != nullptr);
+        std::memset(memory, 0x5a, bytes);
+        CHECK(memory[bytes - 1] == 0x5a);
+        free_big(memory, bytes);
+    }
+    // Faulting in a vector's pages keeps what it holds.
+    std::vector<double> values(1u << 20);
+    for (size_t i = 0; i < values.size(); ++i) values[i] = static_cast<double>(i);
+    prefault_pages(values.data() + 3, (values.size() - 3) * sizeof(double));
+    size_t changed = 0;
+    for (size_t i = 0; i < values.size(); ++i) changed += values[i] != static_cast<double>(i);
+    CHECK(changed == 0);
+}
+
+TEST_CASE("a file is read whole: in one read, or growing through a pipe") {
+    TempDir dir;
+    std::string bytes(3u << 20, '\0');
+    for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<char>(i * 7 + i / 4096);
+    save(dir.file("big.bin"), bytes);
+    BigBuffer read;
+    size_t size = 0;
+    std::string error;
+    REQUIRE_MESSAGE(read_file_bytes(dir.file("big.bin"), read, size, error), error);
+    CHECK(size == bytes.size());
+    CHECK(std::string(read.data(), size) == bytes);
+    save(dir.file("empty.bin"), "");
+    REQUIRE_MESSAGE(read_file_bytes(dir.file("empty.bin"), read, size, error), error);
+    CHECK(size == 0);
+    CHECK_FALSE(read_file_bytes(dir.file("missing.bin"), read, size, error));
+    CHECK(contains(error, "cannot open"));
+#ifndef _WIN32
+    // A pipe announces no size: the buffer doubles from its first guess as bytes arrive.
+    const std::string fifo = dir.file("pipe");
+    REQUIRE(mkfifo(fifo.c_str(), 0600) == 0);
+    std::thread writer([&] { save(fifo, bytes); });
+    const bool ok = read_file_bytes(fifo, read, size, error);
+    writer.join();
+    REQUIRE_MESSAGE(ok, error);
+    CHECK(size == bytes.size());
+    CHECK(std::string(read.data(), size) == bytes);
+#endif
+}
+
 TEST_CASE("ascii PLY, LF and CRLF line ends") {
     std::vector<double> xyz = test_points(30);
     for (const char* newline : {"\n", "\r\n"}) {
@@ -248,6 +466,61 @@ TEST_CASE("XYZ columns: spaces, tabs, commas, comments, blank lines, extra colum
     REQUIRE_MESSAGE(r.ok, r.error);
     CHECK(r.info.format == CloudFormat::xyz);
     CHECK(r.xyz == xyz);
+}
+
+TEST_CASE("fields part at blanks, and at commas and semicolons when asked, no other byte") {
+    for (int byte = 0; byte < 256; ++byte) {
+        const char c = static_cast<char>(byte);
+        CAPTURE(byte);
+        const bool blank = c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+        for (bool commas : {false, true}) {
+            const bool separates = blank || (commas && (c == ',' || c == ';'));
+            const std::string line = std::string("12") + c + "34";
+            std::string_view rest = line;
+            std::string_view field;
+            std::vector<std::string> fields;
+            while (next_field(rest, field, commas)) fields.emplace_back(field);
+            if (separates)
+                CHECK(fields == std::vector<std::string>{"12", "34"});
+            else
+                CHECK(fields == std::vector<std::string>{line});
+        }
+    }
+}
+
+TEST_CASE("numbers read in one pass are the fields and numbers of the two-step scan") {
+    const char* pieces[] = {"1",    "-2.5e3", "+4",  ".5",   "-.5",    "1e400", "-1e-400", "nan",
+                            "-inf", "inf",    "1e",  "1.5x", "0x10",   "abc",   "5+3",     "+",
+                            "-",    "1,2",    "3;4", "1e5",  "7.25E-2", "00012", "1..2",   "\xff"};
+    const char* separators[] = {" ", "\t", ",", ";", "  ", ", ", "\r", ""};
+    std::mt19937 random(99);
+    for (int round = 0; round < 5000; ++round) {
+        std::string line;
+        const int count = static_cast<int>(random() % 6);
+        for (int k = 0; k < count; ++k) {
+            line += separators[random() % 8];
+            line += pieces[random() % 24];
+        }
+        line += separators[random() % 8];
+        CAPTURE(line);
+        for (bool commas : {false, true}) {
+            std::string_view two = line, one = line, field_two, field_one;
+            for (;;) {
+                double value_two = -7, value_one = -7;
+                NumberParse parsed_one = NumberParse::ok;
+                const bool more_two = next_field(two, field_two, commas);
+                const bool more_one = next_number(one, field_one, value_one, parsed_one, commas);
+                REQUIRE(more_two == more_one);
+                if (!more_two) break;
+                const NumberParse parsed_two = scan_number(field_two, value_two);
+                CHECK(field_one == field_two);
+                CHECK(parsed_one == parsed_two);
+                if (parsed_two == NumberParse::ok)
+                    CHECK(std::memcmp(&value_one, &value_two, sizeof(double)) == 0);
+                CHECK(one.data() == two.data());
+            }
+        }
+    }
 }
 
 TEST_CASE("PTS with a count line, and a leading plus sign") {
@@ -787,6 +1060,87 @@ TEST_CASE("STL output: triangle corners to float precision, unit normals facing 
             CHECK(len == doctest::Approx(1.0).epsilon(1e-6));
             CHECK(dot > 0);
         }
+    }
+}
+
+namespace {
+
+// A mesh large enough that every writer fills its block many times: points with awkward
+// doubles (or their floats), two triangles per point, every vertex used.
+WrittenMesh large_mesh(size_t points, bool float_exact) {
+    WrittenMesh m;
+    m.xyz = test_points(points);
+    m.xyz[0] = -0.0;
+    m.xyz[4] = 3e38;
+    if (float_exact) m.xyz = rounded_to_float(m.xyz);
+    if (!float_exact) m.xyz[8] = 1e300; // beyond float: the binary PLY holds doubles
+    for (size_t i = 0; i < 2 * points; ++i) {
+        const uint32_t a = static_cast<uint32_t>(i / 2);
+        m.tris.insert(m.tris.end(), {a, static_cast<uint32_t>((a + 1 + i % 7) % points),
+                                     static_cast<uint32_t>((a + 5 + 3 * (i % 11)) % points)});
+    }
+    return m;
+}
+
+} // namespace
+
+TEST_CASE("large meshes: every format reads back bit for bit, the stream writer's bytes too") {
+    TempDir dir;
+    for (bool float_exact : {false, true}) {
+        const WrittenMesh m = large_mesh(60000, float_exact);
+        const std::pair<const char*, bool> outputs[] = {
+            {"m.ply", false}, {"m.ply", true}, {"m.obj", false}, {"m.off", false}};
+        for (const auto& out : outputs) {
+            const std::string name = out.first;
+            CAPTURE(name);
+            CAPTURE(out.second);
+            CAPTURE(float_exact);
+            const std::string path = dir.file("whole_" + name);
+            const mini_mesh::Mesh back = write_and_read(m, path, out.second);
+            CHECK(back.tris == m.tris);
+            std::vector<double> xyz;
+            std::string error;
+            REQUIRE_MESSAGE(read_cloud_file(path, xyz, error), error);
+            CHECK(same_bits(xyz, m.xyz));
+            if (name == "m.obj") continue; // the stream interleaves OBJ's lines
+            const std::string pieces = dir.file("pieces_" + name);
+            MeshStreamWriter writer;
+            REQUIRE_MESSAGE(writer.open(pieces, mesh_format_from_extension(pieces), out.second,
+                                        error),
+                            error);
+            const size_t half = m.xyz.size() / 6;
+            writer.add_vertices(m.xyz.data(), half);
+            writer.add_vertices(m.xyz.data() + 3 * half, m.xyz.size() / 3 - half);
+            writer.add_triangles(m.tris.data(), m.tris.size() / 3);
+            REQUIRE_MESSAGE(writer.finish(true, error), error);
+            std::string whole_bytes, piece_bytes;
+            REQUIRE(mini_mesh::load(path, whole_bytes));
+            REQUIRE(mini_mesh::load(pieces, piece_bytes));
+            CHECK(whole_bytes == piece_bytes);
+        }
+    }
+}
+
+TEST_CASE("large meshes: STL corners are the vertices' floats, triangle by triangle") {
+    TempDir dir;
+    const WrittenMesh m = large_mesh(30000, false);
+    // Binary STL clamps a finite double beyond float's range to the largest float; text
+    // STL holds the double itself.
+    auto as_float = [](double v, bool ascii) {
+        const double largest = static_cast<double>(std::numeric_limits<float>::max());
+        if (!ascii && std::isfinite(v) && std::fabs(v) > largest) v = v < 0 ? -largest : largest;
+        return static_cast<float>(v);
+    };
+    for (bool ascii : {false, true}) {
+        CAPTURE(ascii);
+        const mini_mesh::Mesh back = write_and_read(m, dir.file("m.stl"), ascii);
+        REQUIRE(back.xyz.size() == 3 * m.tris.size());
+        size_t wrong = 0;
+        for (size_t c = 0; c < m.tris.size(); ++c)
+            for (size_t k = 0; k < 3; ++k)
+                wrong += static_cast<float>(back.xyz[3 * c + k]) !=
+                         as_float(m.xyz[3 * m.tris[c] + k], ascii);
+        CHECK(wrong == 0);
     }
 }
 

@@ -137,6 +137,38 @@ TEST_CASE("an atomic file appears only when committed, keeping the old one until
           (fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read));
 }
 
+TEST_CASE("starting the writeback early is only a hint: the file still appears whole at commit") {
+    ScratchDir dir;
+    const std::string path = dir.file("m.ply");
+    save(path, "old");
+    std::string expected;
+    for (int i = 0; expected.size() < (3u << 20); ++i) expected += std::to_string(i) + "\n";
+    AtomicFile file;
+    std::string error;
+    REQUIRE(file.open(path, error));
+    const size_t half = expected.size() / 2;
+    REQUIRE(std::fwrite(expected.data(), 1, half, file.file()) == half);
+    file.start_writeback();
+    REQUIRE(std::fwrite(expected.data() + half, 1, expected.size() - half, file.file()) ==
+            expected.size() - half);
+    file.start_writeback();
+    CHECK(load(path) == "old");
+    REQUIRE_MESSAGE(file.commit(0, error), error);
+    CHECK(load(path) == expected);
+    CHECK(dir.entries() == 1);
+#ifndef _WIN32
+    // A device is written directly: nothing to start, and its failure still counts.
+    if (fs::exists("/dev/full")) {
+        AtomicFile full;
+        REQUIRE(full.open("/dev/full", error));
+        std::fputs("anything", full.file());
+        full.start_writeback();
+        CHECK_FALSE(full.commit(0, error));
+        CHECK(contains(error, "/dev/full: cannot write"));
+    }
+#endif
+}
+
 TEST_CASE("a failed write leaves the old file and no temporary") {
     ScratchDir dir;
     const std::string path = dir.file("m.ply");

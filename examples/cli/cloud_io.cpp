@@ -114,19 +114,27 @@ bool read_cloud_from_memory(const char* data, size_t size, CloudFormat format,
     return ok;
 }
 
-bool read_file_bytes(const std::string& path, std::vector<char>& bytes, std::string& error) {
-    bytes.clear();
+bool read_file_bytes(const std::string& path, BigBuffer& bytes, size_t& size, std::string& error) {
+    size = 0;
     std::FILE* file = std::fopen(path.c_str(), "rb");
     if (!file) {
         error = "cannot open: " + std::string(std::strerror(errno));
         return false;
     }
-    bytes.reserve(size_hint(path));
-    char chunk[1 << 16];
-    while (size_t got = std::fread(chunk, 1, sizeof chunk, file))
-        bytes.insert(bytes.end(), chunk, chunk + got);
-    bool failed = std::ferror(file) != 0;
-    int failure = errno;
+    // A byte more than the size announced: a read that fills it means the file grew.
+    const size_t kFirstGuess = size_t{1} << 16;
+    size_t capacity = size_hint(path);
+    capacity = capacity > 0 ? capacity + 1 : kFirstGuess;
+    bool failed = !bytes.reallocate(capacity, 0);
+    while (!failed) {
+        // A request this large bypasses stdio's buffer: the system reads into ours.
+        size += std::fread(bytes.data() + size, 1, bytes.size() - size, file);
+        if (size < bytes.size()) break;
+        failed = bytes.size() > SIZE_MAX / 2 || !bytes.reallocate(2 * bytes.size(), size);
+        if (failed) errno = ENOMEM;
+    }
+    failed = failed || std::ferror(file) != 0;
+    const int failure = errno;
     std::fclose(file);
     if (!failed) return true;
     error = "cannot read: " + std::string(std::strerror(failure));
@@ -135,9 +143,10 @@ bool read_file_bytes(const std::string& path, std::vector<char>& bytes, std::str
 
 bool read_cloud_file(const std::string& path, std::vector<double>& xyz, std::string& error,
                      CloudInfo* info) {
-    std::vector<char> bytes;
-    bool ok = read_file_bytes(path, bytes, error) &&
-              read_cloud_from_memory(bytes.data(), bytes.size(), CloudFormat::automatic, xyz, error,
+    BigBuffer bytes;
+    size_t size = 0;
+    bool ok = read_file_bytes(path, bytes, size, error) &&
+              read_cloud_from_memory(bytes.data(), size, CloudFormat::automatic, xyz, error,
                                      info);
     if (!ok) error = path + ": " + error;
     return ok;

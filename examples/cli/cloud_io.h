@@ -17,6 +17,8 @@
 #ifndef STRATMESH_CLI_CLOUD_IO_H
 #define STRATMESH_CLI_CLOUD_IO_H
 
+#include "big_buffer.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -56,8 +58,10 @@ bool read_cloud_from_memory(const char* data, size_t size, CloudFormat format,
                             std::vector<double>& xyz, std::string& error,
                             CloudInfo* info = nullptr);
 
-// Reads a file's bytes, growing the buffer as they arrive.
-bool read_file_bytes(const std::string& path, std::vector<char>& bytes, std::string& error);
+// Reads a whole file into `bytes` (its pages faulted in at once, big_buffer.h), its length
+// into `size`: one request for a regular file whose size does not change, a buffer doubling
+// as the bytes arrive otherwise.
+bool read_file_bytes(const std::string& path, BigBuffer& bytes, size_t& size, std::string& error);
 
 // read_file_bytes + read_cloud_from_memory with the format detected from the content (the
 // content wins over a misleading extension). Errors start with the path.

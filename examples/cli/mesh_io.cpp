@@ -4,34 +4,64 @@
 #include "safe_output.h"
 #include "stratmesh.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cfloat>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <memory>
+#include <string_view>
 #include <vector>
 
 namespace stratmesh_cli {
 
-// Collects output in memory and hands it to the file in large blocks.
+// Collects output in a buffer of a megabyte (it stays in the caches while it is filled)
+// and hands each full one to the file in one write. The formatters write straight into
+// it: room() makes space for a bounded record, advance() takes what they wrote.
 class BlockWriter {
 public:
-    explicit BlockWriter(std::FILE* file) : file_(file) {}
+    // `output`, if given, is the AtomicFile that `file` belongs to: its writeback to the
+    // disk is started as the blocks go out, so that commit() waits for little.
+    explicit BlockWriter(std::FILE* file, AtomicFile* output = nullptr)
+        : file_(file), output_(output), buffer_(new char[kBlockBytes]) {}
 
-    std::string& buffer() { return buffer_; }
     std::FILE* file() const { return file_; }
     bool failed() const { return failure_ != 0; }
 
-    void flush_if_large() {
-        if (buffer_.size() >= kBlockBytes) flush();
+    // Room for `bytes` bytes (at most a block) at the returned cursor.
+    char* room(size_t bytes) {
+        if (kBlockBytes - used_ < bytes) flush();
+        return buffer_.get() + used_;
+    }
+    // How many records of at most `bytes` bytes fit without a flush (at least one).
+    size_t records_that_fit(size_t bytes) {
+        if (kBlockBytes - used_ < bytes) flush();
+        return (kBlockBytes - used_) / bytes;
+    }
+    // The cursor after what was written at room()'s.
+    void advance(char* end) { used_ = static_cast<size_t>(end - buffer_.get()); }
+
+    void append(std::string_view text) {
+        while (!text.empty()) {
+            const size_t step = std::min(text.size(), kBlockBytes);
+            char* out = room(step);
+            std::memcpy(out, text.data(), step);
+            advance(out + step);
+            text.remove_prefix(step);
+        }
     }
 
     void flush() {
-        if (!buffer_.empty() &&
-            std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
+        if (used_ > 0 && std::fwrite(buffer_.get(), 1, used_, file_) != used_)
             remember_failure();
-        buffer_.clear();
+        unsynced_ += used_;
+        used_ = 0;
+        if (output_ && unsynced_ >= kWritebackBytes && failure_ == 0) {
+            output_->start_writeback();
+            unsynced_ = 0;
+        }
     }
 
     // Writes out the buffer; the errno of the first write that failed, 0 if none.
@@ -53,33 +83,62 @@ private:
         if (failure_ == 0) failure_ = errno != 0 ? errno : EIO;
     }
 
-    static const size_t kBlockBytes = 1 << 20;
+    static constexpr size_t kBlockBytes = size_t{1} << 20;
+    static constexpr size_t kWritebackBytes = size_t{8} << 20;
     std::FILE* file_;
-    std::string buffer_;
+    AtomicFile* output_;
+    std::unique_ptr<char[]> buffer_;
+    size_t used_ = 0;
+    size_t unsynced_ = 0;
     int failure_ = 0;
 };
 
 namespace {
 
+// Writes `count` records of at most `most` bytes each: put(cursor, i) writes record i and
+// returns the cursor after it. The loop over a block's records has no other test.
+template <class Put> void put_records(BlockWriter& w, size_t count, size_t most, Put put) {
+    for (size_t i = 0; i < count;) {
+        const size_t stop = i + std::min(w.records_that_fit(most), count - i);
+        char* out = w.room(most);
+        for (; i < stop; ++i) out = put(out, i);
+        w.advance(out);
+    }
+}
 
 // ---- encoding ----------------------------------------------------------------------------
 
-void append_le(std::string& out, uint64_t bits, size_t bytes) {
-    for (size_t i = 0; i < bytes; ++i) out += static_cast<char>((bits >> (8 * i)) & 0xffu);
+bool host_is_little_endian() {
+    const uint16_t probe = 1;
+    unsigned char first = 0;
+    std::memcpy(&first, &probe, 1);
+    return first == 1;
 }
 
-void append_le_u32(std::string& out, uint32_t value) { append_le(out, value, 4); }
+const bool kLittleHost = host_is_little_endian();
 
-void append_le_float(std::string& out, float value) {
+template <class Bits> char* put_le(char* out, Bits bits) {
+    if (kLittleHost) {
+        std::memcpy(out, &bits, sizeof bits);
+    } else {
+        for (size_t i = 0; i < sizeof bits; ++i)
+            out[i] = static_cast<char>((bits >> (8 * i)) & 0xffu);
+    }
+    return out + sizeof bits;
+}
+
+char* put_le_u32(char* out, uint32_t value) { return put_le(out, value); }
+
+char* put_le_float(char* out, float value) {
     uint32_t bits = 0;
     std::memcpy(&bits, &value, sizeof bits);
-    append_le(out, bits, 4);
+    return put_le(out, bits);
 }
 
-void append_le_double(std::string& out, double value) {
+char* put_le_double(char* out, double value) {
     uint64_t bits = 0;
     std::memcpy(&bits, &value, sizeof bits);
-    append_le(out, bits, 8);
+    return put_le(out, bits);
 }
 
 const double kFloatMax = static_cast<double>(FLT_MAX);
@@ -92,25 +151,31 @@ float to_float(double v) {
     return v < 0 ? -FLT_MAX : FLT_MAX;
 }
 
+// The longest shortest form of a double ("-2.2250738585072014e-308") and of an index.
+constexpr size_t kNumberBytes = 24;
+constexpr size_t kIndexBytes = 20;
+
 // The shortest text that reads back as the same double. A float stored in a double also
 // reads back exactly as that float.
-void append_number(std::string& out, double value) {
-    char text[64];
-    std::to_chars_result r = std::to_chars(text, text + sizeof text, value);
-    out.append(text, r.ptr);
+char* put_number(char* out, double value) {
+    return std::to_chars(out, out + kNumberBytes, value).ptr;
 }
 
-void append_point(std::string& out, const double* p) {
-    for (int k = 0; k < 3; ++k) {
-        if (k > 0) out += ' ';
-        append_number(out, p[k]);
-    }
+char* put_point(char* out, const double* p) {
+    out = put_number(out, p[0]);
+    *out++ = ' ';
+    out = put_number(out, p[1]);
+    *out++ = ' ';
+    return put_number(out, p[2]);
 }
 
-void append_index(std::string& out, uint64_t index) {
-    char text[24];
-    std::to_chars_result r = std::to_chars(text, text + sizeof text, index);
-    out.append(text, r.ptr);
+char* put_index(char* out, uint64_t index) {
+    return std::to_chars(out, out + kIndexBytes, index).ptr;
+}
+
+char* put_text(char* out, std::string_view text) {
+    std::memcpy(out, text.data(), text.size());
+    return out + text.size();
 }
 
 const char* generator_comment() {
@@ -120,88 +185,88 @@ const char* generator_comment() {
 
 // ---- formats -----------------------------------------------------------------------------
 
-void write_ply_header(std::string& out, const MeshView& mesh, bool ascii, bool single) {
+std::string ply_header(size_t vertex_count, size_t triangle_count, bool ascii, bool single) {
     const char* type = single ? "float" : "double";
-    out += "ply\nformat ";
+    std::string out = "ply\nformat ";
     out += ascii ? "ascii" : "binary_little_endian";
     out += " 1.0\ncomment ";
     out += generator_comment();
-    out += "\nelement vertex " + std::to_string(mesh.vertex_count) + "\n";
+    out += "\nelement vertex " + std::to_string(vertex_count) + "\n";
     for (const char* axis : {"x", "y", "z"})
         out += std::string("property ") + type + " " + axis + "\n";
-    out += "element face " + std::to_string(mesh.triangle_count) + "\n";
+    out += "element face " + std::to_string(triangle_count) + "\n";
     out += "property list uchar uint vertex_indices\nend_header\n";
+    return out;
 }
 
-void append_binary_vertex(std::string& out, const double* p, bool single) {
-    for (size_t k = 0; k < 3; ++k) {
-        if (single)
-            append_le_float(out, to_float(p[k]));
-        else
-            append_le_double(out, p[k]);
+void put_binary_vertices(BlockWriter& w, const double* xyz, size_t count, bool single) {
+    if (single) {
+        // Every coordinate is a float (all_coordinates_are_floats): converted as it is.
+        put_records(w, count, 12, [xyz](char* out, size_t i) {
+            for (size_t k = 0; k < 3; ++k)
+                out = put_le_float(out, static_cast<float>(xyz[3 * i + k]));
+            return out;
+        });
+    } else {
+        put_records(w, count, 24, [xyz](char* out, size_t i) {
+            for (size_t k = 0; k < 3; ++k) out = put_le_double(out, xyz[3 * i + k]);
+            return out;
+        });
     }
 }
 
-void append_binary_face(std::string& out, const uint32_t* triangle) {
-    out += static_cast<char>(3);
-    for (size_t k = 0; k < 3; ++k) append_le_u32(out, triangle[k]);
-}
-
-void write_ply_binary_body(BlockWriter& w, const MeshView& mesh, bool single) {
-    for (size_t i = 0; i < mesh.vertex_count; ++i) {
-        append_binary_vertex(w.buffer(), mesh.xyz + 3 * i, single);
-        w.flush_if_large();
-    }
-    for (size_t t = 0; t < mesh.triangle_count; ++t) {
-        append_binary_face(w.buffer(), mesh.triangles + 3 * t);
-        w.flush_if_large();
-    }
+void put_binary_faces(BlockWriter& w, const uint32_t* triangles, size_t count) {
+    put_records(w, count, 13, [triangles](char* out, size_t t) {
+        *out++ = static_cast<char>(3);
+        for (size_t k = 0; k < 3; ++k) out = put_le_u32(out, triangles[3 * t + k]);
+        return out;
+    });
 }
 
 // Text PLY, OBJ and OFF share their shape: a vertex line per point, a face line per
 // triangle.
 struct TextStyle {
-    const char* vertex_prefix; // "v " or ""
-    const char* face_prefix;   // "f" or "3"
-    uint32_t index_base;       // 1 or 0
+    std::string_view vertex_prefix; // "v " or ""
+    std::string_view face_prefix;   // "f" or "3"
+    uint32_t index_base;            // 1 or 0
 };
 
 const TextStyle kObjStyle = {"v ", "f", 1};
 const TextStyle kOffStyle = {"", "3", 0}; // text PLY's too
 
-void append_vertex_line(std::string& out, const double* p, const TextStyle& style) {
-    out += style.vertex_prefix;
-    append_point(out, p);
-    out += '\n';
+void put_vertex_lines(BlockWriter& w, const double* xyz, size_t count, const TextStyle& style) {
+    const size_t most = style.vertex_prefix.size() + 3 * kNumberBytes + 3;
+    put_records(w, count, most, [xyz, &style](char* out, size_t i) {
+        out = put_point(put_text(out, style.vertex_prefix), xyz + 3 * i);
+        *out++ = '\n';
+        return out;
+    });
 }
 
-void append_face_line(std::string& out, const uint32_t* triangle, const TextStyle& style) {
-    out += style.face_prefix;
-    for (size_t k = 0; k < 3; ++k) {
-        out += ' ';
-        append_index(out, uint64_t{triangle[k]} + style.index_base);
-    }
-    out += '\n';
-}
-
-void write_text_body(BlockWriter& w, const MeshView& mesh, const TextStyle& style) {
-    for (size_t i = 0; i < mesh.vertex_count; ++i) {
-        append_vertex_line(w.buffer(), mesh.xyz + 3 * i, style);
-        w.flush_if_large();
-    }
-    for (size_t t = 0; t < mesh.triangle_count; ++t) {
-        append_face_line(w.buffer(), mesh.triangles + 3 * t, style);
-        w.flush_if_large();
-    }
+void put_face_lines(BlockWriter& w, const uint32_t* triangles, size_t count,
+                    const TextStyle& style) {
+    const size_t most = style.face_prefix.size() + 3 * (1 + kIndexBytes) + 1;
+    put_records(w, count, most, [triangles, &style](char* out, size_t t) {
+        out = put_text(out, style.face_prefix);
+        for (size_t k = 0; k < 3; ++k) {
+            *out++ = ' ';
+            out = put_index(out, uint64_t{triangles[3 * t + k]} + style.index_base);
+        }
+        *out++ = '\n';
+        return out;
+    });
 }
 
 void write_ply(BlockWriter& w, const MeshView& mesh, bool ascii) {
     bool single = !ascii && all_coordinates_are_floats(mesh.xyz, mesh.vertex_count);
-    write_ply_header(w.buffer(), mesh, ascii, single);
-    if (ascii)
-        write_text_body(w, mesh, kOffStyle);
-    else
-        write_ply_binary_body(w, mesh, single);
+    w.append(ply_header(mesh.vertex_count, mesh.triangle_count, ascii, single));
+    if (ascii) {
+        put_vertex_lines(w, mesh.xyz, mesh.vertex_count, kOffStyle);
+        put_face_lines(w, mesh.triangles, mesh.triangle_count, kOffStyle);
+    } else {
+        put_binary_vertices(w, mesh.xyz, mesh.vertex_count, single);
+        put_binary_faces(w, mesh.triangles, mesh.triangle_count);
+    }
 }
 
 std::string obj_header() { return std::string("# ") + generator_comment() + "\n"; }
@@ -211,14 +276,9 @@ std::string off_header(size_t vertex_count, size_t triangle_count) {
            " " + std::to_string(triangle_count) + " 0\n";
 }
 
-void write_obj(BlockWriter& w, const MeshView& mesh) {
-    w.buffer() += obj_header();
-    write_text_body(w, mesh, kObjStyle);
-}
-
-void write_off(BlockWriter& w, const MeshView& mesh) {
-    w.buffer() += off_header(mesh.vertex_count, mesh.triangle_count);
-    write_text_body(w, mesh, kOffStyle);
+void write_text_mesh(BlockWriter& w, const MeshView& mesh, const TextStyle& style) {
+    put_vertex_lines(w, mesh.xyz, mesh.vertex_count, style);
+    put_face_lines(w, mesh.triangles, mesh.triangle_count, style);
 }
 
 // The unit normal of triangle t (zero if degenerate), from the right-hand rule.
@@ -240,45 +300,47 @@ const double* corner(const MeshView& mesh, size_t t, size_t k) {
 }
 
 void write_stl_binary(BlockWriter& w, const MeshView& mesh) {
-    std::string& out = w.buffer();
     std::string title = "stratmesh " STRATMESH_VERSION_STRING " binary STL";
     title.resize(80, ' ');
-    out += title;
-    append_le_u32(out, static_cast<uint32_t>(mesh.triangle_count));
-    for (size_t t = 0; t < mesh.triangle_count; ++t) {
+    w.append(title);
+    char* count = w.room(4);
+    w.advance(put_le_u32(count, static_cast<uint32_t>(mesh.triangle_count)));
+    put_records(w, mesh.triangle_count, 50, [&mesh](char* out, size_t t) {
         double n[3];
         triangle_normal(mesh, t, n);
-        for (double c : n) append_le_float(out, to_float(c));
+        for (double c : n) out = put_le_float(out, to_float(c));
         for (size_t k = 0; k < 3; ++k)
-            for (size_t j = 0; j < 3; ++j) append_le_float(out, to_float(corner(mesh, t, k)[j]));
-        out += std::string(2, '\0'); // attribute byte count
-        w.flush_if_large();
-    }
+            for (size_t j = 0; j < 3; ++j) out = put_le_float(out, to_float(corner(mesh, t, k)[j]));
+        *out++ = '\0'; // the attribute byte count
+        *out++ = '\0';
+        return out;
+    });
 }
 
 void write_stl_ascii(BlockWriter& w, const MeshView& mesh) {
-    std::string& out = w.buffer();
-    out += "solid stratmesh\n";
-    for (size_t t = 0; t < mesh.triangle_count; ++t) {
+    w.append("solid stratmesh\n");
+    const size_t most = 4 * (3 * kNumberBytes + 16) + 32;
+    put_records(w, mesh.triangle_count, most, [&mesh](char* out, size_t t) {
         double n[3];
         triangle_normal(mesh, t, n);
-        out += "facet normal ";
-        append_point(out, n);
-        out += "\n outer loop\n";
+        out = put_point(put_text(out, "facet normal "), n);
+        out = put_text(out, "\n outer loop\n");
         for (size_t k = 0; k < 3; ++k) {
-            out += "  vertex ";
-            append_point(out, corner(mesh, t, k));
-            out += '\n';
+            out = put_point(put_text(out, "  vertex "), corner(mesh, t, k));
+            *out++ = '\n';
         }
-        out += " endloop\nendfacet\n";
-        w.flush_if_large();
-    }
-    out += "endsolid stratmesh\n";
+        return put_text(out, " endloop\nendfacet\n");
+    });
+    w.append("endsolid stratmesh\n");
 }
 
 // Everything a file format cannot express, found before the file is created.
 bool check_mesh(const MeshView& mesh, MeshFormat format, std::string& error) {
-    for (size_t i = 0; i < 3 * mesh.triangle_count; ++i) {
+    // The largest index first, in a loop the compiler vectorises; the culprit only then.
+    const size_t indices = 3 * mesh.triangle_count;
+    uint32_t largest = 0;
+    for (size_t i = 0; i < indices; ++i) largest = std::max(largest, mesh.triangles[i]);
+    for (size_t i = 0; indices > 0 && largest >= mesh.vertex_count; ++i) {
         if (mesh.triangles[i] >= mesh.vertex_count) {
             error = "triangle " + std::to_string(i / 3) + " refers to vertex " +
                     std::to_string(mesh.triangles[i]) + " of " + std::to_string(mesh.vertex_count);
@@ -295,8 +357,14 @@ bool check_mesh(const MeshView& mesh, MeshFormat format, std::string& error) {
 void write_body(BlockWriter& w, MeshFormat format, const MeshView& mesh, bool ascii) {
     switch (format) {
     case MeshFormat::ply: write_ply(w, mesh, ascii); break;
-    case MeshFormat::obj: write_obj(w, mesh); break;
-    case MeshFormat::off: write_off(w, mesh); break;
+    case MeshFormat::obj:
+        w.append(obj_header());
+        write_text_mesh(w, mesh, kObjStyle);
+        break;
+    case MeshFormat::off:
+        w.append(off_header(mesh.vertex_count, mesh.triangle_count));
+        write_text_mesh(w, mesh, kOffStyle);
+        break;
     case MeshFormat::stl:
         if (ascii)
             write_stl_ascii(w, mesh);
@@ -330,10 +398,18 @@ MeshFormat mesh_format_from_extension(const std::string& path) {
 }
 
 bool all_coordinates_are_floats(const double* xyz, size_t count) {
-    for (size_t i = 0; i < 3 * count; ++i) {
-        double v = xyz[i];
-        if (!fits_float(v)) return false;
-        if (!std::isnan(v) && static_cast<double>(static_cast<float>(v)) != v) return false;
+    // Branch-free within a block: a finite value beyond float's range becomes an infinity
+    // (IEEE 754), unequal to it; an infinity stays itself; NaN is let through by name.
+    constexpr size_t kBlock = 4096;
+    const size_t values = 3 * count;
+    for (size_t first = 0; first < values; first += kBlock) {
+        const size_t stop = std::min(values, first + kBlock);
+        bool all = true;
+        for (size_t i = first; i < stop; ++i) {
+            const double v = xyz[i];
+            all &= (static_cast<double>(static_cast<float>(v)) == v) | (v != v);
+        }
+        if (!all) return false;
     }
     return true;
 }
@@ -350,7 +426,7 @@ bool write_mesh_file(const std::string& path, MeshFormat format, const MeshView&
     }
     AtomicFile file;
     if (!file.open(path, error)) return false;
-    BlockWriter writer(file.file());
+    BlockWriter writer(file.file(), &file);
     write_body(writer, format, mesh, ascii);
     return file.commit(writer.drain(), error);
 }
@@ -371,9 +447,9 @@ bool MeshStreamWriter::open(const std::string& path, MeshFormat format, bool asc
     ascii_ = ascii && format == MeshFormat::ply;
     file_ = std::make_unique<AtomicFile>();
     if (!file_->open(path, error)) return false;
-    out_ = std::make_unique<BlockWriter>(file_->file());
+    out_ = std::make_unique<BlockWriter>(file_->file(), file_.get());
     if (format == MeshFormat::obj) {
-        out_->buffer() += obj_header();
+        out_->append(obj_header());
         return true;
     }
     std::FILE* vertices = scratch_file_beside(path, error);
@@ -388,30 +464,20 @@ bool MeshStreamWriter::open(const std::string& path, MeshFormat format, bool asc
 
 void MeshStreamWriter::add_vertices(const double* xyz, size_t count) {
     BlockWriter& w = format_ == MeshFormat::obj ? *out_ : *vertices_;
-    bool binary = format_ == MeshFormat::ply && !ascii_;
     all_floats_ = all_floats_ && all_coordinates_are_floats(xyz, count);
-    for (size_t i = 0; i < count; ++i) {
-        if (binary)
-            append_binary_vertex(w.buffer(), xyz + 3 * i, false);
-        else
-            append_vertex_line(w.buffer(), xyz + 3 * i,
-                               format_ == MeshFormat::obj ? kObjStyle : kOffStyle);
-        w.flush_if_large();
-    }
+    if (format_ == MeshFormat::ply && !ascii_)
+        put_binary_vertices(w, xyz, count, false);
+    else
+        put_vertex_lines(w, xyz, count, format_ == MeshFormat::obj ? kObjStyle : kOffStyle);
     vertex_count_ += count;
 }
 
 void MeshStreamWriter::add_triangles(const uint32_t* triangles, size_t count) {
     BlockWriter& w = format_ == MeshFormat::obj ? *out_ : *faces_;
-    bool binary = format_ == MeshFormat::ply && !ascii_;
-    for (size_t t = 0; t < count; ++t) {
-        if (binary)
-            append_binary_face(w.buffer(), triangles + 3 * t);
-        else
-            append_face_line(w.buffer(), triangles + 3 * t,
-                             format_ == MeshFormat::obj ? kObjStyle : kOffStyle);
-        w.flush_if_large();
-    }
+    if (format_ == MeshFormat::ply && !ascii_)
+        put_binary_faces(w, triangles, count);
+    else
+        put_face_lines(w, triangles, count, format_ == MeshFormat::obj ? kObjStyle : kOffStyle);
     triangle_count_ += count;
 }
 
@@ -422,13 +488,16 @@ bool MeshStreamWriter::copy_body(BlockWriter& from, bool doubles_to_floats) {
     std::rewind(from.file());
     std::vector<char> chunk(1 << 20); // a whole number of doubles
     while (size_t got = std::fread(chunk.data(), 1, chunk.size(), from.file())) {
-        if (!doubles_to_floats) out_->buffer().append(chunk.data(), got);
-        for (size_t at = 0; doubles_to_floats && at + 8 <= got; at += 8) {
-            double value = 0;
-            std::memcpy(&value, chunk.data() + at, 8);
-            append_le_float(out_->buffer(), to_float(value));
+        if (!doubles_to_floats) {
+            out_->append(std::string_view(chunk.data(), got));
+            continue;
         }
-        out_->flush_if_large();
+        const char* doubles = chunk.data();
+        put_records(*out_, got / 8, 4, [doubles](char* out, size_t i) {
+            double value = 0;
+            std::memcpy(&value, doubles + 8 * i, 8);
+            return put_le_float(out, to_float(value));
+        });
     }
     return !from.failed() && !std::ferror(from.file());
 }
@@ -436,11 +505,9 @@ bool MeshStreamWriter::copy_body(BlockWriter& from, bool doubles_to_floats) {
 bool MeshStreamWriter::finish(bool keep, std::string& error) {
     bool single = format_ == MeshFormat::ply && !ascii_ && all_floats_;
     if (keep && format_ != MeshFormat::obj) {
-        MeshView counts = {nullptr, vertex_count_, nullptr, triangle_count_};
-        if (format_ == MeshFormat::ply)
-            write_ply_header(out_->buffer(), counts, ascii_, single);
-        else
-            out_->buffer() += off_header(vertex_count_, triangle_count_);
+        out_->append(format_ == MeshFormat::ply
+                         ? ply_header(vertex_count_, triangle_count_, ascii_, single)
+                         : off_header(vertex_count_, triangle_count_));
     }
     std::string failure;
     bool ok = keep && (format_ == MeshFormat::obj ||

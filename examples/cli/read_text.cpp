@@ -26,9 +26,9 @@ struct NumberRow {
 NumberRow scan_numbers(std::string_view content, bool commas) {
     NumberRow row;
     std::string_view field;
-    while (next_field(content, field, commas)) {
-        double value = 0;
-        NumberParse parsed = scan_number(field, value);
+    double value = 0;
+    NumberParse parsed = NumberParse::ok;
+    while (next_number(content, field, value, parsed, commas)) {
         bool numeric = parsed == NumberParse::ok;
         if (!numeric && row.bad.empty()) {
             row.bad = field;

@@ -10,6 +10,9 @@
 #ifndef _WIN32
 #include <unistd.h>
 #endif
+#ifdef __linux__
+#include <fcntl.h>
+#endif
 
 namespace stratmesh_cli {
 
@@ -203,6 +206,14 @@ void AtomicFile::discard() {
     if (!temporary_.empty()) std::remove(temporary_.c_str());
     temporary_.clear();
     forget_temporary(slot_);
+}
+
+void AtomicFile::start_writeback() {
+#ifdef __linux__
+    // What stdio still buffers goes out later (its errors are commit()'s to report). The
+    // whole file's range: pages already written or on their way to the disk are skipped.
+    if (file_ && !temporary_.empty()) sync_file_range(fileno(file_), 0, 0, SYNC_FILE_RANGE_WRITE);
+#endif
 }
 
 std::FILE* scratch_file_beside(const std::string& path, std::string& error) {

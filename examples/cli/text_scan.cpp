@@ -8,10 +8,22 @@ namespace stratmesh_cli {
 
 namespace {
 
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+// Separator classes by byte, so that scanning a field is one lookup per byte.
+constexpr unsigned char kBlank = 1, kComma = 2;
 
-bool is_field_separator(char c, bool commas) {
-    return is_blank(c) || (commas && (c == ',' || c == ';'));
+struct SeparatorTable {
+    unsigned char kind[256] = {};
+    constexpr SeparatorTable() {
+        for (char c : {' ', '\t', '\r', '\v', '\f'}) kind[static_cast<unsigned char>(c)] = kBlank;
+        kind[static_cast<unsigned char>(',')] = kComma;
+        kind[static_cast<unsigned char>(';')] = kComma;
+    }
+};
+
+constexpr SeparatorTable kSeparators;
+
+bool is_field_separator(char c, unsigned char classes) {
+    return (kSeparators.kind[static_cast<unsigned char>(c)] & classes) != 0;
 }
 
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
@@ -39,14 +51,15 @@ std::string_view strip_comment(std::string_view line, bool slashes) {
 }
 
 bool next_field(std::string_view& rest, std::string_view& field, bool commas) {
+    const unsigned char classes = commas ? kBlank | kComma : kBlank;
     size_t start = 0;
-    while (start < rest.size() && is_field_separator(rest[start], commas)) ++start;
+    while (start < rest.size() && is_field_separator(rest[start], classes)) ++start;
     if (start == rest.size()) {
         rest = std::string_view();
         return false;
     }
     size_t stop = start;
-    while (stop < rest.size() && !is_field_separator(rest[stop], commas)) ++stop;
+    while (stop < rest.size() && !is_field_separator(rest[stop], classes)) ++stop;
     field = rest.substr(start, stop - start);
     rest.remove_prefix(stop);
     return true;
@@ -72,6 +85,27 @@ NumberParse scan_number(std::string_view token, double& value) {
 
 bool parse_number(std::string_view token, double& value) {
     return scan_number(token, value) == NumberParse::ok;
+}
+
+bool next_number(std::string_view& rest, std::string_view& field, double& value,
+                 NumberParse& parsed, bool commas) {
+    const unsigned char classes = commas ? kBlank | kComma : kBlank;
+    size_t start = 0;
+    while (start < rest.size() && is_field_separator(rest[start], classes)) ++start;
+    const char* first = rest.data() + start;
+    const char* last = rest.data() + rest.size();
+    std::from_chars_result r = std::from_chars(first, last, value);
+    if (r.ec == std::errc() && r.ptr > first &&
+        (r.ptr == last || is_field_separator(*r.ptr, classes))) {
+        field = std::string_view(first, static_cast<size_t>(r.ptr - first));
+        rest.remove_prefix(static_cast<size_t>(r.ptr - rest.data()));
+        parsed = NumberParse::ok;
+        return true;
+    }
+    // Anything else (a sign, a range error, no number, text after it) as the two calls do.
+    if (!next_field(rest, field, commas)) return false;
+    parsed = scan_number(field, value);
+    return true;
 }
 
 std::string_view skip_byte_order_mark(std::string_view text) {

@@ -47,6 +47,12 @@ NumberParse scan_number(std::string_view token, double& value);
 // scan_number() == ok.
 bool parse_number(std::string_view token, double& value);
 
+// next_field(), then scan_number() of that field, in one pass over the bytes when the field
+// is a plain number: it is read where the field starts, and ends where the number does if
+// a separator (or the end) follows. The results are those of the two calls.
+bool next_number(std::string_view& rest, std::string_view& field, double& value,
+                 NumberParse& parsed, bool commas);
+
 // The three bytes of a UTF-8 byte-order mark, which some editors write at the start of a
 // text file.
 constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";

@@ -7347,6 +7347,7 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
     allocate_profile(planning, profile_bin_count(count), &bins, &ranges, &cuts);
     planning.rewind(0);
     planning.alloc<uint32_t>(count);
+    planning.alloc<uint32_t>(count);  // grouping in jobs: its tables (see group_by_layer_in_jobs)
 
     // The caps: every point on a boundary loop, as many triangles as the output can hold.
     Arena caps = Arena::measuring();
@@ -7788,6 +7789,107 @@ inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& 
     }
 }
 
+// ---- passes over all points as jobs ----
+//
+// With Options::run_jobs, a pass over all points that gives the same bits in any order
+// (grouping the points by layer) is cut into kPassRuns runs of consecutive points, run as
+// jobs. As for the layers' jobs (see JobRunner), a run the runner skips is done in order
+// afterwards, and a run done again changes nothing.
+const uint32_t kPassRuns = 16;
+
+// The first point of run k of `count` points.
+inline size_t run_start(size_t count, uint32_t k) {
+    return static_cast<size_t>(static_cast<uint64_t>(count) * k / kPassRuns);
+}
+
+template <class Pass> struct PassJobs {
+    Pass* pass;
+    bool done[kPassRuns];
+};
+
+template <class Pass> inline void run_pass_job(void* context, uint32_t index) {
+    PassJobs<Pass>& jobs = *static_cast<PassJobs<Pass>*>(context);
+    if (index >= kPassRuns) return;  // a runner's mistake: no run of ours
+    jobs.pass->run(index);
+    jobs.done[index] = true;
+}
+
+template <class Pass> inline void run_pass(const Options& options, Pass& pass) {
+    PassJobs<Pass> jobs = {&pass, {}};
+    options.run_jobs(options.jobs_user, kPassRuns, run_pass_job<Pass>, &jobs);
+    for (uint32_t k = 0; k < kPassRuns; ++k)
+        if (!jobs.done[k]) pass.run(k);
+}
+
+// group_by_layer's counting sort, run by run: first each point's layer and each run's count
+// per layer, then (once `first` holds each run's first position per layer) the scatter. The
+// positions come out as in group_by_layer.
+struct GroupingPass {
+    const CloudReader* cloud;
+    const Frame* frame;
+    const LayerPlan* plan;
+    double per_height;
+    size_t count;
+    uint32_t* layer;
+    uint32_t* order;
+    uint32_t* counts;    // per run, per layer: its points there
+    uint32_t* first;     // per run, per layer: its first position there
+    uint32_t* next;      // per run, per layer: the scatter's next position
+    bool scatter;
+
+    void run(uint32_t k) {
+        const size_t layers = plan->count, begin = run_start(count, k), end = run_start(count, k + 1);
+        if (!scatter) {
+            uint32_t* c = counts + k * layers;
+            std::memset(c, 0, layers * sizeof(uint32_t));
+            for (size_t i = begin; i < end; ++i) {
+                layer[i] = cloud->valid(i) ? layer_of(*plan, frame->height(cloud->point(i)), per_height)
+                                           : kNoIndex;
+                if (layer[i] != kNoIndex) ++c[layer[i]];
+            }
+            return;
+        }
+        uint32_t* n = next + k * layers;
+        std::memcpy(n, first + k * layers, layers * sizeof(uint32_t));
+        for (size_t i = begin; i < end; ++i)
+            if (layer[i] != kNoIndex) order[n[layer[i]]++] = static_cast<uint32_t>(i);
+    }
+};
+
+// group_by_layer without staging, as jobs; false (nothing done) where its three tables of a
+// count per run and layer would take more than one count per point, or do not fit.
+inline bool group_by_layer_in_jobs(const Options& options, const CloudReader& cloud,
+                                   size_t count, const Frame& frame, const LayerPlan& plan,
+                                   uint32_t* layer, ReconstructMemory& m, Arena& arena) {
+    const size_t table = kPassRuns * static_cast<size_t>(plan.count);
+    if (!kParallelLayers || !options.run_jobs || 3 * table > count) return false;
+    const size_t mark = arena.mark();
+    GroupingPass pass = {&cloud, &frame, &plan, 0, count, layer, m.order,
+                         arena.alloc<uint32_t>(table), arena.alloc<uint32_t>(table),
+                         arena.alloc<uint32_t>(table), false};
+    if (arena.failed) {
+        arena.failed = false;
+        arena.rewind(mark);
+        return false;
+    }
+    pass.per_height = kFastLoops ? plan.count / (plan.bounds[plan.count] - plan.bounds[0]) : 0;
+    run_pass(options, pass);
+    // Layer by layer, run by run: the positions of a counting sort in input order.
+    uint32_t position = 0;
+    for (uint32_t l = 0; l < plan.count; ++l) {
+        m.layer_start[l] = position;
+        for (uint32_t k = 0; k < kPassRuns; ++k) {
+            pass.first[k * plan.count + l] = position;
+            position += pass.counts[k * plan.count + l];
+        }
+    }
+    m.layer_start[plan.count] = position;
+    pass.scatter = true;
+    run_pass(options, pass);
+    arena.rewind(mark);
+    return true;
+}
+
 STRATMESH_SMALL_NOINLINE inline void report_frame(const Frame& frame, Report& rep) {
     rep.axis[0] = frame.axis.x;
     rep.axis[1] = frame.axis.y;
@@ -7984,7 +8086,8 @@ inline Status plan_tube_layers(const TubeInput& in, const Options& options, cons
     if (arena.failed) return Status::out_of_memory;
     if (kStagePoints && !(kParallelLayers && options.run_jobs))
         *staged = static_cast<Local*>(arena.room_at_end(saturating_product(valid, sizeof(Local))));
-    group_by_layer(in.reader, in.count, frame, plan, layer, *staged, m);
+    if (!group_by_layer_in_jobs(options, in.reader, in.count, frame, plan, layer, m, arena))
+        group_by_layer(in.reader, in.count, frame, plan, layer, *staged, m);
     arena.rewind(mark);
     return Status::ok;
 }

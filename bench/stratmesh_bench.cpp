@@ -148,6 +148,11 @@ constexpr Layering kTubeLayers = {stratmesh::Axis::z, 8, nullptr, 0};
 constexpr Layering kTubeLayersFlipped = {stratmesh::Axis::z, 8, nullptr, 0, stratmesh::surface_flips};
 constexpr Layering kOneLayerAlongZ = {stratmesh::Axis::z, 1, nullptr, 0};
 constexpr Layering kAutomaticAlongZ = {stratmesh::Axis::z, 0, nullptr, 0};
+// The library's defaults (Options all zero), and the same without the search for branches
+// or with the flips on the surface: what each costs on top.
+constexpr Layering kDefaults = {stratmesh::Axis::automatic, 0, nullptr, 0};
+constexpr Layering kDefaultsOneTube = {stratmesh::Axis::automatic, 0, nullptr, 0, stratmesh::one_tube};
+constexpr Layering kDefaultsFlipped = {stratmesh::Axis::automatic, 0, nullptr, 0, stratmesh::surface_flips};
 // A hundred equal layers along z (the stream case cuts them itself, between the extremes).
 constexpr Layering kHundredLayers = {stratmesh::Axis::z, 100, nullptr, 0};
 
@@ -190,6 +195,18 @@ const CaseSpec kCases[] = {
     // The cloud of tube-1e6 (same seed) in a single layer.
     {"tube-1e6-1layer", "tube", Kind::reconstruct, 1000000, 0x5EED0102u, 5,
      bench::generate_tube, kOneLayerAlongZ},
+    // The cloud of tube-1e6 (same seed) with the library's default options; without the
+    // search for branches; with the flips on the surface.
+    {"default-1e5", "default", Kind::reconstruct, 100000, 0x5EED0101u, 5, bench::generate_tube,
+     kDefaults},
+    {"default-1e6", "default", Kind::reconstruct, 1000000, 0x5EED0102u, 5, bench::generate_tube,
+     kDefaults},
+    {"default-1e6-one-tube", "default", Kind::reconstruct, 1000000, 0x5EED0102u, 5,
+     bench::generate_tube, kDefaultsOneTube},
+    {"default-1e6-flips", "default", Kind::reconstruct, 1000000, 0x5EED0102u, 5,
+     bench::generate_tube, kDefaultsFlipped},
+    {"threads-default-1e6", "threads", Kind::threads, 1000000, 0x5EED0102u, 3,
+     bench::generate_tube, kDefaults},
     // The clouds of tube-1e6 and tube-4e6 (same seeds): no runner against two threads.
     {"threads-tube-1e6", "threads", Kind::threads, 1000000, 0x5EED0102u, 3,
      bench::generate_tube, kTubeLayers},

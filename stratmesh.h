@@ -3279,9 +3279,10 @@ inline void plan_layers(const Options& options, double lo, double hi, size_t poi
 //     count-weighted mean of its bins' centroids, give or take three standard errors of
 //     the bin's centroid, so sampling noise alone never cuts) and it is at most kMaxTurns
 //     mean radii
-//     tall (taller layers unroll with distorted aspect), and it holds at most
-//     kMostLayerPoints points (so that a large cloud comes in layers that a job runner can
-//     triangulate side by side, the same layers whatever the runner);
+//     tall (taller layers unroll with distorted aspect), and it holds at most an eighth of
+//     the points (kLayerPointsShare), or kFewestLayerPoints if that is more, so that a
+//     large cloud comes in layers that a job runner can triangulate side by side, the same
+//     layers whatever the runner;
 //   - a layer that is not is cut in two at the bin boundary where the surface changes
 //     least: the smallest sum of centroid drift and radius change between the two bins
 //     (relative to the radius), plus a penalty where the bins are denser than average, so
@@ -3293,7 +3294,8 @@ inline void plan_layers(const Options& options, double lo, double hi, size_t poi
 
 const uint32_t kProfileSectors = 8;
 const double kCentreDrift = 0.75;
-const size_t kMostLayerPoints = size_t{1} << 17;
+const size_t kLayerPointsShare = 8;
+const size_t kFewestLayerPoints = size_t{1} << 16;
 const size_t kPointsPerProfileBin = 256;
 const double kDensityWeight = 0.5;
 
@@ -3377,7 +3379,8 @@ inline void build_profile(const CloudReader& cloud, size_t count, const Frame& f
     }
 }
 
-inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_height) {
+inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_height,
+                          size_t most_points) {
     double cx = 0, cy = 0, radius = 0;
     size_t points = 0;
     for (uint32_t b = range.first; b < range.end; ++b) {
@@ -3391,7 +3394,7 @@ inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_
     cy /= static_cast<double>(points);
     radius /= static_cast<double>(points);
     if (bin_height * (range.end - range.first) > kMaxTurns * radius) return false;
-    if (points > kMostLayerPoints) return false;
+    if (points > most_points) return false;
     for (uint32_t b = range.first; b < range.end; ++b) {
         // Too few points to say, or an arc rather than a ring (the slanted end of a scan):
         // such a bin's centroid says nothing about where the centre line must run.
@@ -3425,12 +3428,14 @@ inline void plan_automatic_layers(const CloudReader& cloud, size_t count, size_t
     build_profile(cloud, count, frame, lo, hi, profile, bins);
     const double bin_height = (hi - lo) / bins;
     const double mean_count = static_cast<double>(valid) / bins;
+    const size_t share = valid / kLayerPointsShare;
+    const size_t most_points = share > kFewestLayerPoints ? share : kFewestLayerPoints;
     size_t pending = 0, cut_count = 0;
     ranges[pending++] = {0, bins};
     while (pending > 0) {
         BinRange r = ranges[--pending];
         uint32_t width = r.end - r.first;
-        if (width < 2 || well_unrolled(profile, r, bin_height)) continue;
+        if (width < 2 || well_unrolled(profile, r, bin_height, most_points)) continue;
         uint32_t margin = width / 4 > 0 ? width / 4 : 1;
         uint32_t best = r.first + margin;
         double best_cost = DBL_MAX;

@@ -1192,7 +1192,8 @@ void print_help(std::FILE* out) {
     std::fputs(
         "usage: stratmesh_bench [--case NAME]... [--xy FILE]... [--cloud FILE.ply]...\n"
         "                       [--axis x|y|z|auto] [--layers N] [--layer-lines]\n"
-        "                       [--runs N] [--no-cgal] [--list] [--help]\n"
+        "                       [--runs N] [--no-cgal] [--list] [--write-cloud CASE FILE]\n"
+        "                       [--help]\n"
         "\n"
         "Times stratmesh on fixed inputs and prints one JSON object per line per case.\n"
         "\n"
@@ -1289,6 +1290,8 @@ void print_help(std::FILE* out) {
         "                up to 1e5 points, 5 up to 1e6, 3 above).\n"
         "  --no-cgal     do not time the CGAL peer even if it is compiled in.\n"
         "  --list        print the case names and families, then exit.\n"
+        "  --write-cloud CASE FILE  write a 3D case's cloud as binary PLY (float64 x, y,\n"
+        "                z), then exit: the cloud bench/end_to_end.sh times.\n"
         "  --help        print this help, then exit.\n"
         "\n",
         out);
@@ -1380,7 +1383,31 @@ struct CommandLine {
     Options options;
     Layering file_layering = {stratmesh::Axis::automatic, 0, nullptr, 0};
     bool file_options = false;  // --axis or --layers given
+    // --write-cloud CASE FILE: the case's cloud written as binary PLY (float64), then exit.
+    const CaseSpec* cloud_case = nullptr;
+    std::string cloud_path;
 };
+
+// A 3D case's generated cloud as a binary little-endian PLY of float64 x, y, z, for tools
+// to read the very cloud a case times (bench/end_to_end.sh). False on a write error.
+bool write_case_cloud(const CaseSpec& spec, const std::string& path) {
+    std::vector<double> xyz;
+    spec.generate(spec.n, spec.seed, xyz);
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) return false;
+    const size_t n = xyz.size() / 3;
+    std::fprintf(f, "ply\nformat binary_little_endian 1.0\nelement vertex %zu\n"
+                    "property double x\nproperty double y\nproperty double z\nend_header\n", n);
+    bool ok = true;
+    for (double v : xyz) {  // byte by byte: the file is little-endian on any machine
+        uint64_t bits;
+        std::memcpy(&bits, &v, sizeof bits);
+        unsigned char bytes[8];
+        for (int k = 0; k < 8; ++k) bytes[k] = static_cast<unsigned char>(bits >> (8 * k));
+        ok = ok && std::fwrite(bytes, 1, 8, f) == 8;
+    }
+    return std::fclose(f) == 0 && ok;
+}
 
 void print_case_list() {
     for (const CaseSpec& spec : kCases)
@@ -1422,6 +1449,13 @@ int parse_arguments(int argc, char** argv, CommandLine& cl) {
             if (!parse_runs(argv[++i], cl.runs_override))
                 return usage_error(std::string("--runs needs a whole number from 1, not '") +
                                    argv[i] + "'");
+        } else if (arg == "--write-cloud") {
+            if (i + 2 >= argc) return usage_error("--write-cloud needs a case and a file name");
+            const std::string name = argv[++i];
+            for (const CaseSpec& spec : kCases)
+                if (name == spec.name && spec.kind != Kind::delaunay_2d) cl.cloud_case = &spec;
+            if (!cl.cloud_case) return usage_error("--write-cloud: no 3D case named '" + name + "'");
+            cl.cloud_path = argv[++i];
         } else if (arg == "--xy") {
             if (!has_value) return usage_error("--xy needs a file name");
             std::string path = argv[++i];
@@ -1483,6 +1517,11 @@ int main(int argc, char** argv) {
     CommandLine cl;
     int exit_status = parse_arguments(argc, argv, cl);
     if (exit_status >= 0) return exit_status;
+    if (cl.cloud_case) {
+        if (write_case_cloud(*cl.cloud_case, cl.cloud_path)) return 0;
+        std::fprintf(stderr, "stratmesh_bench: cannot write %s\n", cl.cloud_path.c_str());
+        return 3;
+    }
     std::vector<Job> jobs = make_jobs(cl);
 
 #ifdef STRATMESH_BENCH_WITH_CGAL

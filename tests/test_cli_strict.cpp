@@ -263,7 +263,7 @@ TEST_CASE("a direction of any finite non-zero length normalises without overflow
     CHECK(v[1] == doctest::Approx(-0.8));
     double zero[3] = {0, 0, -0.0};
     CHECK_FALSE(normalise_direction(zero));
-    double inf[3] = {INFINITY, 0, 0};
+    double inf[3] = {HUGE_VAL, 0, 0};
     CHECK_FALSE(normalise_direction(inf));
 }
 
@@ -284,7 +284,7 @@ TEST_CASE("an origin too far from the cloud is refused, naming --origin") {
     const double far[3] = {-1e300, 0, 0};
     CHECK_FALSE(box.origin_in_reach(far, error));
     CHECK(contains(error, "lies 1e+300 from the cloud, which spans 100"));
-    const double skipped[] = {NAN, 1e300, 0};
+    const double skipped[] = {std::nan(""), 1e300, 0};
     box.add(skipped, 1); // not finite: not part of the box
     CHECK_FALSE(box.origin_in_reach(far, error));
 }

@@ -2709,14 +2709,17 @@ double six_times_volume(const Shape& s, const uint32_t* triangles, size_t count)
     return sum;
 }
 
-// Cap triangles whose normal points towards the middle of the shape along its axis (a
-// bottom cap facing up or a top cap facing down).
+// The caps (the cap triangles above the middle of the shape along its axis, and those
+// below) whose triangles, summed, face towards the middle: a bottom cap facing up or a top
+// cap facing down. Summed, because the triangles that close a loop's ragged pockets along
+// the wall (see "pockets closed before a cap" in the header) stand across the axis, either
+// way.
 size_t caps_facing_inward(const Shape& s, const uint32_t* triangles, size_t first, size_t count) {
     double axis[3], origin[3];
     s.axis_direction(axis);
     s.axis_point(origin);
     const double middle = (s.z_min + s.z_max) / 2;
-    size_t inward = 0;
+    double facing_top = 0, facing_bottom = 0;
     for (size_t t = first; t < count; ++t) {
         const double* p[3] = {s.point(triangles[3 * t]), s.point(triangles[3 * t + 1]),
                               s.point(triangles[3 * t + 2])};
@@ -2728,9 +2731,9 @@ size_t caps_facing_inward(const Shape& s, const uint32_t* triangles, size_t firs
             height += ((p[0][k] + p[1][k] + p[2][k]) / 3 - origin[k]) * axis[k];
             facing += normal[k] * axis[k];
         }
-        if ((height - middle > 0) != (facing > 0)) ++inward;
+        (height > middle ? facing_top : facing_bottom) += facing;
     }
-    return inward;
+    return size_t{facing_top < 0} + size_t{facing_bottom > 0};
 }
 
 // Cap diagonals that a flip would lower (on a bottom cap, facing -axis) or raise (on a top
@@ -2769,10 +2772,20 @@ size_t improvable_cap_diagonals(const Shape& s, const uint32_t* triangles, size_
             uint32_t a = triangles[3 * t + k], b = triangles[3 * t + (k + 1) % 3];
             surface_edges.insert({std::min(a, b), std::max(a, b)});
         }
-    std::map<std::pair<uint32_t, uint32_t>, uint32_t> beyond;  // directed cap edge -> third vertex
-    for (size_t t = first; t < count; ++t)
+    // Directed cap edge -> third vertex, over the triangles that lie across the axis (within
+    // 60 degrees of it): those standing along the wall close a ragged loop's pockets before
+    // the cap (see "pockets closed before a cap" in the header), and are no cap to flip.
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> beyond;
+    for (size_t t = first; t < count; ++t) {
+        double p[3][3];
+        for (size_t k = 0; k < 3; ++k) frame(triangles[3 * t + k], p[k]);
+        double u[3], v[3];
+        for (int k = 0; k < 3; ++k) u[k] = p[1][k] - p[0][k], v[k] = p[2][k] - p[0][k];
+        const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+        if (!(std::fabs(n[2]) >= 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]))) continue;
         for (size_t k = 0; k < 3; ++k)
             beyond[{triangles[3 * t + k], triangles[3 * t + (k + 1) % 3]}] = triangles[3 * t + (k + 2) % 3];
+    }
     size_t improvable = 0;
     for (const auto& edge : beyond) {
         const uint32_t a = edge.first.first, b = edge.first.second, c = edge.second;
@@ -2892,6 +2905,39 @@ TEST_CASE("close_ends on a noisy tube: caps as low (bottom) and high (top) as th
                 CHECK(improvable_cap_diagonals(s, run.triangles.data(), first, run.count) == 0);
             }
         }
+    }
+}
+#endif
+
+#if !defined(STRATMESH_SMALL_CODE)
+TEST_CASE("close_ends on a tilted tube that flares toward its ends: the caps stay clear of the wall") {
+    // Where the wall widens toward an end, a ragged loop's lower points lie inside it seen
+    // along the axis, and a cap over the whole loop dips with them through the wall's top
+    // row; the pockets under the loop's upper hull are closed along the wall first (see
+    // "pockets closed before a cap" in the header). The defaults: the automatic axis.
+    auto flared = [](double theta, double z) {
+        return (1.2 + 0.5 * std::sin(0.9 * z)) * (1 + 0.15 * std::sin(4 * theta));
+    };
+    struct Size { size_t points; double height; uint64_t seed; };
+    for (Size size : {Size{20000, 10, 4}, Size{30000, 5, 6}, Size{60000, 7, 3}}) {
+        Shape s = shapes::radial_random("flared tube", Pose::tilted, flared, 0, size.height,
+                                        size.points, size.seed);
+        Options o = {};
+        o.flags = stratmesh::close_ends;
+        Run run = reconstruct_guarded(cloud_of(s), o);
+        REQUIRE(run.status == Status::ok);
+        mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, true);
+        const size_t first = run.count - run.report.caps.triangle_count;
+        INFO(size.points << " points, height " << size.height << ": " << m.summary());
+        CHECK(run.report.caps.closed_count == 2);
+        CHECK(m.manifold());
+        CHECK(m.boundary_edges == 0);
+        CHECK(m.euler == 2);
+        CHECK(m.vertices_used == s.size());
+        CHECK(m.intersecting_pairs == 0);
+        CHECK(m.vertex_overlaps == 0);
+        CHECK(six_times_volume(s, run.triangles.data(), run.count) > 0);
+        CHECK(caps_facing_inward(s, run.triangles.data(), first, run.count) == 0);
     }
 }
 #endif

@@ -191,7 +191,7 @@ TEST_CASE("a failed write leaves the old file and no temporary") {
     CHECK(dir.entries() == 1);
 }
 
-TEST_CASE("a symlinked destination is replaced at its target; a device is written directly") {
+TEST_CASE("a symlinked destination is replaced at its target, and a device is written directly") {
     ScratchDir dir;
     save(dir.file("real.ply"), "old");
     fs::create_symlink("real.ply", dir.file("link.ply"));

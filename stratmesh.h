@@ -2,9 +2,11 @@
 // Version 0.1.0. MIT licence (text at the end of this file).
 //
 // stratmesh turns a 3D point cloud of a roughly columnar object (a head, a limb, a bone,
-// a pipe, a tree stem) into a triangle mesh that interpolates the points. It slices the
-// cloud into layers across an axis, unrolls each layer from a cylinder onto a plane,
-// triangulates it with its own exact 2D Delaunay triangulation and stitches the layers
+// a pipe, a tree stem) into a triangle mesh that interpolates the points, by the method of
+// Y. Xiao, Z. Deng and B. Li, "A Surface Reconstruction Algorithm Based on 3D Point Cloud
+// Stratified Sliced", Sensors & Transducers, 2014: the cloud is sliced into layers across
+// an axis, each layer is projected onto a cylinder and unrolled onto a plane, triangulated
+// there by an exact 2D Delaunay triangulation, mapped back, and the layers are stitched
 // into one manifold surface. No heap, no exceptions, no globals: all working memory is a
 // buffer the caller sizes in advance.
 //
@@ -14,9 +16,7 @@
 //     #include "stratmesh.h"
 //
 //     // A mesh through n scanned points stored as x, y, z floats.
-//     stratmesh::Options options = {};               // all zero: defaults
-//     options.axis = stratmesh::Axis::z;
-//     options.layer_count = 6;
+//     stratmesh::Options options = {};               // all zero: the defaults
 //     stratmesh::Cloud cloud = {xyz, n, 0, stratmesh::Scalar::float32};  // 0: packed
 //     std::vector<unsigned char> work(stratmesh::reconstruct_workspace_size(n, options));
 //     std::vector<uint32_t> tris(3 * stratmesh::reconstruct_max_triangles(n, options));
@@ -36,6 +36,14 @@
 //                                tris2.data(), tris2.size() / 3, &info, nullptr);
 //
 // (std::vector is only the caller's choice here: any buffer will do, static or stack.)
+//
+// What the defaults do (all-zero Options): the axis is chosen automatically (the direction
+// along which the cloud's sections are loops around one centre line, tried on a sample),
+// the layers are chosen automatically, the cloud is searched for where it parts into
+// branches and, where it does, the trunk and each branch are meshed along their own axes
+// and joined into one surface; the ends stay open (close_ends caps them) and the layers stay
+// Delaunay on their unrolled annulus, as in the paper (surface_flips refines them on the
+// surface, for about 2.5 times the time).
 //
 // ==== Integration ==========================================================================
 //
@@ -60,51 +68,30 @@
 //                            2 KiB on a Cortex-M7): Options::run_jobs is then ignored
 //                            and everything runs in order, with the same result. For
 //                            single-core targets.
-//   STRATMESH_SMALL_CODE     default: not defined. Leaves out all the code that only
-//                            makes reconstruction faster, for targets where code size
-//                            comes first (the Cortex-M7 build): the parallel layers, as
-//                            above, the safety net's shortcut (a check of the loop
-//                            vertices that skips the net on sound chunks, about 0.4 KiB;
-//                            without it the net runs on every chunk), the staging of
-//                            the grouped points in spare workspace (see Memory), and the
-//                            predicates' fast exact stages (in integers, and from exact
-//                            coordinate differences: near-ties go to the general
-//                            expansion stage, which gives the same signs; about 2.7
-//                            KiB). On x86-64 reconstruction then takes 1.4 to 1.55 times
-//                            as long on tubes (400,000 points 1.4, 1e6 points 1.5 to
-//                            1.55) and about 2 times on a scan grid of 400,000 points,
-//                            full of near-ties. The output is the same bytes either way,
-//                            except for caps (close_ends) and slanted and closed ends
-//                            (below): it also leaves out the caps' lowering and raising
-//                            along the axis (see >>caps; 0.3 KiB), so its caps are the Delaunay
-//                            triangulation of each loop's projection, which crosses a
-//                            wall leaning over a ragged loop more often, and their ear
-//                            clipping's restarts (kCapEarStarts) and the exhaustive
-//                            search that follows (kCapSearchCorners) and the flips of
-//                            fins (kCapFinFlips), so a few more loops are left open. It leaves out cap_ends() and
-//                            find_parting() too (not declared: 0.6 KiB and about 4 KiB
-//                            on the Cortex-M7); reconstruct()'s
-//                            close_ends stays. And it leaves out the
-//                            crescent rule (a layer next to a slanted end of the tube
-//                            joins it, see Options and kRingGap; 1.2 KiB): a slanted end
-//                            is then closed across by a membrane, and there the layers
-//                            and triangles differ from the full build's. So do closed
-//                            ends (a dome or a flat base at the cloud's end, see
-//                            kPoleDepth), which it unrolls on the cylinder like the rest:
-//                            a flat base folds and its loop runs through its points
-//                            (as the full build does with the open_ends flag, which
-//                            this one therefore ignores).
-//                            The drop_outliers flag is refused (invalid_argument):
-//                            filter the cloud before it reaches the device. The
-//                            surface_flips flag is ignored (about 4 KiB): the layers
-//                            stay Delaunay on their annulus, as in the paper. A band
-//                            that folds between peeled loops gets all the peeled
-//                            triangles of both loops back, not only those around its
-//                            folds (kLocalUnpeel, 0.4 KiB): a little farther from the
-//                            surface at such seams. The surface's end loops are not
-//                            peeled in a layer that folds (kPeelFoldedEnds): where the
-//                            object forks at its end (horns), a web of triangles stays
-//                            between the branches' tips.
+//   STRATMESH_SMALL_CODE     default: not defined. The reduced build, for targets where
+//                            code size comes first (under 32 KiB of Cortex-M7 code at
+//                            -Os, against under 80 KiB for the full library): it meshes
+//                            one tube along the axis the caller gives, as the paper
+//                            does. It leaves out:
+//                            - what only makes it faster (parallel layers, the safety
+//                              net's shortcut, the staging of grouped points, the
+//                              predicates' integer stages): same bytes, slower;
+//                            - the search for branches (as if one_tube were always
+//                              given), the automatic axis (Axis::automatic returns
+//                              Status::not_compiled), the check for a degenerate
+//                              cloud, find_parting(), join_branches() and cap_ends()
+//                              (not declared);
+//                            - closed ends (a dome or a flat base is unrolled on the
+//                              cylinder like the rest) and the merging of a layer next
+//                              to a slanted end, so the layers and triangles at such
+//                              ends differ from the full build's;
+//                            - the caps' lowering and raising along the axis, their
+//                              pockets, restarts, exhaustive search and fin flips: its
+//                              caps are the Delaunay triangulation of each loop's
+//                              projection, and a few more loops stay open;
+//                            - the flags drop_outliers, surface_flips and open_ends,
+//                              which also return not_compiled (filter the cloud before
+//                              it reaches the device).
 //
 // ==== Memory ===============================================================================
 //
@@ -115,32 +102,25 @@
 // library never writes outside the workspace and the output arrays it is given, whatever
 // the input.
 //
-// delaunay_2d needs 72 bytes per point plus about 10 KiB; its output is at most
-// 2n - 5 triangles (24 bytes per point). reconstruct needs about 115 bytes per point
-// (the triangulation of its largest possible layer with the layer's coordinates, plus the
-// layer grouping and boundary loops), about 121 with the close_ends flag (plus up to
-// 32 KiB for the search of a cap: n (n - 1) / 2 bytes below 256 points), about 166 with a
-// jobs runner (Options::run_jobs); its output is at most 2n triangles. A stream needs about
-// 190 bytes per point it holds at once, whatever the size of the whole cloud; cap_ends()
-// 78 bytes per point of the whole cloud (its loops may pass through every point) plus 12
-// per triangle, plus the same 32 KiB: about 102 per point for a tube. find_parting() needs
-// about 101 bytes per point plus up to 0.5 MiB (its scale's sample, or a cache of grid
-// blocks), 1 bit per point more with drop_outliers.
+// As a guide: delaunay_2d needs 72 bytes per point plus about 10 KiB, and its output is at
+// most 2n - 5 triangles (24 bytes per point). reconstruct needs about 115 bytes per point
+// (the triangulation of its largest possible layer, the layer grouping and the boundary
+// loops), about 121 with close_ends (plus up to 32 KiB for the exhaustive search of a
+// cap), about 166 with a jobs runner; its output is at most 2n triangles plus 160 for the
+// junctions of branches. A stream needs about 190 bytes per point it holds at once,
+// whatever the size of the whole cloud.
 //
 // The whole workspace belongs to the call while it runs, including what it does not need:
-// without a runner, reconstruct keeps the points grouped by layer (24 bytes each) at the
-// end of the workspace when they fit above what it has taken, and loads each layer from
-// there as long as the layers before it have left that room untouched, instead of reading
-// the cloud at random once per layer. The output is the same either way, and
-// Report::workspace_used_bytes leaves that room out (it is the least workspace that suffices).
+// without a runner, reconstruct keeps the points grouped by layer (24 bytes each) in spare
+// workspace when they fit, instead of reading the cloud at random once per layer. The
+// output is the same either way, and Report::workspace_used_bytes leaves that room out (it
+// is the least workspace that suffices).
 //
 // Stack: no recursion anywhere. The exact incircle's expansions (about 8 KiB) live in the
 // workspace when called from the triangulation, and on the stack only when you call
-// incircle() yourself. Measured worst cases (CI checks them): reconstruct 3.0 KiB,
-// stream_push 2.4 KiB and delaunay_2d 1.4 KiB on a Cortex-M7 (GCC -Os, call graph of
-// -fstack-usage, libm and your progress callback not included); painted-stack high-water
-// marks on x86-64 with g++ 12 -O3 of 6.6 KiB for reconstruct and 2.5 KiB for delaunay_2d
-// (inlining makes frames bigger than at -Os); incircle() called directly 9.1 KiB.
+// incircle() yourself. On a Cortex-M7 (GCC -Os, the reduced build) reconstruct needs under
+// 4 KiB of stack, stream_push and delaunay_2d under 3 KiB (your progress callback and libm
+// not included); inlining at -O3 on x86-64 makes frames about twice as large.
 //
 // ==== Errors ===============================================================================
 //
@@ -162,13 +142,11 @@
 //   whose non-zero coordinates and coordinate differences span at most 2^320 in magnitude
 //   within one call for incircle (2^800 for orient2d): say 1e-45 next to 1e+50. Beyond
 //   that, products of differences cannot all be represented and the sign may be wrong
-//   (subnormal and tiny inputs are fine: they are rescaled). A fast floating-point
-//   filter with a proven error bound decides almost every call; fixed-width integer arithmetic decides most of the rest (exact coordinate
-//   differences spanning at most 62 bits, as between neighbours on a grid), and
-//   expansion arithmetic the remainder, after an exact power-of-two rescaling when the
-//   points are very close together or very far apart. The implementation pins
-//   floating-point contraction off (no fused multiply-add), whatever the compiler's
-//   flags.
+//   (subnormal and tiny inputs are fine: they are rescaled). A floating-point filter with
+//   a proven error bound decides almost every call; fixed-width integers decide most of
+//   the rest, and expansion arithmetic the remainder. Floating-point contraction (fused
+//   multiply-add) is pinned off, whatever the compiler's flags, so every platform
+//   computes the same signs.
 // - delaunay_2d produces the Delaunay triangulation of the distinct input points. Where
 //   four or more points are cocircular, the triangulation is made unique by a symbolic
 //   perturbation (each point is lifted off the paraboloid by an infinitesimal amount that
@@ -183,25 +161,21 @@
 //   skipped and counted with the skip_invalid_points flag of reconstruct.
 // - reconstruct keeps its own predicate calls inside that exact range, whatever the cloud:
 //   the frame is rescaled by a power of two (even for a cloud spanning more than the
-//   largest double) and the unrolled coordinates are bounded (see >>unroll), so a far
-//   outlier or a cloud at 1e-300 cannot break a sign.
+//   largest double) and the unrolled coordinates are bounded, so a far outlier or a cloud
+//   at 1e-300 cannot break a sign. A cloud whose surface would have no area (points on a
+//   line up to rounding, or a few points so far away that the rest collapse to one) is
+//   refused with Status::degenerate rather than meshed into slivers.
 // - reconstruct's output is edge- and vertex-manifold and consistently oriented for every
 //   input it accepts: the layers and the bands between them form one annulus by
 //   construction, and a safety net, run on each layer with its band below as soon as they
 //   are built, removes (and counts) any triangle that would break that, keeping the seams
 //   between them manifold too. The stream's output has the same guarantee. The output is
-//   not guaranteed free of self-intersections where a layer is
-//   not star-shaped around its centre (Report::diagnostics.fold_count counts the triangles facing the
-//   axis there); a layer that folds is unrolled around the centre, of 25 tried, where it
-//   folds least (see "the centre search" in >>layer triangulation).
-// - reconstruct's triangles depend on the order of the points, not only on their
-//   coordinates (unlike delaunay_2d's): the frame's origin (the centroid) and each
-//   layer's fitted centre are sums taken in input order, whose last bits differ from one
-//   order to another, and the centre search samples every k-th point of a layer. The same
-//   input gives the same bytes on every platform, but a shuffled cloud gives another mesh,
-//   as valid: on the bundled bust (axis z, 1 to 24 layers) 5 to 9% of the triangles
-//   differ with surface_flips, none without; more where layers fold (README, Known
-//   limitations).
+//   free of self-intersections where every layer is star-shaped around its centre, caps
+//   included; where a layer is not, it may cross itself, and
+//   Report::diagnostics.fold_count counts the triangles facing the axis there.
+// - The same input gives the same bytes on every platform and for every thread count. A
+//   reordered cloud gives another mesh, as valid: the frame's origin and the layers'
+//   centres are sums taken in input order, whose last bits depend on the order.
 
 #ifndef STRATMESH_H
 #define STRATMESH_H
@@ -331,7 +305,12 @@ struct Cloud {
 
 // The direction the layers are stacked along.
 enum class Axis : uint32_t {
-    automatic = 0,  // the principal direction of the cloud (largest-variance eigenvector)
+    // The direction along which the cloud's sections are loops around one centre line:
+    // the first principal direction where a sample's surface runs along it (a tube, a
+    // limb), else whichever of the principal directions and x, y, z gives a sample the
+    // smallest surface (a layer that cannot follow the surface folds and adds area). The
+    // reduced build (STRATMESH_SMALL_CODE) returns Status::not_compiled.
+    automatic = 0,
     x,
     y,
     z,
@@ -344,24 +323,18 @@ enum Flags : uint32_t {
     skip_invalid_points = 1u << 0,
     // Closes the surface's boundary loops with caps, so a tube becomes a closed, edge- and
     // vertex-manifold, consistently oriented surface (Euler characteristic 2, normals
-    // outward: the bottom cap faces -axis, the top one +axis). A cap is a triangulation of
-    // its loop over the loop's own vertices (no new vertex): a triangulation of the loop's
-    // projection across the axis (Report::axis), the bottom cap as low and the top cap as
-    // high along the axis as the loop allows (so that a wall leaning over a ragged loop
-    // stays clear of it), constrained Delaunay where the loop is planar, avoiding any
-    // diagonal that is already an edge of the surface. Where the surface's fins (triangles
-    // with two edges on the loop) leave no such cap, the edge under a fin may be flipped
-    // (the fin and the triangle beyond it become two others: same corners, same count; the
-    // loop unchanged), which frees its chord for the cap; only flips the cap then uses are
-    // made (Report::caps.wall_flip_count counts them). A loop whose projection is not a simple
-    // polygon, or that neither ear clipping nor (for loops of at most 256 corners) an
-    // exhaustive search closes, with or without those flips, stays open: the call
-    // still returns ok, Report::caps.open_count counts it and Report::detail says so. Caps
-    // do not cross one another; like the rest of the surface, they are not checked against
-    // the tube. The workspace bound grows by about 6 bytes per point with this flag, plus
-    // up to 32 KiB for that search; reconstruct_max_triangles() still suffices (a closed
-    // surface through V vertices has 2V - 4 triangles). The stream refuses the flag: its
-    // surface is capped afterwards by cap_ends().
+    // outward: the bottom cap faces -axis, the top one +axis). A cap triangulates its loop
+    // over the loop's own vertices (no new vertex), as seen across the axis: pockets of the
+    // loop along the wall are closed first, then the rest by a triangulation lowered (bottom)
+    // or raised (top) along the axis as far as the loop allows, so that a wall leaning over
+    // a ragged loop stays clear of it, and Delaunay where the loop is planar. No cap repeats
+    // an edge of the surface; where the surface's fins (triangles with two edges on the
+    // loop) leave no such cap, the edge under a fin may be flipped (two triangles change in
+    // place, same corners, same count; Report::caps.wall_flip_count). A loop whose
+    // projection is not a simple polygon, or that no cap closes, stays open: the call
+    // still returns ok, Report::caps.open_count counts it and Report::detail says so.
+    // reconstruct_max_triangles() still suffices (a closed surface through V vertices has
+    // 2V - 4 triangles). The stream refuses the flag: cap_ends() caps its surface afterwards.
     close_ends = 1u << 1,
     // The frame's reference point is Options::origin instead of the centroid of the cloud
     // (reconstruct) or of the first layer (the stream). The reference point changes only
@@ -369,48 +342,37 @@ enum Flags : uint32_t {
     // the same one.
     origin_given = 1u << 2,
     // Points far from the rest of the cloud (stray returns, flying pixels, specks of fewer
-    // than 8 points) are left out before anything else and counted (Report::points.outlier_count, part
-    // of Report::points.rejected_count), so they neither tilt the automatic axis nor stretch the layers
-    // nor become spikes: a point with fewer than 8 points, itself included, within 4 to 12
-    // times the distance that nine points in ten have to their nearest neighbour (the rule
-    // is "outliers" in >>layers). Meant for raw sensor clouds; off by default, since
-    // without it every valid point is a vertex. Assumes that fewer than a tenth of the
-    // points are outliers, and a surface sampled nowhere much sparser than that distance
-    // says. The workspace bound grows by a bit per point (the 56 bytes per point it uses
-    // while it runs are less than the rest takes). reconstruct() only: the stream refuses
-    // it (invalid_argument), and so does a build with STRATMESH_SMALL_CODE.
+    // than 8 points) are left out before anything else and counted (outlier_count, part of
+    // rejected_count in Report::points), so they neither tilt the automatic axis nor stretch
+    // the layers nor become spikes: a point with fewer than 8 points, itself included,
+    // within 4 to 12 times the distance that nine points in ten have to their nearest
+    // neighbour. For raw sensor clouds; off by default, since without it every valid point
+    // is a vertex. Assumes that fewer than a tenth of the points are outliers. The
+    // workspace bound grows by a bit per point. The stream refuses it (invalid_argument);
+    // the reduced build returns not_compiled.
     drop_outliers = 1u << 3,
     // After each layer is triangulated on its unrolled annulus (the paper's method), its
     // edges are flipped on the surface itself: by the empty-circle rule with angles
     // measured in 3D, and toward the direction in which the surface curves least. The
     // unrolling squeezes whatever lies almost across the axis (the underside of an ear, a
-    // chin, a crease) and bumps that turn the surface steeply around the axis; there the
-    // flips join the points that are near on the surface, and everywhere they lay edges
-    // along the surface's flattest direction. Once a layer is stitched to the one below,
-    // the band and the layer's triangles at that seam are flipped the same way, so a cut
-    // costs less (16 layers of a bumpy tube 12% farther from the true surface than one
-    // layer instead of 24%). No vertex or loop changes; a flip never makes a fold nor an
-    // angle over 150 degrees (unless it narrows one), and is checked against crossing the
-    // nearby triangles (at a seam only gentle flips are made, which need no check); the
-    // stream gives the same triangles as reconstruct() with it. Measured (README, "Flips
-    // on the surface"), mean distance to the true surface: 25% smaller on a synthetic
-    // bust with ears, 11% with horns, 11% on a hand, 9% on a femur, 30 to 44% on analytic
-    // tubes, 34 to 47% on a cone, 3% on a vase, the same on the bundled bust; 2.4 to 2.8
-    // times the time on the 1e6-point tube. Off by default, for that time (the
-    // command-line tool turns it on). A build with STRATMESH_SMALL_CODE ignores it.
+    // chin, a crease); there the flips join the points that are near on the surface. Each
+    // seam between layers is flipped the same way once the layers are stitched. No vertex
+    // or loop changes; a flip never makes a fold nor an angle over 150 degrees (unless it
+    // narrows one) and is checked against crossing the nearby triangles; the stream gives
+    // the same triangles as reconstruct() with it. Closer to the true surface (by about
+    // 10% on scans, 30 to 45% on smooth analytic tubes), for about 2.5 times the time:
+    // off by default. The reduced build returns not_compiled.
     surface_flips = 1u << 4,
     // No end of the surface is taken for a closed one (see ClosedEnd): the end layers are
     // unrolled on the cylinder like the others, never around a pole, so the surface's loops
     // lie where the cylinder's picture puts them (a flat end's points on its rim, a dome
     // up to its highest points). For a cloud cut out of a larger object (a region of
     // interest, a branch meshed on its own), whose ends are cuts however many points lie
-    // across them: a cut through the notch between the femur's condyles leaves points
-    // inside the shaft's outline, which the detection takes for a closed end and meshes
-    // across (README, Known limitations). A build with STRATMESH_SMALL_CODE, which has no
-    // closed ends, ignores it.
+    // across them. The reduced build, which has no closed ends, returns not_compiled.
     open_ends = 1u << 5,
     // reconstruct() meshes the cloud as one tube without looking for where it parts into
-    // branches (see PartCounts): the search's time saved, the paper's single column.
+    // branches (see PartCounts): the paper's single column, and the search's time saved
+    // (a few percent on a cloud that does not part). The stream always meshes one tube.
     one_tube = 1u << 6,
     // reconstruct() keeps the trunk and branches meshed apart even where a side could not
     // be joined or points past a cut belong to no branch (left apart or unused, as
@@ -443,18 +405,18 @@ struct Options {
     // dot(point, axis) (with Axis::z, a cut at 68 is the plane z = 68; a point on a cut,
     // up to 2^-40 of the cloud's height, belongs to the layer above); any order,
     // repeats and cuts outside the cloud are ignored; else layer_count equal-height
-    // layers; else layers of about layer_height; else automatic: the fewest layers (at
-    // most 256) such that one centre line serves each layer and none is taller than 24
-    // of its radii, cut where the cross-section changes least and not through dense
-    // detail (the paper's rule; see "automatic layers" in >>layers). A layer with fewer
-    // than 16 points, thinner than about one and a half rows of points around its own
-    // radius, or whose points do not surround its centre, is merged with the next one (a
-    // remainder that small or thin, with the last), and so is a layer next to a crescent
-    // (a slanted end of the tube: an arc of the section with a gap of over 34 degrees that
-    // the two layers together narrow; a half cylinder's gap stays); a layer with triangles
-    // facing the axis is joined with the next one or two where that leaves fewer (see
-    // "folding layers" at add_group); the report lists the layers actually used
-    // (Report::layers.info: bottom and top).
+    // layers; else layers of about layer_height; else automatic: the fewest layers such
+    // that one centre line serves each layer, none is taller than 24 of its radii and none
+    // holds more than an eighth of the points (or 65,536, if that is more, so that large
+    // clouds come in layers that jobs can triangulate side by side), cut where the
+    // cross-section changes least and not through dense detail (the paper's rule).
+    // Planned layers are then merged where the method needs it: a layer with fewer than
+    // 16 points, thinner than about one and a half rows of points around its radius, or
+    // whose points do not surround its centre joins the next one (a remainder like that
+    // joins the last); a layer next to a slanted end of the tube (a crescent: an arc with a
+    // gap of over 34 degrees that the two layers together narrow) joins it; a layer with
+    // triangles facing the axis is joined with the next one or two where that leaves
+    // fewer. Report::layers gives the planned and used counts and the layers used.
     const double* cuts;
     size_t cut_count;
     uint32_t layer_count;
@@ -483,15 +445,18 @@ const uint32_t kMaxJobs = 64;
 // LayerInfo::closed_ends. The surface's first layer (closed_bottom) or last layer
 // (closed_top) that holds a closed end of the object (a dome, a skull, a flat base: points
 // across the end, not only around its rim) is meshed across that end, up to a small loop
-// around its pole (see "closed ends" in >>unroll). An end left open as a tube's rim, any
-// other layer, and every layer with STRATMESH_SMALL_CODE report 0.
+// around its pole: the layer is unrolled around a pole inside the end rather than on the
+// cylinder, which would fold the end's points onto its rim. The small loop is a boundary
+// (close_ends caps it). An end left open as a tube's rim, any other layer, and every layer
+// of the reduced build report 0.
 enum ClosedEnd : uint32_t { closed_bottom = 1u << 0, closed_top = 1u << 1 };
 
 struct LayerInfo {
     double bottom, top;      // extent along the axis, as dot(point, axis)
     double centre[3];        // the axis of the unrolling cylinder passes through this
                              // (the fitted centre, or the one the centre search chose)
-    double radius;           // the unrolling radius (see >>unroll in the implementation)
+    double radius;           // the unrolling cylinder's radius: the layer's mean distance
+                             // from its centre line, at least a 24th of its height
     uint32_t point_count;    // distinct valid points in the layer
     uint32_t triangle_count; // the layer's own triangles plus the band joining it to the
                              // layer below, before the safety net
@@ -505,8 +470,6 @@ struct LayerInfo {
 const uint32_t kMaxBranches = 20;
 // The fewest points a branch holds.
 const uint32_t kSmallestBranch = 64;
-// The gap, in median nearest-neighbour distances.
-const double kPartingGap = 4.0;
 
 struct Parting {
     double gap;               // the linking distance, in the cloud's units; 0 if the cloud
@@ -525,9 +488,9 @@ struct Parting {
     uint32_t below_point_counts[kMaxBranches];
     size_t workspace_used_bytes;    // peak workspace bytes, from the start of the buffer
     const char* detail;       // a static sentence on why, when the call failed or, with
-                              // ok, searched nothing (a cloud without a scale, gap 0; one
-                              // too crowded to search: see kPartingChecksPerPoint in the
-                              // implementation)
+                              // ok, searched nothing (a cloud without a scale, gap 0, or
+                              // one so crowded that the search would cost more than a
+                              // bounded number of distance checks per point)
 };
 
 // Labels of find_parting()'s branch_of: a point in no branch (the trunk, a NaN point, every
@@ -645,23 +608,33 @@ struct Report {
 
 // A size in bytes that is always enough workspace for reconstruct() of point_count
 // points with these options. It assumes the worst layout (every point in one layer);
-// Report::workspace_used_bytes tells what a run really needed, which follows its largest layer
-// (measured on 2000-point tubes: the bound is 1.05 times the peak for one layer, 3.1 to
-// 3.3 times it with six or more layers). With Options::run_jobs it also covers the
-// layers triangulated ahead and the jobs' scratch (about 166 bytes per point instead of
-// 115). 0 if no workspace can serve that many points (as for delaunay_2d_workspace_size).
+// Report::workspace_used_bytes tells what a run really needed, which follows its largest
+// layer (about a third of the bound on a tube of six or more layers). With
+// Options::run_jobs it also covers the layers triangulated ahead and the jobs' scratch.
+// 0 if no workspace can serve that many points (as for delaunay_2d_workspace_size).
 size_t reconstruct_workspace_size(size_t point_count, const Options& options);
 
-// The most triangles reconstruct() can produce for point_count points: 2n (0 if that does
-// not fit in size_t).
+// The most triangles reconstruct() can produce for point_count points: 2n, plus four per
+// possible branch (160) where the options search for branches (0 if that does not fit in
+// size_t).
 size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 
 // Reconstructs a triangle mesh through the points of a columnar cloud: one surface,
 // edge- and vertex-manifold, consistently oriented, an open tube (two boundary loops) on
-// columnar input, closed by two caps with the close_ends flag, with every valid distinct
+// columnar input, closed by caps with the close_ends flag, with every valid distinct
 // point a vertex unless the report says why not. Where the cloud's end is closed (points
 // across it: a dome, a flat base), the surface goes across it too, and that end's loop is
-// a small one around the axis (see "closed ends" in >>unroll).
+// a small one around the axis (see ClosedEnd).
+//
+// In its steps: check the arguments and read the cloud (refusing NaN, a degenerate cloud);
+// choose the axis (Axis::automatic); look for where the cloud parts into branches (unless
+// one_tube) and, where it does, mesh the trunk along the axis and each branch along its
+// own automatic axis, and join them into one surface (see PartCounts and join_branches());
+// otherwise, or where the parts cannot all be joined (unless keep_parts), mesh one tube:
+// layer by layer, each unrolled and triangulated, stitched to the layer below, passed
+// through the manifold safety net; then the caps (close_ends). The branch search runs on a
+// sample of 4,096 points first on larger clouds and in full only where the sample parts,
+// so a branch of fewer than about n / 64 points can go unseen in a cloud of n points.
 //
 // cloud           the points (see Cloud), at most 2^32 - 3. They are only read.
 // options         see Options; `Options options = {};` gives the defaults.
@@ -684,7 +657,7 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // Returns ok; invalid_argument (a null pointer with a non-zero count, a stride smaller than
 // one point, an unknown Scalar, cut_count without cuts, a null triangle_count, a NaN or
 // infinite origin with origin_given,
-// drop_outliers in a build with STRATMESH_SMALL_CODE, or any two of the span of the cloud's
+// or any two of the span of the cloud's
 // points, the workspace, the triangle array, *triangle_count, *report and the report's
 // layer array sharing a byte: then nothing at all is written, not even the report);
 // too_many_points; invalid_point (Report::points.first_invalid_index, unless
@@ -692,9 +665,12 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // infinite, or of a length outside 1.5e-154 to 1.3e154);
 // invalid_layers (a NaN or infinite cut, more than 2^32 - 2 cuts, a negative or
 // non-finite layer_height);
-// too_few_points (fewer than 3 valid points, or no surface spans them); flat_cloud (no
-// extent along the axis); not_columnar (no layer's points surround its centre: try
-// another axis); out_of_memory; triangle_capacity; internal_error.
+// not_compiled (Axis::automatic, drop_outliers, surface_flips or open_ends in the reduced
+// build);
+// too_few_points (fewer than 3 valid points, or no surface spans them); degenerate (the
+// surface would have no area: see the robustness contract); flat_cloud (no extent along
+// the axis); not_columnar (no layer's points surround its centre: try another axis);
+// out_of_memory; triangle_capacity; internal_error.
 Status reconstruct(const Cloud& cloud, const Options& options,
                    void* workspace, size_t workspace_bytes,
                    uint32_t* triangles, size_t triangle_capacity, size_t* triangle_count,
@@ -718,14 +694,16 @@ Status reconstruct(const Cloud& cloud, const Options& options,
 //     for (each layer) stratmesh::stream_push(stream, layer_cloud, layer_top);
 //     stratmesh::stream_close(stream);
 //
-// Same triangles as reconstruct(): a push is one planned layer, as between two cuts, and
+// The stream meshes one tube (it cannot know where a cloud parts before it has seen it):
+// the same triangles as reconstruct() with the one_tube flag. A push is one planned
+// layer, as between two cuts, and
 // the stream forms layers from pushes by the rules reconstruct() applies to its planned
 // layers (a push too small, too thin, not surrounding its axis or next to a crescent joins
 // the next; a last rest too small or thin joins the layer below it), waiting for later
 // pushes where a rule needs them. So reconstruct() of the concatenated pushes, with
 // Options::cuts at the tops of all pushes but the last, the same axis, the same origin
-// (flag origin_given) and the points of each push in the same order, gives the same
-// triangles in the same order, with the same global indices (checked on every test shape),
+// (flag origin_given), the one_tube flag and the points of each push in the same order,
+// gives the same triangles in the same order, with the same global indices,
 // provided no point lies within 2^-40 of the height range below a cut (reconstruct()
 // counts such a point in the layer above) and no cut lies outside the points' height
 // range. The stream makes no caps (the close_ends flag is refused): cap_ends() closes its
@@ -818,10 +796,10 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count);
 // a fin of the surface is flipped (see close_ends): two of the given triangles then
 // change, in place. options: axis, direction, origin (with
 // origin_given) and skip_invalid_points as given to the stream or reconstruct(); the rest
-// is not used. report (optional): only caps_closed, caps_left_open, cap_triangles,
-// cap_wall_flips, workspace_used_bytes (this call's) and detail are set, the rest left as it
-// is: the stream's report can be passed, its counts kept (its workspace_used_bytes replaced).
-// Returns ok (loops whose projection is not simple stay open: caps_left_open);
+// is not used. report (optional): only Report::caps, workspace_used_bytes (this call's)
+// and detail are set, the rest left as it is: the stream's report can be passed, its
+// counts kept (its workspace_used_bytes replaced).
+// Returns ok (loops that cannot be capped stay open: Report::caps.open_count);
 // invalid_argument (a null triangle_count, triangles or workspace where needed, a bad
 // stride or scalar, *triangle_count above triangle_capacity, an index outside the cloud or
 // naming an invalid point, buffers sharing a byte); too_many_points; invalid_point (a NaN
@@ -835,15 +813,16 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
 // ---- Where the cloud parts into branches ----
 //
 // One tube cannot follow an object that forks (the horns on a head, the fingers of a hand,
-// the condyles at a femur's end): it wraps the branches and the gaps between them (README,
-// Known limitations). find_parting() finds where along the axis the cloud parts: the lowest
-// cut above which the points make two separate branches or more, and the highest below
-// which they do. A caller can then mesh each side on its own, the branches with open_ends
-// (README, "Where the cloud parts").
+// the condyles at a femur's end): it wraps the branches and the gaps between them.
+// find_parting() finds where along the axis the cloud parts: the lowest cut above which
+// the points make two separate branches or more, and the highest below which they do.
+// reconstruct() uses it by default; a caller can also mesh each side on its own, the
+// branches with open_ends, and join them with join_branches().
 //
 // Points join one piece when they lie within Parting::gap of each other (single linkage).
-// The gap is kPartingGap times the median distance from a point to its nearest distinct
-// neighbour (over at most 16,384 points, every k-th in the order of a grid). Cuts are tried
+// The gap is four times the median distance from a point to its nearest distinct
+// neighbour (on every k-th point in the order of a grid, at most 2,048 of them): the
+// points of one branch lie closer, the branches of a fork farther apart. Cuts are tried
 // every half gap along the axis (at most one per point). A side of a cut parts when it is
 // four gaps thick or more (a thinner one is a rim, which falls apart into arcs). Its pieces
 // count from kSmallestBranch points and a twentieth of the side's (specks and scraps do not
@@ -854,12 +833,8 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
 // gaps or more from the cut (else it is a bump, or the crown of a skull between two horns),
 // and the centroids of its points within a gap of the cut and within the next gap lie less
 // than two gaps apart across the axis (else it is a cap joined to a branch, whose section
-// jumps). Measured on the clouds of ../shared/data, the bundled bust and
-// a bust with horns (README, "Where the cloud parts"): the horns are found above the skull,
-// on that cloud and on 70% to 90% of its points alike; nothing on the hand, the kitten,
-// the bundled bust, nor the femur, whose condyles part for only a gap below their notch,
-// as a bump would.
-
+// jumps). So horns above a skull are found; the condyles of a femur, which part for only
+// a gap below their notch, are not, as a bump would not be.
 
 // Bytes of workspace find_parting() needs for point_count points (about 100 a point);
 // 0 if that is beyond what this platform can address.
@@ -868,10 +843,9 @@ size_t find_parting_workspace_size(size_t point_count, const Options& options);
 
 // Finds where the cloud parts into branches (see above). options: axis, direction, and
 // the flags skip_invalid_points and drop_outliers (outliers are left out first); the rest
-// is not used. The same axis as reconstruct() with these options. Deterministic; the
-// order of the points changes only rounding (the frame's origin is their centroid) on up
-// to 16,384 points, and on more the sample the scale is measured on (the gap by a fraction
-// of a percent). Returns ok (parting filled, whether or not
+// is not used. The same axis as reconstruct() with these options. Deterministic; another
+// order of the points changes only rounding (the frame's origin is their centroid) and
+// which points sample the scale. Returns ok (parting filled, whether or not
 // a cut was found); invalid_argument (a null parting, or workspace with points; a bad
 // stride or scalar; buffers sharing a byte); too_many_points; invalid_point (a NaN or
 // infinite point without skip_invalid_points); invalid_axis; too_few_points (fewer than 3
@@ -888,16 +862,16 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 // ---- Joining the branches to the trunk ----
 //
 // join_branches() joins a trunk and its branches, meshed apart (each label of
-// find_parting's branch_of its own reconstruct(), as the tool's --split-branches does),
+// find_parting's branch_of its own reconstruct(), as reconstruct() does by default),
 // into one surface. At each side that parts, the trunk's boundary loop nearest the
 // branches (the highest of the loops whose points are all kInTrunk, seen from that side)
 // is joined to each branch's loop nearest the cut: the trunk's loop is split at the gaps
 // between the branches, in their order around the trunk's centre (the vertex whose angle
 // is nearest the middle of each gap); each arc is zipped to its branch's whole loop, which
 // is opened at its point nearest the trunk's centre (the two chains merged in the order of
-// their angle around the branch's centre: on the tool tests' fork, trunk in 4 layers,
-// meshq counts 3 self-intersecting pairs where shortest diagonals first, as contour
-// stitching does, made 79); and the crotch is closed by a triangle per gap, from the
+// their angle around the branch's centre, which crosses itself far less than shortest
+// diagonals first, as contour stitching does); and the crotch is closed by a triangle per
+// gap, from the
 // trunk's vertex there to the two branches' opening points, and a fan over those points
 // where three branches or more meet.
 //
@@ -920,8 +894,7 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 // taken out as a disc that keeps every vertex on a triangle, and the hole's loop is zipped
 // to the branch's by angle around the branch's centre. The surface stays an oriented edge-
 // and vertex-manifold and every point stays a vertex; the band can cross the trunk's
-// triangles beside the stump where the stump's wall leans over the hole (the bust with horns
-// of bench/README.md: 92 self-intersecting pairs, all between the bands and the trunk).
+// triangles beside the stump where the stump's wall leans over the hole.
 struct JoinReport {
     uint32_t joined_side_count;      // 0, 1 or 2
     uint32_t apart_side_count;  // sides that part whose loops could not be joined (detail)
@@ -3941,10 +3914,9 @@ inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* count, 
 // centre (the loop still turns monotonically), and the two new loop edges rise at most
 // kPeelSlope (45 degrees) on the surface's ends (the first layer's bottom loop, the last
 // one's top loop: steeper loops made the caps fail on ragged ends), kInnerPeelSlope (63
-// degrees) between layers, where the gentler limit left chords several spacings long: on
-// the test tubes with 24 layers 1.12 to 1.19 times the single layer's mean distance to
-// the true surface, 1.02 to 1.10 with it (72 degrees: 1.00 to 1.08, but more
-// self-intersections on the hand of ../shared/data; no limit: 0.98 to 1.05). And only in
+// degrees) between layers, where the gentler limit left chords several spacings long (a
+// steeper limit brings the layers' seams no closer to the surface and crosses more). And
+// only in
 // a layer without folds: where the layer is not star-shaped around its centre the loops
 // are not monotone around the band's centre either, and longer loops gave the bands more
 // self-intersections. Except the surface's end loops, which meet no band (kPeelFoldedEnds):
@@ -3952,11 +3924,9 @@ inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* count, 
 // (the horns of bench/horned_bust.py): the hull runs from tip to tip and the triangles
 // under it are a web across the gap, down to where the branches meet. There an end loop
 // peels at any slope short of vertical, up to kFoldedEndPeelPasses passes, and most of the
-// web goes: on the horned bust with 4, 8 and 16 layers along z, mean distance to the true
-// surface 0.0046 -> 0.0022 of the diagonal, Hausdorff 0.15 -> 0.053 (with 8 passes 0.0036;
-// up to 63 degrees about as close, but 309 self-intersecting pairs with one layer where
-// this has 243, and 426 before). A cap (close_ends) over such a loop, which dips to where
-// the branches meet, can cross them (README, known limitations). The passes are bounded:
+// web goes (on a bust with horns, half the mean distance to the true surface). A cap
+// (close_ends) over such a loop, which dips to where the branches meet, can cross them.
+// The passes are bounded:
 // each peels every loop edge at most once.
 // Each loop keeps, per vertex, the pass that put it there (LayerLoops::bottom_flags,
 // top_flags), so that the band can put the peeled triangles back: where a band between
@@ -4209,18 +4179,13 @@ inline void find_closed_ends(LoadedLayer& layer, uint32_t ends) {
 // has the least area (bridges add area), and the fitted centre on ties with it. Radius and
 // scale stay the fitted ones, and a centre outside the sample's hull is never taken (the
 // layer must surround it). The search needs less workspace than the layer's own
-// triangulation. Cost: one triangulation of the sample per layer (about 1% of a
-// 1e6-point tube's time: its layers do not fold), 25 for a layer that folds: about 10
-// times the time of the whole reconstruction on a 3,900-point femur whose 8 layers all
-// fold (0.04 s against 0.004 s), at most about 25,000 insertions per layer on large ones.
-// Measured on the real clouds of the README (femur, hand, kitten, bust; 64 runs of 4 to 48
-// layers, axis z and automatic), with the band's centre choice in >>stitch: 63% fewer
-// self-intersecting triangle pairs, mean distance to the reference 14% (femur) and 31%
-// (hand) smaller; samples of 256 or 128 points lost most of that. A layer that bridges a
-// concavity without folding (a membrane over the neck between two lobes) is not searched:
-// searching every layer by area improved such synthetic layers 3 to 4 times but cost a
-// third more time on a 1e6-point tube and gave the real clouds no fewer
-// self-intersections.
+// triangulation. Cost: one triangulation of the sample per layer (little: a tube's layers
+// do not fold), 25 for a layer that folds, at most about 25,000 insertions per layer on
+// large ones. With the band's centre choice in >>stitch it removes most of the crossing
+// triangle pairs of scans whose layers fold; smaller samples lose most of that. A layer
+// that bridges a concavity without folding (a membrane over the neck between two lobes)
+// is not searched: searching every layer costs a third more time on a large tube and
+// gives scans no fewer self-intersections.
 
 const size_t kCentreSamplePoints = 1024;
 const int32_t kCentreRings = 2;  // the candidates: a 5 x 5 grid around the fitted centre
@@ -5513,10 +5478,8 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
 // (above, on the top cap): the lower or upper envelope of the loop, where the quadrilaterals
 // allow. On ties (a planar loop, a CT contour) the Delaunay criterion decides, so planar
 // caps are the constrained Delaunay triangulation (ear clipping alone leaves slivers).
-// Measured with CGAL's self-intersection test on the real clouds of the README, 32 runs:
-// pairs where a cap crosses the wall 1,367 with Delaunay caps, 371 now (the bundled bust
-// with default options 17 -> 0; see the README). The flips are bounded (kCapFlipsPerCorner
-// per loop vertex; the real clouds needed at most 1.4): any triangulation of the polygon is
+// Delaunay caps alone cross a wall leaning over a ragged loop several times as often. The
+// flips are bounded (kCapFlipsPerCorner per loop vertex): any triangulation of the polygon is
 // valid, so stopping early only leaves a cap less low. STRATMESH_SMALL_CODE leaves the
 // heights out: Delaunay caps.
 //
@@ -6132,8 +6095,8 @@ const char* const kLoopLeftOpenDetail =
 //
 // A loop with fins can have no cap at all: each fin's middle corner needs a diagonal to a
 // corner it sees across the loop, and with fins close together those diagonals cross or
-// see nothing (a fin under every other edge; 35 of the 43 loops the search left open on
-// sparse crops of the bundled bust, README). Then the wall gives way: the fin (u, v, m)
+// see nothing (a fin under every other edge: most loops the search leaves open on
+// sparsely sampled ends). Then the wall gives way: the fin (u, v, m)
 // and the wall triangle beyond its chord, (v, u, x), become (u, x, m) and (x, v, m) (m,
 // the fin's middle corner, has no other triangle, so m - x is a new edge and the surface
 // stays a manifold), and the chord u - v is free for the cap. Only fins whose x is on no
@@ -6792,11 +6755,8 @@ inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const Laye
 // end is taken in from below, and from above as the rings below reach it. A half cylinder,
 // whose gap no neighbour narrows, keeps its layers. The gaps are read on a sample of each
 // layer, and a gap that chance leaves among that many points of a ring (crescent_gap) is
-// not a crescent, so sparse layers keep theirs too. Measured with bench/layer_sweep.sh
-// (16 layerings each; README, "Decisions worth knowing"): the bundled bust's mean distance
-// to the true surface 0.00057 -> 0.00033 of the diagonal (worst run 0.0029 -> 0.00034);
-// self-intersecting pairs on the real clouds femur 93 -> 111, hand 37 -> 40, kitten
-// 1,447 -> 1,519 (none is columnar: merged layers fold differently).
+// not a crescent, so sparse layers keep theirs too. Without the merge a slanted end is
+// closed across by a membrane, far from the true surface.
 const uint32_t kRingGap = 3;
 
 // sectors_held by planned layers [first, last] around (cx, cy), read from the cloud.
@@ -6937,9 +6897,8 @@ inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerL
 //
 // With the surface_flips flag. A layer's flips on the surface (see "flips on the surface")
 // run before its band is stitched and never move a loop's edge, so the band and the layer's
-// triangles at its bottom loop keep the unrolled Delaunay's choice: 16 layers of a bumpy
-// tube came 24% farther from the true surface than one (README, "Flips on the surface";
-// 12% with the seam's flips). Once a chunk is
+// triangles at its bottom loop keep the unrolled Delaunay's choice, and every cut would
+// cost closeness to the surface (twice as much as with the seam's flips). Once a chunk is
 // final, its seam (the triangles with a corner on the loop below or on the layer's bottom
 // loop) is flipped by the same rules, with three limits that keep everything outside the
 // seam as it is:
@@ -7241,9 +7200,8 @@ inline bool flip_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
 // (the notch between a femur's condyles, a thumb beside the fist), the thin layers there
 // fold, their loops skip across the notch, and the bands between such loops cross the
 // layers next to them; a taller layer gives the centre search more of the section to
-// choose a centre from, and has one band fewer. The femur of
-// ../shared/data along z in 40 layers: 57 self-intersecting pairs, all at one band, and
-// 31 folds before; none with it (README, "Known limitations"). It costs up to four
+// choose a centre from, and has one band fewer (on a femur in 40 layers, it takes the
+// crossing pairs at its notch from dozens to none). It costs up to four
 // triangulations more, only where a layer folds (at most seven times that layer's time);
 // the stream waits for the layers above as it does for crescents, and makes the same
 // groups.
@@ -8822,14 +8780,26 @@ inline void principal_directions(const double m[3][3], Vec3 out[3]) {
 
 // The scatter matrix of `count` points, packed, about their mean.
 inline void scatter_of(const double* xyz, size_t count, double m[3][3]) {
+    // Scaled by the power of two that brings the largest coordinate near 1 (exactly, so
+    // directions and ratios keep their bits): squares of coordinates near either end of the
+    // double range would overflow or vanish.
+    double largest = 0;
+    for (size_t i = 0; i < 3 * count; ++i)
+        largest = abs_value(xyz[i]) > largest ? abs_value(xyz[i]) : largest;
+    int exponent = 0;
+    std::frexp(largest, &exponent);
     Vec3 mean = {0, 0, 0};
     for (size_t i = 0; i < count; ++i)
-        mean = Vec3{mean.x + xyz[3 * i], mean.y + xyz[3 * i + 1], mean.z + xyz[3 * i + 2]};
+        mean = Vec3{mean.x + std::ldexp(xyz[3 * i], -exponent),
+                    mean.y + std::ldexp(xyz[3 * i + 1], -exponent),
+                    mean.z + std::ldexp(xyz[3 * i + 2], -exponent)};
     mean = scaled(mean, 1.0 / static_cast<double>(count));
     for (int r = 0; r < 3; ++r)
         for (int s = 0; s < 3; ++s) m[r][s] = 0;
     for (size_t i = 0; i < count; ++i) {
-        const double d[3] = {xyz[3 * i] - mean.x, xyz[3 * i + 1] - mean.y, xyz[3 * i + 2] - mean.z};
+        const double d[3] = {std::ldexp(xyz[3 * i], -exponent) - mean.x,
+                             std::ldexp(xyz[3 * i + 1], -exponent) - mean.y,
+                             std::ldexp(xyz[3 * i + 2], -exponent) - mean.z};
         for (int r = 0; r < 3; ++r)
             for (int s = 0; s < 3; ++s) m[r][s] += d[r] * d[s];
     }
@@ -9141,6 +9111,9 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
 
 namespace detail {
 
+// The gap, in median nearest-neighbour distances: points of one branch lie closer, the
+// branches of a fork farther apart.
+const double kPartingGap = 4.0;
 const uint32_t kStepsPerGap = 2;
 // The points the scale (the median distance to the nearest neighbour) is measured on:
 // enough for the median within a few percent.

@@ -17,7 +17,7 @@ namespace bench {
 // z in [0, 8]: n points with (theta, z) uniform in [0, 2 pi) x [0, 8].
 void generate_tube(size_t n, uint64_t seed, std::vector<double>& xyz);
 
-// Layering comparisons (issue 8): a vase r = 1 + 0.5 sin(1.5 z), z in [-3, 3], whose
+// Layering comparisons: a vase r = 1 + 0.5 sin(1.5 z), z in [-3, 3], whose
 // calmest sections (radius extremes) are at z = -pi/3 and pi/3 (kVaseCuts); and a
 // unit tube over z in [-6, 6] whose centre line bends to x = 2 sin(pi z / 12), so no
 // straight line runs inside all of it (kBentTubeCuts: five equal layers, the fewest equal

@@ -3,8 +3,7 @@
 
     bench/branch_profile.py CLOUD.ply [--gap D] [--slab T] [--step S] [--json]
 
-The other half of the branching experiment of branch_split.py (README, "Known
-limitations"): cuts the cloud (x, y, z of the vertex element) into slabs T high along z
+The other half of the branching experiment of branch_split.py: cuts the cloud (x, y, z of the vertex element) into slabs T high along z
 and counts each slab's pieces: the connected parts of its points when points closer than
 D join (single linkage, as branch_split.py; D defaults to 4 times the median distance from
 a point to its nearest neighbour, T to 2 D). A piece counts when it holds at least 20
@@ -15,7 +14,7 @@ above which the points make two branches or more (branch_split.py HEIGHT), and t
 highest below which they do (branch_split.py HEIGHT --below), every piece there a branch:
 one that starts at the cut and goes on from it, its section too (see is_branch). With
 --json, one JSON line instead. E.g. on the horned bust (horned_bust.py), whose horns
-leave the skull at z = 2.85 (bench/README.md has what it finds on the other clouds):
+leave the skull at z = 2.85:
 
     bench/branch_profile.py horned.ply
     bench/branch_split.py horned.ply HEIGHT split.ply -- --axis z --layers 8

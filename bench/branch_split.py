@@ -5,8 +5,8 @@
                           [--stratmesh PATH] [--piece-options "OPTIONS"]
                           [-- TRUNK_OPTIONS...]
 
-An experiment for the branching that stratmesh does not do yet (README, "Known
-limitations"): splits the cloud (x, y, z of the vertex element) at HEIGHT along z into the
+An experiment on branches meshed as tubes of their own, without the library's junction:
+splits the cloud (x, y, z of the vertex element) at HEIGHT along z into the
 trunk below and the pieces above it (with --below: the trunk above and the pieces below),
 pieces being the connected parts of those points when points closer than D join (single
 linkage; D defaults to 4 times the median distance from a point to its nearest
@@ -18,12 +18,13 @@ pieces such as the femur's condyles, where a long horn wants its own); and write
 OUT.ply, one mesh over every point of the cloud in its order, with the triangles of all
 those runs: the branches as tubes of their own, not joined to the trunk (each junction
 leaves a gap and two loops). Prints one JSON line: the pieces' point counts, each run's
-status, layers and folds. Measure it with the checker of ../shared/tools/meshq, against a
-reference made as bench/README.md describes, e.g. on the horned bust (horned_bust.py; its
-horns leave the skull's section at z = 2.85):
+status, layers and folds. Measure it with a mesh-quality checker (the one
+quality_vs_afr.sh takes as MESH_CHECKER), against a reference made as bench/README.md
+describes, e.g. on the horned bust (horned_bust.py; its horns leave the skull's section at
+z = 2.85):
 
     bench/branch_split.py horned.ply 2.85 split.ply -- --axis z --layers 8
-    meshq --mesh split.ply --ref horned_reference.off --cloud horned.ply
+    "$MESH_CHECKER" --mesh split.ply --ref horned_reference.off --cloud horned.ply
 
 HEIGHT auto takes the cut, and the gap unless --gap is given, from the library's
 find_parting (the tool's --branches along z): the lowest cut above which the cloud parts,

@@ -13,8 +13,7 @@ which each surface has a loop at the crop's bottom and a ragged one where it was
 Prints one line per run that leaves a loop open, then one JSON line: the runs, the loops
 closed and left open, the runs whose caps flipped wall edges under fins and those edges,
 and the runs whose status was not ok. --quick runs the first seed
-only (60 runs). README.md ("Known limitations", caps over wall fins) quotes it on the
-bundled bust:
+only (60 runs). On the bundled bust:
 
     bench/cap_crops.py examples/data/bust.ply
 

@@ -10,7 +10,7 @@ midpoints to the reference (exact point-triangle distances, the candidates found
 points sampled on the reference), and counted in the layer holding its three
 vertices, or in the band between layers when they lie in more than one. Prints, per layer and
 for the bands: triangles, share of the mesh's area, share of the area-weighted distance, and
-the mean distance (area-weighted, relative to the reference's diagonal, as meshq's
+the mean distance (area-weighted, relative to the reference's diagonal, as a mesh checker's
 mean_out_to_ref); then the share of area and of distance that the triangles farther than
 0.5% and 1% of the diagonal carry; with --box (repeatable), the same for the triangles
 whose centroid lies in one of the boxes (corners in the mesh's coordinates) and for the
@@ -19,8 +19,8 @@ rest. For example (bench/README.md):
     stratmesh femur.ply -o femur_out.ply --ascii --report femur.json
     bench/error_by_layer.py femur_out.ply femur.json femur_reference.off
 
-Pure Python (no numpy): 10 to 20 s for the femur and the hand of ../shared/data (a few
-thousand triangles each way); 6 minutes for the bundled bust against a reference of its
+Pure Python (no numpy): 10 to 20 s for a cloud of a few thousand points (a few thousand
+triangles each way); 6 minutes for the bundled bust against a reference of its
 300,000-point scan.
 """
 import json

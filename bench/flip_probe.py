@@ -5,7 +5,7 @@
 
 Reads an ascii output of the stratmesh tool (--ascii) and its --report, flips the mesh's
 edges on the surface by the rules of the library's surface_flips (header, "flips on the
-surface"), and writes the result as ascii PLY for meshq. The library flips each layer's
+surface"), and writes the result as ascii PLY for a mesh checker. The library flips each layer's
 own edges before the bands exist; this probe measures what the same rules would do with
 more of the surface in reach, after the bands are stitched:
 

@@ -13,7 +13,7 @@ rounded to a multiple of STEP (as a scanner storing integer units gives), the sa
 copies. Prints one JSON line: the triangle counts, how many triangles of each mesh the
 other lacks, that share of the first, and the first run's report fields status, folds and
 caps. Exit status 0 when both runs succeeded (however different), 1 when a run failed, 2
-on a usage error. For example (README.md, "Known limitations"):
+on a usage error. For example:
 
     bench/order_probe.py examples/data/bust.ply -- --axis z --layers 8
     bench/order_probe.py examples/data/bust.ply --round 0.18716 -- --axis z --layers 8 --cap

@@ -3,26 +3,38 @@
 # next to CGAL's advancing-front reconstruction (stratmesh_afr_peer) of the same cloud.
 #
 #   bench/quality_vs_afr.sh [--ref REF.off] [--label NAME] [--keep DIR]
-#                           [--stratmesh PATH] [--afr PATH] [--meshq PATH]
+#                           [--stratmesh PATH] [--afr PATH] [--checker PATH]
 #                           CLOUD.ply [-- STRATMESH_OPTIONS...]
 #
 # Runs the stratmesh tool (with STRATMESH_OPTIONS, e.g. --axis z --layers 8 --threads 1)
-# and stratmesh_afr_peer on CLOUD, then the independent checker meshq on both meshes
-# (--cloud CLOUD, and --ref REF when given), and prints one JSON line per tool (stratmesh
-# first). README.md, "Surface quality against CGAL's advancing front", lists the fields.
+# and stratmesh_afr_peer on CLOUD, then the mesh-quality checker on both meshes
+# (CHECKER --mesh MESH --cloud CLOUD [--ref REF]), and prints one JSON line per tool
+# (stratmesh first). bench/README.md lists the fields.
 #
-# Tools, unless given: the stratmesh tool at build/examples/cli/stratmesh and the peer at
-# build/bench/stratmesh_afr_peer (relative to the source tree), meshq from PATH. Environment
-# variables STRATMESH, AFR_PEER and MESHQ work too. Needs bash and python3 (to merge the
-# JSON). The meshes go to a temporary directory that is removed, or to --keep DIR.
-# Exit status: 0 both tools ran and were measured, 1 a tool or meshq failed (its line
-# says so), 2 usage error.
+# The checker is not part of this repository: any mesh-quality checker that takes those
+# arguments and prints one JSON object with the fields this script copies: hausdorff,
+# hausdorff_out_to_ref, hausdorff_ref_to_out, chamfer_mean, mean_out_to_ref,
+# mean_ref_to_out, rms_out_to_ref, rms_ref_to_out (distances between the mesh and REF,
+# relative to REF's bounding-box diagonal), area_ratio (the mesh's area over REF's),
+# n_nonmanifold_edges, n_nonmanifold_vertices, n_components, n_boundary_loops,
+# n_self_intersecting_pairs, n_self_intersecting_pairs_complete, cloud_frac_vertex_float
+# (the share of CLOUD's points that are vertices), consistently_oriented, min_angle_p05
+# (the 5th percentile of the triangles' smallest angles); a field it lacks comes out null,
+# and an "error" field marks its run as failed. Give it with --checker PATH or the
+# environment variable MESH_CHECKER.
+#
+# The other tools, unless given: the stratmesh tool at build/examples/cli/stratmesh and
+# the peer at build/bench/stratmesh_afr_peer (relative to the source tree); environment
+# variables STRATMESH and AFR_PEER work too. Needs bash and python3 (to merge the JSON).
+# The meshes go to a temporary directory that is removed, or to --keep DIR.
+# Exit status: 0 both tools ran and were measured, 1 a tool or the checker failed (its
+# line says so), 2 usage error.
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
 stratmesh=${STRATMESH:-$root/build/examples/cli/stratmesh}
 afr=${AFR_PEER:-$root/build/bench/stratmesh_afr_peer}
-meshq=${MESHQ:-meshq}
+checker=${MESH_CHECKER:-}
 ref=""
 label=""
 keep=""
@@ -30,7 +42,7 @@ cloud=""
 options=()
 
 usage() {
-  sed -n '4,7p' "$0" | sed 's/^# \{0,1\}//' >&2
+  sed -n '4,31p' "$0" | sed 's/^# \{0,1\}//' >&2
   exit "${1:-2}"
 }
 
@@ -41,7 +53,7 @@ while [ $# -gt 0 ]; do
     --keep) [ $# -ge 2 ] || usage; keep=$2; shift 2 ;;
     --stratmesh) [ $# -ge 2 ] || usage; stratmesh=$2; shift 2 ;;
     --afr) [ $# -ge 2 ] || usage; afr=$2; shift 2 ;;
-    --meshq) [ $# -ge 2 ] || usage; meshq=$2; shift 2 ;;
+    --checker) [ $# -ge 2 ] || usage; checker=$2; shift 2 ;;
     -h|--help) usage 0 ;;
     --) shift; options=("$@"); break ;;
     -*) echo "quality_vs_afr.sh: unknown option $1" >&2; usage ;;
@@ -51,7 +63,8 @@ done
 [ -n "$cloud" ] || usage
 [ -f "$cloud" ] || { echo "quality_vs_afr.sh: no cloud $cloud" >&2; exit 2; }
 [ -z "$ref" ] || [ -f "$ref" ] || { echo "quality_vs_afr.sh: no reference $ref" >&2; exit 2; }
-for tool in "$stratmesh" "$afr" "$meshq"; do
+[ -n "$checker" ] || { echo "quality_vs_afr.sh: no checker: set MESH_CHECKER or give --checker" >&2; exit 2; }
+for tool in "$stratmesh" "$afr" "$checker"; do
   command -v "$tool" > /dev/null || { echo "quality_vs_afr.sh: cannot run $tool" >&2; exit 2; }
 done
 command -v python3 > /dev/null || { echo "quality_vs_afr.sh: needs python3" >&2; exit 2; }
@@ -65,8 +78,8 @@ else
   trap 'rm -rf "$work"' EXIT
 fi
 
-meshq_args=(--cloud "$cloud")
-[ -z "$ref" ] || meshq_args+=(--ref "$ref")
+checker_args=(--cloud "$cloud")
+[ -z "$ref" ] || checker_args+=(--ref "$ref")
 
 # stratmesh: its JSON report gives the library call's time, layers and folds.
 sm_mesh=$work/$label.stratmesh.ply
@@ -75,8 +88,8 @@ sm_status=0
   ${options[@]+"${options[@]}"} > "$work/$label.stratmesh.log" 2>&1 || sm_status=$?
 sm_q_status=0
 if [ "$sm_status" -eq 0 ]; then
-  "$meshq" --mesh "$sm_mesh" "${meshq_args[@]}" > "$work/$label.stratmesh.meshq.json" \
-    2> "$work/$label.stratmesh.meshq.log" || sm_q_status=$?
+  "$checker" --mesh "$sm_mesh" "${checker_args[@]}" > "$work/$label.stratmesh.checker.json" \
+    2> "$work/$label.stratmesh.checker.log" || sm_q_status=$?
 fi
 
 # The peer: its own JSON line gives the time of the CGAL call.
@@ -86,8 +99,8 @@ afr_status=0
   afr_status=$?
 afr_q_status=0
 if [ "$afr_status" -eq 0 ]; then
-  "$meshq" --mesh "$afr_mesh" "${meshq_args[@]}" > "$work/$label.afr.meshq.json" \
-    2> "$work/$label.afr.meshq.log" || afr_q_status=$?
+  "$checker" --mesh "$afr_mesh" "${checker_args[@]}" > "$work/$label.afr.checker.json" \
+    2> "$work/$label.afr.checker.log" || afr_q_status=$?
 fi
 
 python3 - "$work" "$label" "$cloud" "$ref" \
@@ -122,7 +135,7 @@ def tail(name):
         return ""
 
 def figures(q):
-    """The key figures of a meshq line (None where meshq gave none)."""
+    """The key figures of a checker line (None where the checker gave none)."""
     g = lambda k: q.get(k) if q else None
     return {
         "hausdorff": g("hausdorff"),
@@ -149,14 +162,14 @@ lines = []
 
 # stratmesh
 report = load(label + ".stratmesh.report.json") if sm_status == 0 else None
-q = load(label + ".stratmesh.meshq.json") if sm_status == 0 else None
+q = load(label + ".stratmesh.checker.json") if sm_status == 0 else None
 row = {"tool": "stratmesh", "cloud": cloud, "ref": ref or None, "options": options}
 if sm_status != 0:
     row["status"] = "error"
     row["error"] = "stratmesh exit %d: %s" % (sm_status, tail(label + ".stratmesh.log"))
 elif sm_q_status != 0 or q is None or "error" in q:
     row["status"] = "error"
-    row["error"] = "meshq: %s" % ((q or {}).get("error") or tail(label + ".stratmesh.meshq.log"))
+    row["error"] = "checker: %s" % ((q or {}).get("error") or tail(label + ".stratmesh.checker.log"))
 else:
     row["status"] = "ok"
 row["points"] = report["points"]["in"] if report else None
@@ -170,7 +183,7 @@ lines.append(row)
 
 # CGAL's advancing front
 peer = load(label + ".afr.json")
-q = load(label + ".afr.meshq.json") if afr_status == 0 else None
+q = load(label + ".afr.checker.json") if afr_status == 0 else None
 row = {"tool": "cgal_afr", "cloud": cloud, "ref": ref or None,
        "options": ["radius_ratio_bound=%g" % peer["radius_ratio_bound"],
                    "beta=%g" % peer["beta"]] if peer else []}
@@ -180,7 +193,7 @@ if afr_status != 0:
         afr_status, (peer or {}).get("error") or tail(label + ".afr.log"))
 elif afr_q_status != 0 or q is None or "error" in q:
     row["status"] = "error"
-    row["error"] = "meshq: %s" % ((q or {}).get("error") or tail(label + ".afr.meshq.log"))
+    row["error"] = "checker: %s" % ((q or {}).get("error") or tail(label + ".afr.checker.log"))
 else:
     row["status"] = "ok"
 row["points"] = peer["points"] if peer else None

@@ -215,7 +215,7 @@ const CaseSpec kCases[] = {
     // The cloud of tube-4e6 streamed in 100 layers, against reconstruct on the same layers.
     {"stream-tube-4e6", "stream", Kind::stream, 4000000, 0x5EED0103u, 3, bench::generate_tube,
      kHundredLayers},
-    // Automatic layers against one layer and against cuts chosen by hand (issue 8).
+    // Automatic layers against one layer and against cuts chosen by hand.
     {"layering-head-auto", "layering", Kind::reconstruct, bench::kHeadPoints, 0x5EED0201u, 5,
      bench::generate_paper_head, kAutomaticAlongZ},
     {"layering-head-1layer", "layering", Kind::reconstruct, bench::kHeadPoints, 0x5EED0201u, 5,

@@ -1281,7 +1281,8 @@ size_t stratmesh_stream_workspace_size(size_t max_points_held,
 
 // Opens a stream in the workspace (stratmesh::stream_open): options (not NULL) as there,
 // emit receives the triangles, report (optional) is updated after every call on the
-// stream and must stay valid until the stream is closed. On success *stream is the handle.
+// stream and must stay valid until the stream is closed; its workspace_used_bytes counts
+// from the start of this workspace, the handle included. On success *stream is the handle.
 // Returns the C++ statuses; OUT_OF_MEMORY also when the workspace cannot hold the handle.
 stratmesh_status stratmesh_stream_open(const stratmesh_options* options, void* workspace,
                                        size_t workspace_bytes,
@@ -11278,6 +11279,7 @@ struct stratmesh_stream {
     stratmesh_report* user_report;
     stratmesh_triangle_callback emit;
     void* emit_user;
+    size_t prefix;                     // bytes of the caller's workspace before the C++ one
 };
 
 namespace stratmesh {
@@ -11390,6 +11392,13 @@ inline void c_report_start(Report& r, const stratmesh_report* c) {
     if (!c || !c->layers.info) return;
     r.layers.info = reinterpret_cast<LayerInfo*>(c->layers.info);
     r.layers.info_capacity = c->layers.info_capacity;
+}
+
+// The stream's C report, its workspace counted from the start of the caller's buffer.
+inline void c_stream_report(const stratmesh_stream& s) {
+    if (!s.user_report) return;
+    c_report(s.report, *s.user_report);
+    s.user_report->workspace_used_bytes += s.prefix;
 }
 
 inline ByteRange c_report_bytes(const stratmesh_report* c) {
@@ -11542,7 +11551,8 @@ stratmesh_status stratmesh_stream_open(const stratmesh_options* options, void* w
         detail::c_options(options), bytes + sizeof *s, workspace_bytes - pad - sizeof *s,
         detail::c_emit, s, report ? &s->report : nullptr, &s->stream);
     if (status != stratmesh::Status::ok) return static_cast<stratmesh_status>(status);
-    if (report) detail::c_report(s->report, *report);
+    s->prefix = pad + sizeof *s;
+    detail::c_stream_report(*s);
     *stream = s;
     return STRATMESH_STATUS_OK;
 }
@@ -11552,14 +11562,14 @@ stratmesh_status stratmesh_stream_push(stratmesh_stream* stream,
     if (!stream || !points) return STRATMESH_STATUS_INVALID_ARGUMENT;
     const stratmesh::Status status =
         stratmesh::stream_push(stream->stream, stratmesh::detail::c_cloud(*points), top);
-    if (stream->user_report) stratmesh::detail::c_report(stream->report, *stream->user_report);
+    stratmesh::detail::c_stream_report(*stream);
     return static_cast<stratmesh_status>(status);
 }
 
 stratmesh_status stratmesh_stream_close(stratmesh_stream* stream) {
     if (!stream) return STRATMESH_STATUS_INVALID_ARGUMENT;
     const stratmesh::Status status = stratmesh::stream_close(stream->stream);
-    if (stream->user_report) stratmesh::detail::c_report(stream->report, *stream->user_report);
+    stratmesh::detail::c_stream_report(*stream);
     return static_cast<stratmesh_status>(status);
 }
 

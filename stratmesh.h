@@ -64,6 +64,10 @@
 //                            2 KiB on a Cortex-M7): Options::run_jobs is then ignored
 //                            and everything runs in order, with the same result. For
 //                            single-core targets.
+//   STRATMESH_C_API          0 or 1; default 1, or 0 with STRATMESH_SMALL_CODE. Declares
+//                            and compiles the C interface (see "C interface"); define it
+//                            alike where the implementation is compiled and where the
+//                            header is included.
 //   STRATMESH_SMALL_CODE     default: not defined. Leaves out all the code that only
 //                            makes reconstruction faster, for targets where code size
 //                            comes first (the Cortex-M7 build): the parallel layers, as
@@ -990,9 +994,9 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
 //
 //   STRATMESH_C_API     0 or 1, where the implementation is compiled and where the header
 //                       is included alike. Default 1, or 0 with STRATMESH_SMALL_CODE,
-//                       whose build is measured against a code budget: define it to 1
-//                       there to have the C functions (about 1 KiB on a Cortex-M7). With 0
-//                       this section declares nothing and defines nothing.
+//                       whose build is held to a code budget: define it to 1 there to
+//                       have the C functions. With 0 this section declares nothing and
+//                       the implementation defines nothing of it.
 
 #if !defined(STRATMESH_C_API)
 #if defined(STRATMESH_SMALL_CODE)

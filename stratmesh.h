@@ -985,8 +985,8 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
 // is and sees only this section; a C++ file sees it next to the C++ interface. The
 // implementation is C++: compile stratmesh.cpp with a C++17 compiler (g++ -std=c++17 -c
 // stratmesh.cpp) and link it, or link CMake's target stratmesh::stratmesh (libstratmesh.a);
-// the program is then linked by the C++ compiler driver (or with -lstdc++ -lm), though the
-// library calls nothing of the C++ runtime. Defining STRATMESH_IMPLEMENTATION in a C file
+// link the program with the C++ compiler driver (or add -lstdc++ -lm), so that whatever
+// the C++ compiler's code refers to is found. Defining STRATMESH_IMPLEMENTATION in a C file
 // is an error. Each function wraps the C++ one of the same name (stratmesh_reconstruct is
 // stratmesh::reconstruct) and converts its structs, field for field: the contracts, the
 // statuses and the results are the C++ ones, documented above; a C++ program can call
@@ -1229,10 +1229,11 @@ typedef struct stratmesh_diagnostics {
     size_t diagonal_swap_count;    // band diagonals swapped when stitching layers
 } stratmesh_diagnostics;
 
-// stratmesh::Report, its groups as nested structs. Filled on every status of
-// stratmesh_reconstruct (and by the stream after every call), counts adding up, except
-// when it is refused with INVALID_ARGUMENT for overlapping buffers: then nothing is
-// written. Set layers.info (or nothing: all zero is fine) before the call.
+// stratmesh::Report, its groups as nested structs, so that C code reads the same counts
+// under the same names. stratmesh_reconstruct fills it on every status, counts adding up,
+// except when it refuses overlapping buffers (INVALID_ARGUMENT: nothing written); the
+// stream fills it when it opens and after every push and close. Set layers.info and
+// layers.info_capacity before the call for per-layer details (all zero: none).
 typedef struct stratmesh_report {
     size_t triangle_count;
     double axis[3];                 // unit axis used

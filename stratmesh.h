@@ -52,6 +52,10 @@
 // that, and link it (CMake: target stratmesh::stratmesh). Including the header several
 // times, with or without the macro, is safe.
 //
+// From C (C99): include the header as it is; it then declares the C interface only
+// (stratmesh_reconstruct and the rest, see "C interface" at the end of the declarations).
+// Compile stratmesh.cpp with a C++17 compiler and link it with the C program.
+//
 // Only C++17 headers that need no runtime support are used: <cstddef>, <cstdint>,
 // <cstring>, <cfloat>, <climits> and <cmath> (for sqrt, floor, ceil, frexp and ldexp, which
 // IEEE-754 defines exactly, so every platform computes the same bits). Builds with
@@ -68,6 +72,10 @@
 //                            2 KiB on a Cortex-M7): Options::run_jobs is then ignored
 //                            and everything runs in order, with the same result. For
 //                            single-core targets.
+//   STRATMESH_C_API          0 or 1; default 1, or 0 with STRATMESH_SMALL_CODE. Declares
+//                            and compiles the C interface (see "C interface"); define it
+//                            alike where the implementation is compiled and where the
+//                            header is included.
 //   STRATMESH_SMALL_CODE     default: not defined. The reduced build, for targets where
 //                            code size comes first (under 32 KiB of Cortex-M7 code at
 //                            -Os, against under 80 KiB for the full library): it meshes
@@ -89,6 +97,10 @@
 //                              pockets, restarts, exhaustive search and fin flips: its
 //                              caps are the Delaunay triangulation of each loop's
 //                              projection, and a few more loops stay open;
+//                            - the finer peeling of loops where layers fold: where the
+//                              object forks at its end (horns), a web of triangles may
+//                              stay between the branches' tips;
+//                            - the C interface, unless STRATMESH_C_API is 1;
 //                            - the flags drop_outliers, surface_flips and open_ends,
 //                              which also return not_compiled (filter the cloud before
 //                              it reaches the device).
@@ -180,13 +192,16 @@
 #ifndef STRATMESH_H
 #define STRATMESH_H
 
-#include <cstddef>
-#include <cstdint>
-
 #define STRATMESH_VERSION_MAJOR 0
 #define STRATMESH_VERSION_MINOR 1
 #define STRATMESH_VERSION_PATCH 0
 #define STRATMESH_VERSION_STRING "0.1.0"
+
+// The C++ interface; a C compiler sees only the C interface below it (see "C interface").
+#ifdef __cplusplus
+
+#include <cstddef>
+#include <cstdint>
 
 namespace stratmesh {
 
@@ -938,13 +953,346 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
 
 } // namespace stratmesh
 
+#endif // __cplusplus
+
+// ==== C interface ==========================================================================
+//
+// The same fixed-workspace functions for C99 callers: stratmesh_-prefixed functions over
+// plain structs, enum constants prefixed STRATMESH_. A C file includes this header as it
+// is and sees only this section; a C++ file sees it next to the C++ interface. The
+// implementation is C++: compile stratmesh.cpp with a C++17 compiler (g++ -std=c++17 -c
+// stratmesh.cpp) and link it, or link CMake's target stratmesh::stratmesh (libstratmesh.a);
+// link the program with the C++ compiler driver (or add -lstdc++ -lm), so that whatever
+// the C++ compiler's code refers to is found. Defining STRATMESH_IMPLEMENTATION in a C file
+// is an error. Each function wraps the C++ one of the same name (stratmesh_reconstruct is
+// stratmesh::reconstruct) and converts its structs, field for field: the contracts, the
+// statuses and the results are the C++ ones, documented above; a C++ program can call
+// either.
+//
+//   STRATMESH_C_API     0 or 1, where the implementation is compiled and where the header
+//                       is included alike. Default 1, or 0 with STRATMESH_SMALL_CODE,
+//                       whose build is held to a code budget: define it to 1 there to
+//                       have the C functions. With 0 this section declares nothing and
+//                       the implementation defines nothing of it.
+
+#if !defined(STRATMESH_C_API)
+#if defined(STRATMESH_SMALL_CODE)
+#define STRATMESH_C_API 0
+#else
+#define STRATMESH_C_API 1
+#endif
+#endif
+
+#if STRATMESH_C_API
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+// stratmesh::Status, value for value (the C++ part asserts it). Every function that does
+// work returns one; stratmesh_status_string() names it.
+typedef enum stratmesh_status {
+    STRATMESH_STATUS_OK = 0,
+    STRATMESH_STATUS_INVALID_ARGUMENT,
+    STRATMESH_STATUS_TOO_MANY_POINTS,
+    STRATMESH_STATUS_NOT_COMPILED,
+    STRATMESH_STATUS_INVALID_POINT,
+    STRATMESH_STATUS_TOO_FEW_POINTS,
+    STRATMESH_STATUS_COLLINEAR,
+    STRATMESH_STATUS_INVALID_AXIS,
+    STRATMESH_STATUS_INVALID_LAYERS,
+    STRATMESH_STATUS_FLAT_CLOUD,
+    STRATMESH_STATUS_NOT_COLUMNAR,
+    STRATMESH_STATUS_DEGENERATE,
+    STRATMESH_STATUS_OUT_OF_ORDER,
+    STRATMESH_STATUS_OUT_OF_MEMORY,
+    STRATMESH_STATUS_TRIANGLE_CAPACITY,
+    STRATMESH_STATUS_INTERNAL_ERROR
+} stratmesh_status;
+
+// stratmesh::Scalar: the type of a cloud's coordinates (stratmesh_cloud::scalar).
+typedef enum stratmesh_scalar {
+    STRATMESH_SCALAR_FLOAT64 = 0,
+    STRATMESH_SCALAR_FLOAT32 = 1
+} stratmesh_scalar;
+
+// stratmesh::Axis: the direction the layers are stacked along (stratmesh_options::axis).
+typedef enum stratmesh_axis {
+    STRATMESH_AXIS_AUTOMATIC = 0,  // the cloud's principal direction
+    STRATMESH_AXIS_X,
+    STRATMESH_AXIS_Y,
+    STRATMESH_AXIS_Z,
+    STRATMESH_AXIS_DIRECTION       // stratmesh_options::direction
+} stratmesh_axis;
+
+// stratmesh::Flags: bits of stratmesh_options::flags, each documented at its C++ name
+// (STRATMESH_FLAG_CLOSE_ENDS is stratmesh::close_ends).
+enum stratmesh_flags {
+    STRATMESH_FLAG_SKIP_INVALID_POINTS = 1 << 0,
+    STRATMESH_FLAG_CLOSE_ENDS = 1 << 1,
+    STRATMESH_FLAG_ORIGIN_GIVEN = 1 << 2,
+    STRATMESH_FLAG_DROP_OUTLIERS = 1 << 3,
+    STRATMESH_FLAG_SURFACE_FLIPS = 1 << 4,
+    STRATMESH_FLAG_OPEN_ENDS = 1 << 5,
+    STRATMESH_FLAG_ONE_TUBE = 1 << 6,
+    STRATMESH_FLAG_KEEP_PARTS = 1 << 7
+};
+
+// stratmesh::ClosedEnd: bits of stratmesh_layer_info::closed_ends.
+enum stratmesh_closed_end {
+    STRATMESH_CLOSED_BOTTOM = 1 << 0,
+    STRATMESH_CLOSED_TOP = 1 << 1
+};
+
+// stratmesh::Phase: the phases reported to stratmesh_options::progress, in order.
+typedef enum stratmesh_phase {
+    STRATMESH_PHASE_VALIDATE = 0,
+    STRATMESH_PHASE_LAYERS,
+    STRATMESH_PHASE_TRIANGULATE,
+    STRATMESH_PHASE_STITCH,
+    STRATMESH_PHASE_MANIFOLD,
+    STRATMESH_PHASE_DONE
+} stratmesh_phase;
+
+// stratmesh::PartsOutcome: how reconstruction met a cloud that parts into branches
+// (stratmesh_part_counts::outcome).
+typedef enum stratmesh_parts_outcome {
+    STRATMESH_PARTS_ONE_TUBE = 0,
+    STRATMESH_PARTS_JOINED,
+    STRATMESH_PARTS_KEPT_APART,
+    STRATMESH_PARTS_UNDONE
+} stratmesh_parts_outcome;
+
+// The name of a status and a one-line explanation (stratmesh::status_string); never NULL,
+// "unknown status" for a value outside the list.
+const char* stratmesh_status_string(stratmesh_status status);
+
+// Exact-sign predicates on double[2] points (stratmesh::orient2d, stratmesh::incircle):
+// twice the signed area of abc, and positive when d lies inside the circle through the
+// counter-clockwise a, b, c.
+double stratmesh_orient2d(const double a[2], const double b[2], const double c[2]);
+double stratmesh_incircle(const double a[2], const double b[2], const double c[2],
+                          const double d[2]);
+
+// stratmesh::Delaunay2dInfo.
+typedef struct stratmesh_delaunay_2d_info {
+    size_t triangle_count;        // written (or needed, on TRIANGLE_CAPACITY)
+    size_t duplicate_count;       // points repeating an earlier point's coordinates
+    size_t hull_vertex_count;     // points on the convex hull, collinear ones too
+    size_t first_invalid_index;   // the first NaN/Inf point, on INVALID_POINT
+    size_t workspace_used_bytes;  // peak workspace bytes
+} stratmesh_delaunay_2d_info;
+
+// Workspace bytes and most triangles for stratmesh_delaunay_2d of point_count points
+// (stratmesh::delaunay_2d_workspace_size and _max_triangles): bounds, so that a caller
+// sizes its buffers once; 0 when no buffer can serve that many points.
+size_t stratmesh_delaunay_2d_workspace_size(size_t point_count);
+size_t stratmesh_delaunay_2d_max_triangles(size_t point_count);
+
+// The Delaunay triangulation of point_count points (x, y doubles, the next point
+// stride_bytes later), as stratmesh::delaunay_2d: info and duplicate_of may be NULL.
+stratmesh_status stratmesh_delaunay_2d(const double* xy, size_t point_count,
+                                       size_t stride_bytes, void* workspace,
+                                       size_t workspace_bytes, uint32_t* triangles,
+                                       size_t triangle_capacity,
+                                       stratmesh_delaunay_2d_info* info,
+                                       uint32_t* duplicate_of);
+
+// stratmesh::Cloud: x, y, z of the first point at xyz, each next point stride_bytes
+// further (0: packed), scalar a stratmesh_scalar. Read in place, any alignment.
+typedef struct stratmesh_cloud {
+    const void* xyz;
+    size_t count;
+    size_t stride_bytes;
+    uint32_t scalar;  // stratmesh_scalar
+} stratmesh_cloud;
+
+// One job of a batch (stratmesh::JobFunction): job(context, index).
+typedef void (*stratmesh_job_function)(void* context, uint32_t index);
+
+// Runs job(context, i) for every i in [0, count) on any threads and returns when all have
+// finished (stratmesh::JobRunner, same contract).
+typedef void (*stratmesh_job_runner)(void* user, uint32_t count, stratmesh_job_function job,
+                                     void* context);
+
+// stratmesh::Options, field for field, with uint32_t for the enums so that the layout
+// does not depend on the compiler's enum size. All zero means defaults: `stratmesh_options
+// options = {0};` (or memset) is always valid. Each field is documented at its C++ name.
+typedef struct stratmesh_options {
+    uint32_t axis;                  // stratmesh_axis
+    double direction[3];            // for STRATMESH_AXIS_DIRECTION
+    const double* cuts;             // explicit cut heights, dot(point, axis)
+    size_t cut_count;
+    uint32_t layer_count;           // else equal-height layers
+    double layer_height;            // else layers of about this height; else automatic
+    uint32_t flags;                 // stratmesh_flags bits
+    double origin[3];               // with STRATMESH_FLAG_ORIGIN_GIVEN
+    // Optional: called with each phase as it starts and with the fraction done; must not
+    // call back into stratmesh.
+    void (*progress)(void* user, stratmesh_phase phase, double fraction);
+    void* progress_user;
+    // Optional, reconstruction only: runs the layers' jobs on the caller's threads.
+    stratmesh_job_runner run_jobs;
+    void* jobs_user;
+} stratmesh_options;
+
+// stratmesh::LayerInfo: one layer of the output (stratmesh_layer_counts::info).
+typedef struct stratmesh_layer_info {
+    double bottom, top;       // extent along the axis, as dot(point, axis)
+    double centre[3];         // a point on the unrolling cylinder's axis
+    double radius;            // the unrolling radius
+    uint32_t point_count;     // distinct valid points in the layer
+    uint32_t triangle_count;  // its triangles and its band below, before the safety net
+    uint32_t fold_count;      // of those, triangles facing the axis
+    uint32_t closed_ends;     // stratmesh_closed_end bits
+} stratmesh_layer_info;
+
+// stratmesh::PointCounts: in_count = used_count + duplicate_count + rejected_count +
+// unused_count on every status.
+typedef struct stratmesh_point_counts {
+    size_t in_count;             // points given (the stream: pushed so far)
+    size_t used_count;           // vertices of the output
+    size_t duplicate_count;      // same coordinates as a lower-indexed point
+    size_t rejected_count;       // NaN/Inf (with SKIP_INVALID_POINTS) and outliers
+    size_t outlier_count;        // of rejected_count: left out by DROP_OUTLIERS
+    size_t unused_count;         // valid but not a vertex (detail says why)
+    size_t first_invalid_index;  // on INVALID_POINT: the first NaN/Inf point
+    size_t held_count;           // the stream only: the most points held at once
+} stratmesh_point_counts;
+
+// stratmesh::LayerCounts. The caller points info at info_capacity entries (or leaves it
+// NULL); the first min(used_count, info_capacity) are filled.
+typedef struct stratmesh_layer_counts {
+    size_t planned_count;   // layers planned, before merging
+    size_t used_count;      // layers of the output
+    size_t parallel_count;  // of those, triangulated by run_jobs' jobs
+    stratmesh_layer_info* info;
+    size_t info_capacity;
+} stratmesh_layer_counts;
+
+// stratmesh::CapCounts, with STRATMESH_FLAG_CLOSE_ENDS; all 0 without it.
+typedef struct stratmesh_cap_counts {
+    size_t closed_count;     // boundary loops closed by a cap
+    size_t open_count;       // loops left open
+    size_t triangle_count;   // the caps' triangles, the last of the output
+    size_t wall_flip_count;  // the surface's edges flipped so that a loop could be capped
+} stratmesh_cap_counts;
+
+// stratmesh::PartCounts, flattened: the counts and where the cloud parts (the gap, the
+// cuts and their branch counts of stratmesh::Parting). The per-branch point counts and the
+// per-part details are left to the C++ interface.
+typedef struct stratmesh_part_counts {
+    uint32_t outcome;                 // stratmesh_parts_outcome
+    double gap;                       // Parting::gap: the linking distance
+    double above;                     // the lowest cut above which the cloud parts
+    uint32_t above_branch_count;      // (0: it does not part above any cut)
+    double below;                     // the highest cut below which it parts
+    uint32_t below_branch_count;
+    size_t part_count;                // parts meshed apart (0: one tube)
+    size_t joined_side_count;         // sides whose branches were joined
+    size_t apart_side_count;          // sides left apart
+    size_t grafted_branch_count;      // branches grafted onto the trunk's closed end
+    size_t junction_triangle_count;   // triangles the junctions added
+    size_t removed_triangle_count;    // trunk triangles the grafts took out
+} stratmesh_part_counts;
+
+// stratmesh::Diagnostics: what a user checks before trusting the mesh.
+typedef struct stratmesh_diagnostics {
+    size_t fold_count;             // output triangles whose normal faces the axis
+    size_t illegal_removed_count;  // triangles removed by the manifold safety net
+    size_t diagonal_swap_count;    // band diagonals swapped when stitching layers
+} stratmesh_diagnostics;
+
+// stratmesh::Report, its groups as nested structs, so that C code reads the same counts
+// under the same names. stratmesh_reconstruct fills it on every status, counts adding up,
+// except when it refuses overlapping buffers (INVALID_ARGUMENT: nothing written); the
+// stream fills it when it opens and after every push and close. Set layers.info and
+// layers.info_capacity before the call for per-layer details (all zero: none).
+typedef struct stratmesh_report {
+    size_t triangle_count;
+    double axis[3];                 // unit axis used
+    double axis_origin[3];          // a point on it
+    stratmesh_point_counts points;
+    stratmesh_layer_counts layers;
+    stratmesh_cap_counts caps;
+    stratmesh_part_counts parts;
+    stratmesh_diagnostics diagnostics;
+    const char* detail;             // a static sentence on why something failed or was dropped
+    size_t workspace_used_bytes;    // the least workspace that suffices for this input
+} stratmesh_report;
+
+// Workspace bytes that always suffice for stratmesh_reconstruct of point_count points
+// with these options (NULL: the defaults), and the most triangles it can produce
+// (stratmesh::reconstruct_workspace_size and _max_triangles): bounds, so that a caller
+// sizes its buffers before it has the points; 0 when no buffer can serve that many.
+size_t stratmesh_reconstruct_workspace_size(size_t point_count,
+                                            const stratmesh_options* options);
+size_t stratmesh_reconstruct_max_triangles(size_t point_count,
+                                           const stratmesh_options* options);
+
+// Reconstructs the surface through a columnar cloud (stratmesh::reconstruct): triangles
+// receives 3 * *triangle_count indices into the cloud, counter-clockwise seen from
+// outside. options NULL means the defaults; report may be NULL. A NULL cloud, or a report
+// sharing a byte with the cloud's points, the workspace, the triangles, *triangle_count or
+// the report's layer array, returns STRATMESH_STATUS_INVALID_ARGUMENT and writes nothing;
+// every other status is the C++ function's.
+stratmesh_status stratmesh_reconstruct(const stratmesh_cloud* cloud,
+                                       const stratmesh_options* options, void* workspace,
+                                       size_t workspace_bytes, uint32_t* triangles,
+                                       size_t triangle_capacity, size_t* triangle_count,
+                                       stratmesh_report* report);
+
+// A stream in the caller's workspace (stratmesh::Stream, with the C report it updates):
+// opaque, valid from stratmesh_stream_open until stratmesh_stream_close or until the
+// workspace is reused. Nothing to free.
+typedef struct stratmesh_stream stratmesh_stream;
+
+// Receives the stream's final triangles: 3 * count global indices, valid during the call
+// only (stratmesh::TriangleCallback). Must not call back into the same stream.
+typedef void (*stratmesh_triangle_callback)(void* user, const uint32_t* triangles,
+                                            size_t count);
+
+// Workspace bytes for a stream that holds at most max_points_held points at once
+// (stratmesh::stream_workspace_size, plus the C handle and its report); 0 if beyond what
+// this platform can address.
+size_t stratmesh_stream_workspace_size(size_t max_points_held,
+                                       const stratmesh_options* options);
+
+// Opens a stream in the workspace (stratmesh::stream_open): options (not NULL) as there,
+// emit receives the triangles, report (optional) is updated after every call on the
+// stream and must stay valid until the stream is closed; its workspace_used_bytes counts
+// from the start of this workspace, the handle included. On success *stream is the handle.
+// Returns the C++ statuses; OUT_OF_MEMORY also when the workspace cannot hold the handle.
+stratmesh_status stratmesh_stream_open(const stratmesh_options* options, void* workspace,
+                                       size_t workspace_bytes,
+                                       stratmesh_triangle_callback emit, void* emit_user,
+                                       stratmesh_report* report, stratmesh_stream** stream);
+
+// Pushes the next layer, its points and its top (stratmesh::stream_push); a NULL stream or
+// points returns INVALID_ARGUMENT. May call emit.
+stratmesh_status stratmesh_stream_push(stratmesh_stream* stream,
+                                       const stratmesh_cloud* points, double top);
+
+// Forms and emits the last layers and completes the report (stratmesh::stream_close).
+stratmesh_status stratmesh_stream_close(stratmesh_stream* stream);
+
+#ifdef __cplusplus
+}  // extern "C"
+#endif
+
+#endif  // STRATMESH_C_API
 #endif // STRATMESH_H
 
 // ===========================================================================================
 // ==== Implementation =======================================================================
 // ===========================================================================================
 
-#if defined(STRATMESH_IMPLEMENTATION) && !defined(STRATMESH_IMPLEMENTATION_DONE)
+#if defined(STRATMESH_IMPLEMENTATION) && !defined(__cplusplus)
+#error "the stratmesh implementation is C++17: compile stratmesh.cpp with a C++ compiler and link it; C files include stratmesh.h without STRATMESH_IMPLEMENTATION"
+#elif defined(STRATMESH_IMPLEMENTATION) && !defined(STRATMESH_IMPLEMENTATION_DONE)
 #define STRATMESH_IMPLEMENTATION_DONE
 
 #include <cfloat>
@@ -10822,6 +11170,392 @@ Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
 }
 
 }  // namespace stratmesh
+
+// >>c interface =============================================================================
+//
+// The C functions convert their structs field for field and call the C++ ones; the enum
+// values are asserted equal, so a status, an axis or a flag passes as it is. The layer
+// array is the one exception: stratmesh_layer_info and LayerInfo are asserted to have the
+// same layout, and the caller's array is handed to the C++ report as it is, since a copy
+// would need a second array. Callbacks go through small adapters, because a C function
+// pointer's type is not the C++ one (the C enums in its signature, its language linkage).
+
+#if STRATMESH_C_API
+
+#define STRATMESH_C_SAME(c_value, cpp_value)                                                \
+    static_assert(static_cast<uint32_t>(c_value) == static_cast<uint32_t>(cpp_value),    \
+                  #c_value " differs from " #cpp_value);
+STRATMESH_C_SAME(STRATMESH_STATUS_OK, stratmesh::Status::ok)
+STRATMESH_C_SAME(STRATMESH_STATUS_INVALID_ARGUMENT, stratmesh::Status::invalid_argument)
+STRATMESH_C_SAME(STRATMESH_STATUS_TOO_MANY_POINTS, stratmesh::Status::too_many_points)
+STRATMESH_C_SAME(STRATMESH_STATUS_NOT_COMPILED, stratmesh::Status::not_compiled)
+STRATMESH_C_SAME(STRATMESH_STATUS_INVALID_POINT, stratmesh::Status::invalid_point)
+STRATMESH_C_SAME(STRATMESH_STATUS_TOO_FEW_POINTS, stratmesh::Status::too_few_points)
+STRATMESH_C_SAME(STRATMESH_STATUS_COLLINEAR, stratmesh::Status::collinear)
+STRATMESH_C_SAME(STRATMESH_STATUS_INVALID_AXIS, stratmesh::Status::invalid_axis)
+STRATMESH_C_SAME(STRATMESH_STATUS_INVALID_LAYERS, stratmesh::Status::invalid_layers)
+STRATMESH_C_SAME(STRATMESH_STATUS_FLAT_CLOUD, stratmesh::Status::flat_cloud)
+STRATMESH_C_SAME(STRATMESH_STATUS_NOT_COLUMNAR, stratmesh::Status::not_columnar)
+STRATMESH_C_SAME(STRATMESH_STATUS_DEGENERATE, stratmesh::Status::degenerate)
+STRATMESH_C_SAME(STRATMESH_STATUS_OUT_OF_ORDER, stratmesh::Status::out_of_order)
+STRATMESH_C_SAME(STRATMESH_STATUS_OUT_OF_MEMORY, stratmesh::Status::out_of_memory)
+STRATMESH_C_SAME(STRATMESH_STATUS_TRIANGLE_CAPACITY, stratmesh::Status::triangle_capacity)
+STRATMESH_C_SAME(STRATMESH_STATUS_INTERNAL_ERROR, stratmesh::Status::internal_error)
+STRATMESH_C_SAME(STRATMESH_SCALAR_FLOAT64, stratmesh::Scalar::float64)
+STRATMESH_C_SAME(STRATMESH_SCALAR_FLOAT32, stratmesh::Scalar::float32)
+STRATMESH_C_SAME(STRATMESH_AXIS_AUTOMATIC, stratmesh::Axis::automatic)
+STRATMESH_C_SAME(STRATMESH_AXIS_X, stratmesh::Axis::x)
+STRATMESH_C_SAME(STRATMESH_AXIS_Y, stratmesh::Axis::y)
+STRATMESH_C_SAME(STRATMESH_AXIS_Z, stratmesh::Axis::z)
+STRATMESH_C_SAME(STRATMESH_AXIS_DIRECTION, stratmesh::Axis::direction)
+STRATMESH_C_SAME(STRATMESH_FLAG_SKIP_INVALID_POINTS, stratmesh::skip_invalid_points)
+STRATMESH_C_SAME(STRATMESH_FLAG_CLOSE_ENDS, stratmesh::close_ends)
+STRATMESH_C_SAME(STRATMESH_FLAG_ORIGIN_GIVEN, stratmesh::origin_given)
+STRATMESH_C_SAME(STRATMESH_FLAG_DROP_OUTLIERS, stratmesh::drop_outliers)
+STRATMESH_C_SAME(STRATMESH_FLAG_SURFACE_FLIPS, stratmesh::surface_flips)
+STRATMESH_C_SAME(STRATMESH_FLAG_OPEN_ENDS, stratmesh::open_ends)
+STRATMESH_C_SAME(STRATMESH_FLAG_ONE_TUBE, stratmesh::one_tube)
+STRATMESH_C_SAME(STRATMESH_FLAG_KEEP_PARTS, stratmesh::keep_parts)
+STRATMESH_C_SAME(STRATMESH_CLOSED_BOTTOM, stratmesh::closed_bottom)
+STRATMESH_C_SAME(STRATMESH_CLOSED_TOP, stratmesh::closed_top)
+STRATMESH_C_SAME(STRATMESH_PHASE_VALIDATE, stratmesh::Phase::validate)
+STRATMESH_C_SAME(STRATMESH_PHASE_LAYERS, stratmesh::Phase::layers)
+STRATMESH_C_SAME(STRATMESH_PHASE_TRIANGULATE, stratmesh::Phase::triangulate)
+STRATMESH_C_SAME(STRATMESH_PHASE_STITCH, stratmesh::Phase::stitch)
+STRATMESH_C_SAME(STRATMESH_PHASE_MANIFOLD, stratmesh::Phase::manifold)
+STRATMESH_C_SAME(STRATMESH_PHASE_DONE, stratmesh::Phase::done)
+STRATMESH_C_SAME(STRATMESH_PARTS_ONE_TUBE, stratmesh::PartsOutcome::one_tube)
+STRATMESH_C_SAME(STRATMESH_PARTS_JOINED, stratmesh::PartsOutcome::joined)
+STRATMESH_C_SAME(STRATMESH_PARTS_KEPT_APART, stratmesh::PartsOutcome::kept_apart)
+STRATMESH_C_SAME(STRATMESH_PARTS_UNDONE, stratmesh::PartsOutcome::undone)
+#undef STRATMESH_C_SAME
+
+// A status added to the list needs its C constant too.
+#define STRATMESH_C_COUNT(name, message) +1
+static_assert(0 STRATMESH_STATUS_LIST(STRATMESH_C_COUNT) == STRATMESH_STATUS_INTERNAL_ERROR + 1,
+              "stratmesh_status needs one constant per stratmesh::Status");
+#undef STRATMESH_C_COUNT
+
+// The layer array is shared, not copied: the same fields at the same places.
+#define STRATMESH_C_FIELD(field)                                                            \
+    static_assert(offsetof(stratmesh_layer_info, field) == offsetof(stratmesh::LayerInfo, field), \
+                  "stratmesh_layer_info::" #field " is not where LayerInfo has it");
+STRATMESH_C_FIELD(bottom)
+STRATMESH_C_FIELD(top)
+STRATMESH_C_FIELD(centre)
+STRATMESH_C_FIELD(radius)
+STRATMESH_C_FIELD(point_count)
+STRATMESH_C_FIELD(triangle_count)
+STRATMESH_C_FIELD(fold_count)
+STRATMESH_C_FIELD(closed_ends)
+#undef STRATMESH_C_FIELD
+static_assert(sizeof(stratmesh_layer_info) == sizeof(stratmesh::LayerInfo) &&
+                  alignof(stratmesh_layer_info) == alignof(stratmesh::LayerInfo),
+              "stratmesh_layer_info and LayerInfo differ in size or alignment");
+
+// The C stream: the C++ stream's report and the C callback, at the first aligned address
+// of the caller's workspace; the C++ stream takes the rest.
+struct stratmesh_stream {
+    stratmesh::Stream* stream;
+    stratmesh::Report report;          // the C++ stream's, converted after every call
+    stratmesh_report* user_report;
+    stratmesh_triangle_callback emit;
+    void* emit_user;
+    size_t prefix;                     // bytes of the caller's workspace before the C++ one
+};
+
+namespace stratmesh {
+namespace detail {
+
+// A batch of jobs as the C runner sees it: the C++ job and its context.
+struct CJobBatch {
+    JobFunction job;
+    void* context;
+};
+
+extern "C" {
+static void c_run_job(void* batch, uint32_t index) {
+    const CJobBatch* b = static_cast<const CJobBatch*>(batch);
+    b->job(b->context, index);
+}
+}
+
+// The adapters' user pointer is the caller's stratmesh_options, alive during the call.
+inline void c_progress(void* user, Phase phase, double fraction) {
+    const stratmesh_options* c = static_cast<const stratmesh_options*>(user);
+    c->progress(c->progress_user, static_cast<stratmesh_phase>(phase), fraction);
+}
+
+inline void c_run_jobs(void* user, uint32_t count, JobFunction job, void* context) {
+    const stratmesh_options* c = static_cast<const stratmesh_options*>(user);
+    CJobBatch batch = {job, context};
+    c->run_jobs(c->jobs_user, count, c_run_job, &batch);
+}
+
+inline void c_emit(void* user, const uint32_t* triangles, size_t count) {
+    const stratmesh_stream* s = static_cast<const stratmesh_stream*>(user);
+    s->emit(s->emit_user, triangles, count);
+}
+
+inline Options c_options(const stratmesh_options* c) {
+    Options o;
+    std::memset(&o, 0, sizeof o);
+    if (!c) return o;
+    o.axis = static_cast<Axis>(c->axis);
+    o.cuts = c->cuts;
+    o.cut_count = c->cut_count;
+    o.layer_count = c->layer_count;
+    o.layer_height = c->layer_height;
+    o.flags = c->flags;
+    for (int i = 0; i < 3; ++i) {
+        o.direction[i] = c->direction[i];
+        o.origin[i] = c->origin[i];
+    }
+    void* user = const_cast<stratmesh_options*>(c);
+    if (c->progress) {
+        o.progress = c_progress;
+        o.progress_user = user;
+    }
+    if (c->run_jobs) {
+        o.run_jobs = c_run_jobs;
+        o.jobs_user = user;
+    }
+    return o;
+}
+
+inline Cloud c_cloud(const stratmesh_cloud& c) {
+    return Cloud{c.xyz, c.count, c.stride_bytes, static_cast<Scalar>(c.scalar)};
+}
+
+// The C++ report into the C one; the layer array is the caller's already.
+inline void c_report(const Report& r, stratmesh_report& c) {
+    c.triangle_count = r.triangle_count;
+    for (int i = 0; i < 3; ++i) {
+        c.axis[i] = r.axis[i];
+        c.axis_origin[i] = r.axis_origin[i];
+    }
+    c.points.in_count = r.points.in_count;
+    c.points.used_count = r.points.used_count;
+    c.points.duplicate_count = r.points.duplicate_count;
+    c.points.rejected_count = r.points.rejected_count;
+    c.points.outlier_count = r.points.outlier_count;
+    c.points.unused_count = r.points.unused_count;
+    c.points.first_invalid_index = r.points.first_invalid_index;
+    c.points.held_count = r.points.held_count;
+    c.layers.planned_count = r.layers.planned_count;
+    c.layers.used_count = r.layers.used_count;
+    c.layers.parallel_count = r.layers.parallel_count;
+    c.caps.closed_count = r.caps.closed_count;
+    c.caps.open_count = r.caps.open_count;
+    c.caps.triangle_count = r.caps.triangle_count;
+    c.caps.wall_flip_count = r.caps.wall_flip_count;
+    c.parts.outcome = static_cast<uint32_t>(r.parts.outcome);
+    c.parts.gap = r.parts.parting.gap;
+    c.parts.above = r.parts.parting.above;
+    c.parts.above_branch_count = r.parts.parting.above_branch_count;
+    c.parts.below = r.parts.parting.below;
+    c.parts.below_branch_count = r.parts.parting.below_branch_count;
+    c.parts.part_count = r.parts.part_count;
+    c.parts.joined_side_count = r.parts.joined_side_count;
+    c.parts.apart_side_count = r.parts.apart_side_count;
+    c.parts.grafted_branch_count = r.parts.grafted_branch_count;
+    c.parts.junction_triangle_count = r.parts.junction_triangle_count;
+    c.parts.removed_triangle_count = r.parts.removed_triangle_count;
+    c.diagnostics.fold_count = r.diagnostics.fold_count;
+    c.diagnostics.illegal_removed_count = r.diagnostics.illegal_removed_count;
+    c.diagnostics.diagonal_swap_count = r.diagnostics.diagonal_swap_count;
+    c.detail = r.detail;
+    c.workspace_used_bytes = r.workspace_used_bytes;
+}
+
+// A C++ report that writes the layers into the C report's array.
+inline void c_report_start(Report& r, const stratmesh_report* c) {
+    std::memset(&r, 0, sizeof r);
+    if (!c || !c->layers.info) return;
+    r.layers.info = reinterpret_cast<LayerInfo*>(c->layers.info);
+    r.layers.info_capacity = c->layers.info_capacity;
+}
+
+// The stream's C report, its workspace counted from the start of the caller's buffer.
+inline void c_stream_report(const stratmesh_stream& s) {
+    if (!s.user_report) return;
+    c_report(s.report, *s.user_report);
+    s.user_report->workspace_used_bytes += s.prefix;
+}
+
+inline ByteRange c_report_bytes(const stratmesh_report* c) {
+    return byte_range(c, sizeof *c);
+}
+
+inline ByteRange c_layer_bytes(const stratmesh_report* c) {
+    return c ? byte_range(c->layers.info, saturating_product(c->layers.info_capacity,
+                                                             sizeof(stratmesh_layer_info)))
+             : ByteRange{0, 0};
+}
+
+}  // namespace detail
+}  // namespace stratmesh
+
+const char* stratmesh_status_string(stratmesh_status status) {
+    return stratmesh::status_string(static_cast<stratmesh::Status>(status));
+}
+
+double stratmesh_orient2d(const double a[2], const double b[2], const double c[2]) {
+    return stratmesh::orient2d(a, b, c);
+}
+
+double stratmesh_incircle(const double a[2], const double b[2], const double c[2],
+                          const double d[2]) {
+    return stratmesh::incircle(a, b, c, d);
+}
+
+size_t stratmesh_delaunay_2d_workspace_size(size_t point_count) {
+    return stratmesh::delaunay_2d_workspace_size(point_count);
+}
+
+size_t stratmesh_delaunay_2d_max_triangles(size_t point_count) {
+    return stratmesh::delaunay_2d_max_triangles(point_count);
+}
+
+stratmesh_status stratmesh_delaunay_2d(const double* xy, size_t point_count,
+                                       size_t stride_bytes, void* workspace,
+                                       size_t workspace_bytes, uint32_t* triangles,
+                                       size_t triangle_capacity,
+                                       stratmesh_delaunay_2d_info* info,
+                                       uint32_t* duplicate_of) {
+    static_assert(sizeof(stratmesh_delaunay_2d_info) == sizeof(stratmesh::Delaunay2dInfo), "");
+    stratmesh::Delaunay2dInfo cpp_info;
+    std::memset(&cpp_info, 0, sizeof cpp_info);
+    // The C++ info is on the stack: the C one is checked against the buffers here.
+    if (info) {
+        const size_t point_bytes = 2 * sizeof(double);
+        const stratmesh::detail::ByteRange ranges[] = {
+            stratmesh::detail::byte_range(info, sizeof *info),
+            stratmesh::detail::strided_range(xy, point_count,
+                                             stride_bytes < point_bytes ? point_bytes : stride_bytes,
+                                             point_bytes),
+            stratmesh::detail::byte_range(workspace, workspace_bytes),
+            stratmesh::detail::byte_range(
+                triangles, stratmesh::detail::saturating_product(triangle_capacity, 3 * sizeof(uint32_t))),
+            stratmesh::detail::byte_range(
+                duplicate_of, stratmesh::detail::saturating_product(point_count, sizeof(uint32_t)))};
+        if (stratmesh::detail::any_overlap(ranges, 5)) return STRATMESH_STATUS_INVALID_ARGUMENT;
+    }
+    const stratmesh::Status status =
+        stratmesh::delaunay_2d(xy, point_count, stride_bytes, workspace, workspace_bytes,
+                               triangles, triangle_capacity, info ? &cpp_info : nullptr,
+                               duplicate_of);
+    if (info) {
+        info->triangle_count = cpp_info.triangle_count;
+        info->duplicate_count = cpp_info.duplicate_count;
+        info->hull_vertex_count = cpp_info.hull_vertex_count;
+        info->first_invalid_index = cpp_info.first_invalid_index;
+        info->workspace_used_bytes = cpp_info.workspace_used_bytes;
+    }
+    return static_cast<stratmesh_status>(status);
+}
+
+size_t stratmesh_reconstruct_workspace_size(size_t point_count,
+                                            const stratmesh_options* options) {
+    return stratmesh::reconstruct_workspace_size(point_count,
+                                                 stratmesh::detail::c_options(options));
+}
+
+size_t stratmesh_reconstruct_max_triangles(size_t point_count,
+                                           const stratmesh_options* options) {
+    return stratmesh::reconstruct_max_triangles(point_count,
+                                                stratmesh::detail::c_options(options));
+}
+
+stratmesh_status stratmesh_reconstruct(const stratmesh_cloud* cloud,
+                                       const stratmesh_options* options, void* workspace,
+                                       size_t workspace_bytes, uint32_t* triangles,
+                                       size_t triangle_capacity, size_t* triangle_count,
+                                       stratmesh_report* report) {
+    namespace detail = stratmesh::detail;
+    if (!cloud) return STRATMESH_STATUS_INVALID_ARGUMENT;
+    const stratmesh::Cloud points = detail::c_cloud(*cloud);
+    // The C++ report is on the stack: the C one is checked against the buffers here, as
+    // reconstruct() checks its own (and not when the count is refused first).
+    if (report && points.count <= detail::kMaxPoints - 1) {
+        const detail::ByteRange ranges[] = {
+            detail::c_report_bytes(report),
+            detail::cloud_bytes(points),
+            detail::byte_range(workspace, workspace_bytes),
+            detail::byte_range(triangles, detail::saturating_product(triangle_capacity,
+                                                                     3 * sizeof(uint32_t))),
+            detail::byte_range(triangle_count, sizeof(size_t)),
+            detail::c_layer_bytes(report)};
+        if (detail::any_overlap(ranges, 6)) return STRATMESH_STATUS_INVALID_ARGUMENT;
+    }
+    stratmesh::Report rep;
+    detail::c_report_start(rep, report);
+    const stratmesh::Status status =
+        stratmesh::reconstruct(points, detail::c_options(options), workspace, workspace_bytes,
+                               triangles, triangle_capacity, triangle_count,
+                               report ? &rep : nullptr);
+    if (report) detail::c_report(rep, *report);
+    return static_cast<stratmesh_status>(status);
+}
+
+size_t stratmesh_stream_workspace_size(size_t max_points_held,
+                                       const stratmesh_options* options) {
+    const size_t bytes = stratmesh::stream_workspace_size(max_points_held,
+                                                          stratmesh::detail::c_options(options));
+    const size_t handle = sizeof(stratmesh_stream) + alignof(stratmesh_stream) - 1;
+    return bytes == 0 || bytes > SIZE_MAX - handle ? 0 : bytes + handle;
+}
+
+stratmesh_status stratmesh_stream_open(const stratmesh_options* options, void* workspace,
+                                       size_t workspace_bytes,
+                                       stratmesh_triangle_callback emit, void* emit_user,
+                                       stratmesh_report* report, stratmesh_stream** stream) {
+    namespace detail = stratmesh::detail;
+    if (!options || !workspace || !emit || !stream) return STRATMESH_STATUS_INVALID_ARGUMENT;
+    *stream = nullptr;
+    if (report) {
+        const detail::ByteRange ranges[] = {detail::byte_range(workspace, workspace_bytes),
+                                            detail::c_report_bytes(report),
+                                            detail::c_layer_bytes(report)};
+        if (detail::any_overlap(ranges, 3)) return STRATMESH_STATUS_INVALID_ARGUMENT;
+    }
+    const size_t align = alignof(stratmesh_stream);
+    const size_t pad = (align - reinterpret_cast<uintptr_t>(workspace) % align) % align;
+    if (workspace_bytes < pad + sizeof(stratmesh_stream)) return STRATMESH_STATUS_OUT_OF_MEMORY;
+    unsigned char* bytes = static_cast<unsigned char*>(workspace) + pad;
+    stratmesh_stream* s = reinterpret_cast<stratmesh_stream*>(bytes);
+    std::memset(static_cast<void*>(s), 0, sizeof *s);
+    s->user_report = report;
+    s->emit = emit;
+    s->emit_user = emit_user;
+    detail::c_report_start(s->report, report);
+    const stratmesh::Status status = stratmesh::stream_open(
+        detail::c_options(options), bytes + sizeof *s, workspace_bytes - pad - sizeof *s,
+        detail::c_emit, s, report ? &s->report : nullptr, &s->stream);
+    if (status != stratmesh::Status::ok) return static_cast<stratmesh_status>(status);
+    s->prefix = pad + sizeof *s;
+    detail::c_stream_report(*s);
+    *stream = s;
+    return STRATMESH_STATUS_OK;
+}
+
+stratmesh_status stratmesh_stream_push(stratmesh_stream* stream,
+                                       const stratmesh_cloud* points, double top) {
+    if (!stream || !points) return STRATMESH_STATUS_INVALID_ARGUMENT;
+    const stratmesh::Status status =
+        stratmesh::stream_push(stream->stream, stratmesh::detail::c_cloud(*points), top);
+    stratmesh::detail::c_stream_report(*stream);
+    return static_cast<stratmesh_status>(status);
+}
+
+stratmesh_status stratmesh_stream_close(stratmesh_stream* stream) {
+    if (!stream) return STRATMESH_STATUS_INVALID_ARGUMENT;
+    const stratmesh::Status status = stratmesh::stream_close(stream->stream);
+    stratmesh::detail::c_stream_report(*stream);
+    return static_cast<stratmesh_status>(status);
+}
+
+#endif  // STRATMESH_C_API
 
 #undef STRATMESH_SMALL_NOINLINE
 #undef STRATMESH_FAST_NOINLINE

@@ -726,9 +726,11 @@ Status reconstruct(const Cloud& cloud, const Options& options,
 //
 // Memory: stream_workspace_size(max_points_held) bytes, about 190 per point held. The
 // stream holds the last layer's top loop, the layer being formed (pushes that join it
-// included) and the pushes after it until they can form a layer: when every push is at
-// least 16 points and 1.5 rows of points thick and none is a crescent, three times the
-// largest push suffices.
+// included) and the pushes after it until they can form a layer. A layer that folds waits
+// for the two pushes after it (it may join them), so when every push is at least 16 points
+// and 1.5 rows of points thick and none is a crescent, it holds at most a loop and three
+// pushes: four times the largest push always suffices, and three times plus the largest
+// loop (a small share of a layer) in practice.
 // A push that would hold more returns out_of_memory and changes nothing; Report::points.held_count
 // says what a run needed.
 
@@ -1289,6 +1291,30 @@ stratmesh_status stratmesh_stream_close(stratmesh_stream* stream);
 // ===========================================================================================
 // ==== Implementation =======================================================================
 // ===========================================================================================
+//
+// Sections in the order the data flows; search for ">>name" to jump to one.
+//
+//   >>config             build switches: what STRATMESH_SMALL_CODE leaves out
+//   >>arena              the bump allocator over the caller's workspace
+//   >>predicates         orient2d and incircle: filter, integer and expansion stages
+//   >>spatial sort       the insertion order of the Delaunay triangulation
+//   >>delaunay           the incremental 2D Delaunay triangulation (delaunay_2d)
+//   >>layers             the frame, the outliers, grouping by layer, automatic layers
+//   >>unroll             a layer onto its annulus (cylinder and closed ends)
+//   >>layer triangulation  one layer: its triangulation, closed ends, the centre search,
+//                        flips on the surface
+//   >>stitch             the band between two layers' loops
+//   >>manifold           the safety net that keeps the surface a manifold
+//   >>caps               closing a boundary loop: pockets, lowered caps, fins
+//   >>reconstruct        one tube: chunks of layers, seam flips, parallel layers
+//   >>stream             the same surface, layer by layer, in bounded memory
+//   >>axis               the automatic axis
+//   >>cap ends           cap_ends() for a surface the caller holds
+//   >>parting            find_parting(): where the cloud parts into branches
+//   >>join branches      join_branches(): zips and grafts
+//   >>parts              reconstruct()'s default: trunk and branches, meshed and joined
+//   >>reconstruct entry  reconstruct() in its steps: validate, axis, parts or one tube
+//   >>c interface        the C functions over the C++ ones
 
 #if defined(STRATMESH_IMPLEMENTATION) && !defined(__cplusplus)
 #error "the stratmesh implementation is C++17: compile stratmesh.cpp with a C++ compiler and link it; C files include stratmesh.h without STRATMESH_IMPLEMENTATION"

@@ -955,7 +955,7 @@ void run_stream(const LayeredCloud& cloud, const stratmesh::Options& options,
     out.seconds = seconds_between(start, Clock::now());
 }
 
-// Times the stream (workspace for 3 times the largest layer, as the header documents) and
+// Times the stream (workspace for 4 times the largest layer, as the header documents) and
 // reconstruct() with the same cuts and origin on the regrouped cloud, alternately, and
 // compares their triangles.
 Result measure_stream(const std::string& name, const std::vector<double>& coords,
@@ -968,7 +968,7 @@ Result measure_stream(const std::string& name, const std::vector<double>& coords
     options.axis = stratmesh::Axis::z;
     options.flags = stratmesh::origin_given;
     for (size_t k = 0; k < 3; ++k) options.origin[k] = layered.xyz[k];
-    size_t stream_bytes = stratmesh::stream_workspace_size(largest * 3, options);
+    size_t stream_bytes = stratmesh::stream_workspace_size(largest * 4, options);
     stratmesh::Options batch = options;
     batch.cuts = layered.cuts.data();
     batch.cut_count = layered.cuts.size();
@@ -1263,7 +1263,7 @@ void print_help(std::FILE* out) {
         "stream (case stream-tube-4e6: 100 equal layers along z):\n"
         "  stream_seconds, reconstruct_seconds   medians of the stream pushed layer by\n"
         "                            layer and of reconstruct with the same cuts and origin\n"
-        "  stream_workspace_bytes    stream_workspace_size(3 x largest_push)\n"
+        "  stream_workspace_bytes    stream_workspace_size(4 x largest_push)\n"
         "  reconstruct_workspace_bytes, workspace_ratio (reconstruct / stream)\n"
         "  stream_workspace_used, reconstruct_workspace_used, workspace_used_ratio\n"
         "                            Report::workspace_used_bytes of each\n"

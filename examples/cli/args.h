@@ -2,6 +2,7 @@
 #ifndef STRATMESH_CLI_ARGS_H
 #define STRATMESH_CLI_ARGS_H
 
+#include "mesh_io.h"
 #include "safe_output.h"
 #include "stratmesh.h"
 
@@ -12,8 +13,10 @@
 namespace stratmesh_cli {
 
 struct CommandLine {
-    std::string input;
-    std::string output;
+    std::string input;  // "-": standard input
+    std::string output; // "-": standard output
+    // From --format, else from the output's extension (--format is required with -o -).
+    MeshFormat output_format = MeshFormat::unknown;
     std::string report; // --report, empty if not given
     stratmesh::Axis axis = stratmesh::Axis::automatic;
     double direction[3] = {0, 0, 0}; // with Axis::direction
@@ -32,7 +35,9 @@ struct CommandLine {
     bool find_branches = false;    // --branches: only find and report where it parts
     bool split_branches = false;   // --split-branches: keep the parts, joined or apart
     bool one_tube = false;         // --one-tube: do not look; one tube through every point
-    bool quiet = false;
+    bool quiet = false;             // no summary (warnings and errors still)
+    bool verbose = false;           // --verbose: timings, memory and details in the summary
+    bool strict = false;            // --strict: warnings give an exit status of their own
     uint32_t threads = 1;           // --threads (default: the hardware's threads, at least 1)
     bool stream = false;            // --stream: read and reconstruct layer by layer
     uint64_t stream_points = 3000000; // --stream-points: the most points the stream holds

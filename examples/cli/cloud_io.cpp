@@ -2,6 +2,7 @@
 
 #include "cloud_readers.h"
 #include "path_util.h"
+#include "safe_output.h"
 #include "text_scan.h"
 
 #include <cerrno>
@@ -62,6 +63,7 @@ bool dispatch(std::string_view data, CloudFormat format, std::vector<double>& xy
 // The file's size as the file system reports it, to allocate the buffer once; 0 if
 // unknown. Only a hint: reading stops at the real end whatever it says.
 size_t size_hint(const std::string& path) {
+    if (path == kStandardStream) return 0;
     std::error_code error;
     uintmax_t size = std::filesystem::file_size(path, error);
     return error || size > SIZE_MAX / 2 ? 0 : static_cast<size_t>(size);
@@ -116,7 +118,8 @@ bool read_cloud_from_memory(const char* data, size_t size, CloudFormat format,
 
 bool read_file_bytes(const std::string& path, BigBuffer& bytes, size_t& size, std::string& error) {
     size = 0;
-    std::FILE* file = std::fopen(path.c_str(), "rb");
+    const bool standard_input = path == kStandardStream;
+    std::FILE* file = standard_input ? stdin : std::fopen(path.c_str(), "rb");
     if (!file) {
         error = "cannot open: " + std::string(std::strerror(errno));
         return false;
@@ -135,7 +138,7 @@ bool read_file_bytes(const std::string& path, BigBuffer& bytes, size_t& size, st
     }
     failed = failed || std::ferror(file) != 0;
     const int failure = errno;
-    std::fclose(file);
+    if (!standard_input) std::fclose(file);
     if (!failed) return true;
     error = "cannot read: " + std::string(std::strerror(failure));
     return false;
@@ -148,15 +151,19 @@ bool read_cloud_file(const std::string& path, std::vector<double>& xyz, std::str
     bool ok = read_file_bytes(path, bytes, size, error) &&
               read_cloud_from_memory(bytes.data(), size, CloudFormat::automatic, xyz, error,
                                      info);
-    if (!ok) error = path + ": " + error;
+    if (!ok) error = display_name(path) + ": " + error;
     return ok;
+}
+
+std::string display_name(const std::string& path) {
+    return path == kStandardStream ? "standard input" : path;
 }
 
 std::unique_ptr<PointReader> open_point_reader(const std::string& path, CloudInfo& info,
                                                std::string& error) {
     // Enough to detect any format (detect_cloud_format looks at 200 lines at most).
     const size_t kDetectBytes = 1 << 16;
-    std::FILE* opened = std::fopen(path.c_str(), "rb");
+    std::FILE* opened = path == kStandardStream ? stdin : std::fopen(path.c_str(), "rb");
     if (!opened) {
         error = path + ": cannot open: " + std::strerror(errno);
         return nullptr;
@@ -179,7 +186,8 @@ std::unique_ptr<PointReader> open_point_reader(const std::string& path, CloudInf
         // ("1 2 3"), an OBJ vertex two characters more ("v 1 2 3"), and a line end but on
         // the last line.
         std::error_code failed;
-        const bool regular = std::filesystem::is_regular_file(path, failed);
+        const bool regular =
+            path != kStandardStream && std::filesystem::is_regular_file(path, failed);
         const uintmax_t bytes = regular ? std::filesystem::file_size(path, failed) : 0;
         if (regular && !failed)
             info.point_limit = bytes / (info.format == CloudFormat::obj ? 8 : 6) + 1;
@@ -187,7 +195,7 @@ std::unique_ptr<PointReader> open_point_reader(const std::string& path, CloudInf
             file->skip(kByteOrderMark.size());
         reader = open_text_points(std::move(file), info.format == CloudFormat::obj);
     }
-    if (!reader) error = path + ": " + error;
+    if (!reader) error = display_name(path) + ": " + error;
     return reader;
 }
 

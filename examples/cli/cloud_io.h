@@ -58,10 +58,13 @@ bool read_cloud_from_memory(const char* data, size_t size, CloudFormat format,
                             std::vector<double>& xyz, std::string& error,
                             CloudInfo* info = nullptr);
 
-// Reads a whole file into `bytes` (its pages faulted in at once, big_buffer.h), its length
-// into `size`: one request for a regular file whose size does not change, a buffer doubling
-// as the bytes arrive otherwise.
+// Reads a whole file ("-": standard input) into `bytes` (its pages faulted in at once,
+// big_buffer.h), its length into `size`: one request for a regular file whose size does
+// not change, a buffer doubling as the bytes arrive otherwise.
 bool read_file_bytes(const std::string& path, BigBuffer& bytes, size_t& size, std::string& error);
+
+// How messages name an input: "standard input" for "-", else the path.
+std::string display_name(const std::string& path);
 
 // read_file_bytes + read_cloud_from_memory with the format detected from the content (the
 // content wins over a misleading extension). Errors start with the path.
@@ -83,8 +86,8 @@ public:
     virtual uint64_t faces_ignored() const { return 0; }
 };
 
-// Opens `path` for reading point by point, with the format detected from its first
-// block; null with `error` (starting with the path) if it cannot.
+// Opens `path` ("-": standard input) for reading point by point, with the format detected
+// from its first block; null with `error` (starting with the path) if it cannot.
 std::unique_ptr<PointReader> open_point_reader(const std::string& path, CloudInfo& info,
                                                std::string& error);
 

@@ -23,7 +23,8 @@ const char kUsage[] =
     "\n"
     "Input, recognised by its content (the extension is only a hint):\n"
     "  PLY      ascii, binary_little_endian or binary_big_endian; x, y, z of the vertex\n"
-    "           element (float, double or an integer type); everything else is skipped\n"
+    "           element (float, double or an integer type); its other scalar properties\n"
+    "           go to the output (see --no-attributes); everything else is skipped\n"
     "  XYZ      .xyz .pts .txt .csv: 3 or more numeric columns separated by spaces, tabs\n"
     "           or commas; '#' and '//' comments; a PTS count line is skipped\n"
     "  OFF, OBJ their vertices; faces are ignored (with a warning that counts them)\n"
@@ -53,6 +54,12 @@ const char kUsage[] =
     "                        them the layers are chosen automatically)\n"
     "  --report FILE.json    write counts, timings, memory and per-layer details as JSON\n"
     "  --ascii               text PLY or STL\n"
+    "  --no-attributes       write only the points' coordinates: without it, the other\n"
+    "                        vertex properties of a PLY input (normals, colours,\n"
+    "                        intensity, any scalar; not lists) go with each vertex,\n"
+    "                        unchanged into a PLY output (same names, types and values),\n"
+    "                        the normals (vn) and colours (v x y z r g b, 0 to 1) into\n"
+    "                        OBJ; OFF, STL and --stream carry none\n"
     "  --skip-invalid        skip points with NaN or infinite coordinates (they stay in\n"
     "                        the output, unused) instead of refusing the input\n"
     "  --drop-outliers       leave out points far from the rest of the cloud (stray\n"
@@ -257,6 +264,7 @@ bool apply_valued(std::string_view name, std::string_view value, CommandLine& li
 
 bool apply_flag(std::string_view name, CommandLine& line) {
     if (name == "--ascii") line.ascii = true;
+    if (name == "--no-attributes") line.no_attributes = true;
     if (name == "--skip-invalid") line.skip_invalid = true;
     if (name == "--cap") line.cap = true;
     if (name == "--drop-outliers") line.drop_outliers = true;
@@ -279,7 +287,8 @@ const char* const kValuedOptions[] = {"--output",  "--report",        "--axis",
 const char* const kFlags[] = {"--ascii", "--skip-invalid", "--cap",     "--quiet",
                               "--help",  "--version",      "--stream", "--drop-outliers",
                               "--surface-flips", "--open-ends", "--branches",
-                              "--split-branches", "--one-tube", "--verbose", "--strict"};
+                              "--split-branches", "--one-tube", "--verbose", "--strict",
+                              "--no-attributes"};
 
 // What --stream cannot do, or an empty string.
 std::string stream_conflict(const CommandLine& line) {

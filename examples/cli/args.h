@@ -24,6 +24,7 @@ struct CommandLine {
     uint32_t layer_count = 0;        // --layers, 0 if not given
     double layer_height = 0;         // --layer-height, 0 if not given
     bool ascii = false;
+    bool no_attributes = false;    // --no-attributes: write the points' coordinates only
     bool skip_invalid = false;
     bool cap = false;              // --cap: close the ends (stratmesh::close_ends)
     bool drop_outliers = false;    // --drop-outliers (stratmesh::drop_outliers)

@@ -46,12 +46,13 @@ CloudFormat detect_text_format(std::string_view text) {
 }
 
 bool dispatch(std::string_view data, CloudFormat format, std::vector<double>& xyz,
-              std::string& error, std::string& encoding, uint64_t& faces) {
+              std::string& error, std::string& encoding, uint64_t& faces,
+              PointAttributes* attributes) {
     encoding = "text";
     faces = 0;
     const std::string_view text = skip_byte_order_mark(data);
     switch (format) {
-    case CloudFormat::ply: return read_ply(data, xyz, error, encoding, faces);
+    case CloudFormat::ply: return read_ply(data, xyz, error, encoding, faces, attributes);
     case CloudFormat::off: return read_off(text, xyz, error, faces);
     case CloudFormat::obj: return read_obj(text, xyz, error, faces);
     case CloudFormat::xyz:
@@ -70,6 +71,34 @@ size_t size_hint(const std::string& path) {
 }
 
 } // namespace
+
+int PointAttributes::find(const std::string& name) const {
+    for (size_t k = 0; k < properties.size(); ++k)
+        if (properties[k].name == name) return static_cast<int>(k);
+    return -1;
+}
+
+double PointAttributes::value(size_t point, size_t property) const {
+    const Property& p = properties[property];
+    const unsigned char* at = bytes.data() + point * record_bytes + p.offset;
+    uint64_t bits = 0;
+    for (size_t i = 0; i < p.size; ++i) bits |= uint64_t{at[i]} << (8 * i);
+    if (!p.integral) {
+        if (p.size == 4) {
+            const uint32_t narrow = static_cast<uint32_t>(bits);
+            float f = 0;
+            std::memcpy(&f, &narrow, sizeof f);
+            return static_cast<double>(f);
+        }
+        double d = 0;
+        std::memcpy(&d, &bits, sizeof d);
+        return d;
+    }
+    const unsigned shift = static_cast<unsigned>(64 - 8 * p.size);
+    if (p.is_signed) // sign-extended from its top bit
+        return static_cast<double>(static_cast<int64_t>(bits << shift) >> shift);
+    return static_cast<double>(bits);
+}
 
 const char* cloud_format_name(CloudFormat format) {
     switch (format) {
@@ -107,7 +136,9 @@ bool read_cloud_from_memory(const char* data, size_t size, CloudFormat format,
     if (format == CloudFormat::automatic) format = detect_cloud_format(data, size);
     std::string encoding;
     uint64_t faces = 0;
-    bool ok = dispatch(std::string_view(data, size), format, xyz, error, encoding, faces);
+    PointAttributes* attributes = info && info->keep_attributes ? &info->attributes : nullptr;
+    bool ok = dispatch(std::string_view(data, size), format, xyz, error, encoding, faces,
+                       attributes);
     if (info) {
         info->format = format;
         info->encoding = encoding;

@@ -40,6 +40,29 @@ CloudFormat cloud_format_from_extension(const std::string& path);
 // else is taken for numeric columns (XYZ).
 CloudFormat detect_cloud_format(const char* data, size_t size);
 
+// The input's per-point data besides x, y, z: a PLY vertex element's other scalar
+// properties (normals, colours, intensity, any scalar), kept as their raw bytes so that the
+// writers carry them over unchanged. List properties are not kept.
+struct PointAttributes {
+    struct Property {
+        std::string name;
+        std::string type;   // the PLY type name ("uchar", "float", ...)
+        size_t size = 0;    // bytes
+        size_t offset = 0;  // within a record
+        bool integral = false, is_signed = false;
+    };
+    std::vector<Property> properties;
+    size_t record_bytes = 0;          // the properties' sizes added up
+    std::vector<unsigned char> bytes; // a record per point, in point order, little-endian
+    uint64_t lists_dropped = 0;       // list properties of the vertex element, not kept
+
+    bool empty() const { return properties.empty(); }
+    // The property's index, or -1.
+    int find(const std::string& name) const;
+    // The value of property `property` of point `point`, as a double (exact for every type).
+    double value(size_t point, size_t property) const;
+};
+
 struct CloudInfo {
     CloudFormat format = CloudFormat::automatic; // the format actually read
     std::string encoding; // PLY: "ascii", "binary_little_endian", "binary_big_endian"
@@ -49,6 +72,9 @@ struct CloudInfo {
     uint64_t point_limit = UINT64_MAX;
     // Faces in the file (OFF, OBJ, a PLY 'face' element), which the cloud leaves out.
     uint64_t faces_ignored = 0;
+    // Set by the caller: keep the per-point data in `attributes` (whole-file PLY only).
+    bool keep_attributes = false;
+    PointAttributes attributes;
 };
 
 // Parses a whole file image. `format` automatic detects it from the content; any other

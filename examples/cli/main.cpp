@@ -131,9 +131,14 @@ size_t layer_capacity(const CommandLine& line, size_t points) {
     return asked < most ? asked : most;
 }
 
-bool read_input(const CommandLine& line, std::vector<double>& xyz, RunRecord& record) {
+// Reads the points and, unless --no-attributes or the output carries none, their other
+// data into `attributes`.
+bool read_input(const CommandLine& line, std::vector<double>& xyz, PointAttributes& attributes,
+                RunRecord& record) {
     Clock::time_point start = Clock::now();
     CloudInfo info;
+    info.keep_attributes = !line.no_attributes && (line.output_format == MeshFormat::ply ||
+                                                   line.output_format == MeshFormat::obj);
     std::string error;
     if (!read_cloud_file(line.input, xyz, error, &info)) {
         std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
@@ -143,6 +148,9 @@ bool read_input(const CommandLine& line, std::vector<double>& xyz, RunRecord& re
     record.input_format = cloud_format_name(info.format);
     record.input_encoding = info.encoding;
     record.input_faces_ignored = info.faces_ignored;
+    attributes = std::move(info.attributes);
+    record.point_properties = attributes.properties.size();
+    record.point_properties_carried = carried_attributes(&attributes, line.output_format);
     CloudFormat named = cloud_format_from_extension(line.input);
     if (!line.quiet && named != CloudFormat::automatic && named != info.format)
         std::fprintf(stderr, "stratmesh: note: %s holds %s, not %s; read as %s\n",
@@ -369,9 +377,11 @@ bool write_report(const CommandLine& line, const RunRecord& record) {
 }
 
 bool write_output(const CommandLine& line, const std::vector<double>& xyz,
-                  const Reconstruction& result, RunRecord& record) {
+                  const PointAttributes& attributes, const Reconstruction& result,
+                  RunRecord& record) {
     Clock::time_point start = Clock::now();
-    MeshView mesh = {xyz.data(), xyz.size() / 3, result.triangles.get(), result.triangle_count};
+    MeshView mesh = {xyz.data(), xyz.size() / 3, result.triangles.get(), result.triangle_count,
+                     &attributes};
     std::string error;
     if (!write_mesh_file(line.output, line.output_format, mesh, line.ascii, error)) {
         std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
@@ -435,8 +445,9 @@ int run(const CommandLine& line) {
     record_command_line(line, record);
     if (line.stream) return run_streamed(line, record);
     std::vector<double> xyz;
+    PointAttributes attributes;
     Reconstruction result;
-    if (!read_input(line, xyz, record)) return kExitFile;
+    if (!read_input(line, xyz, attributes, record)) return kExitFile;
     if (line.origin_given && !origin_in_reach(line, xyz)) return kExitUsage;
     if (line.find_branches && !find_branches(xyz, line, record)) return kExitRefused;
     if (!reconstruct_points(xyz, line, result, record)) return kExitRefused;
@@ -444,7 +455,7 @@ int run(const CommandLine& line) {
     measure_along_axis(xyz, record);
     record.ends = find_surface_ends(xyz.data(), result.triangles.get(), result.triangle_count,
                                     record.report.axis, record.layers);
-    if (!write_output(line, xyz, result, record)) return kExitFile;
+    if (!write_output(line, xyz, attributes, result, record)) return kExitFile;
     return finish_run(line, record);
 }
 

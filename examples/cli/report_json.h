@@ -23,6 +23,9 @@ struct RunRecord {
     // Input and output.
     std::string input_path, input_format, input_encoding;
     uint64_t input_faces_ignored = 0; // faces in the input, left out of the cloud
+    // The input's per-point properties besides x, y, z that were read (PLY, unless
+    // --no-attributes or the output carries none), and how many the output carries.
+    size_t point_properties = 0, point_properties_carried = 0;
     std::string output_path, output_format;
     bool output_ascii = false;
     bool output_written = false;

@@ -331,12 +331,22 @@ void print_warnings(std::FILE* out, const std::vector<std::string>& warnings) {
         std::fprintf(out, "stratmesh: warning: %s\n", warning.c_str());
 }
 
+// ", 7 point properties carried" (of those read), or nothing.
+std::string properties_text(const RunRecord& r) {
+    if (r.point_properties == 0) return "";
+    std::string text = ", " + std::to_string(r.point_properties_carried);
+    if (r.point_properties_carried != r.point_properties)
+        text += " of " + std::to_string(r.point_properties);
+    return text + (r.point_properties == 1 ? " point property carried" : " point properties carried");
+}
+
 void print_summary(std::FILE* out, const RunRecord& record, size_t warning_count, bool verbose) {
-    std::fprintf(out, "stratmesh: %s (%s %s) -> %s (%s%s)\n",
+    std::fprintf(out, "stratmesh: %s (%s %s) -> %s (%s%s%s)\n",
                  file_name(record.input_path, "standard input").c_str(),
                  record.input_format.c_str(), record.input_encoding.c_str(),
                  file_name(record.output_path, "standard output").c_str(),
-                 record.output_format.c_str(), record.output_ascii ? " text" : "");
+                 record.output_format.c_str(), record.output_ascii ? " text" : "",
+                 properties_text(record).c_str());
     print_counts(out, record);
     if (verbose) {
         print_branches(out, record);

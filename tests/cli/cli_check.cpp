@@ -10,6 +10,11 @@
 //         a.b:text       the string at a.b is `text` (or true, false, null)
 //   stratmesh_cli_check same-mesh FILE FILE
 //       the two meshes read back with the same vertices and the same triangles, in order
+//   stratmesh_cli_check attributes INPUT.ply OUTPUT
+//       OUTPUT's vertices carry INPUT's per-point data, point by point: a PLY output all of
+//       its scalar properties (names, types, values), an OBJ output its normals and colours
+//   stratmesh_cli_check no-attributes FILE
+//       the mesh's vertices carry their coordinates only
 //   stratmesh_cli_check mesh FILE VERTICES [REPORT.json]
 //       the mesh (.ply .obj .off .stl) reads back, has VERTICES vertices (not checked for
 //       STL), at least one triangle, indices in range, and as many triangles as the
@@ -163,6 +168,67 @@ std::string as_binary_ply(const std::vector<double>& xyz) {
     return bytes;
 }
 
+// The cylinder with per-point data of every kind: normals before the coordinates, colours,
+// an intensity, a quality and a signed label; ascii, binary little-endian, or binary
+// big-endian with a list property among them (which the tool does not carry).
+enum class PlyEncoding { ascii, little, big_with_list };
+
+void append_bytes(std::string& bytes, uint64_t bits, size_t size, bool big) {
+    for (size_t i = 0; i < size; ++i)
+        bytes += static_cast<char>((bits >> (8 * (big ? size - 1 - i : i))) & 0xffu);
+}
+
+std::string as_attribute_ply(const std::vector<double>& xyz, PlyEncoding encoding) {
+    const bool list = encoding == PlyEncoding::big_with_list;
+    std::string bytes = std::string("ply\nformat ") +
+                        (encoding == PlyEncoding::ascii    ? "ascii"
+                         : encoding == PlyEncoding::little ? "binary_little_endian"
+                                                           : "binary_big_endian") +
+                        " 1.0\nelement vertex " + std::to_string(xyz.size() / 3) +
+                        "\nproperty float nx\nproperty float ny\nproperty float nz\n"
+                        "property float x\nproperty float y\nproperty float z\n"
+                        "property uchar red\nproperty uchar green\nproperty uchar blue\n" +
+                        (list ? "property list uchar int neighbours\n" : "") +
+                        "property ushort intensity\nproperty double quality\nproperty int label\n"
+                        "end_header\n";
+    for (size_t i = 0; i < xyz.size() / 3; ++i) {
+        const double* p = &xyz[3 * i];
+        const double r = std::sqrt(p[0] * p[0] + p[1] * p[1]);
+        const float floats[6] = {static_cast<float>(p[0] / r), static_cast<float>(p[1] / r), 0.0f,
+                                 static_cast<float>(p[0]), static_cast<float>(p[1]),
+                                 static_cast<float>(p[2])};
+        const unsigned colour[3] = {unsigned(i % 256), unsigned(i * 7 % 256), unsigned(255 - i % 256)};
+        const unsigned intensity = unsigned(i * 37 % 65536);
+        const double quality = p[2] / 3;
+        const int label = static_cast<int>(i) - 1500;
+        if (encoding == PlyEncoding::ascii) {
+            for (float f : floats) bytes += number_text(static_cast<double>(f)) + " ";
+            for (unsigned c : colour) bytes += std::to_string(c) + " ";
+            char text[64];
+            std::snprintf(text, sizeof text, "%u %.17g %d\n", intensity, quality, label);
+            bytes += text;
+            continue;
+        }
+        const bool big = encoding == PlyEncoding::big_with_list;
+        for (float f : floats) {
+            uint32_t bits = 0;
+            std::memcpy(&bits, &f, sizeof bits);
+            append_bytes(bytes, bits, 4, big);
+        }
+        for (unsigned c : colour) append_bytes(bytes, c, 1, big);
+        if (list) { // a list of i % 2 neighbours
+            append_bytes(bytes, i % 2, 1, big);
+            if (i % 2) append_bytes(bytes, static_cast<uint32_t>(i + 1), 4, big);
+        }
+        append_bytes(bytes, intensity, 2, big);
+        uint64_t bits = 0;
+        std::memcpy(&bits, &quality, sizeof bits);
+        append_bytes(bytes, bits, 8, big);
+        append_bytes(bytes, static_cast<uint32_t>(label), 4, big);
+    }
+    return bytes;
+}
+
 std::string truncated_ply() {
     std::string text = "ply\nformat binary_little_endian 1.0\nelement vertex 100\n"
                        "property float x\nproperty float y\nproperty float z\nend_header\n";
@@ -213,6 +279,11 @@ int make_inputs(const std::string& dir) {
               write_file(dir + "/sorted.xyz", as_xyz(sorted, 0)) &&
               write_file(dir + "/mesh.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 1\n3 0 1 2\n") &&
               write_file(dir + "/sorted.ply", as_binary_ply(sorted)) &&
+              write_file(dir + "/attributes.ply", as_attribute_ply(cylinder, PlyEncoding::little)) &&
+              write_file(dir + "/attributes_ascii.ply",
+                         as_attribute_ply(cylinder, PlyEncoding::ascii)) &&
+              write_file(dir + "/attributes_big.ply",
+                         as_attribute_ply(cylinder, PlyEncoding::big_with_list)) &&
               write_file(dir + "/more_records.ply", ply_more_records_than_declared(cylinder)) &&
               write_file(dir + "/huge_integer.xyz", xyz_with_huge_integer()) &&
               write_file(dir + "/sorted_nan.xyz", sorted_with_nan_at(sorted, 1500)) &&
@@ -407,6 +478,67 @@ int check_mesh(int argc, char** argv) {
     return ok ? 0 : 1;
 }
 
+// The output's vertex data against the input's, point by point: in a PLY output, the
+// input's properties but its lists, with the same names and types in the same order, and
+// the same values; in an OBJ output, the normals as vn lines and the colours over 255.
+int check_attributes(char** argv) {
+    const std::string input = argv[2], output = argv[3];
+    mini_mesh::Mesh in, out;
+    if (!mini_mesh::read(input, in) || !mini_mesh::read(output, out)) {
+        std::fprintf(stderr, "cannot read %s or %s\n", input.c_str(), output.c_str());
+        return 1;
+    }
+    const size_t vertices = in.xyz.size() / 3;
+    if (out.xyz != in.xyz || in.properties.empty()) {
+        std::fprintf(stderr, "%s: not the points of %s, or no properties there\n", output.c_str(),
+                     input.c_str());
+        return 1;
+    }
+    const bool obj = output.size() > 4 && output.substr(output.size() - 4) == ".obj";
+    if (!obj) {
+        bool same = out.properties.size() == in.properties.size();
+        for (size_t k = 0; same && k < in.properties.size(); ++k)
+            same = out.properties[k].name == in.properties[k].name &&
+                   out.properties[k].type == in.properties[k].type;
+        if (!same || out.values != in.values) {
+            std::fprintf(stderr, "%s: the vertex properties differ from %s's\n", output.c_str(),
+                         input.c_str());
+            return 1;
+        }
+        return 0;
+    }
+    auto column = [&](const char* name) {
+        for (size_t k = 0; k < in.properties.size(); ++k)
+            if (in.properties[k].name == name) return k;
+        return in.properties.size();
+    };
+    const size_t columns = in.properties.size();
+    const size_t normal[3] = {column("nx"), column("ny"), column("nz")};
+    const size_t colour[3] = {column("red"), column("green"), column("blue")};
+    bool ok = out.obj_normals.size() == 3 * vertices && out.obj_colours.size() == 3 * vertices;
+    for (size_t i = 0; ok && i < vertices; ++i) {
+        for (size_t k = 0; k < 3; ++k) {
+            ok = ok && out.obj_normals[3 * i + k] == in.values[i * columns + normal[k]] &&
+                 out.obj_colours[3 * i + k] == in.values[i * columns + colour[k]] / 255;
+        }
+    }
+    if (!ok)
+        std::fprintf(stderr, "%s: the normals or colours differ from %s's\n", output.c_str(),
+                     input.c_str());
+    return ok ? 0 : 1;
+}
+
+int check_no_attributes(char** argv) {
+    mini_mesh::Mesh mesh;
+    if (!mini_mesh::read(argv[2], mesh) || mesh.tris.empty()) {
+        std::fprintf(stderr, "cannot read the mesh %s\n", argv[2]);
+        return 1;
+    }
+    if (mesh.properties.empty() && mesh.obj_normals.empty() && mesh.obj_colours.empty()) return 0;
+    std::fprintf(stderr, "%s: the vertices carry more than their coordinates\n", argv[2]);
+    return 1;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -415,7 +547,10 @@ int main(int argc, char** argv) {
     if (command == "json" && argc >= 3) return check_json(argc, argv);
     if (command == "mesh" && (argc == 4 || argc == 5)) return check_mesh(argc, argv);
     if (command == "same-mesh" && argc == 4) return check_same_mesh(argv);
+    if (command == "attributes" && argc == 4) return check_attributes(argv);
+    if (command == "no-attributes" && argc == 3) return check_no_attributes(argv);
     std::fprintf(stderr, "usage: stratmesh_cli_check make-inputs DIR | json FILE [ASSERTION...] |"
-                         " mesh FILE VERTICES [REPORT.json] | same-mesh FILE FILE\n");
+                         " mesh FILE VERTICES [REPORT.json] | same-mesh FILE FILE |"
+                         " attributes INPUT.ply OUTPUT | no-attributes FILE\n");
     return 2;
 }

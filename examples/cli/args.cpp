@@ -53,6 +53,10 @@ const char kUsage[] =
     "                        (at most one of --cuts, --layers, --layer-height; without\n"
     "                        them the layers are chosen automatically)\n"
     "  --report FILE.json    write counts, timings, memory and per-layer details as JSON\n"
+    "  --preview FILE.svg    draw the mesh from the front and the side (orthographic,\n"
+    "                        shaded, the layers in alternating tints, the boundary edges\n"
+    "                        in red): a polygon per triangle and view, about 200 bytes\n"
+    "                        a triangle (not with --stream)\n"
     "  --ascii               text PLY or STL\n"
     "  --no-attributes       write only the points' coordinates: without it, the other\n"
     "                        vertex properties of a PLY input (normals, colours,\n"
@@ -250,6 +254,7 @@ bool apply_valued(std::string_view name, std::string_view value, CommandLine& li
                   std::string& error) {
     if (name == "--output") line.output = std::string(value);
     if (name == "--report") line.report = std::string(value);
+    if (name == "--preview") line.preview = std::string(value);
     if (name == "--axis") return parse_axis(value, line, error);
     if (name == "--cuts") return parse_cuts(value, line, error);
     if (name == "--layers") return parse_layers(value, line, error);
@@ -283,7 +288,7 @@ bool apply_flag(std::string_view name, CommandLine& line) {
 const char* const kValuedOptions[] = {"--output",  "--report",        "--axis",
                                       "--cuts",    "--layers",        "--layer-height",
                                       "--threads", "--stream-points", "--origin",
-                                      "--format"};
+                                      "--format",  "--preview"};
 const char* const kFlags[] = {"--ascii", "--skip-invalid", "--cap",     "--quiet",
                               "--help",  "--version",      "--stream", "--drop-outliers",
                               "--surface-flips", "--open-ends", "--branches",
@@ -304,6 +309,9 @@ std::string stream_conflict(const CommandLine& line) {
     if (line.find_branches || line.split_branches)
         return "--stream cannot find --branches (nor --split-branches): where a cloud parts "
                "is told from all of its points, which the stream never holds";
+    if (!line.preview.empty())
+        return "--stream cannot --preview: it writes the triangles as they come and keeps "
+               "none to draw";
     if (line.output_format == MeshFormat::stl)
         return "--stream cannot write STL (its triangles repeat their corners' coordinates, "
                "which the stream no longer holds): write PLY, OBJ or OFF";
@@ -452,12 +460,13 @@ CommandAction parse_command_line(int argc, const char* const* argv, CommandLine&
 }
 
 std::vector<NamedFile> named_files(const CommandLine& line) {
-    // "-" (the standard streams) is no file that another name can clobber.
+    // Options not given name nothing, and "-" (the standard streams) is no file that
+    // another name can clobber.
     std::vector<NamedFile> files;
     const NamedFile all[] = {{"the input", line.input}, {"-o", line.output},
-                             {"--report", line.report}};
+                             {"--report", line.report}, {"--preview", line.preview}};
     for (const NamedFile& file : all)
-        if (file.path != kStandardStream) files.push_back(file);
+        if (!file.path.empty() && file.path != kStandardStream) files.push_back(file);
     return files;
 }
 

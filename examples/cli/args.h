@@ -18,6 +18,7 @@ struct CommandLine {
     // From --format, else from the output's extension (--format is required with -o -).
     MeshFormat output_format = MeshFormat::unknown;
     std::string report; // --report, empty if not given
+    std::string preview; // --preview FILE.svg, empty if not given
     stratmesh::Axis axis = stratmesh::Axis::automatic;
     double direction[3] = {0, 0, 0}; // with Axis::direction
     std::vector<double> cuts;        // --cuts
@@ -54,8 +55,8 @@ enum class CommandAction { run, help, version, usage_error };
 CommandAction parse_command_line(int argc, const char* const* argv, CommandLine& line,
                                  std::string& error);
 
-// The files the command line names, the input first, each with how the command line names
-// it: what check_distinct_files (safe_output.h) compares.
+// The files the command line names (not "-", the standard streams), the input first, each
+// with how the command line names it: what check_distinct_files (safe_output.h) compares.
 std::vector<NamedFile> named_files(const CommandLine& line);
 
 // The --help text.

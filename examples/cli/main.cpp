@@ -10,6 +10,7 @@
 #include "mesh_ends.h"
 #include "mesh_io.h"
 #include "peak_memory.h"
+#include "preview.h"
 #include "progress.h"
 #include "report_json.h"
 #include "safe_output.h"
@@ -368,6 +369,19 @@ void measure_along_axis(const std::vector<double>& xyz, RunRecord& record) {
     }
 }
 
+// With --preview: the picture of the mesh, written whole or not at all.
+bool write_preview(const CommandLine& line, const std::vector<double>& xyz,
+                   const Reconstruction& result, const RunRecord& record) {
+    if (line.preview.empty()) return true;
+    const MeshView mesh = {xyz.data(), xyz.size() / 3, result.triangles.get(),
+                           result.triangle_count};
+    std::string error;
+    if (write_preview_svg(line.preview, mesh, record.report.axis, record.layers, error))
+        return true;
+    std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
+    return false;
+}
+
 bool write_report(const CommandLine& line, const RunRecord& record) {
     if (line.report.empty()) return true;
     std::string error;
@@ -456,6 +470,7 @@ int run(const CommandLine& line) {
     record.ends = find_surface_ends(xyz.data(), result.triangles.get(), result.triangle_count,
                                     record.report.axis, record.layers);
     if (!write_output(line, xyz, attributes, result, record)) return kExitFile;
+    if (!write_preview(line, xyz, result, record)) return kExitFile;
     return finish_run(line, record);
 }
 

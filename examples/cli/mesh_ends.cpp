@@ -13,16 +13,37 @@ double height(const double* p, const double axis[3]) {
     return p[0] * axis[0] + p[1] * axis[1] + p[2] * axis[2];
 }
 
-// The edges used by exactly one triangle, as vertex pairs (smaller index first).
+// splitmix64's finaliser: vertex indices spread over 64 bits.
+uint64_t mix(uint32_t v) {
+    uint64_t x = v + 0x9E3779B97F4A7C15ull;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+    return x ^ (x >> 31);
+}
+
+} // namespace
+
 std::vector<uint64_t> boundary_edges(const uint32_t* triangles, size_t count) {
-    std::vector<uint64_t> edges;
-    edges.reserve(3 * count);
-    for (size_t t = 0; t < count; ++t) {
+    // On an oriented surface an inner edge runs a -> b in one triangle and b -> a in the
+    // other, so around an inner vertex the neighbours its edges leave for and those they
+    // arrive from are the same: their hashes, added and taken away, cancel. Only edges
+    // between two vertices where they do not (the boundary's, and a few more) are counted.
+    uint32_t vertices = 0;
+    for (size_t i = 0; i < 3 * count; ++i) vertices = std::max(vertices, triangles[i] + 1);
+    std::vector<uint64_t> balance(vertices, 0);
+    for (size_t t = 0; t < count; ++t)
         for (size_t k = 0; k < 3; ++k) {
             const uint32_t a = triangles[3 * t + k], b = triangles[3 * t + (k + 1) % 3];
-            edges.push_back(uint64_t{std::min(a, b)} << 32 | std::max(a, b));
+            balance[a] += mix(b);
+            balance[b] -= mix(a);
         }
-    }
+    std::vector<uint64_t> edges;
+    for (size_t t = 0; t < count; ++t)
+        for (size_t k = 0; k < 3; ++k) {
+            const uint32_t a = triangles[3 * t + k], b = triangles[3 * t + (k + 1) % 3];
+            if (balance[a] != 0 && balance[b] != 0)
+                edges.push_back(uint64_t{std::min(a, b)} << 32 | std::max(a, b));
+        }
     std::sort(edges.begin(), edges.end());
     size_t kept = 0;
     for (size_t i = 0; i < edges.size();) {
@@ -34,6 +55,8 @@ std::vector<uint64_t> boundary_edges(const uint32_t* triangles, size_t count) {
     edges.resize(kept);
     return edges;
 }
+
+namespace {
 
 // The boundary edges chained into loops (the vertices of each, in order). The surface is
 // vertex-manifold, so a boundary vertex has two boundary edges; a chain that does not
@@ -81,6 +104,9 @@ double distance_from_centre_line(const double* xyz, const std::vector<uint32_t>&
     return largest;
 }
 
+// The corners whose median height splits the ends: enough for any shape.
+const size_t kSampledCorners = 1 << 16;
+
 // A pole loop lies within this share of the end layer's unrolling radius from its centre
 // line; a rim lies about one radius out.
 const double kPoleShare = 0.5;
@@ -100,10 +126,13 @@ SurfaceEnds find_surface_ends(const double* xyz, const uint32_t* triangles,
     SurfaceEnds ends;
     ends.known = true;
     if (triangle_count == 0) return ends;
-    // The median corner: a stray vertex far along the axis does not move it.
-    std::vector<double> heights(3 * triangle_count);
-    for (size_t i = 0; i < heights.size(); ++i)
-        heights[i] = height(xyz + 3 * size_t{triangles[i]}, axis);
+    // The median corner (of an even sample of at most kSampledCorners): a stray vertex far
+    // along the axis does not move it.
+    const size_t corners = 3 * triangle_count;
+    const size_t step = corners > kSampledCorners ? corners / kSampledCorners : 1;
+    std::vector<double> heights;
+    for (size_t i = 0; i < corners; i += step)
+        heights.push_back(height(xyz + 3 * size_t{triangles[i]}, axis));
     const auto half = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2);
     std::nth_element(heights.begin(), half, heights.end());
     const double middle = *half;

@@ -24,6 +24,10 @@ struct SurfaceEnds {
     SurfaceEnd bottom, top;
 };
 
+// The edges used by exactly one triangle, each as (smaller index << 32 | larger index),
+// sorted.
+std::vector<uint64_t> boundary_edges(const uint32_t* triangles, size_t count);
+
 // The boundary loops of a mesh whose vertices are `xyz` (3 doubles each): a loop is put at
 // the bottom end when its vertices' mean height, dot(point, axis), lies below the median
 // height of the triangles' corners. `layers` (bottom up, possibly empty) names pole loops.

@@ -15,6 +15,9 @@
 //       its scalar properties (names, types, values), an OBJ output its normals and colours
 //   stratmesh_cli_check no-attributes FILE
 //       the mesh's vertices carry their coordinates only
+//   stratmesh_cli_check svg FILE REPORT.json
+//       FILE is well-formed XML, an <svg> with a polygon per triangle and a line per
+//       boundary edge of the report, in each of its two views
 //   stratmesh_cli_check mesh FILE VERTICES [REPORT.json]
 //       the mesh (.ply .obj .off .stl) reads back, has VERTICES vertices (not checked for
 //       STL), at least one triangle, indices in range, and as many triangles as the
@@ -22,6 +25,7 @@
 #include "mini_json.h"
 #include "mini_mesh.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -528,6 +532,150 @@ int check_attributes(char** argv) {
     return ok ? 0 : 1;
 }
 
+// ---- svg ---------------------------------------------------------------------------------
+
+bool is_name_char(char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == ':' || c == '-' ||
+           c == '.';
+}
+
+// Character data or an attribute value: no '<', every '&' a known entity.
+bool valid_text(const std::string& text) {
+    if (text.find('<') != std::string::npos) return false;
+    for (size_t at = text.find('&'); at != std::string::npos; at = text.find('&', at + 1)) {
+        const size_t end = text.find(';', at);
+        if (end == std::string::npos) return false;
+        const std::string entity = text.substr(at + 1, end - at - 1);
+        const bool known = entity == "amp" || entity == "lt" || entity == "gt" ||
+                           entity == "quot" || entity == "apos" ||
+                           (entity.size() > 1 && entity[0] == '#');
+        if (!known) return false;
+    }
+    return true;
+}
+
+// A small XML well-formedness check: a declaration, comments, one root element, tags
+// nested and closed in order, attributes name="value" once each, text without '<' or
+// stray '&'. Counts the elements by name.
+bool check_xml(const std::string& text, std::unordered_map<std::string, size_t>& counts,
+               std::string& why) {
+    std::vector<std::string> open;
+    bool root_seen = false;
+    size_t at = 0;
+    auto fail = [&](const std::string& what) {
+        why = what + " at byte " + std::to_string(at);
+        return false;
+    };
+    while (at < text.size()) {
+        if (text[at] != '<') {
+            const size_t next = std::min(text.find('<', at), text.size());
+            const std::string chars = text.substr(at, next - at);
+            if (!valid_text(chars)) return fail("bad character data");
+            if (open.empty() && chars.find_first_not_of(" \t\r\n") != std::string::npos)
+                return fail("text outside the root element");
+            at = next;
+            continue;
+        }
+        if (text.compare(at, 4, "<!--") == 0 || text.compare(at, 2, "<?") == 0) {
+            const bool comment = text[at + 1] == '!';
+            const size_t end = text.find(comment ? "-->" : "?>", at);
+            if (end == std::string::npos) return fail("an unclosed comment or declaration");
+            at = end + (comment ? 3 : 2);
+            continue;
+        }
+        const bool closing = text.compare(at, 2, "</") == 0;
+        size_t cursor = at + (closing ? 2 : 1);
+        const size_t name_start = cursor;
+        while (cursor < text.size() && is_name_char(text[cursor])) ++cursor;
+        const std::string name = text.substr(name_start, cursor - name_start);
+        if (name.empty() || std::isdigit(static_cast<unsigned char>(name[0])))
+            return fail("a tag without a name");
+        auto skip_space = [&]() {
+            while (cursor < text.size() && std::isspace(static_cast<unsigned char>(text[cursor])))
+                ++cursor;
+        };
+        if (closing) {
+            skip_space();
+            if (cursor >= text.size() || text[cursor] != '>') return fail("a malformed end tag");
+            if (open.empty() || open.back() != name) return fail("</" + name + "> closes nothing open");
+            open.pop_back();
+            at = cursor + 1;
+            continue;
+        }
+        if (open.empty() && root_seen) return fail("a second root element");
+        root_seen = true;
+        std::unordered_set<std::string> attributes;
+        bool empty_element = false;
+        for (;;) {
+            skip_space();
+            if (cursor >= text.size()) return fail("an unclosed tag");
+            if (text.compare(cursor, 2, "/>") == 0) {
+                empty_element = true;
+                cursor += 2;
+                break;
+            }
+            if (text[cursor] == '>') {
+                ++cursor;
+                break;
+            }
+            const size_t attribute_start = cursor;
+            while (cursor < text.size() && is_name_char(text[cursor])) ++cursor;
+            const std::string attribute = text.substr(attribute_start, cursor - attribute_start);
+            if (attribute.empty() || !attributes.insert(attribute).second)
+                return fail("a missing or repeated attribute in <" + name + ">");
+            skip_space();
+            if (cursor >= text.size() || text[cursor] != '=') return fail("an attribute without '='");
+            ++cursor;
+            skip_space();
+            const char quote = cursor < text.size() ? text[cursor] : '\0';
+            if (quote != '"' && quote != '\'') return fail("an unquoted attribute value");
+            const size_t end = text.find(quote, cursor + 1);
+            if (end == std::string::npos || !valid_text(text.substr(cursor + 1, end - cursor - 1)))
+                return fail("a bad attribute value");
+            cursor = end + 1;
+        }
+        ++counts[name];
+        if (!empty_element) open.push_back(name);
+        at = cursor;
+    }
+    if (!open.empty()) return fail("<" + open.back() + "> never closed");
+    if (!root_seen) return fail("no root element");
+    return true;
+}
+
+// The picture is well-formed XML whose root is <svg>, with a polygon per triangle in each
+// of its two views and a red line per boundary edge in each (the report's triangles and
+// its ends' loops).
+int check_svg(char** argv) {
+    std::string text;
+    mini_json::Value report;
+    if (!mini_mesh::load(argv[2], text) || !load_json(argv[3], report)) {
+        std::fprintf(stderr, "cannot read %s or %s\n", argv[2], argv[3]);
+        return 1;
+    }
+    std::unordered_map<std::string, size_t> counts;
+    std::string why;
+    if (!check_xml(text, counts, why)) {
+        std::fprintf(stderr, "%s: not well-formed XML: %s\n", argv[2], why.c_str());
+        return 1;
+    }
+    const mini_json::Value* triangles = report.at("triangles");
+    size_t boundary = 0;
+    for (const char* end : {"ends.bottom.loop_edges", "ends.top.loop_edges"})
+        if (const mini_json::Value* loops = report.at(end))
+            for (const mini_json::Value& edges : loops->items)
+                boundary += static_cast<size_t>(edges.num);
+    const bool ok = counts["svg"] == 1 && text.find("<svg") < text.find("<g") && triangles &&
+                    static_cast<double>(counts["polygon"]) == 2 * triangles->num &&
+                    counts["polyline"] == 2 * boundary;
+    if (!ok)
+        std::fprintf(stderr, "%s: %zu polygons and %zu boundary lines; the report has %g "
+                             "triangles and %zu boundary edges, in each of two views\n",
+                     argv[2], counts["polygon"], counts["polyline"],
+                     triangles ? triangles->num : -1.0, boundary);
+    return ok ? 0 : 1;
+}
+
 int check_no_attributes(char** argv) {
     mini_mesh::Mesh mesh;
     if (!mini_mesh::read(argv[2], mesh) || mesh.tris.empty()) {
@@ -549,8 +697,10 @@ int main(int argc, char** argv) {
     if (command == "same-mesh" && argc == 4) return check_same_mesh(argv);
     if (command == "attributes" && argc == 4) return check_attributes(argv);
     if (command == "no-attributes" && argc == 3) return check_no_attributes(argv);
+    if (command == "svg" && argc == 4) return check_svg(argv);
     std::fprintf(stderr, "usage: stratmesh_cli_check make-inputs DIR | json FILE [ASSERTION...] |"
                          " mesh FILE VERTICES [REPORT.json] | same-mesh FILE FILE |"
-                         " attributes INPUT.ply OUTPUT | no-attributes FILE\n");
+                         " attributes INPUT.ply OUTPUT | no-attributes FILE |"
+                         " svg FILE REPORT.json\n");
     return 2;
 }

@@ -207,12 +207,23 @@ std::string branches_warning(const RunRecord& r) {
     return "";
 }
 
-std::string unused_warning(const RunRecord& r) {
-    const size_t unused = r.report.points.unused_count;
-    if (unused == 0) return "";
-    std::string text = plural(unused, "point", "points") +
-                       " left out of the mesh (in the output, used by no triangle)";
-    if (r.report.detail) text += std::string(": ") + r.report.detail;
+// Points that are no vertex of the surface, though not merged into a duplicate: rejected
+// (NaN or infinite with --skip-invalid, outliers with --drop-outliers) or unused (the
+// library's detail says why). They stay in the output, used by no triangle.
+std::string left_out_warning(const RunRecord& r) {
+    const stratmesh::PointCounts& p = r.report.points;
+    const size_t invalid = p.rejected_count - p.outlier_count;
+    if (p.rejected_count + p.unused_count == 0) return "";
+    std::string parts;
+    auto add = [&parts](size_t count, const std::string& what) {
+        if (count) parts += (parts.empty() ? "" : ", ") + std::to_string(count) + " " + what;
+    };
+    add(invalid, "invalid (--skip-invalid)");
+    add(p.outlier_count, p.outlier_count == 1 ? "outlier (--drop-outliers)" : "outliers (--drop-outliers)");
+    add(p.unused_count, "unused");
+    std::string text = plural(p.rejected_count + p.unused_count, "point", "points") +
+                       " left out of the mesh (in the output, used by no triangle): " + parts;
+    if (p.unused_count && r.report.detail) text += std::string("; ") + r.report.detail;
     return text;
 }
 
@@ -320,7 +331,7 @@ std::string faces_warning(const RunRecord& record) {
 std::vector<std::string> run_warnings(const RunRecord& record) {
     std::vector<std::string> warnings;
     for (const std::string& warning :
-         {folds_warning(record), branches_warning(record), unused_warning(record),
+         {folds_warning(record), branches_warning(record), left_out_warning(record),
           caps_warning(record), faces_warning(record), cuts_warning(record)})
         if (!warning.empty()) warnings.push_back(warning);
     return warnings;

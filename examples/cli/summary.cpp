@@ -89,7 +89,7 @@ std::string merge_reason(const RunRecord& r) {
 }
 
 // "18 of 100000 asked (30000 planned: at most one a point); merged where ...", "4 as
-// asked", "7 (automatic)".
+// asked", "4 (about --layer-height 30 high)", "7 (automatic)".
 std::string layers_text(const RunRecord& r) {
     const size_t used = r.report.layers.used_count, planned = r.report.layers.planned_count;
     std::string text = std::to_string(used);
@@ -102,7 +102,10 @@ std::string layers_text(const RunRecord& r) {
         asked = r.cuts.size() + 1;
         why_planned = "cuts outside the cloud or repeated are dropped";
     } else if (r.layer_height > 0) {
-        asked = planned; // about --layer-height high, as many as the height takes
+        // As many as the height takes: the plan is what was asked.
+        if (used >= planned) return text + " (about --layer-height " + number_text(r.layer_height) + " high)";
+        return text + " of " + std::to_string(planned) + " planned by --layer-height " +
+               number_text(r.layer_height) + "; " + merge_reason(r);
     }
     if (asked == 0) {
         if (used >= planned) return text + " (automatic)";
@@ -184,14 +187,14 @@ std::string parting_text(const stratmesh::Parting& p) {
            number_text(p.gap) + ")";
 }
 
-bool parts(const RunRecord& r) {
+bool branches_found(const RunRecord& r) {
     return r.parting_run && r.parting_status == stratmesh::Status::ok &&
            r.parting.above_branch_count + r.parting.below_branch_count > 0;
 }
 
 // Branches wrapped in one tube, which webs over the gaps between them; or left apart.
 std::string branches_warning(const RunRecord& r) {
-    if (!parts(r)) return "";
+    if (!branches_found(r)) return "";
     const std::string where = parting_text(r.parting);
     if (r.split.empty())
         return "one tube wraps branches and the gaps between them, " + where +

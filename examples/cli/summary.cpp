@@ -306,7 +306,9 @@ void print_costs(std::FILE* out, const RunRecord& r) {
     std::fprintf(out, "  time       read %s, reconstruct %s%s, %swrite %s\n",
                  seconds_text(r.read_seconds).c_str(), seconds_text(r.reconstruct_seconds).c_str(),
                  phase_times_text(r).c_str(),
-                 r.parting_run ? ("branches " + seconds_text(r.branches_seconds) + ", ").c_str() : "",
+                 std::isfinite(r.branches_seconds)
+                     ? ("branches " + seconds_text(r.branches_seconds) + ", ").c_str()
+                     : "",
                  seconds_text(r.write_seconds).c_str());
     double per_point = r.report.points.in_count ? static_cast<double>(r.workspace_bytes) /
                                                 static_cast<double>(r.report.points.in_count)

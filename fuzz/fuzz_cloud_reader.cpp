@@ -274,9 +274,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         std::vector<double> xyz;
         std::string error;
         stratmesh_cli::CloudInfo info;
+        info.keep_attributes = true; // the second read below does not: the same points
         bool ok = stratmesh_cli::read_cloud_from_memory(p, size, format, xyz, error, &info);
         if (ok) {
             STRATMESH_FUZZ_CHECK(xyz.size() % 3 == 0, "coordinates not in threes");
+            const stratmesh_cli::PointAttributes& kept = info.attributes;
+            STRATMESH_FUZZ_CHECK(kept.bytes.size() == (kept.empty() ? 0 : kept.record_bytes * (xyz.size() / 3)),
+                                 "per-point data not one record per point");
             STRATMESH_FUZZ_CHECK(xyz.size() / 3 <= size / 3, "more points than the input can hold");
             if (format == CloudFormat::automatic)
                 STRATMESH_FUZZ_CHECK(info.format == detected, "automatic read disagrees with detection");

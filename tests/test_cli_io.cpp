@@ -7,6 +7,7 @@
 #include "args.h"
 #include "big_buffer.h"
 #include "cloud_io.h"
+#include "mesh_ends.h"
 #include "mesh_io.h"
 #include "report_json.h"
 #include "text_scan.h"
@@ -1316,4 +1317,52 @@ TEST_CASE("command line: usage errors") {
         "--stream needs --cuts or --layer-height"));
     CHECK(contains(usage_error({"a.ply", "-o", "m.stl", "--stream", "--axis", "z", "--cuts", "1"}),
                    "--stream cannot write STL"));
+}
+
+// A ring of 8 quads (an open tube, 16 triangles, counter-clockwise seen from outside)
+// between z = 0 and z = 1, optionally closed by a fan to a pole at each end.
+std::vector<uint32_t> tube_triangles(bool close_bottom, bool close_top) {
+    std::vector<uint32_t> tris;
+    for (uint32_t k = 0; k < 8; ++k) {
+        const uint32_t a = k, b = (k + 1) % 8, c = 8 + k, d = 8 + (k + 1) % 8;
+        tris.insert(tris.end(), {a, b, d, a, d, c});
+        if (close_bottom) tris.insert(tris.end(), {16, b, a});
+        if (close_top) tris.insert(tris.end(), {17, c, d});
+    }
+    return tris;
+}
+
+std::vector<double> tube_points() {
+    std::vector<double> xyz;
+    for (int level = 0; level < 2; ++level)
+        for (int k = 0; k < 8; ++k) {
+            const double angle = 6.283185307179586 * k / 8;
+            xyz.insert(xyz.end(), {std::cos(angle), std::sin(angle), double(level)});
+        }
+    xyz.insert(xyz.end(), {0, 0, -0.5, 0, 0, 1.5});
+    return xyz;
+}
+
+TEST_CASE("the surface's ends come from its boundary edges") {
+    const std::vector<double> xyz = tube_points();
+    const double axis[3] = {0, 0, 1};
+    const std::vector<stratmesh::LayerInfo> no_layers;
+    std::vector<uint32_t> open = tube_triangles(false, false);
+    CHECK(boundary_edges(open.data(), open.size() / 3).size() == 16);
+    SurfaceEnds ends = find_surface_ends(xyz.data(), open.data(), open.size() / 3, axis, no_layers);
+    CHECK(ends.known);
+    CHECK(ends.bottom.loop_edges == std::vector<size_t>{8});
+    CHECK(ends.top.loop_edges == std::vector<size_t>{8});
+    std::vector<uint32_t> capped_below = tube_triangles(true, false);
+    ends = find_surface_ends(xyz.data(), capped_below.data(), capped_below.size() / 3, axis,
+                             no_layers);
+    CHECK(ends.bottom.loop_edges.empty());
+    CHECK(ends.top.loop_edges == std::vector<size_t>{8});
+    std::vector<uint32_t> closed = tube_triangles(true, true);
+    CHECK(boundary_edges(closed.data(), closed.size() / 3).empty());
+    // One triangle taken out of the closed surface leaves a hole of three edges.
+    closed.erase(closed.begin(), closed.begin() + 3);
+    const std::vector<uint64_t> hole = boundary_edges(closed.data(), closed.size() / 3);
+    CHECK(hole == std::vector<uint64_t>{uint64_t{0} << 32 | 1, uint64_t{0} << 32 | 9,
+                                        uint64_t{1} << 32 | 9});
 }

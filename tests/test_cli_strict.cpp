@@ -104,16 +104,24 @@ TEST_CASE("two names of one file are refused, through symlinks and hard links") 
     }
 }
 
-TEST_CASE("the command line's files are the input, -o and --report") {
+TEST_CASE("the command line's files are the input, -o, --report and --preview") {
     CommandLine line;
     std::string error;
-    const char* argv[] = {"stratmesh", "in.ply", "-o", "out.ply", "--report", "r.json"};
-    REQUIRE(parse_command_line(6, argv, line, error) == CommandAction::run);
+    const char* argv[] = {"stratmesh", "in.ply", "-o",         "out.ply",
+                          "--report",  "r.json", "--preview", "p.svg"};
+    REQUIRE(parse_command_line(8, argv, line, error) == CommandAction::run);
     std::vector<NamedFile> files = named_files(line);
-    REQUIRE(files.size() == 3);
+    REQUIRE(files.size() == 4);
     CHECK(files[0].path == "in.ply");
     CHECK(files[1].option == "-o");
     CHECK(files[2].path == "r.json");
+    CHECK(files[3].option == "--preview");
+    // The standard streams and options not given name no file.
+    CommandLine streams;
+    const char* dashes[] = {"stratmesh", "-", "-o", "-", "--format", "off"};
+    REQUIRE(parse_command_line(6, dashes, streams, error) == CommandAction::run);
+    CHECK(streams.output_format == MeshFormat::off);
+    CHECK(named_files(streams).empty());
 }
 
 TEST_CASE("an atomic file appears only when committed, keeping the old one until then") {

@@ -15,6 +15,7 @@ namespace {
 
 const char kUsage[] =
     "Usage: stratmesh INPUT -o OUTPUT [options]\n"
+    "       (INPUT - reads standard input; -o - --format F writes standard output)\n"
     "\n"
     "Reconstructs a triangle mesh through the points of a roughly columnar cloud (a head,\n"
     "a limb, a bone, a stem): the cloud is sliced into layers along an axis and each\n"
@@ -22,12 +23,14 @@ const char kUsage[] =
     "\n"
     "Input, recognised by its content (the extension is only a hint):\n"
     "  PLY      ascii, binary_little_endian or binary_big_endian; x, y, z of the vertex\n"
-    "           element (float, double or an integer type); everything else is skipped\n"
+    "           element (float, double or an integer type); its other scalar properties\n"
+    "           go to the output (see --no-attributes); everything else is skipped\n"
     "  XYZ      .xyz .pts .txt .csv: 3 or more numeric columns separated by spaces, tabs\n"
     "           or commas; '#' and '//' comments; a PTS count line is skipped\n"
-    "  OFF, OBJ their vertices; faces are ignored\n"
+    "  OFF, OBJ their vertices; faces are ignored (with a warning that counts them)\n"
+    "  -        standard input, its format recognised the same way\n"
     "\n"
-    "Output, by the extension of OUTPUT:\n"
+    "Output, by the extension of OUTPUT or --format:\n"
     "  .ply binary little-endian (text with --ascii)   .obj  text\n"
     "  .stl binary (text with --ascii)                 .off  text\n"
     "  The output vertices are the input points as read, all of them and in input order,\n"
@@ -36,18 +39,31 @@ const char kUsage[] =
     "  vertices and only lists triangles.\n"
     "\n"
     "Options:\n"
-    "  -o, --output FILE     the mesh to write (required)\n"
+    "  -o, --output FILE     the mesh to write (required); - for standard output\n"
+    "  --format ply|obj|off|stl  the output's format, whatever its extension (required\n"
+    "                        with -o -)\n"
     "  --axis x|y|z|X,Y,Z    the axis the layers are stacked along (default: automatic,\n"
-    "                        the cloud's principal direction); a direction of any finite\n"
-    "                        non-zero length\n"
+    "                        the cloud's principal direction; x or X alike); a direction\n"
+    "                        of any finite non-zero length\n"
     "  --cuts H1,H2,...      cut the layers at these positions along the axis, measured\n"
-    "                        as dot(point, unit axis): with --axis z, 68 is the plane z = 68\n"
+    "                        as dot(point, unit axis): with --axis z, 68 is the plane z = 68;\n"
+    "                        cuts outside the cloud are ignored, with a warning\n"
     "  --layers N            N layers of equal height\n"
     "  --layer-height H      layers about H high\n"
     "                        (at most one of --cuts, --layers, --layer-height; without\n"
     "                        them the layers are chosen automatically)\n"
     "  --report FILE.json    write counts, timings, memory and per-layer details as JSON\n"
+    "  --preview FILE.svg    draw the mesh from the front and the side (orthographic,\n"
+    "                        shaded, the layers in alternating tints, the boundary edges\n"
+    "                        in red): a polygon per triangle and view, about 200 bytes\n"
+    "                        a triangle (not with --stream)\n"
     "  --ascii               text PLY or STL\n"
+    "  --no-attributes       write only the points' coordinates: without it, the other\n"
+    "                        vertex properties of a PLY input (normals, colours,\n"
+    "                        intensity, any scalar; not lists) go with each vertex,\n"
+    "                        unchanged into a PLY output (same names, types and values),\n"
+    "                        the normals (vn) and colours (v x y z r g b, 0 to 1) into\n"
+    "                        OBJ; OFF, STL and --stream carry none\n"
     "  --skip-invalid        skip points with NaN or infinite coordinates (they stay in\n"
     "                        the output, unused) instead of refusing the input\n"
     "  --drop-outliers       leave out points far from the rest of the cloud (stray\n"
@@ -90,7 +106,11 @@ const char kUsage[] =
     "  --stream-points N     the most points the stream may hold at once (default\n"
     "                        3000000, about 190 bytes each; never more than the input\n"
     "                        file can hold); about three layers' worth\n"
-    "  -q, --quiet           no progress and no summary on stderr (errors still are)\n"
+    "  -q, --quiet           no progress and no summary on stderr (warnings and errors\n"
+    "                        still are)\n"
+    "  --verbose             the summary also gives the branches and parts, the threads,\n"
+    "                        the times, the memory and the stream\n"
+    "  --strict              warnings make the exit status 5 (the mesh is still written)\n"
     "  --version             print the version and exit\n"
     "  -h, --help            print this help and exit\n"
     "\n"
@@ -108,9 +128,16 @@ const char kUsage[] =
     "  a smooth tube; where nothing parts the mesh is the one tube's. With --stream the\n"
     "  tool does not look.\n"
     "\n"
+    "Summary, on stderr: the input and output, the points, the layers (asked and used,\n"
+    "and why layers were merged), the triangles and the ends (closed only where no\n"
+    "boundary loop is left; a small loop around a pole is named), then the warnings, each\n"
+    "on a line 'stratmesh: warning: ...': folds, branches wrapped in one tube or left\n"
+    "apart, points left out, caps left open, input faces ignored, cuts outside the cloud.\n"
+    "\n"
     "Exit status: 0 success; 1 the reconstruction refused the input; 2 usage error;\n"
     "3 file error (cannot open, read, parse or write); 4 with --stream, a point lies below\n"
-    "the one before it along the axis (sort the input along the axis first).\n";
+    "the one before it along the axis (sort the input along the axis first); 5 with\n"
+    "--strict, the mesh was written but with warnings.\n";
 
 bool parse_finite(std::string_view text, double& value) {
     return parse_number(text, value) && std::isfinite(value);
@@ -138,8 +165,11 @@ bool parse_axis(std::string_view text, CommandLine& line, std::string& error) {
                  {"z", stratmesh::Axis::z},
                  {"auto", stratmesh::Axis::automatic},
                  {"automatic", stratmesh::Axis::automatic}};
+    std::string lower(text);
+    for (char& c : lower)
+        if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
     for (const auto& n : names) {
-        if (text == n.name) {
+        if (lower == n.name) {
             line.axis = n.axis;
             return true;
         }
@@ -206,6 +236,13 @@ bool parse_origin(std::string_view text, CommandLine& line, std::string& error) 
     return true;
 }
 
+bool parse_format(std::string_view text, CommandLine& line, std::string& error) {
+    line.output_format = mesh_format_from_extension("." + std::string(text));
+    if (line.output_format != MeshFormat::unknown) return true;
+    error = "--format: expected ply, obj, off or stl, not '" + std::string(text) + "'";
+    return false;
+}
+
 bool parse_cuts(std::string_view text, CommandLine& line, std::string& error) {
     if (parse_number_list(text, line.cuts)) return true;
     error = "--cuts: expected numbers separated by commas, not '" + std::string(text) + "'";
@@ -217,6 +254,7 @@ bool apply_valued(std::string_view name, std::string_view value, CommandLine& li
                   std::string& error) {
     if (name == "--output") line.output = std::string(value);
     if (name == "--report") line.report = std::string(value);
+    if (name == "--preview") line.preview = std::string(value);
     if (name == "--axis") return parse_axis(value, line, error);
     if (name == "--cuts") return parse_cuts(value, line, error);
     if (name == "--layers") return parse_layers(value, line, error);
@@ -224,12 +262,14 @@ bool apply_valued(std::string_view name, std::string_view value, CommandLine& li
     if (name == "--threads") return parse_threads(value, line, error);
     if (name == "--stream-points") return parse_stream_points(value, line, error);
     if (name == "--origin") return parse_origin(value, line, error);
+    if (name == "--format") return parse_format(value, line, error);
     if (value.empty()) error = std::string(name) + ": the file name is empty";
     return error.empty();
 }
 
 bool apply_flag(std::string_view name, CommandLine& line) {
     if (name == "--ascii") line.ascii = true;
+    if (name == "--no-attributes") line.no_attributes = true;
     if (name == "--skip-invalid") line.skip_invalid = true;
     if (name == "--cap") line.cap = true;
     if (name == "--drop-outliers") line.drop_outliers = true;
@@ -239,17 +279,21 @@ bool apply_flag(std::string_view name, CommandLine& line) {
     if (name == "--split-branches") line.split_branches = true;
     if (name == "--one-tube") line.one_tube = true;
     if (name == "--quiet") line.quiet = true;
+    if (name == "--verbose") line.verbose = true;
+    if (name == "--strict") line.strict = true;
     if (name == "--stream") line.stream = true;
     return true;
 }
 
 const char* const kValuedOptions[] = {"--output",  "--report",        "--axis",
                                       "--cuts",    "--layers",        "--layer-height",
-                                      "--threads", "--stream-points", "--origin"};
+                                      "--threads", "--stream-points", "--origin",
+                                      "--format",  "--preview"};
 const char* const kFlags[] = {"--ascii", "--skip-invalid", "--cap",     "--quiet",
                               "--help",  "--version",      "--stream", "--drop-outliers",
                               "--surface-flips", "--open-ends", "--branches",
-                              "--split-branches", "--one-tube"};
+                              "--split-branches", "--one-tube", "--verbose", "--strict",
+                              "--no-attributes"};
 
 // What --stream cannot do, or an empty string.
 std::string stream_conflict(const CommandLine& line) {
@@ -265,7 +309,10 @@ std::string stream_conflict(const CommandLine& line) {
     if (line.find_branches || line.split_branches)
         return "--stream cannot find --branches (nor --split-branches): where a cloud parts "
                "is told from all of its points, which the stream never holds";
-    if (mesh_format_from_extension(line.output) == MeshFormat::stl)
+    if (!line.preview.empty())
+        return "--stream cannot --preview: it writes the triangles as they come and keeps "
+               "none to draw";
+    if (line.output_format == MeshFormat::stl)
         return "--stream cannot write STL (its triangles repeat their corners' coordinates, "
                "which the stream no longer holds): write PLY, OBJ or OFF";
     return "";
@@ -322,8 +369,10 @@ private:
     }
 
     void take_input(std::string_view arg) {
-        if (!line_.input.empty())
-            fail("more than one input file ('" + line_.input + "' and '" + std::string(arg) + "')");
+        if (!line_.input.empty()) {
+            if (extra_input_.empty()) extra_input_ = std::string(arg);
+            return;
+        }
         line_.input = std::string(arg);
     }
 
@@ -365,10 +414,25 @@ private:
         int layer_choices = (line_.cuts.empty() ? 0 : 1) + (line_.layer_count ? 1 : 0) +
                             (line_.layer_height > 0 ? 1 : 0);
         if (line_.input.empty()) return fail("no input file");
+        if (!extra_input_.empty()) {
+            // Two file names and no -o: most likely the output's -o was left out.
+            const std::string hint = line_.output.empty() ? "; did you mean: stratmesh " +
+                                                                line_.input + " -o " +
+                                                                extra_input_ + "?"
+                                                          : "";
+            return fail("more than one input file ('" + line_.input + "' and '" +
+                        extra_input_ + "')" + hint);
+        }
         if (line_.output.empty()) return fail("no output file (use -o OUTPUT)");
-        if (mesh_format_from_extension(line_.output) == MeshFormat::unknown)
+        if (line_.output_format == MeshFormat::unknown && line_.output == "-")
+            return fail("-o - writes to standard output: give its format with --format "
+                        "ply|obj|off|stl");
+        if (line_.output_format == MeshFormat::unknown)
+            line_.output_format = mesh_format_from_extension(line_.output);
+        if (line_.output_format == MeshFormat::unknown)
             return fail("cannot tell the mesh format of '" + line_.output +
-                        "' from its extension (use .ply, .obj, .off or .stl)");
+                        "' from its extension (use .ply, .obj, .off or .stl, or --format)");
+        if (line_.quiet && line_.verbose) return fail("give at most one of --quiet and --verbose");
         if (layer_choices > 1)
             return fail("give at most one of --cuts, --layers and --layer-height");
         if (int(line_.find_branches) + int(line_.split_branches) + int(line_.one_tube) > 1)
@@ -384,6 +448,7 @@ private:
     bool help_ = false;
     bool version_ = false;
     std::string seen_; // " --name " for each valued option seen
+    std::string extra_input_; // the first file name after the input, if any
     std::string error_;
 };
 
@@ -395,7 +460,14 @@ CommandAction parse_command_line(int argc, const char* const* argv, CommandLine&
 }
 
 std::vector<NamedFile> named_files(const CommandLine& line) {
-    return {{"the input", line.input}, {"-o", line.output}, {"--report", line.report}};
+    // Options not given name nothing, and "-" (the standard streams) is no file that
+    // another name can clobber.
+    std::vector<NamedFile> files;
+    const NamedFile all[] = {{"the input", line.input}, {"-o", line.output},
+                             {"--report", line.report}, {"--preview", line.preview}};
+    for (const NamedFile& file : all)
+        if (!file.path.empty() && file.path != kStandardStream) files.push_back(file);
+    return files;
 }
 
 const char* usage_text() { return kUsage; }

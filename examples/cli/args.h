@@ -2,6 +2,7 @@
 #ifndef STRATMESH_CLI_ARGS_H
 #define STRATMESH_CLI_ARGS_H
 
+#include "mesh_io.h"
 #include "safe_output.h"
 #include "stratmesh.h"
 
@@ -12,15 +13,19 @@
 namespace stratmesh_cli {
 
 struct CommandLine {
-    std::string input;
-    std::string output;
+    std::string input;  // "-": standard input
+    std::string output; // "-": standard output
+    // From --format, else from the output's extension (--format is required with -o -).
+    MeshFormat output_format = MeshFormat::unknown;
     std::string report; // --report, empty if not given
+    std::string preview; // --preview FILE.svg, empty if not given
     stratmesh::Axis axis = stratmesh::Axis::automatic;
     double direction[3] = {0, 0, 0}; // with Axis::direction
     std::vector<double> cuts;        // --cuts
     uint32_t layer_count = 0;        // --layers, 0 if not given
     double layer_height = 0;         // --layer-height, 0 if not given
     bool ascii = false;
+    bool no_attributes = false;    // --no-attributes: write the points' coordinates only
     bool skip_invalid = false;
     bool cap = false;              // --cap: close the ends (stratmesh::close_ends)
     bool drop_outliers = false;    // --drop-outliers (stratmesh::drop_outliers)
@@ -32,7 +37,9 @@ struct CommandLine {
     bool find_branches = false;    // --branches: only find and report where it parts
     bool split_branches = false;   // --split-branches: keep the parts, joined or apart
     bool one_tube = false;         // --one-tube: do not look; one tube through every point
-    bool quiet = false;
+    bool quiet = false;             // no summary (warnings and errors still)
+    bool verbose = false;           // --verbose: timings, memory and details in the summary
+    bool strict = false;            // --strict: warnings give an exit status of their own
     uint32_t threads = 1;           // --threads (default: the hardware's threads, at least 1)
     bool stream = false;            // --stream: read and reconstruct layer by layer
     uint64_t stream_points = 3000000; // --stream-points: the most points the stream holds
@@ -48,8 +55,8 @@ enum class CommandAction { run, help, version, usage_error };
 CommandAction parse_command_line(int argc, const char* const* argv, CommandLine& line,
                                  std::string& error);
 
-// The files the command line names, the input first, each with how the command line names
-// it: what check_distinct_files (safe_output.h) compares.
+// The files the command line names (not "-", the standard streams), the input first, each
+// with how the command line names it: what check_distinct_files (safe_output.h) compares.
 std::vector<NamedFile> named_files(const CommandLine& line);
 
 // The --help text.

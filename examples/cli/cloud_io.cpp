@@ -2,6 +2,7 @@
 
 #include "cloud_readers.h"
 #include "path_util.h"
+#include "safe_output.h"
 #include "text_scan.h"
 
 #include <cerrno>
@@ -45,12 +46,13 @@ CloudFormat detect_text_format(std::string_view text) {
 }
 
 bool dispatch(std::string_view data, CloudFormat format, std::vector<double>& xyz,
-              std::string& error, std::string& encoding, uint64_t& faces) {
+              std::string& error, std::string& encoding, uint64_t& faces,
+              PointAttributes* attributes) {
     encoding = "text";
     faces = 0;
     const std::string_view text = skip_byte_order_mark(data);
     switch (format) {
-    case CloudFormat::ply: return read_ply(data, xyz, error, encoding, faces);
+    case CloudFormat::ply: return read_ply(data, xyz, error, encoding, faces, attributes);
     case CloudFormat::off: return read_off(text, xyz, error, faces);
     case CloudFormat::obj: return read_obj(text, xyz, error, faces);
     case CloudFormat::xyz:
@@ -62,12 +64,41 @@ bool dispatch(std::string_view data, CloudFormat format, std::vector<double>& xy
 // The file's size as the file system reports it, to allocate the buffer once; 0 if
 // unknown. Only a hint: reading stops at the real end whatever it says.
 size_t size_hint(const std::string& path) {
+    if (path == kStandardStream) return 0;
     std::error_code error;
     uintmax_t size = std::filesystem::file_size(path, error);
     return error || size > SIZE_MAX / 2 ? 0 : static_cast<size_t>(size);
 }
 
 } // namespace
+
+int PointAttributes::find(const std::string& name) const {
+    for (size_t k = 0; k < properties.size(); ++k)
+        if (properties[k].name == name) return static_cast<int>(k);
+    return -1;
+}
+
+double PointAttributes::value(size_t point, size_t property) const {
+    const Property& p = properties[property];
+    const unsigned char* at = bytes.data() + point * record_bytes + p.offset;
+    uint64_t bits = 0;
+    for (size_t i = 0; i < p.size; ++i) bits |= uint64_t{at[i]} << (8 * i);
+    if (!p.integral) {
+        if (p.size == 4) {
+            const uint32_t narrow = static_cast<uint32_t>(bits);
+            float f = 0;
+            std::memcpy(&f, &narrow, sizeof f);
+            return static_cast<double>(f);
+        }
+        double d = 0;
+        std::memcpy(&d, &bits, sizeof d);
+        return d;
+    }
+    const unsigned shift = static_cast<unsigned>(64 - 8 * p.size);
+    if (p.is_signed) // sign-extended from its top bit
+        return static_cast<double>(static_cast<int64_t>(bits << shift) >> shift);
+    return static_cast<double>(bits);
+}
 
 const char* cloud_format_name(CloudFormat format) {
     switch (format) {
@@ -105,7 +136,9 @@ bool read_cloud_from_memory(const char* data, size_t size, CloudFormat format,
     if (format == CloudFormat::automatic) format = detect_cloud_format(data, size);
     std::string encoding;
     uint64_t faces = 0;
-    bool ok = dispatch(std::string_view(data, size), format, xyz, error, encoding, faces);
+    PointAttributes* attributes = info && info->keep_attributes ? &info->attributes : nullptr;
+    bool ok = dispatch(std::string_view(data, size), format, xyz, error, encoding, faces,
+                       attributes);
     if (info) {
         info->format = format;
         info->encoding = encoding;
@@ -116,7 +149,8 @@ bool read_cloud_from_memory(const char* data, size_t size, CloudFormat format,
 
 bool read_file_bytes(const std::string& path, BigBuffer& bytes, size_t& size, std::string& error) {
     size = 0;
-    std::FILE* file = std::fopen(path.c_str(), "rb");
+    const bool standard_input = path == kStandardStream;
+    std::FILE* file = standard_input ? stdin : std::fopen(path.c_str(), "rb");
     if (!file) {
         error = "cannot open: " + std::string(std::strerror(errno));
         return false;
@@ -135,7 +169,7 @@ bool read_file_bytes(const std::string& path, BigBuffer& bytes, size_t& size, st
     }
     failed = failed || std::ferror(file) != 0;
     const int failure = errno;
-    std::fclose(file);
+    if (!standard_input) std::fclose(file);
     if (!failed) return true;
     error = "cannot read: " + std::string(std::strerror(failure));
     return false;
@@ -148,15 +182,19 @@ bool read_cloud_file(const std::string& path, std::vector<double>& xyz, std::str
     bool ok = read_file_bytes(path, bytes, size, error) &&
               read_cloud_from_memory(bytes.data(), size, CloudFormat::automatic, xyz, error,
                                      info);
-    if (!ok) error = path + ": " + error;
+    if (!ok) error = display_name(path) + ": " + error;
     return ok;
+}
+
+std::string display_name(const std::string& path) {
+    return path == kStandardStream ? "standard input" : path;
 }
 
 std::unique_ptr<PointReader> open_point_reader(const std::string& path, CloudInfo& info,
                                                std::string& error) {
     // Enough to detect any format (detect_cloud_format looks at 200 lines at most).
     const size_t kDetectBytes = 1 << 16;
-    std::FILE* opened = std::fopen(path.c_str(), "rb");
+    std::FILE* opened = path == kStandardStream ? stdin : std::fopen(path.c_str(), "rb");
     if (!opened) {
         error = path + ": cannot open: " + std::strerror(errno);
         return nullptr;
@@ -179,7 +217,8 @@ std::unique_ptr<PointReader> open_point_reader(const std::string& path, CloudInf
         // ("1 2 3"), an OBJ vertex two characters more ("v 1 2 3"), and a line end but on
         // the last line.
         std::error_code failed;
-        const bool regular = std::filesystem::is_regular_file(path, failed);
+        const bool regular =
+            path != kStandardStream && std::filesystem::is_regular_file(path, failed);
         const uintmax_t bytes = regular ? std::filesystem::file_size(path, failed) : 0;
         if (regular && !failed)
             info.point_limit = bytes / (info.format == CloudFormat::obj ? 8 : 6) + 1;
@@ -187,7 +226,7 @@ std::unique_ptr<PointReader> open_point_reader(const std::string& path, CloudInf
             file->skip(kByteOrderMark.size());
         reader = open_text_points(std::move(file), info.format == CloudFormat::obj);
     }
-    if (!reader) error = path + ": " + error;
+    if (!reader) error = display_name(path) + ": " + error;
     return reader;
 }
 

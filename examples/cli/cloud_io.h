@@ -40,6 +40,29 @@ CloudFormat cloud_format_from_extension(const std::string& path);
 // else is taken for numeric columns (XYZ).
 CloudFormat detect_cloud_format(const char* data, size_t size);
 
+// The input's per-point data besides x, y, z: a PLY vertex element's other scalar
+// properties (normals, colours, intensity, any scalar), kept as their raw bytes so that the
+// writers carry them over unchanged. List properties are not kept.
+struct PointAttributes {
+    struct Property {
+        std::string name;
+        std::string type;   // the PLY type name ("uchar", "float", ...)
+        size_t size = 0;    // bytes
+        size_t offset = 0;  // within a record
+        bool integral = false, is_signed = false;
+    };
+    std::vector<Property> properties;
+    size_t record_bytes = 0;          // the properties' sizes added up
+    std::vector<unsigned char> bytes; // a record per point, in point order, little-endian
+    uint64_t lists_dropped = 0;       // list properties of the vertex element, not kept
+
+    bool empty() const { return properties.empty(); }
+    // The property's index, or -1.
+    int find(const std::string& name) const;
+    // The value of property `property` of point `point`, as a double (exact for every type).
+    double value(size_t point, size_t property) const;
+};
+
 struct CloudInfo {
     CloudFormat format = CloudFormat::automatic; // the format actually read
     std::string encoding; // PLY: "ascii", "binary_little_endian", "binary_big_endian"
@@ -49,6 +72,9 @@ struct CloudInfo {
     uint64_t point_limit = UINT64_MAX;
     // Faces in the file (OFF, OBJ, a PLY 'face' element), which the cloud leaves out.
     uint64_t faces_ignored = 0;
+    // Set by the caller: keep the per-point data in `attributes` (whole-file PLY only).
+    bool keep_attributes = false;
+    PointAttributes attributes;
 };
 
 // Parses a whole file image. `format` automatic detects it from the content; any other
@@ -58,10 +84,13 @@ bool read_cloud_from_memory(const char* data, size_t size, CloudFormat format,
                             std::vector<double>& xyz, std::string& error,
                             CloudInfo* info = nullptr);
 
-// Reads a whole file into `bytes` (its pages faulted in at once, big_buffer.h), its length
-// into `size`: one request for a regular file whose size does not change, a buffer doubling
-// as the bytes arrive otherwise.
+// Reads a whole file ("-": standard input) into `bytes` (its pages faulted in at once,
+// big_buffer.h), its length into `size`: one request for a regular file whose size does
+// not change, a buffer doubling as the bytes arrive otherwise.
 bool read_file_bytes(const std::string& path, BigBuffer& bytes, size_t& size, std::string& error);
+
+// How messages name an input: "standard input" for "-", else the path.
+std::string display_name(const std::string& path);
 
 // read_file_bytes + read_cloud_from_memory with the format detected from the content (the
 // content wins over a misleading extension). Errors start with the path.
@@ -83,8 +112,8 @@ public:
     virtual uint64_t faces_ignored() const { return 0; }
 };
 
-// Opens `path` for reading point by point, with the format detected from its first
-// block; null with `error` (starting with the path) if it cannot.
+// Opens `path` ("-": standard input) for reading point by point, with the format detected
+// from its first block; null with `error` (starting with the path) if it cannot.
 std::unique_ptr<PointReader> open_point_reader(const std::string& path, CloudInfo& info,
                                                std::string& error);
 

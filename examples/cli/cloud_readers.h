@@ -16,8 +16,9 @@ namespace stratmesh_cli {
 // file holds (and the reader skips). read_ply takes the whole file, a byte-order mark
 // included (its byte offsets count from the file's start); the text readers take the
 // text after any byte-order mark.
+// `attributes`, if given, receives the vertex element's other scalar properties.
 bool read_ply(std::string_view data, std::vector<double>& xyz, std::string& error,
-              std::string& encoding, uint64_t& faces);
+              std::string& encoding, uint64_t& faces, PointAttributes* attributes);
 bool read_xyz(std::string_view data, std::vector<double>& xyz, std::string& error);
 bool read_off(std::string_view data, std::vector<double>& xyz, std::string& error,
               uint64_t& faces);

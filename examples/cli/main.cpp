@@ -7,8 +7,10 @@
 #include "args.h"
 #include "cloud_io.h"
 #include "frame_check.h"
+#include "mesh_ends.h"
 #include "mesh_io.h"
 #include "peak_memory.h"
+#include "preview.h"
 #include "progress.h"
 #include "report_json.h"
 #include "safe_output.h"
@@ -46,6 +48,7 @@ const int kExitRefused = 1;
 const int kExitUsage = 2;
 const int kExitFile = 3;
 const int kExitUnsorted = 4;
+const int kExitWarned = 5; // --strict: the mesh is written, with warnings
 
 // Progress is drawn for inputs this large, when stderr is a terminal.
 const size_t kProgressPoints = 200000;
@@ -70,7 +73,7 @@ template <class T> std::unique_ptr<T, FreeDeleter> allocate(size_t count) {
 }
 
 void record_command_line(const CommandLine& line, RunRecord& record) {
-    MeshFormat format = mesh_format_from_extension(line.output);
+    MeshFormat format = line.output_format;
     record.input_path = line.input;
     record.output_path = line.output;
     record.output_format = mesh_format_name(format);
@@ -129,9 +132,14 @@ size_t layer_capacity(const CommandLine& line, size_t points) {
     return asked < most ? asked : most;
 }
 
-bool read_input(const CommandLine& line, std::vector<double>& xyz, RunRecord& record) {
+// Reads the points and, unless --no-attributes or the output carries none, their other
+// data into `attributes`.
+bool read_input(const CommandLine& line, std::vector<double>& xyz, PointAttributes& attributes,
+                RunRecord& record) {
     Clock::time_point start = Clock::now();
     CloudInfo info;
+    info.keep_attributes = !line.no_attributes && (line.output_format == MeshFormat::ply ||
+                                                   line.output_format == MeshFormat::obj);
     std::string error;
     if (!read_cloud_file(line.input, xyz, error, &info)) {
         std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
@@ -141,6 +149,9 @@ bool read_input(const CommandLine& line, std::vector<double>& xyz, RunRecord& re
     record.input_format = cloud_format_name(info.format);
     record.input_encoding = info.encoding;
     record.input_faces_ignored = info.faces_ignored;
+    attributes = std::move(info.attributes);
+    record.point_properties = attributes.properties.size();
+    record.point_properties_carried = carried_attributes(&attributes, line.output_format);
     CloudFormat named = cloud_format_from_extension(line.input);
     if (!line.quiet && named != CloudFormat::automatic && named != info.format)
         std::fprintf(stderr, "stratmesh: note: %s holds %s, not %s; read as %s\n",
@@ -291,7 +302,7 @@ void name_far_point(const std::vector<double>& xyz) {
 }
 
 void explain_refusal(const CommandLine& line, const RunRecord& record) {
-    std::fprintf(stderr, "stratmesh: cannot reconstruct %s: %s\n", line.input.c_str(),
+    std::fprintf(stderr, "stratmesh: cannot reconstruct %s: %s\n", display_name(line.input).c_str(),
                  stratmesh::status_string(record.status));
     if (record.status == stratmesh::Status::invalid_point)
         std::fprintf(stderr,
@@ -309,6 +320,68 @@ void explain_refusal(const CommandLine& line, const RunRecord& record) {
                      static_cast<unsigned long long>(record.stream_points));
 }
 
+// The valid points' range along the axis used, the cuts given outside it, and with layers
+// from the options, how many of the layers planned as the library plans them (Options:
+// the cuts inside the range, or equal heights) hold fewer than kFewestLayerPoints points.
+// Counted over the valid points as given: duplicates and outliers, which the library
+// leaves out first, count too.
+void measure_along_axis(const std::vector<double>& xyz, RunRecord& record) {
+    const bool layers_asked = !record.cuts.empty() || record.layer_count > 0 ||
+                              record.layer_height > 0;
+    if (!layers_asked) return;
+    const double* axis = record.report.axis;
+    std::vector<double> heights;
+    heights.reserve(xyz.size() / 3);
+    for (size_t i = 0; i + 2 < xyz.size(); i += 3) {
+        const double h = xyz[i] * axis[0] + xyz[i + 1] * axis[1] + xyz[i + 2] * axis[2];
+        if (std::isfinite(h)) heights.push_back(h);
+    }
+    if (heights.empty()) return;
+    std::sort(heights.begin(), heights.end());
+    const double low = heights.front(), high = heights.back();
+    record.range_known = true;
+    record.range_low = low;
+    record.range_high = high;
+    std::vector<double> bounds = {low};
+    if (!record.cuts.empty()) {
+        std::vector<double> cuts = record.cuts;
+        std::sort(cuts.begin(), cuts.end());
+        for (double cut : cuts) {
+            if (cut < low || cut > high) record.cuts_outside.push_back(cut);
+            else if (cut > bounds.back() && cut < high) bounds.push_back(cut);
+        }
+    } else {
+        double count = record.layer_count > 0 ? record.layer_count
+                                              : std::ceil((high - low) / record.layer_height);
+        count = std::max(1.0, std::min(count, static_cast<double>(heights.size())));
+        const size_t layers = static_cast<size_t>(count);
+        for (size_t k = 1; k < layers; ++k)
+            bounds.push_back(low + (high - low) * (static_cast<double>(k) / count));
+    }
+    bounds.push_back(high);
+    for (size_t k = 0; k + 1 < bounds.size(); ++k) {
+        const auto first = std::lower_bound(heights.begin(), heights.end(), bounds[k]);
+        const auto stop = k + 2 == bounds.size()
+                              ? heights.end()
+                              : std::lower_bound(heights.begin(), heights.end(), bounds[k + 1]);
+        if (stop - first < static_cast<std::ptrdiff_t>(kFewestLayerPoints))
+            ++record.sparse_planned_layers;
+    }
+}
+
+// With --preview: the picture of the mesh, written whole or not at all.
+bool write_preview(const CommandLine& line, const std::vector<double>& xyz,
+                   const Reconstruction& result, const RunRecord& record) {
+    if (line.preview.empty()) return true;
+    const MeshView mesh = {xyz.data(), xyz.size() / 3, result.triangles.get(),
+                           result.triangle_count};
+    std::string error;
+    if (write_preview_svg(line.preview, mesh, record.report.axis, record.layers, error))
+        return true;
+    std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
+    return false;
+}
+
 bool write_report(const CommandLine& line, const RunRecord& record) {
     if (line.report.empty()) return true;
     std::string error;
@@ -318,12 +391,13 @@ bool write_report(const CommandLine& line, const RunRecord& record) {
 }
 
 bool write_output(const CommandLine& line, const std::vector<double>& xyz,
-                  const Reconstruction& result, RunRecord& record) {
+                  const PointAttributes& attributes, const Reconstruction& result,
+                  RunRecord& record) {
     Clock::time_point start = Clock::now();
-    MeshView mesh = {xyz.data(), xyz.size() / 3, result.triangles.get(), result.triangle_count};
+    MeshView mesh = {xyz.data(), xyz.size() / 3, result.triangles.get(), result.triangle_count,
+                     &attributes};
     std::string error;
-    if (!write_mesh_file(line.output, mesh_format_from_extension(line.output), mesh, line.ascii,
-                         error)) {
+    if (!write_mesh_file(line.output, line.output_format, mesh, line.ascii, error)) {
         std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
         return false;
     }
@@ -332,23 +406,20 @@ bool write_output(const CommandLine& line, const std::vector<double>& xyz,
     return true;
 }
 
-// The input's faces, which the cloud leaves out.
-void warn_faces_ignored(const CommandLine& line, const RunRecord& record) {
-    if (line.quiet || record.input_faces_ignored == 0) return;
-    std::fprintf(stderr, "stratmesh: warning: %llu faces in %s ignored\n",
-                 static_cast<unsigned long long>(record.input_faces_ignored), line.input.c_str());
-}
-
-// Prints the summary and writes the report of a run whose mesh is written.
+// Prints the summary (not with --quiet) and the warnings (always), and writes the report
+// of a run whose mesh is written.
 int finish_run(const CommandLine& line, RunRecord& record) {
     record.peak_rss_bytes = peak_resident_bytes();
-    warn_faces_ignored(line, record);
-    if (!line.quiet) print_summary(stderr, record);
-    return write_report(line, record) ? kExitOk : kExitFile;
+    const std::vector<std::string> warnings = run_warnings(record);
+    if (!line.quiet) print_summary(stderr, record, warnings.size(), line.verbose);
+    print_warnings(stderr, warnings);
+    if (!write_report(line, record)) return kExitFile;
+    return line.strict && !warnings.empty() ? kExitWarned : kExitOk;
 }
 
 int refuse(const CommandLine& line, RunRecord& record, const std::vector<double>& xyz) {
-    warn_faces_ignored(line, record);
+    const std::string faces = faces_warning(record);
+    if (!faces.empty()) print_warnings(stderr, {faces});
     explain_refusal(line, record);
     if (record.status == stratmesh::Status::not_columnar ||
         record.status == stratmesh::Status::degenerate)
@@ -371,7 +442,7 @@ int run_streamed(const CommandLine& line, RunRecord& record) {
         std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
         return kExitUsage;
     case StreamOutcome::unsorted:
-        std::fprintf(stderr, "stratmesh: %s: %s\n", line.input.c_str(), error.c_str());
+        std::fprintf(stderr, "stratmesh: %s: %s\n", display_name(line.input).c_str(), error.c_str());
         return kExitUnsorted;
     }
     std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
@@ -388,13 +459,18 @@ int run(const CommandLine& line) {
     record_command_line(line, record);
     if (line.stream) return run_streamed(line, record);
     std::vector<double> xyz;
+    PointAttributes attributes;
     Reconstruction result;
-    if (!read_input(line, xyz, record)) return kExitFile;
+    if (!read_input(line, xyz, attributes, record)) return kExitFile;
     if (line.origin_given && !origin_in_reach(line, xyz)) return kExitUsage;
     if (line.find_branches && !find_branches(xyz, line, record)) return kExitRefused;
     if (!reconstruct_points(xyz, line, result, record)) return kExitRefused;
     if (record.status != stratmesh::Status::ok) return refuse(line, record, xyz);
-    if (!write_output(line, xyz, result, record)) return kExitFile;
+    measure_along_axis(xyz, record);
+    record.ends = find_surface_ends(xyz.data(), result.triangles.get(), result.triangle_count,
+                                    record.report.axis, record.layers);
+    if (!write_output(line, xyz, attributes, result, record)) return kExitFile;
+    if (!write_preview(line, xyz, result, record)) return kExitFile;
     return finish_run(line, record);
 }
 

@@ -185,7 +185,8 @@ const char* generator_comment() {
 
 // ---- formats -----------------------------------------------------------------------------
 
-std::string ply_header(size_t vertex_count, size_t triangle_count, bool ascii, bool single) {
+std::string ply_header(size_t vertex_count, size_t triangle_count, bool ascii, bool single,
+                       const PointAttributes* attributes = nullptr) {
     const char* type = single ? "float" : "double";
     std::string out = "ply\nformat ";
     out += ascii ? "ascii" : "binary_little_endian";
@@ -194,9 +195,26 @@ std::string ply_header(size_t vertex_count, size_t triangle_count, bool ascii, b
     out += "\nelement vertex " + std::to_string(vertex_count) + "\n";
     for (const char* axis : {"x", "y", "z"})
         out += std::string("property ") + type + " " + axis + "\n";
+    if (attributes)
+        for (const PointAttributes::Property& p : attributes->properties)
+            out += "property " + p.type + " " + p.name + "\n";
     out += "element face " + std::to_string(triangle_count) + "\n";
     out += "property list uchar uint vertex_indices\nend_header\n";
     return out;
+}
+
+// The point's coordinates, then its attribute record as it was read (little-endian).
+void put_binary_vertices_with(BlockWriter& w, const double* xyz, size_t count, bool single,
+                              const PointAttributes& attributes) {
+    const size_t record = attributes.record_bytes;
+    const unsigned char* bytes = attributes.bytes.data();
+    put_records(w, count, 24 + record, [=](char* out, size_t i) {
+        for (size_t k = 0; k < 3; ++k)
+            out = single ? put_le_float(out, static_cast<float>(xyz[3 * i + k]))
+                         : put_le_double(out, xyz[3 * i + k]);
+        std::memcpy(out, bytes + i * record, record);
+        return out + record;
+    });
 }
 
 void put_binary_vertices(BlockWriter& w, const double* xyz, size_t count, bool single) {
@@ -257,16 +275,103 @@ void put_face_lines(BlockWriter& w, const uint32_t* triangles, size_t count,
     });
 }
 
+// An attribute's value as text: integers whole, floats in the shortest digits that read
+// back as the same float, doubles as the same double.
+char* put_attribute(char* out, const PointAttributes& attributes, size_t point, size_t property) {
+    const PointAttributes::Property& p = attributes.properties[property];
+    const double value = attributes.value(point, property);
+    if (p.integral) return std::to_chars(out, out + kNumberBytes, static_cast<int64_t>(value)).ptr;
+    if (p.size == 4) return std::to_chars(out, out + kNumberBytes, static_cast<float>(value)).ptr;
+    return put_number(out, value);
+}
+
+// Text PLY vertex lines with the attributes after the coordinates.
+void put_ply_vertex_lines_with(BlockWriter& w, const double* xyz, size_t count,
+                               const PointAttributes& attributes) {
+    const size_t values = attributes.properties.size();
+    const size_t most = (3 + values) * (kNumberBytes + 1) + 1;
+    put_records(w, count, most, [&](char* out, size_t i) {
+        out = put_point(out, xyz + 3 * i);
+        for (size_t k = 0; k < values; ++k) {
+            *out++ = ' ';
+            out = put_attribute(out, attributes, i, k);
+        }
+        *out++ = '\n';
+        return out;
+    });
+}
+
 void write_ply(BlockWriter& w, const MeshView& mesh, bool ascii) {
     bool single = !ascii && all_coordinates_are_floats(mesh.xyz, mesh.vertex_count);
-    w.append(ply_header(mesh.vertex_count, mesh.triangle_count, ascii, single));
+    const PointAttributes* attributes =
+        mesh.attributes && !mesh.attributes->empty() ? mesh.attributes : nullptr;
+    w.append(ply_header(mesh.vertex_count, mesh.triangle_count, ascii, single, attributes));
     if (ascii) {
-        put_vertex_lines(w, mesh.xyz, mesh.vertex_count, kOffStyle);
+        if (attributes)
+            put_ply_vertex_lines_with(w, mesh.xyz, mesh.vertex_count, *attributes);
+        else
+            put_vertex_lines(w, mesh.xyz, mesh.vertex_count, kOffStyle);
         put_face_lines(w, mesh.triangles, mesh.triangle_count, kOffStyle);
     } else {
-        put_binary_vertices(w, mesh.xyz, mesh.vertex_count, single);
+        if (attributes)
+            put_binary_vertices_with(w, mesh.xyz, mesh.vertex_count, single, *attributes);
+        else
+            put_binary_vertices(w, mesh.xyz, mesh.vertex_count, single);
         put_binary_faces(w, mesh.triangles, mesh.triangle_count);
     }
+}
+
+// ---- OBJ with normals and colours -----------------------------------------------------------
+
+// A colour channel's scale to OBJ's 0 to 1: integers over their type's largest value.
+double channel_scale(const PointAttributes::Property& p) {
+    if (!p.integral) return 1;
+    return static_cast<double>((uint64_t{1} << (8 * p.size - (p.is_signed ? 1 : 0))) - 1);
+}
+
+void write_obj_with(BlockWriter& w, const MeshView& mesh, const ObjAttributes& obj) {
+    const PointAttributes& a = *mesh.attributes;
+    const bool colours = obj.colour[0] >= 0;
+    const bool normals = obj.normal[0] >= 0;
+    double scale[3] = {1, 1, 1};
+    if (colours)
+        for (size_t k = 0; k < 3; ++k)
+            scale[k] = channel_scale(a.properties[static_cast<size_t>(obj.colour[k])]);
+    put_records(w, mesh.vertex_count, 2 + 6 * (kNumberBytes + 1) + 1, [&](char* out, size_t i) {
+        out = put_point(put_text(out, "v "), mesh.xyz + 3 * i);
+        for (size_t k = 0; colours && k < 3; ++k) {
+            *out++ = ' ';
+            out = put_number(out, a.value(i, static_cast<size_t>(obj.colour[k])) / scale[k]);
+        }
+        *out++ = '\n';
+        return out;
+    });
+    if (normals) {
+        put_records(w, mesh.vertex_count, 3 + 3 * (kNumberBytes + 1) + 1, [&](char* out, size_t i) {
+            out = put_text(out, "vn");
+            for (size_t k = 0; k < 3; ++k) {
+                *out++ = ' ';
+                out = put_number(out, a.value(i, static_cast<size_t>(obj.normal[k])));
+            }
+            *out++ = '\n';
+            return out;
+        });
+    }
+    // With normals each corner names its normal, the vertex's own: "f 1//1 2//2 3//3".
+    put_records(w, mesh.triangle_count, 1 + 3 * (2 * kIndexBytes + 3) + 1,
+                [&](char* out, size_t t) {
+                    *out++ = 'f';
+                    for (size_t k = 0; k < 3; ++k) {
+                        const uint64_t index = uint64_t{mesh.triangles[3 * t + k]} + 1;
+                        *out++ = ' ';
+                        out = put_index(out, index);
+                        if (!normals) continue;
+                        out = put_text(out, "//");
+                        out = put_index(out, index);
+                    }
+                    *out++ = '\n';
+                    return out;
+                });
 }
 
 std::string obj_header() { return std::string("# ") + generator_comment() + "\n"; }
@@ -359,7 +464,10 @@ void write_body(BlockWriter& w, MeshFormat format, const MeshView& mesh, bool as
     case MeshFormat::ply: write_ply(w, mesh, ascii); break;
     case MeshFormat::obj:
         w.append(obj_header());
-        write_text_mesh(w, mesh, kObjStyle);
+        if (const ObjAttributes obj = obj_attributes(mesh.attributes); obj.carried() > 0)
+            write_obj_with(w, mesh, obj);
+        else
+            write_text_mesh(w, mesh, kObjStyle);
         break;
     case MeshFormat::off:
         w.append(off_header(mesh.vertex_count, mesh.triangle_count));
@@ -376,6 +484,30 @@ void write_body(BlockWriter& w, MeshFormat format, const MeshView& mesh, bool as
 }
 
 } // namespace
+
+ObjAttributes obj_attributes(const PointAttributes* attributes) {
+    ObjAttributes obj;
+    if (!attributes) return obj;
+    const char* const normals[3] = {"nx", "ny", "nz"};
+    const char* const colours[3] = {"red", "green", "blue"};
+    int normal[3], colour[3];
+    for (size_t k = 0; k < 3; ++k) {
+        normal[k] = attributes->find(normals[k]);
+        colour[k] = attributes->find(colours[k]);
+    }
+    if (normal[0] >= 0 && normal[1] >= 0 && normal[2] >= 0)
+        for (size_t k = 0; k < 3; ++k) obj.normal[k] = normal[k];
+    if (colour[0] >= 0 && colour[1] >= 0 && colour[2] >= 0)
+        for (size_t k = 0; k < 3; ++k) obj.colour[k] = colour[k];
+    return obj;
+}
+
+size_t carried_attributes(const PointAttributes* attributes, MeshFormat format) {
+    if (!attributes) return 0;
+    if (format == MeshFormat::ply) return attributes->properties.size();
+    if (format == MeshFormat::obj) return obj_attributes(attributes).carried();
+    return 0;
+}
 
 const char* mesh_format_name(MeshFormat format) {
     switch (format) {

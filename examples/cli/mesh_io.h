@@ -10,8 +10,15 @@
 // the same double (which also read back as the same float when the value is one). Binary
 // PLY stores float when every coordinate is exactly a float (as after reading float
 // data), double otherwise. Binary STL is float by definition.
+//
+// The input's per-point data (PointAttributes, from a PLY input) goes with its vertex: into
+// a PLY output whole (the same names, types and values), into OBJ only the normals (nx, ny,
+// nz as vn lines) and colours (red, green, blue after the coordinates, scaled to 0..1);
+// OFF and STL carry none.
 #ifndef STRATMESH_CLI_MESH_IO_H
 #define STRATMESH_CLI_MESH_IO_H
+
+#include "cloud_io.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -34,7 +41,23 @@ struct MeshView {
     size_t vertex_count;
     const uint32_t* triangles; // 3 * triangle_count indices below vertex_count
     size_t triangle_count;
+    const PointAttributes* attributes = nullptr; // per vertex, or null
 };
+
+// Which attributes an OBJ output carries: the indices of nx, ny, nz and of red, green,
+// blue in PointAttributes (-1 where the input has not all three).
+struct ObjAttributes {
+    int normal[3] = {-1, -1, -1};
+    int colour[3] = {-1, -1, -1};
+    size_t carried() const {
+        return (normal[0] >= 0 ? size_t{3} : size_t{0}) + (colour[0] >= 0 ? size_t{3} : size_t{0});
+    }
+};
+ObjAttributes obj_attributes(const PointAttributes* attributes);
+
+// How many of the attributes the format carries (all for PLY, the normals and colours for
+// OBJ, none for OFF and STL).
+size_t carried_attributes(const PointAttributes* attributes, MeshFormat format);
 
 // True if every coordinate converts to float and back unchanged (NaN and infinities too).
 bool all_coordinates_are_floats(const double* xyz, size_t count);

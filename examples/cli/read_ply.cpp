@@ -1,6 +1,7 @@
-// PLY reader: ascii, binary_little_endian and binary_big_endian. Only the vertex element's
-// x, y and z are kept; every other property and element is stepped over, so normals,
-// colours, intensities and faces (before or after the vertices) do no harm. Stepped over
+// PLY reader: ascii, binary_little_endian and binary_big_endian. The vertex element's x, y
+// and z are the points; its other scalar properties (normals, colours, intensities) are
+// kept as raw bytes when asked (PointAttributes), else stepped over, as are its list
+// properties and every other element (faces, before or after the vertices). Stepped over
 // is still checked: the whole body must match the header (docs/formats.md), an ascii
 // record being one line of exactly its properties' values, each within its type.
 #include "big_buffer.h"
@@ -337,7 +338,7 @@ class ByteReader {
 public:
     ByteReader(std::string_view data, size_t start, bool big_endian)
         : data_(reinterpret_cast<const unsigned char*>(data.data())), size_(data.size()),
-          pos_(start), swap_(big_endian == host_is_little_endian()) {}
+          pos_(start), swap_(big_endian == host_is_little_endian()), big_endian_(big_endian) {}
 
     size_t offset() const { return pos_; }
     uint64_t remaining() const { return size_ - pos_; }
@@ -353,6 +354,14 @@ public:
         unsigned char bytes[8];
         if (!take(type_size(type), bytes)) return false;
         value = decode(type, bytes);
+        return true;
+    }
+
+    // The next `n` bytes, one value, into `out` in little-endian order.
+    bool little_endian(size_t n, unsigned char* out) {
+        if (n > remaining()) return false;
+        for (size_t i = 0; i < n; ++i) out[i] = data_[pos_ + (big_endian_ ? n - 1 - i : i)];
+        pos_ += n;
         return true;
     }
 
@@ -382,6 +391,7 @@ private:
     size_t size_;
     size_t pos_;
     bool swap_;
+    bool big_endian_;
 };
 
 std::string record_place(const PlyElement& element, uint64_t record) {
@@ -412,18 +422,27 @@ bool skip_binary_list(ByteReader& in, const PlyElement& element, const PlyProper
     return false;
 }
 
-// Reads one record; scalars whose coordinate_of entry is 0..2 land in xyz[that].
+// Reads one record; scalars whose coordinate_of entry is 0..2 land in xyz[that], the other
+// scalars, if `kept` is given, one after another there as little-endian bytes.
 bool read_binary_record(ByteReader& in, const PlyElement& element,
                         const std::vector<int>& coordinate_of, double* xyz, uint64_t record,
-                        std::string& error) {
+                        std::string& error, unsigned char* kept = nullptr) {
     for (size_t p = 0; p < element.properties.size(); ++p) {
         const PlyProperty& property = element.properties[p];
         if (property.is_list) {
             if (!skip_binary_list(in, element, property, record, error)) return false;
             continue;
         }
-        bool ok = coordinate_of[p] >= 0 ? in.scalar(property.type, xyz[coordinate_of[p]])
-                                        : in.skip(type_size(property.type));
+        const size_t size = type_size(property.type);
+        bool ok = true;
+        if (coordinate_of[p] >= 0) {
+            ok = in.scalar(property.type, xyz[coordinate_of[p]]);
+        } else if (kept) {
+            ok = in.little_endian(size, kept);
+            kept += size;
+        } else {
+            ok = in.skip(size);
+        }
         if (!ok) {
             error = truncated_in(in, element, record);
             return false;
@@ -518,6 +537,33 @@ template <bool Swap> ColumnConverter column_converter(PlyType type) {
     return convert_column<double, Swap>;
 }
 
+// Copies the kept properties of `count` records, `record_size` bytes each from `records`,
+// to the end of attributes.bytes, each value little-endian.
+void keep_fixed_attributes(const unsigned char* records, size_t count, size_t record_size,
+                           const PlyElement& element, const VertexLayout& layout,
+                           bool big_endian, PointAttributes& attributes) {
+    struct Field {
+        size_t from, size;
+    };
+    std::vector<Field> fields;
+    size_t at = 0;
+    for (size_t p = 0; p < element.properties.size(); ++p) {
+        const size_t size = type_size(element.properties[p].type);
+        if (layout.coordinate_of[p] < 0) fields.push_back({at, size});
+        at += size;
+    }
+    const size_t start = attributes.bytes.size();
+    attributes.bytes.resize(start + count * attributes.record_bytes);
+    unsigned char* out = attributes.bytes.data() + start;
+    for (size_t r = 0; r < count; ++r) {
+        const unsigned char* record = records + r * record_size;
+        for (const Field& field : fields) {
+            for (size_t i = 0; i < field.size; ++i)
+                *out++ = record[field.from + (big_endian ? field.size - 1 - i : i)];
+        }
+    }
+}
+
 // The vertex element's records, all present (check_claimed_size) and of `record_size`
 // bytes each, appended to `xyz`.
 void read_fixed_vertices(ByteReader& in, const PlyElement& element, const VertexLayout& layout,
@@ -550,17 +596,26 @@ void read_fixed_vertices(ByteReader& in, const PlyElement& element, const Vertex
 }
 
 bool read_binary_vertices(ByteReader& in, const PlyElement& element, const VertexLayout& layout,
-                          bool big_endian, std::vector<double>& xyz, std::string& error) {
+                          bool big_endian, std::vector<double>& xyz, PointAttributes* attributes,
+                          std::string& error) {
     if (!check_claimed_size(in, element, error)) return false;
     if (const uint64_t size = fixed_record_size(element); size > 0) {
+        if (attributes)
+            keep_fixed_attributes(in.here(), static_cast<size_t>(element.count),
+                                  static_cast<size_t>(size), element, layout, big_endian,
+                                  *attributes);
         read_fixed_vertices(in, element, layout, static_cast<size_t>(size),
                             big_endian == host_is_little_endian(), xyz);
         return true;
     }
+    std::vector<unsigned char> kept(attributes ? attributes->record_bytes : 0);
     for (uint64_t r = 0; r < element.count; ++r) {
         double point[3] = {0, 0, 0};
-        if (!read_binary_record(in, element, layout.coordinate_of, point, r, error)) return false;
+        if (!read_binary_record(in, element, layout.coordinate_of, point, r, error,
+                                attributes ? kept.data() : nullptr))
+            return false;
         xyz.insert(xyz.end(), point, point + 3);
+        if (attributes) attributes->bytes.insert(attributes->bytes.end(), kept.begin(), kept.end());
     }
     return true;
 }
@@ -576,13 +631,13 @@ std::string trailing_bytes_message(uint64_t offset, uint64_t count, const PlyHea
 }
 
 bool read_binary_body(std::string_view data, const PlyHeader& header, const VertexLayout& layout,
-                      std::vector<double>& xyz, std::string& error) {
+                      std::vector<double>& xyz, PointAttributes* attributes, std::string& error) {
     ByteReader in(data, header.data_offset, header.encoding == PlyEncoding::big_endian);
     for (size_t e = 0; e < header.elements.size(); ++e) {
         bool ok = e == layout.element
                       ? read_binary_vertices(in, header.elements[e], layout,
                                              header.encoding == PlyEncoding::big_endian, xyz,
-                                             error)
+                                             attributes, error)
                       : skip_binary_element(in, header.elements[e], error);
         if (!ok) return false;
     }
@@ -638,10 +693,29 @@ bool next_ascii_value(std::string_view& rest, size_t line, const PlyElement& ele
     return false;
 }
 
+// A value read from text as its type's little-endian bytes (it is within the type's range:
+// next_ascii_value checked).
+unsigned char* put_little_endian(PlyType type, double value, unsigned char* out) {
+    uint64_t bits = 0;
+    if (type == PlyType::float32) {
+        const float narrow = static_cast<float>(value);
+        uint32_t narrow_bits = 0;
+        std::memcpy(&narrow_bits, &narrow, sizeof narrow);
+        bits = narrow_bits;
+    } else if (type == PlyType::float64) {
+        std::memcpy(&bits, &value, sizeof bits);
+    } else {
+        bits = static_cast<uint64_t>(static_cast<int64_t>(value)); // two's complement
+    }
+    for (size_t i = 0; i < type_size(type); ++i) *out++ = static_cast<unsigned char>(bits >> (8 * i));
+    return out;
+}
+
+// Reads one record's line; as read_binary_record, the other scalars go to `kept`.
 template <class Lines>
 bool read_ascii_record(Lines& in, const PlyElement& element,
                        const std::vector<int>& coordinate_of, double* xyz, uint64_t record,
-                       std::string& error) {
+                       std::string& error, unsigned char* kept = nullptr) {
     std::string_view line;
     if (!in.next(line)) {
         error = at_line(in.line_number()) + "the file ends before " + record_place(element, record);
@@ -662,7 +736,10 @@ bool read_ascii_record(Lines& in, const PlyElement& element,
             if (!next_ascii_value(rest, number, element, property, property.type, record, value,
                                   error))
                 return false;
-            if (coordinate_of[p] >= 0) xyz[coordinate_of[p]] = value;
+            if (coordinate_of[p] >= 0)
+                xyz[coordinate_of[p]] = value;
+            else if (kept)
+                kept = put_little_endian(property.type, value, kept);
             ++values;
             continue;
         }
@@ -693,12 +770,16 @@ bool read_ascii_record(Lines& in, const PlyElement& element,
 template <class Lines>
 bool read_ascii_element(Lines& in, const PlyElement& element,
                         const std::vector<int>& coordinate_of, std::vector<double>* xyz,
-                        std::string& error) {
+                        std::string& error, PointAttributes* attributes = nullptr) {
     if (element.properties.empty()) return true;
+    std::vector<unsigned char> kept(attributes ? attributes->record_bytes : 0);
     for (uint64_t r = 0; r < element.count; ++r) {
         double point[3] = {0, 0, 0};
-        if (!read_ascii_record(in, element, coordinate_of, point, r, error)) return false;
+        if (!read_ascii_record(in, element, coordinate_of, point, r, error,
+                               attributes ? kept.data() : nullptr))
+            return false;
         if (xyz) xyz->insert(xyz->end(), point, point + 3);
+        if (attributes) attributes->bytes.insert(attributes->bytes.end(), kept.begin(), kept.end());
     }
     return true;
 }
@@ -720,13 +801,13 @@ bool check_ascii_end(Lines& in, const PlyHeader& header, std::string& error) {
 }
 
 bool read_ascii_body(std::string_view data, const PlyHeader& header, const VertexLayout& layout,
-                     std::vector<double>& xyz, std::string& error) {
+                     std::vector<double>& xyz, PointAttributes* attributes, std::string& error) {
     BodyLines in(data.substr(header.data_offset), header.data_line);
     for (size_t e = 0; e < header.elements.size(); ++e) {
         const PlyElement& element = header.elements[e];
         bool ok = true;
         if (e == layout.element) {
-            ok = read_ascii_element(in, element, layout.coordinate_of, &xyz, error);
+            ok = read_ascii_element(in, element, layout.coordinate_of, &xyz, error, attributes);
         } else {
             std::vector<int> none(element.properties.size(), -1);
             ok = read_ascii_element(in, element, none, nullptr, error);
@@ -734,6 +815,30 @@ bool read_ascii_body(std::string_view data, const PlyHeader& header, const Verte
         if (!ok) return false;
     }
     return check_ascii_end(in, header, error);
+}
+
+// The vertex element's properties that PointAttributes keeps: its scalars but x, y, z.
+void describe_attributes(const PlyElement& vertex, const VertexLayout& layout,
+                         PointAttributes& attributes) {
+    attributes = PointAttributes();
+    for (size_t p = 0; p < vertex.properties.size(); ++p) {
+        const PlyProperty& property = vertex.properties[p];
+        if (property.is_list) {
+            ++attributes.lists_dropped;
+            continue;
+        }
+        if (layout.coordinate_of[p] >= 0) continue;
+        PointAttributes::Property kept;
+        kept.name = property.name;
+        kept.type = type_name(property.type);
+        kept.size = type_size(property.type);
+        kept.offset = attributes.record_bytes;
+        kept.integral = is_integral(property.type);
+        kept.is_signed = property.type == PlyType::int8 || property.type == PlyType::int16 ||
+                         property.type == PlyType::int32;
+        attributes.record_bytes += kept.size;
+        attributes.properties.push_back(kept);
+    }
 }
 
 uint64_t face_count(const PlyHeader& header) {
@@ -950,7 +1055,7 @@ std::unique_ptr<PointReader> open_ply_points(std::unique_ptr<FileWindow> file, s
 }
 
 bool read_ply(std::string_view data, std::vector<double>& xyz, std::string& error,
-              std::string& encoding, uint64_t& faces) {
+              std::string& encoding, uint64_t& faces, PointAttributes* attributes) {
     PlyHeader header;
     VertexLayout layout;
     if (!parse_header(data, header, error)) return false;
@@ -961,9 +1066,13 @@ bool read_ply(std::string_view data, std::vector<double>& xyz, std::string& erro
     encoding = encoding_name(header.encoding);
     faces = face_count(header);
     xyz.clear();
+    if (attributes) {
+        describe_attributes(header.elements[layout.element], layout, *attributes);
+        if (attributes->empty()) attributes = nullptr;
+    }
     if (header.encoding == PlyEncoding::ascii)
-        return read_ascii_body(data, header, layout, xyz, error);
-    return read_binary_body(data, header, layout, xyz, error);
+        return read_ascii_body(data, header, layout, xyz, attributes, error);
+    return read_binary_body(data, header, layout, xyz, attributes, error);
 }
 
 } // namespace stratmesh_cli

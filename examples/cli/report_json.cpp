@@ -1,6 +1,7 @@
 #include "report_json.h"
 
 #include "safe_output.h"
+#include "summary.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -171,6 +172,7 @@ void write_files(JsonWriter& j, const RunRecord& r) {
     j.text_field("format", r.input_format);
     j.text_field("encoding", r.input_encoding);
     j.count_field("faces_ignored", r.input_faces_ignored);
+    j.count_field("point_properties", r.point_properties);
     j.end_object();
     j.key("output");
     j.begin_object();
@@ -178,6 +180,7 @@ void write_files(JsonWriter& j, const RunRecord& r) {
     j.text_field("format", r.output_format);
     j.flag_field("ascii", r.output_ascii);
     j.flag_field("written", r.output_written);
+    j.count_field("point_properties", r.point_properties_carried);
     j.end_object();
 }
 
@@ -367,6 +370,31 @@ void write_layers(JsonWriter& j, const RunRecord& r) {
     j.flag_field("layers_complete", r.layers.size() == r.report.layers.used_count);
 }
 
+// The surface's ends: each one's boundary loops (their edge counts; none where it is
+// closed) and whether its one loop is the small one left around a pole; null when the
+// triangles were not kept (the stream without --cap).
+void write_ends(JsonWriter& j, const RunRecord& r) {
+    j.key("ends");
+    if (!r.ends.known) {
+        j.null();
+        return;
+    }
+    j.begin_object();
+    for (const auto& [name, end] : {std::pair<const char*, const SurfaceEnd*>{"bottom", &r.ends.bottom},
+                                    std::pair<const char*, const SurfaceEnd*>{"top", &r.ends.top}}) {
+        j.key(name);
+        j.begin_object();
+        j.key("loop_edges");
+        j.begin_array();
+        for (size_t edges : end->loop_edges) j.integer(edges);
+        j.end_array();
+        j.flag_field("closed", end->loop_edges.empty());
+        j.flag_field("pole_loop", end->pole_loop);
+        j.end_object();
+    }
+    j.end_object();
+}
+
 void write_costs(JsonWriter& j, const RunRecord& r) {
     j.key("seconds");
     j.begin_object();
@@ -485,6 +513,15 @@ std::string run_record_json(const RunRecord& record) {
     write_status(j, record);
     write_counts(j, record.report, record.status);
     write_layers(j, record);
+    write_ends(j, record);
+    // The warnings printed: a refused run's only warning is the input's faces.
+    const bool meshed = record.reconstructed && record.status == stratmesh::Status::ok;
+    j.key("warnings");
+    j.begin_array();
+    for (const std::string& warning :
+         meshed ? run_warnings(record) : std::vector<std::string>{faces_warning(record)})
+        if (!warning.empty()) j.string(warning);
+    j.end_array();
     write_stream(j, record);
     write_branches(j, record);
     write_split(j, record);

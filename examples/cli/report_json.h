@@ -2,6 +2,7 @@
 #ifndef STRATMESH_CLI_REPORT_JSON_H
 #define STRATMESH_CLI_REPORT_JSON_H
 
+#include "mesh_ends.h"
 #include "stratmesh.h"
 
 #include <cstddef>
@@ -22,6 +23,9 @@ struct RunRecord {
     // Input and output.
     std::string input_path, input_format, input_encoding;
     uint64_t input_faces_ignored = 0; // faces in the input, left out of the cloud
+    // The input's per-point properties besides x, y, z that were read (PLY, unless
+    // --no-attributes or the output carries none), and how many the output carries.
+    size_t point_properties = 0, point_properties_carried = 0;
     std::string output_path, output_format;
     bool output_ascii = false;
     bool output_written = false;
@@ -53,6 +57,16 @@ struct RunRecord {
     stratmesh::Status status = stratmesh::Status::ok;
     stratmesh::Report report = {};
     std::vector<stratmesh::LayerInfo> layers;
+    // The surface's boundary loops at each end (mesh_ends.h).
+    SurfaceEnds ends;
+    // The valid points' range along the axis used, dot(point, Report::axis) (known when
+    // `range_known`), and the cuts given outside it.
+    bool range_known = false;
+    double range_low = 0, range_high = 0;
+    std::vector<double> cuts_outside;
+    // With --layers, --cuts or --layer-height and `range_known`: the planned layers that
+    // held fewer than the library's 16 points, which it merges into the next.
+    size_t sparse_planned_layers = 0;
     // The cost; seconds are NaN when unknown (written as null).
     double read_seconds, reconstruct_seconds, write_seconds, branches_seconds;
     double phase_seconds[kTimedPhases];

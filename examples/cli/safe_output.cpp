@@ -142,11 +142,15 @@ AtomicFile::~AtomicFile() { discard(); }
 
 bool AtomicFile::open(const std::string& path, std::string& error) {
     discard();
+    standard_output_ = false;
     path_ = target_ = path;
     std::error_code e;
     const fs::file_status status = fs::status(path, e);
     int failure = 0;
-    if (fs::is_directory(status)) {
+    if (path == kStandardStream) {
+        file_ = stdout;
+        standard_output_ = true;
+    } else if (fs::is_directory(status)) {
         failure = EISDIR;
     } else if (fs::exists(status) && !fs::is_regular_file(status)) {
         file_ = std::fopen(path.c_str(), "wb");
@@ -180,7 +184,7 @@ bool AtomicFile::commit(int failure, std::string& error) {
     // new one, never an empty one (some file systems commit a rename before the data).
     if (!temporary_.empty() && failure == 0 && fsync(fileno(file_)) != 0) failure = errno;
 #endif
-    if (std::fclose(file_) != 0 && failure == 0) failure = errno;
+    if (!standard_output_ && std::fclose(file_) != 0 && failure == 0) failure = errno;
     file_ = nullptr;
     if (failure == 0 && !temporary_.empty()) {
         std::error_code e;
@@ -201,7 +205,7 @@ bool AtomicFile::commit(int failure, std::string& error) {
 }
 
 void AtomicFile::discard() {
-    if (file_) std::fclose(file_);
+    if (file_ && !standard_output_) std::fclose(file_);
     file_ = nullptr;
     if (!temporary_.empty()) std::remove(temporary_.c_str());
     temporary_.clear();
@@ -221,7 +225,7 @@ std::FILE* scratch_file_beside(const std::string& path, std::string& error) {
     const fs::file_status status = fs::status(path, e);
     std::FILE* file = nullptr;
 #ifndef _WIN32
-    if (!fs::exists(status) || fs::is_regular_file(status)) {
+    if (path != kStandardStream && (!fs::exists(status) || fs::is_regular_file(status))) {
         // Beside the destination: on its file system, not on a /tmp that may be smaller.
         std::string temporary;
         int slot = -1;
@@ -232,7 +236,7 @@ std::FILE* scratch_file_beside(const std::string& path, std::string& error) {
     } else
 #endif
     {
-        // A device or a pipe has no directory of its own to write in.
+        // A device, a pipe or standard output has no directory of its own to write in.
         file = std::tmpfile();
     }
     if (!file) error = path + ": cannot create a temporary file beside it: " + std::strerror(errno);

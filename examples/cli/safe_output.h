@@ -11,6 +11,9 @@
 
 namespace stratmesh_cli {
 
+// The name that stands for standard input (as the input) or standard output (as -o).
+inline const char kStandardStream[] = "-";
+
 // A file the tool reads or writes, with how the command line names it ("the input", "-o",
 // "--report").
 struct NamedFile {
@@ -27,8 +30,8 @@ bool check_distinct_files(const std::vector<NamedFile>& files, std::string& erro
 // directory (the directory of a symlink's target), commit() flushes it to the disk and
 // renames it onto the destination, keeping the permissions of a file it replaces. A
 // destination that exists and is no regular file (a device such as /dev/null, a pipe) is
-// written directly: renaming onto it would replace the device. Destroyed uncommitted, it
-// removes its temporary.
+// written directly: renaming onto it would replace the device, and so is "-", which
+// stands for standard output (left open). Destroyed uncommitted, it removes its temporary.
 class AtomicFile {
 public:
     AtomicFile() = default;
@@ -56,6 +59,7 @@ private:
     std::string target_;    // the file to replace: `path_` or its symlink's target
     std::string temporary_; // empty when writing directly
     int slot_ = -1;         // in the table the signal handler cleans
+    bool standard_output_ = false; // `file_` is stdout, flushed but never closed
 };
 
 // A scratch file in the directory of `path`, already unlinked on systems that allow it (it

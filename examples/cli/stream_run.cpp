@@ -2,6 +2,7 @@
 
 #include "cloud_io.h"
 #include "frame_check.h"
+#include "mesh_ends.h"
 #include "mesh_io.h"
 
 #include <algorithm>
@@ -88,13 +89,17 @@ public:
         if (record_.stream_points > most) record_.stream_points = most;
         record_.input_format = cloud_format_name(info.format);
         record_.input_encoding = info.encoding;
-        if (!writer_.open(line_.output, mesh_format_from_extension(line_.output), line_.ascii,
-                          error))
+        if (!writer_.open(line_.output, line_.output_format, line_.ascii, error))
             return StreamOutcome::file_error;
         StreamOutcome outcome = read_and_push(*reader, error);
         if (outcome == StreamOutcome::done) outcome = close(error);
         if (outcome == StreamOutcome::refused) count_refused_push();
         record_.take_report(report_, layers_);
+        // With --cap every triangle is kept: the ends can be read off them.
+        if (outcome == StreamOutcome::done && line_.cap)
+            record_.ends = find_surface_ends(all_points_.data(), kept_.data(),
+                                             record_.report.triangle_count, axis_,
+                                             record_.layers);
         record_.read_seconds = seconds_since(start) - stream_seconds_ - write_seconds_;
         return outcome;
     }
@@ -122,7 +127,7 @@ private:
         }
         record_.input_faces_ignored = reader.faces_ignored();
         if (error.empty()) return StreamOutcome::done;
-        error = line_.input + ": " + error;
+        error = display_name(line_.input) + ": " + error;
         return StreamOutcome::file_error;
     }
 
@@ -245,12 +250,17 @@ private:
     }
 
     std::string backwards_message(double height) const {
+        // sort(1) sorts lines: text only, and a text PLY's header would be sorted too.
+        const bool columns = record_.input_format == cloud_format_name(CloudFormat::xyz);
         return "point " + std::to_string(points_read_) + " (counting from 0) lies at height " +
                number_text(height) + " along the axis, below the point before it (" +
                number_text(highest_) +
-               "): --stream needs the points sorted along the axis, lowest first (for example "
-               "sort the columns of an XYZ file with 'sort -g -k3' for --axis z), or run "
-               "without --stream";
+               "): --stream needs the points sorted along the axis, lowest first (" +
+               (columns ? "for example sort the columns of an XYZ file with 'sort -g -k3' for "
+                          "--axis z"
+                        : "write the points in that order, or convert them to XYZ columns and "
+                          "sort those") +
+               "), or run without --stream";
     }
 
     static std::string number_text(double value) {

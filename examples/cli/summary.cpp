@@ -1,5 +1,7 @@
 #include "summary.h"
 
+#include "safe_output.h"
+
 #include <cmath>
 #include <string>
 
@@ -49,64 +51,202 @@ std::string phase_times_text(const RunRecord& r) {
     return text.empty() ? text : " (" + text + ")";
 }
 
-// The surface's ends: a closed end (a crown, a base) is meshed across to a small loop at
-// its pole; an open one is the rim of the tube. Known only when every layer was recorded.
-void print_ends(std::FILE* out, const RunRecord& r) {
-    if (r.layers.empty() || r.layers.size() != r.report.layers.used_count) return;
-    const bool bottom = r.layers.front().closed_ends & stratmesh::closed_bottom;
-    const bool top = r.layers.back().closed_ends & stratmesh::closed_top;
-    std::fprintf(out, "  ends       bottom %s, top %s\n", bottom ? "closed" : "open",
-                 top ? "closed" : "open");
+std::string plural(size_t count, const char* one, const char* many) {
+    return std::to_string(count) + " " + (count == 1 ? one : many);
 }
 
-// Where the surface folds (triangles facing the axis): the layers, bottom up from 1, with
-// their fold counts, so that a user can move the cuts or the axis there. Known only when
-// every layer was recorded.
-void print_folds(std::FILE* out, const RunRecord& r) {
-    if (r.report.diagnostics.fold_count == 0 || r.layers.empty() || r.layers.size() != r.report.layers.used_count)
-        return;
-    const size_t kListed = 6;
-    std::string list;
-    size_t listed = 0, folding = 0;
-    for (size_t k = 0; k < r.layers.size(); ++k) {
-        if (r.layers[k].fold_count == 0) continue;
-        ++folding;
-        if (listed == kListed) continue;
-        ++listed;
-        const uint32_t folds = r.layers[k].fold_count;
-        list += (list.empty() ? "" : ", ") + std::to_string(k + 1) + " (" +
-                std::to_string(folds) + (folds == 1 ? " fold)" : " folds)");
+std::string file_name(const std::string& path, const char* stream) {
+    return path == kStandardStream ? stream : path;
+}
+
+// "bottom closed", "top open: a pole loop of 6 edges", from the boundary loops.
+std::string end_text(const char* name, const SurfaceEnd& end) {
+    const std::vector<size_t>& loops = end.loop_edges;
+    std::string text = std::string(name) + " ";
+    if (loops.empty()) return text + "closed";
+    if (end.pole_loop) return text + "open: a pole loop of " + plural(loops[0], "edge", "edges");
+    if (loops.size() == 1) return text + "open (a rim of " + plural(loops[0], "edge", "edges") + ")";
+    text += "open: " + std::to_string(loops.size()) + " loops (";
+    for (size_t k = 0; k < loops.size(); ++k) text += (k ? ", " : "") + std::to_string(loops[k]);
+    return text + " edges)";
+}
+
+std::string ends_text(const RunRecord& r) {
+    if (!r.ends.known) return "ends not checked (--stream keeps the triangles only with --cap)";
+    return "ends: " + end_text("bottom", r.ends.bottom) + ", " + end_text("top", r.ends.top);
+}
+
+// Why the library used fewer layers than it planned: the planned layers that held too few
+// points, when the tool could count them, and its other rules, in the words of
+// LayerCounts::planned_count (Options in stratmesh.h says each).
+std::string merge_reason(const RunRecord& r) {
+    const std::string fewest = "under " + std::to_string(kFewestLayerPoints) + " points";
+    if (!r.range_known) return "merged where a layer held " + fewest + ", or was thin, open or folding";
+    if (r.sparse_planned_layers == 0)
+        return "merged where a layer was thin, open or folding (none held " + fewest + ")";
+    return "merged where a layer held " + fewest + " (" + std::to_string(r.sparse_planned_layers) +
+           " did), or was thin, open or folding";
+}
+
+// "18 of 100000 asked (30000 planned: at most one a point); merged where ...", "4 as
+// asked", "4 (about --layer-height 30 high)", "7 (automatic)".
+std::string layers_text(const RunRecord& r) {
+    const size_t used = r.report.layers.used_count, planned = r.report.layers.planned_count;
+    std::string text = std::to_string(used);
+    size_t asked = 0;
+    std::string why_planned;
+    if (r.layer_count > 0) {
+        asked = r.layer_count;
+        why_planned = "at most one a point";
+    } else if (!r.cuts.empty()) {
+        asked = r.cuts.size() + 1;
+        why_planned = "cuts outside the cloud or repeated are dropped";
+    } else if (r.layer_height > 0) {
+        // As many as the height takes: the plan is what was asked.
+        if (used >= planned) return text + " (about --layer-height " + number_text(r.layer_height) + " high)";
+        return text + " of " + std::to_string(planned) + " planned by --layer-height " +
+               number_text(r.layer_height) + "; " + merge_reason(r);
     }
-    if (folding > listed) list += ", ...";
-    std::fprintf(out, "  folds      in layer%s %s of %zu, bottom up:\n"
-                      "             not star-shaped around any centre tried (a branch, an "
-                      "overhang):\n             the surface may bridge gaps or cross itself "
-                      "there\n",
-                 folding > 1 ? "s" : "", list.c_str(), r.layers.size());
+    if (asked == 0) {
+        if (used >= planned) return text + " (automatic)";
+        return text + " (automatic: " + std::to_string(planned) + " planned; " + merge_reason(r) +
+               ")";
+    }
+    if (asked == used) return text + " as asked";
+    text += " of " + std::to_string(asked) + " asked";
+    if (planned != asked) text += " (" + std::to_string(planned) + " planned: " + why_planned + ")";
+    if (used < planned) text += "; " + merge_reason(r);
+    return text;
+}
+
+std::string caps_text(const stratmesh::Report& rep) {
+    if (rep.caps.closed_count + rep.caps.open_count == 0) return "";
+    std::string text = ", caps: " + std::to_string(rep.caps.closed_count) + " closed (" +
+                       plural(rep.caps.triangle_count, "triangle", "triangles") + "), " +
+                       std::to_string(rep.caps.open_count) + " left open";
+    if (rep.caps.wall_flip_count)
+        text += ", " + std::to_string(rep.caps.wall_flip_count) + " wall edges flipped under fins";
+    return text;
 }
 
 void print_counts(std::FILE* out, const RunRecord& r) {
     const stratmesh::Report& rep = r.report;
+    const std::string outliers =
+        rep.points.outlier_count ? " (" + std::to_string(rep.points.outlier_count) + " outliers)"
+                                 : "";
     std::fprintf(out, "  points     %zu read: %zu used, %zu duplicates, %zu rejected%s, %zu unused\n",
-                 rep.points.in_count, rep.points.used_count, rep.points.duplicate_count, rep.points.rejected_count,
-                 rep.points.outlier_count ? (" (" + std::to_string(rep.points.outlier_count) + " outliers)").c_str() : "",
-                 rep.points.unused_count);
-    std::fprintf(out, "  layers     %zu (%zu triangulated in parallel)\n", rep.layers.used_count,
-                 rep.layers.parallel_count);
-    print_ends(out, r);
-    std::fprintf(out, "  triangles  %zu (%zu illegal removed, %zu folds)\n", rep.triangle_count,
-                 rep.diagnostics.illegal_removed_count, rep.diagnostics.fold_count);
-    print_folds(out, r);
-    if (rep.caps.closed_count + rep.caps.open_count > 0)
-        std::fprintf(out, "  caps       %zu closed (%zu triangles), %zu left open%s\n",
-                     rep.caps.closed_count, rep.caps.triangle_count, rep.caps.open_count,
-                     rep.caps.wall_flip_count ? (", " + std::to_string(rep.caps.wall_flip_count) +
-                                           " wall edges flipped under fins").c_str()
-                                        : "");
+                 rep.points.in_count, rep.points.used_count, rep.points.duplicate_count,
+                 rep.points.rejected_count, outliers.c_str(), rep.points.unused_count);
+    std::fprintf(out, "  layers     %s\n", layers_text(r).c_str());
+    std::fprintf(out, "  triangles  %zu%s; %s\n", rep.triangle_count, caps_text(rep).c_str(),
+                 ends_text(r).c_str());
 }
 
-// With --branches: where the cloud parts, each side's cut along the axis (as --cuts takes
-// it) and its branches' point counts.
+// ---- warnings ----------------------------------------------------------------------------
+
+// Where the surface folds (triangles facing the axis): the layers, bottom up from 1, with
+// their fold counts, so that a user can move the cuts or the axis there. The layers are
+// named only when every layer was recorded.
+std::string folds_warning(const RunRecord& r) {
+    const size_t folds = r.report.diagnostics.fold_count;
+    if (folds == 0) return "";
+    std::string text = plural(folds, "triangle folds", "triangles fold") + " (facing the axis)";
+    if (!r.layers.empty() && r.layers.size() == r.report.layers.used_count) {
+        const size_t kListed = 6;
+        std::string list;
+        size_t listed = 0, folding = 0;
+        for (size_t k = 0; k < r.layers.size(); ++k) {
+            if (r.layers[k].fold_count == 0) continue;
+            ++folding;
+            if (listed == kListed) continue;
+            ++listed;
+            list += (list.empty() ? "" : ", ") + std::to_string(k + 1) + " (" +
+                    plural(r.layers[k].fold_count, "fold", "folds") + ")";
+        }
+        if (folding > listed) list += ", ...";
+        if (folding > 0)
+            text += " in layer" + std::string(folding > 1 ? "s " : " ") + list + " of " +
+                    std::to_string(r.layers.size()) + ", bottom up";
+    }
+    return text + ": not star-shaped around any centre tried (a branch, an overhang), the "
+                  "surface may bridge gaps or cross itself there";
+}
+
+// "above 12.5: 2 (750, 740 points); below: none (gap 0.8)".
+std::string parting_text(const stratmesh::Parting& p) {
+    auto side = [](const char* name, double cut, const uint32_t* points, uint32_t branches) {
+        if (branches == 0) return std::string(name) + ": none";
+        std::string text = std::string(name) + " " + number_text(cut) + ": " +
+                           std::to_string(branches) + " (";
+        for (uint32_t k = 0; k < branches; ++k)
+            text += (k ? ", " : "") + std::to_string(points[k]);
+        return text + " points)";
+    };
+    return side("above", p.above, p.above_point_counts, p.above_branch_count) + "; " +
+           side("below", p.below, p.below_point_counts, p.below_branch_count) + " (gap " +
+           number_text(p.gap) + ")";
+}
+
+bool branches_found(const RunRecord& r) {
+    return r.parting_run && r.parting_status == stratmesh::Status::ok &&
+           r.parting.above_branch_count + r.parting.below_branch_count > 0;
+}
+
+// Branches wrapped in one tube, which webs over the gaps between them; or left apart.
+std::string branches_warning(const RunRecord& r) {
+    if (!branches_found(r)) return "";
+    const std::string where = parting_text(r.parting);
+    if (r.split.empty())
+        return "one tube wraps branches and the gaps between them, " + where +
+               ": mesh each side apart (README, \"Where the cloud parts\")";
+    if (r.split_undone)
+        return "the cloud parts into branches (" + where +
+               ") but the parts were not kept: meshed as one tube instead, which wraps the "
+               "branches and the gaps between them (--verbose says why; --split-branches "
+               "keeps the parts)";
+    if (r.junction.apart_side_count > 0 || r.junction_status != stratmesh::Status::ok)
+        return "branches left apart from the trunk, not joined (" + where +
+               "): the surface is in pieces (--verbose says why)";
+    return "";
+}
+
+// Points that are no vertex of the surface, though not merged into a duplicate: rejected
+// (NaN or infinite with --skip-invalid, outliers with --drop-outliers) or unused (the
+// library's detail says why). They stay in the output, used by no triangle.
+std::string left_out_warning(const RunRecord& r) {
+    const stratmesh::PointCounts& p = r.report.points;
+    const size_t invalid = p.rejected_count - p.outlier_count;
+    if (p.rejected_count + p.unused_count == 0) return "";
+    std::string parts;
+    auto add = [&parts](size_t count, const std::string& what) {
+        if (count) parts += (parts.empty() ? "" : ", ") + std::to_string(count) + " " + what;
+    };
+    add(invalid, "invalid (--skip-invalid)");
+    add(p.outlier_count, p.outlier_count == 1 ? "outlier (--drop-outliers)" : "outliers (--drop-outliers)");
+    add(p.unused_count, "unused");
+    std::string text = plural(p.rejected_count + p.unused_count, "point", "points") +
+                       " left out of the mesh (in the output, used by no triangle): " + parts;
+    if (p.unused_count && r.report.detail) text += std::string("; ") + r.report.detail;
+    return text;
+}
+
+std::string caps_warning(const RunRecord& r) {
+    if (r.report.caps.open_count == 0) return "";
+    return plural(r.report.caps.open_count, "boundary loop", "boundary loops") +
+           " could not be capped: the surface is not closed there";
+}
+
+std::string cuts_warning(const RunRecord& r) {
+    if (r.cuts_outside.empty()) return "";
+    std::string list;
+    for (double cut : r.cuts_outside) list += (list.empty() ? "" : ",") + number_text(cut);
+    return "--cuts " + list + (r.cuts_outside.size() == 1 ? " lies" : " lie") +
+           " outside the cloud's range along the axis (" + number_text(r.range_low) + " to " +
+           number_text(r.range_high) + "): ignored";
+}
+
+// ---- details, with --verbose -------------------------------------------------------------
+
 // ", 2 branches grafted (41 triangles of the trunk taken out)", or nothing.
 std::string grafted_note(const stratmesh::JoinReport& j) {
     if (j.grafted_branch_count == 0) return "";
@@ -115,28 +255,14 @@ std::string grafted_note(const stratmesh::JoinReport& j) {
            std::to_string(j.removed_triangle_count) + " triangles of the trunk taken out)";
 }
 
+// Where the cloud parts: each side's cut along the axis (as --cuts takes it) and its
+// branches' point counts.
 void print_branches(std::FILE* out, const RunRecord& r) {
     if (!r.parting_run) return;
-    const stratmesh::Parting& p = r.parting;
-    if (r.parting_status != stratmesh::Status::ok) {
+    if (r.parting_status != stratmesh::Status::ok)
         std::fprintf(out, "  branches   not found: %s\n", stratmesh::status_string(r.parting_status));
-        return;
-    }
-    auto side = [&](const char* name, double cut, const uint32_t* points, uint32_t branches) {
-        if (branches == 0) return std::string(name) + ": none";
-        std::string text = std::string(name) + " " + number_text(cut) + ": " +
-                           std::to_string(branches) + " (";
-        for (uint32_t k = 0; k < branches; ++k)
-            text += (k ? ", " : "") + std::to_string(points[k]);
-        return text + " points)";
-    };
-    std::fprintf(out, "  branches   %s; %s (gap %s)\n",
-                 side("above", p.above, p.above_point_counts, p.above_branch_count).c_str(),
-                 side("below", p.below, p.below_point_counts, p.below_branch_count).c_str(),
-                 number_text(p.gap).c_str());
-    if (p.above_branch_count + p.below_branch_count > 0 && r.split.empty())
-        std::fprintf(out, "             one tube wraps branches and the gaps between them: mesh "
-                          "each side apart\n             (README, \"Where the cloud parts\")\n");
+    else
+        std::fprintf(out, "  branches   %s\n", parting_text(r.parting).c_str());
 }
 
 // Where the cloud parts and the parts are meshed: each tube meshed apart.
@@ -175,11 +301,14 @@ void print_split(std::FILE* out, const RunRecord& r) {
 
 void print_costs(std::FILE* out, const RunRecord& r) {
     if (!r.stream) // the stream triangulates in order, whatever --threads says
-        std::fprintf(out, "  threads    %u\n", static_cast<unsigned>(r.threads));
+        std::fprintf(out, "  threads    %u (%zu layers triangulated in parallel)\n",
+                     static_cast<unsigned>(r.threads), r.report.layers.parallel_count);
     std::fprintf(out, "  time       read %s, reconstruct %s%s, %swrite %s\n",
                  seconds_text(r.read_seconds).c_str(), seconds_text(r.reconstruct_seconds).c_str(),
                  phase_times_text(r).c_str(),
-                 r.parting_run ? ("branches " + seconds_text(r.branches_seconds) + ", ").c_str() : "",
+                 std::isfinite(r.branches_seconds)
+                     ? ("branches " + seconds_text(r.branches_seconds) + ", ").c_str()
+                     : "",
                  seconds_text(r.write_seconds).c_str());
     double per_point = r.report.points.in_count ? static_cast<double>(r.workspace_bytes) /
                                                 static_cast<double>(r.report.points.in_count)
@@ -197,15 +326,53 @@ void print_costs(std::FILE* out, const RunRecord& r) {
 
 } // namespace
 
-void print_summary(std::FILE* out, const RunRecord& record) {
-    std::fprintf(out, "stratmesh: %s (%s %s) -> %s (%s%s)\n", record.input_path.c_str(),
+std::string faces_warning(const RunRecord& record) {
+    if (record.input_faces_ignored == 0) return "";
+    return plural(static_cast<size_t>(record.input_faces_ignored), "face", "faces") + " in " +
+           file_name(record.input_path, "standard input") +
+           " ignored: the points alone are meshed";
+}
+
+std::vector<std::string> run_warnings(const RunRecord& record) {
+    std::vector<std::string> warnings;
+    for (const std::string& warning :
+         {folds_warning(record), branches_warning(record), left_out_warning(record),
+          caps_warning(record), faces_warning(record), cuts_warning(record)})
+        if (!warning.empty()) warnings.push_back(warning);
+    return warnings;
+}
+
+void print_warnings(std::FILE* out, const std::vector<std::string>& warnings) {
+    for (const std::string& warning : warnings)
+        std::fprintf(out, "stratmesh: warning: %s\n", warning.c_str());
+}
+
+// ", 7 point properties carried" (of those read), or nothing.
+std::string properties_text(const RunRecord& r) {
+    if (r.point_properties == 0) return "";
+    std::string text = ", " + std::to_string(r.point_properties_carried);
+    if (r.point_properties_carried != r.point_properties)
+        text += " of " + std::to_string(r.point_properties);
+    return text + (r.point_properties == 1 ? " point property carried" : " point properties carried");
+}
+
+void print_summary(std::FILE* out, const RunRecord& record, size_t warning_count, bool verbose) {
+    std::fprintf(out, "stratmesh: %s (%s %s) -> %s (%s%s%s)\n",
+                 file_name(record.input_path, "standard input").c_str(),
                  record.input_format.c_str(), record.input_encoding.c_str(),
-                 record.output_path.c_str(), record.output_format.c_str(),
-                 record.output_ascii ? " text" : "");
+                 file_name(record.output_path, "standard output").c_str(),
+                 record.output_format.c_str(), record.output_ascii ? " text" : "",
+                 properties_text(record).c_str());
     print_counts(out, record);
-    print_branches(out, record);
-    print_split(out, record);
-    print_costs(out, record);
+    if (verbose) {
+        print_branches(out, record);
+        print_split(out, record);
+        print_costs(out, record);
+    }
+    if (warning_count == 0)
+        std::fprintf(out, "  warnings   none\n");
+    else
+        std::fprintf(out, "  warnings   %zu, below\n", warning_count);
 }
 
 } // namespace stratmesh_cli

@@ -1,14 +1,35 @@
-// The short human summary the tool prints on stderr.
+// What the tool tells a user on stderr: a short summary, its details with --verbose, and
+// the warnings, which are printed even with --quiet.
 #ifndef STRATMESH_CLI_SUMMARY_H
 #define STRATMESH_CLI_SUMMARY_H
 
 #include "report_json.h"
 
 #include <cstdio>
+#include <string>
+#include <vector>
 
 namespace stratmesh_cli {
 
-void print_summary(std::FILE* out, const RunRecord& record);
+// The fewest points the library keeps a layer with (Options: a layer with fewer is merged
+// with the next one).
+const size_t kFewestLayerPoints = 16;
+
+// What a user should check before trusting the mesh, each a sentence without the
+// "stratmesh: warning: " prefix: folds, branches wrapped in one tube or left apart, points
+// left out, caps left open, input faces ignored, cuts outside the cloud.
+std::vector<std::string> run_warnings(const RunRecord& record);
+
+// The input faces left out of the cloud, or an empty string.
+std::string faces_warning(const RunRecord& record);
+
+// Each warning on a line of its own, "stratmesh: warning: ...".
+void print_warnings(std::FILE* out, const std::vector<std::string>& warnings);
+
+// At most five lines (input and output, points, layers, triangles and ends, warnings);
+// `verbose` adds the branches, the parts, the threads, the times, the memory and the
+// stream. The warnings themselves are print_warnings'.
+void print_summary(std::FILE* out, const RunRecord& record, size_t warning_count, bool verbose);
 
 } // namespace stratmesh_cli
 

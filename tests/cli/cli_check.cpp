@@ -10,6 +10,14 @@
 //         a.b:text       the string at a.b is `text` (or true, false, null)
 //   stratmesh_cli_check same-mesh FILE FILE
 //       the two meshes read back with the same vertices and the same triangles, in order
+//   stratmesh_cli_check attributes INPUT.ply OUTPUT
+//       OUTPUT's vertices carry INPUT's per-point data, point by point: a PLY output all of
+//       its scalar properties (names, types, values), an OBJ output its normals and colours
+//   stratmesh_cli_check no-attributes FILE
+//       the mesh's vertices carry their coordinates only
+//   stratmesh_cli_check svg FILE REPORT.json
+//       FILE is well-formed XML, an <svg> with a polygon per triangle and a line per
+//       boundary edge of the report, in each of its two views
 //   stratmesh_cli_check mesh FILE VERTICES [REPORT.json]
 //       the mesh (.ply .obj .off .stl) reads back, has VERTICES vertices (not checked for
 //       STL), at least one triangle, indices in range, and as many triangles as the
@@ -17,6 +25,7 @@
 #include "mini_json.h"
 #include "mini_mesh.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -163,6 +172,67 @@ std::string as_binary_ply(const std::vector<double>& xyz) {
     return bytes;
 }
 
+// The cylinder with per-point data of every kind: normals before the coordinates, colours,
+// an intensity, a quality and a signed label; ascii, binary little-endian, or binary
+// big-endian with a list property among them (which the tool does not carry).
+enum class PlyEncoding { ascii, little, big_with_list };
+
+void append_bytes(std::string& bytes, uint64_t bits, size_t size, bool big) {
+    for (size_t i = 0; i < size; ++i)
+        bytes += static_cast<char>((bits >> (8 * (big ? size - 1 - i : i))) & 0xffu);
+}
+
+std::string as_attribute_ply(const std::vector<double>& xyz, PlyEncoding encoding) {
+    const bool list = encoding == PlyEncoding::big_with_list;
+    std::string bytes = std::string("ply\nformat ") +
+                        (encoding == PlyEncoding::ascii    ? "ascii"
+                         : encoding == PlyEncoding::little ? "binary_little_endian"
+                                                           : "binary_big_endian") +
+                        " 1.0\nelement vertex " + std::to_string(xyz.size() / 3) +
+                        "\nproperty float nx\nproperty float ny\nproperty float nz\n"
+                        "property float x\nproperty float y\nproperty float z\n"
+                        "property uchar red\nproperty uchar green\nproperty uchar blue\n" +
+                        (list ? "property list uchar int neighbours\n" : "") +
+                        "property ushort intensity\nproperty double quality\nproperty int label\n"
+                        "end_header\n";
+    for (size_t i = 0; i < xyz.size() / 3; ++i) {
+        const double* p = &xyz[3 * i];
+        const double r = std::sqrt(p[0] * p[0] + p[1] * p[1]);
+        const float floats[6] = {static_cast<float>(p[0] / r), static_cast<float>(p[1] / r), 0.0f,
+                                 static_cast<float>(p[0]), static_cast<float>(p[1]),
+                                 static_cast<float>(p[2])};
+        const unsigned colour[3] = {unsigned(i % 256), unsigned(i * 7 % 256), unsigned(255 - i % 256)};
+        const unsigned intensity = unsigned(i * 37 % 65536);
+        const double quality = p[2] / 3;
+        const int label = static_cast<int>(i) - 1500;
+        if (encoding == PlyEncoding::ascii) {
+            for (float f : floats) bytes += number_text(static_cast<double>(f)) + " ";
+            for (unsigned c : colour) bytes += std::to_string(c) + " ";
+            char text[64];
+            std::snprintf(text, sizeof text, "%u %.17g %d\n", intensity, quality, label);
+            bytes += text;
+            continue;
+        }
+        const bool big = encoding == PlyEncoding::big_with_list;
+        for (float f : floats) {
+            uint32_t bits = 0;
+            std::memcpy(&bits, &f, sizeof bits);
+            append_bytes(bytes, bits, 4, big);
+        }
+        for (unsigned c : colour) append_bytes(bytes, c, 1, big);
+        if (list) { // a list of i % 2 neighbours
+            append_bytes(bytes, i % 2, 1, big);
+            if (i % 2) append_bytes(bytes, static_cast<uint32_t>(i + 1), 4, big);
+        }
+        append_bytes(bytes, intensity, 2, big);
+        uint64_t bits = 0;
+        std::memcpy(&bits, &quality, sizeof bits);
+        append_bytes(bytes, bits, 8, big);
+        append_bytes(bytes, static_cast<uint32_t>(label), 4, big);
+    }
+    return bytes;
+}
+
 std::string truncated_ply() {
     std::string text = "ply\nformat binary_little_endian 1.0\nelement vertex 100\n"
                        "property float x\nproperty float y\nproperty float z\nend_header\n";
@@ -213,6 +283,11 @@ int make_inputs(const std::string& dir) {
               write_file(dir + "/sorted.xyz", as_xyz(sorted, 0)) &&
               write_file(dir + "/mesh.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 1\n3 0 1 2\n") &&
               write_file(dir + "/sorted.ply", as_binary_ply(sorted)) &&
+              write_file(dir + "/attributes.ply", as_attribute_ply(cylinder, PlyEncoding::little)) &&
+              write_file(dir + "/attributes_ascii.ply",
+                         as_attribute_ply(cylinder, PlyEncoding::ascii)) &&
+              write_file(dir + "/attributes_big.ply",
+                         as_attribute_ply(cylinder, PlyEncoding::big_with_list)) &&
               write_file(dir + "/more_records.ply", ply_more_records_than_declared(cylinder)) &&
               write_file(dir + "/huge_integer.xyz", xyz_with_huge_integer()) &&
               write_file(dir + "/sorted_nan.xyz", sorted_with_nan_at(sorted, 1500)) &&
@@ -407,6 +482,211 @@ int check_mesh(int argc, char** argv) {
     return ok ? 0 : 1;
 }
 
+// The output's vertex data against the input's, point by point: in a PLY output, the
+// input's properties but its lists, with the same names and types in the same order, and
+// the same values; in an OBJ output, the normals as vn lines and the colours over 255.
+int check_attributes(char** argv) {
+    const std::string input = argv[2], output = argv[3];
+    mini_mesh::Mesh in, out;
+    if (!mini_mesh::read(input, in) || !mini_mesh::read(output, out)) {
+        std::fprintf(stderr, "cannot read %s or %s\n", input.c_str(), output.c_str());
+        return 1;
+    }
+    const size_t vertices = in.xyz.size() / 3;
+    if (out.xyz != in.xyz || in.properties.empty()) {
+        std::fprintf(stderr, "%s: not the points of %s, or no properties there\n", output.c_str(),
+                     input.c_str());
+        return 1;
+    }
+    const bool obj = output.size() > 4 && output.substr(output.size() - 4) == ".obj";
+    if (!obj) {
+        bool same = out.properties.size() == in.properties.size();
+        for (size_t k = 0; same && k < in.properties.size(); ++k)
+            same = out.properties[k].name == in.properties[k].name &&
+                   out.properties[k].type == in.properties[k].type;
+        if (!same || out.values != in.values) {
+            std::fprintf(stderr, "%s: the vertex properties differ from %s's\n", output.c_str(),
+                         input.c_str());
+            return 1;
+        }
+        return 0;
+    }
+    auto column = [&](const char* name) {
+        for (size_t k = 0; k < in.properties.size(); ++k)
+            if (in.properties[k].name == name) return k;
+        return in.properties.size();
+    };
+    const size_t columns = in.properties.size();
+    const size_t normal[3] = {column("nx"), column("ny"), column("nz")};
+    const size_t colour[3] = {column("red"), column("green"), column("blue")};
+    bool ok = out.obj_normals.size() == 3 * vertices && out.obj_colours.size() == 3 * vertices;
+    for (size_t i = 0; ok && i < vertices; ++i) {
+        for (size_t k = 0; k < 3; ++k) {
+            ok = ok && out.obj_normals[3 * i + k] == in.values[i * columns + normal[k]] &&
+                 out.obj_colours[3 * i + k] == in.values[i * columns + colour[k]] / 255;
+        }
+    }
+    if (!ok)
+        std::fprintf(stderr, "%s: the normals or colours differ from %s's\n", output.c_str(),
+                     input.c_str());
+    return ok ? 0 : 1;
+}
+
+// ---- svg ---------------------------------------------------------------------------------
+
+bool is_name_char(char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == ':' || c == '-' ||
+           c == '.';
+}
+
+// Character data or an attribute value: no '<', every '&' a known entity.
+bool valid_text(const std::string& text) {
+    if (text.find('<') != std::string::npos) return false;
+    for (size_t at = text.find('&'); at != std::string::npos; at = text.find('&', at + 1)) {
+        const size_t end = text.find(';', at);
+        if (end == std::string::npos) return false;
+        const std::string entity = text.substr(at + 1, end - at - 1);
+        const bool known = entity == "amp" || entity == "lt" || entity == "gt" ||
+                           entity == "quot" || entity == "apos" ||
+                           (entity.size() > 1 && entity[0] == '#');
+        if (!known) return false;
+    }
+    return true;
+}
+
+// A small XML well-formedness check: a declaration, comments, one root element, tags
+// nested and closed in order, attributes name="value" once each, text without '<' or
+// stray '&'. Counts the elements by name.
+bool check_xml(const std::string& text, std::unordered_map<std::string, size_t>& counts,
+               std::string& why) {
+    std::vector<std::string> open;
+    bool root_seen = false;
+    size_t at = 0;
+    auto fail = [&](const std::string& what) {
+        why = what + " at byte " + std::to_string(at);
+        return false;
+    };
+    while (at < text.size()) {
+        if (text[at] != '<') {
+            const size_t next = std::min(text.find('<', at), text.size());
+            const std::string chars = text.substr(at, next - at);
+            if (!valid_text(chars)) return fail("bad character data");
+            if (open.empty() && chars.find_first_not_of(" \t\r\n") != std::string::npos)
+                return fail("text outside the root element");
+            at = next;
+            continue;
+        }
+        if (text.compare(at, 4, "<!--") == 0 || text.compare(at, 2, "<?") == 0) {
+            const bool comment = text[at + 1] == '!';
+            const size_t end = text.find(comment ? "-->" : "?>", at);
+            if (end == std::string::npos) return fail("an unclosed comment or declaration");
+            at = end + (comment ? 3 : 2);
+            continue;
+        }
+        const bool closing = text.compare(at, 2, "</") == 0;
+        size_t cursor = at + (closing ? 2 : 1);
+        const size_t name_start = cursor;
+        while (cursor < text.size() && is_name_char(text[cursor])) ++cursor;
+        const std::string name = text.substr(name_start, cursor - name_start);
+        if (name.empty() || std::isdigit(static_cast<unsigned char>(name[0])))
+            return fail("a tag without a name");
+        auto skip_space = [&]() {
+            while (cursor < text.size() && std::isspace(static_cast<unsigned char>(text[cursor])))
+                ++cursor;
+        };
+        if (closing) {
+            skip_space();
+            if (cursor >= text.size() || text[cursor] != '>') return fail("a malformed end tag");
+            if (open.empty() || open.back() != name) return fail("</" + name + "> closes nothing open");
+            open.pop_back();
+            at = cursor + 1;
+            continue;
+        }
+        if (open.empty() && root_seen) return fail("a second root element");
+        root_seen = true;
+        std::unordered_set<std::string> attributes;
+        bool empty_element = false;
+        for (;;) {
+            skip_space();
+            if (cursor >= text.size()) return fail("an unclosed tag");
+            if (text.compare(cursor, 2, "/>") == 0) {
+                empty_element = true;
+                cursor += 2;
+                break;
+            }
+            if (text[cursor] == '>') {
+                ++cursor;
+                break;
+            }
+            const size_t attribute_start = cursor;
+            while (cursor < text.size() && is_name_char(text[cursor])) ++cursor;
+            const std::string attribute = text.substr(attribute_start, cursor - attribute_start);
+            if (attribute.empty() || !attributes.insert(attribute).second)
+                return fail("a missing or repeated attribute in <" + name + ">");
+            skip_space();
+            if (cursor >= text.size() || text[cursor] != '=') return fail("an attribute without '='");
+            ++cursor;
+            skip_space();
+            const char quote = cursor < text.size() ? text[cursor] : '\0';
+            if (quote != '"' && quote != '\'') return fail("an unquoted attribute value");
+            const size_t end = text.find(quote, cursor + 1);
+            if (end == std::string::npos || !valid_text(text.substr(cursor + 1, end - cursor - 1)))
+                return fail("a bad attribute value");
+            cursor = end + 1;
+        }
+        ++counts[name];
+        if (!empty_element) open.push_back(name);
+        at = cursor;
+    }
+    if (!open.empty()) return fail("<" + open.back() + "> never closed");
+    if (!root_seen) return fail("no root element");
+    return true;
+}
+
+// The picture is well-formed XML whose root is <svg>, with a polygon per triangle in each
+// of its two views and a red line per boundary edge in each (the report's triangles and
+// its ends' loops).
+int check_svg(char** argv) {
+    std::string text;
+    mini_json::Value report;
+    if (!mini_mesh::load(argv[2], text) || !load_json(argv[3], report)) {
+        std::fprintf(stderr, "cannot read %s or %s\n", argv[2], argv[3]);
+        return 1;
+    }
+    std::unordered_map<std::string, size_t> counts;
+    std::string why;
+    if (!check_xml(text, counts, why)) {
+        std::fprintf(stderr, "%s: not well-formed XML: %s\n", argv[2], why.c_str());
+        return 1;
+    }
+    const mini_json::Value* triangles = report.at("triangles");
+    size_t boundary = 0;
+    for (const char* end : {"ends.bottom.loop_edges", "ends.top.loop_edges"})
+        if (const mini_json::Value* loops = report.at(end))
+            for (const mini_json::Value& edges : loops->items)
+                boundary += static_cast<size_t>(edges.num);
+    const bool ok = counts["svg"] == 1 && text.find("<svg") < text.find("<g") && triangles &&
+                    static_cast<double>(counts["polygon"]) == 2 * triangles->num &&
+                    counts["polyline"] == 2 * boundary;
+    if (!ok)
+        std::fprintf(stderr, "%s: %zu polygons and %zu boundary lines; the report has %g "
+                             "triangles and %zu boundary edges, in each of two views\n",
+                     argv[2], counts["polygon"], counts["polyline"],
+                     triangles ? triangles->num : -1.0, boundary);
+    return ok ? 0 : 1;
+}
+
+int check_no_attributes(char** argv) {
+    mini_mesh::Mesh mesh;
+    if (!mini_mesh::read(argv[2], mesh) || mesh.tris.empty()) {
+        std::fprintf(stderr, "cannot read the mesh %s\n", argv[2]);
+        return 1;
+    }
+    if (mesh.properties.empty() && mesh.obj_normals.empty() && mesh.obj_colours.empty()) return 0;
+    std::fprintf(stderr, "%s: the vertices carry more than their coordinates\n", argv[2]);
+    return 1;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -415,7 +695,12 @@ int main(int argc, char** argv) {
     if (command == "json" && argc >= 3) return check_json(argc, argv);
     if (command == "mesh" && (argc == 4 || argc == 5)) return check_mesh(argc, argv);
     if (command == "same-mesh" && argc == 4) return check_same_mesh(argv);
+    if (command == "attributes" && argc == 4) return check_attributes(argv);
+    if (command == "no-attributes" && argc == 3) return check_no_attributes(argv);
+    if (command == "svg" && argc == 4) return check_svg(argv);
     std::fprintf(stderr, "usage: stratmesh_cli_check make-inputs DIR | json FILE [ASSERTION...] |"
-                         " mesh FILE VERTICES [REPORT.json] | same-mesh FILE FILE\n");
+                         " mesh FILE VERTICES [REPORT.json] | same-mesh FILE FILE |"
+                         " attributes INPUT.ply OUTPUT | no-attributes FILE |"
+                         " svg FILE REPORT.json\n");
     return 2;
 }

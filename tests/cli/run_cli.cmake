@@ -7,15 +7,27 @@
 #   EXPECT_STDOUT  optional regular expression stdout must match
 #   EXPECT_STDERR  optional regular expression stderr must match
 #   REJECT_STDERR  optional regular expression stderr must not match
+#   STDIN_FILE     optional file given as the tool's standard input
+#   STDOUT_FILE    optional file in WORK_DIR that receives the tool's standard output
+#                  (EXPECT_STDOUT is then not checked)
 #   CHECKS         optional commands to run afterwards in WORK_DIR, each must exit 0:
 #                  arguments separated by '|', commands by '||'
 file(REMOVE_RECURSE "${WORK_DIR}")
 file(MAKE_DIRECTORY "${WORK_DIR}")
 
 string(REPLACE "|" ";" args "${ARGS}")
+set(streams "")
+if(DEFINED STDIN_FILE)
+  list(APPEND streams INPUT_FILE "${STDIN_FILE}")
+endif()
+if(DEFINED STDOUT_FILE)
+  list(APPEND streams OUTPUT_FILE "${WORK_DIR}/${STDOUT_FILE}")
+else()
+  list(APPEND streams OUTPUT_VARIABLE out)
+endif()
 execute_process(COMMAND "${TOOL}" ${args}
   WORKING_DIRECTORY "${WORK_DIR}"
-  RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  RESULT_VARIABLE code ERROR_VARIABLE err ${streams})
 message(STATUS "stratmesh ${args}\n-- exit: ${code}\n-- stdout:\n${out}\n-- stderr:\n${err}")
 
 if(NOT "${code}" STREQUAL "${EXPECT_EXIT}")

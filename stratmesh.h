@@ -1068,9 +1068,10 @@ typedef enum stratmesh_parts_outcome {
     STRATMESH_PARTS_UNDONE
 } stratmesh_parts_outcome;
 
-// The name of a status and a one-line explanation (stratmesh::status_string); never NULL,
-// "unknown status" for a value outside the list.
-const char* stratmesh_status_string(stratmesh_status status);
+// The name of a status (a stratmesh_status value) and a one-line explanation
+// (stratmesh::status_string); never NULL, "unknown status" for a value outside the list.
+// An integer, so that any value a caller holds can be named without undefined behaviour.
+const char* stratmesh_status_string(uint32_t status);
 
 // Exact-sign predicates on double[2] points (stratmesh::orient2d, stratmesh::incircle):
 // twice the signed area of abc, and positive when d lies inside the circle through the
@@ -11422,7 +11423,7 @@ inline ByteRange c_layer_bytes(const stratmesh_report* c) {
 }  // namespace detail
 }  // namespace stratmesh
 
-const char* stratmesh_status_string(stratmesh_status status) {
+const char* stratmesh_status_string(uint32_t status) {
     return stratmesh::status_string(static_cast<stratmesh::Status>(status));
 }
 

@@ -307,7 +307,7 @@ TEST_CASE("C interface: the C stream gives the C++ stream's triangles and report
 
 TEST_CASE("C interface: status strings and the 2D triangulation are the C++ ones") {
     for (uint32_t v = 0; v <= STRATMESH_STATUS_INTERNAL_ERROR + 1; ++v)
-        CHECK(std::strcmp(stratmesh_status_string(static_cast<stratmesh_status>(v)),
+        CHECK(std::strcmp(stratmesh_status_string(v),
                           stratmesh::status_string(static_cast<Status>(v))) == 0);
     std::vector<double> xy;
     for (int i = 0; i < 40; ++i) {

@@ -9157,24 +9157,25 @@ inline void principal_directions(const double m[3][3], Vec3 out[3]) {
 inline void scatter_of(const double* xyz, size_t count, double m[3][3]) {
     // Scaled by the power of two that brings the largest coordinate near 1 (exactly, so
     // directions and ratios keep their bits): squares of coordinates near either end of the
-    // double range would overflow or vanish.
+    // double range would overflow or vanish. A multiplication where the factor is a normal
+    // double, ldexp (a call) only where it is not.
     double largest = 0;
     for (size_t i = 0; i < 3 * count; ++i)
         largest = abs_value(xyz[i]) > largest ? abs_value(xyz[i]) : largest;
     int exponent = 0;
     std::frexp(largest, &exponent);
+    const double factor = exponent > -1000 && exponent < 1000 ? std::ldexp(1.0, -exponent) : 0;
+    auto unit = [&](double v) { return factor != 0 ? v * factor : std::ldexp(v, -exponent); };
     Vec3 mean = {0, 0, 0};
     for (size_t i = 0; i < count; ++i)
-        mean = Vec3{mean.x + std::ldexp(xyz[3 * i], -exponent),
-                    mean.y + std::ldexp(xyz[3 * i + 1], -exponent),
-                    mean.z + std::ldexp(xyz[3 * i + 2], -exponent)};
+        mean = Vec3{mean.x + unit(xyz[3 * i]), mean.y + unit(xyz[3 * i + 1]),
+                    mean.z + unit(xyz[3 * i + 2])};
     mean = scaled(mean, 1.0 / static_cast<double>(count));
     for (int r = 0; r < 3; ++r)
         for (int s = 0; s < 3; ++s) m[r][s] = 0;
     for (size_t i = 0; i < count; ++i) {
-        const double d[3] = {std::ldexp(xyz[3 * i], -exponent) - mean.x,
-                             std::ldexp(xyz[3 * i + 1], -exponent) - mean.y,
-                             std::ldexp(xyz[3 * i + 2], -exponent) - mean.z};
+        const double d[3] = {unit(xyz[3 * i]) - mean.x, unit(xyz[3 * i + 1]) - mean.y,
+                             unit(xyz[3 * i + 2]) - mean.z};
         for (int r = 0; r < 3; ++r)
             for (int s = 0; s < 3; ++s) m[r][s] += d[r] * d[s];
     }

@@ -8,6 +8,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <vector>
@@ -86,15 +87,26 @@ struct Run {
 
 const size_t kInfo = 64;
 
+// A workspace at a 64-byte boundary: the peak a run reports counts from the buffer's start,
+// alignment padding included, so two runs compare only at the same alignment (malloc gives
+// 16 bytes on 64-bit targets, 8 on 32-bit ones).
+unsigned char* aligned_workspace(std::vector<unsigned char>& storage, size_t bytes) {
+    storage.assign(bytes + 64, 0);
+    const size_t skip = (64 - reinterpret_cast<uintptr_t>(storage.data()) % 64) % 64;
+    return storage.data() + skip;
+}
+
 Run run_cpp(const Shape& s, const Options& o, Report& rep, std::vector<stratmesh::LayerInfo>& info) {
     Run run;
-    std::vector<unsigned char> work(stratmesh::reconstruct_workspace_size(s.size(), o));
+    std::vector<unsigned char> storage;
+    const size_t bytes = stratmesh::reconstruct_workspace_size(s.size(), o);
+    unsigned char* work = aligned_workspace(storage, bytes);
     run.tris.resize(3 * stratmesh::reconstruct_max_triangles(s.size(), o));
     info.assign(kInfo, stratmesh::LayerInfo{});
     rep = Report{};
     rep.layers.info = info.data();
     rep.layers.info_capacity = info.size();
-    run.status = stratmesh::reconstruct(cloud_of(s), o, work.data(), work.size(), run.tris.data(),
+    run.status = stratmesh::reconstruct(cloud_of(s), o, work, bytes, run.tris.data(),
                                         run.tris.size() / 3, &run.count, &rep);
     run.tris.resize(3 * run.count);
     return run;
@@ -103,14 +115,16 @@ Run run_cpp(const Shape& s, const Options& o, Report& rep, std::vector<stratmesh
 Run run_c(const Shape& s, const stratmesh_options& o, stratmesh_report& rep,
           std::vector<stratmesh_layer_info>& info) {
     Run run;
-    std::vector<unsigned char> work(stratmesh_reconstruct_workspace_size(s.size(), &o));
+    std::vector<unsigned char> storage;
+    const size_t bytes = stratmesh_reconstruct_workspace_size(s.size(), &o);
+    unsigned char* work = aligned_workspace(storage, bytes);
     run.tris.resize(3 * stratmesh_reconstruct_max_triangles(s.size(), &o));
     info.assign(kInfo, stratmesh_layer_info{});
     std::memset(&rep, 0, sizeof rep);
     rep.layers.info = info.data();
     rep.layers.info_capacity = info.size();
     const stratmesh_cloud cloud = to_c(cloud_of(s));
-    run.status = static_cast<Status>(stratmesh_reconstruct(&cloud, &o, work.data(), work.size(),
+    run.status = static_cast<Status>(stratmesh_reconstruct(&cloud, &o, work, bytes,
                                                            run.tris.data(), run.tris.size() / 3,
                                                            &run.count, &rep));
     run.tris.resize(3 * run.count);

@@ -173,6 +173,7 @@ bool mutate_structure(std::string& text, Random& random) {
         std::string& header_line = lines[random.below(end_header)];
         if (header_line.rfind("property ", 0) != 0) return false;
         std::vector<std::pair<size_t, size_t>> t = tokens_of(header_line);
+        if (t.size() < 2) return false;  // "property" alone: nothing to replace
         size_t k = 1 + random.below(t.size() - 1);
         const char* names[] = {"x", "y", "z", "red"};
         const std::string replacement = k + 1 == t.size() && random.below(2)

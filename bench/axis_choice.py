@@ -12,8 +12,8 @@ distance from the mesh to REF relative to REF's bounding-box diagonal, and area_
 mesh's area over REF's). Prints one JSON line per cloud: the automatic axis's distance and
 area, the best explicit axis (by distance) with its figures, the ratio of the automatic
 distance to the best (1.0: as good), and the share of the automatic run's reconstruction
-time spent choosing the axis (the report's seconds.phases.validate, which holds the choice,
-over seconds.reconstruct).
+time spent before the layers are made (the report's seconds.phases.validate over
+seconds.reconstruct: checking the cloud, choosing the axis and searching for branches).
 
 Needs Debian's python3 with numpy (for the principal directions) and a built tool
 (default build/examples/cli/stratmesh).
@@ -76,7 +76,7 @@ def measure(tool, checker, cloud, ref, axis_args, work, tag):
     quality = json.loads(subprocess.run([checker, "--mesh", mesh, "--ref", ref, "--no-si"],
                                         capture_output=True, text=True).stdout)
     return {"mean": quality["mean_out_to_ref"], "area": quality["area_ratio"],
-            "choice_share": seconds["phases"]["validate"] / max(seconds["reconstruct"], 1e-12)}
+            "before_layers_share": seconds["phases"]["validate"] / max(seconds["reconstruct"], 1e-12)}
 
 
 def main(argv):

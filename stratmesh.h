@@ -728,9 +728,8 @@ Status reconstruct(const Cloud& cloud, const Options& options,
 // stream holds the last layer's top loop, the layer being formed (pushes that join it
 // included) and the pushes after it until they can form a layer. A layer that folds waits
 // for the two pushes after it (it may join them), so when every push is at least 16 points
-// and 1.5 rows of points thick and none is a crescent, it holds at most a loop and three
-// pushes: four times the largest push always suffices, and three times plus the largest
-// loop (a small share of a layer) in practice.
+// and 1.5 rows of points thick and none is a crescent, three times the largest push
+// suffices where no layer folds and about four times where layers fold.
 // A push that would hold more returns out_of_memory and changes nothing; Report::points.held_count
 // says what a run needed.
 

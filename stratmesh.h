@@ -43,7 +43,7 @@
 // branches and, where it does, the trunk and each branch are meshed along their own axes
 // and joined into one surface; the ends stay open (close_ends caps them) and the layers stay
 // Delaunay on their unrolled annulus, as in the paper (surface_flips refines them on the
-// surface, for about 2.5 times the time).
+// surface, for about three times the time).
 //
 // ==== Integration ==========================================================================
 //
@@ -375,7 +375,7 @@ enum Flags : uint32_t {
     // or loop changes; a flip never makes a fold nor an angle over 150 degrees (unless it
     // narrows one) and is checked against crossing the nearby triangles; the stream gives
     // the same triangles as reconstruct() with it. Closer to the true surface (by about
-    // 10% on scans, 30 to 45% on smooth analytic tubes), for about 2.5 times the time:
+    // 10% on scans, 30 to 45% on smooth analytic tubes), for about three times the time:
     // off by default. The reduced build returns not_compiled.
     surface_flips = 1u << 4,
     // No end of the surface is taken for a closed one (see ClosedEnd): the end layers are

@@ -73,7 +73,7 @@ const char kUsage[] =
     "                        paper's method), flip its edges on the surface in 3D, by the\n"
     "                        empty-circle rule and toward where the surface curves least\n"
     "                        (stratmesh's surface_flips): closer to the true surface where\n"
-    "                        the unrolling squeezes it, for about 2.5 times the time\n"
+    "                        the unrolling squeezes it, for about three times the time\n"
     "  --open-ends           take no end of the cloud for a closed one (a dome, a base,\n"
     "                        otherwise meshed across from a pole): both are unrolled on\n"
     "                        the cylinder like the rest; for a cloud cut out of a larger\n"

@@ -39,6 +39,16 @@ static unsigned char* guarded(size_t bytes) {
     return p;
 }
 
+/* The test's POINTS points, packed doubles. */
+static stratmesh_cloud packed_cloud(const double* xyz) {
+    stratmesh_cloud cloud;
+    cloud.xyz = xyz;
+    cloud.count = POINTS;
+    cloud.stride_bytes = 0;
+    cloud.scalar = STRATMESH_SCALAR_FLOAT64;
+    return cloud;
+}
+
 static int guard_intact(const unsigned char* p, size_t bytes) {
     size_t i;
     for (i = 0; i < GUARD; ++i)
@@ -133,10 +143,7 @@ static void test_reconstruct(const double* xyz, int close_ends) {
     options.axis = STRATMESH_AXIS_Z;
     options.layer_count = LAYERS;
     if (close_ends) options.flags = STRATMESH_FLAG_CLOSE_ENDS;
-    cloud.xyz = xyz;
-    cloud.count = POINTS;
-    cloud.stride_bytes = 0;
-    cloud.scalar = STRATMESH_SCALAR_FLOAT64;
+    cloud = packed_cloud(xyz);
 
     work_bytes = stratmesh_reconstruct_workspace_size(POINTS, &options);
     max_tris = stratmesh_reconstruct_max_triangles(POINTS, &options);
@@ -338,10 +345,7 @@ static void test_stream(const double* xyz) {
     /* The reference: reconstruct with the same cuts. */
     options.cuts = cuts;
     options.cut_count = LAYERS - 1;
-    cloud.xyz = xyz;
-    cloud.count = POINTS;
-    cloud.stride_bytes = 0;
-    cloud.scalar = STRATMESH_SCALAR_FLOAT64;
+    cloud = packed_cloud(xyz);
     work_bytes = stratmesh_reconstruct_workspace_size(POINTS, &options);
     max_tris = stratmesh_reconstruct_max_triangles(POINTS, &options);
     work = guarded(work_bytes);

@@ -390,20 +390,24 @@ struct RoundCone {  // a segment a -> b with radius ra at a and rb at b, rounded
 
 namespace detail {
 
-// n points spread evenly over the boundary of the union of three round cones (the parts
-// of each piece outside the others), cut to heights [z0, z1] (open there); deviation() is
-// the union's signed distance (a piece's is measured across its centre line, within 1% of
-// the true distance for a taper like a horn's). No piece may lie along y.
-inline Shape union_of_round_cones(const char* name, Pose pose, const RoundCone* parts, double z0,
-                                  double z1, size_t n, uint64_t seed) {
+// n points spread evenly over the boundary of the union of round cones (the parts of each
+// piece outside the others), cut to heights [z0, z1] (open there); deviation() is the
+// union's signed distance (a piece's is measured across its centre line, within 1% of the
+// true distance for a taper like a horn's).
+inline Shape union_of_round_cones(const char* name, Pose pose, std::vector<RoundCone> parts,
+                                  double z0, double z1, size_t n, uint64_t seed) {
     Shape s = start(name, pose, cylinder_radius, z0, z1);
     s.closed_distance = [parts](const double* p) {
-        return std::min(parts[0].distance(p), std::min(parts[1].distance(p), parts[2].distance(p)));
+        double d = parts[0].distance(p);
+        for (const RoundCone& q : parts) d = std::min(d, q.distance(p));
+        return d;
     };
     // Each piece: its side (area about pi (ra + rb) times its length) and its two end caps
     // (half spheres of radius ra and rb).
-    double side[3], area[3], total = 0;
-    for (int c = 0; c < 3; ++c) {
+    const size_t count = parts.size();
+    std::vector<double> side(count), area(count);
+    double total = 0;
+    for (size_t c = 0; c < count; ++c) {
         const RoundCone& q = parts[c];
         side[c] = kPi * (q.ra + q.rb) * std::hypot(q.b[0] - q.a[0], q.b[1] - q.a[1], q.b[2] - q.a[2]);
         area[c] = side[c] + 2 * kPi * (q.ra * q.ra + q.rb * q.rb);
@@ -414,16 +418,21 @@ inline Shape union_of_round_cones(const char* name, Pose pose, const RoundCone* 
     while (s.size() < n) {
         ++tries;
         double u = rng.uniform(0, total);
-        int c = 0;
-        while (c < 2 && u >= area[c]) u -= area[c++];
+        size_t c = 0;
+        while (c + 1 < count && u >= area[c]) u -= area[c++];
         const RoundCone& q = parts[c];
         double axis[3] = {q.b[0] - q.a[0], q.b[1] - q.a[1], q.b[2] - q.a[2]};
         const double length = std::hypot(axis[0], axis[1], axis[2]);
         for (double& x : axis) x /= length;
-        // Two unit vectors across the segment (no segment is along y).
+        // Two unit vectors across the segment: (z, 0, -x) normalised, or x for a piece
+        // along y.
         double e1[3] = {axis[2], 0, -axis[0]};
         const double l1 = std::hypot(e1[0], e1[1], e1[2]);
-        for (double& x : e1) x /= l1;
+        if (l1 < 1e-9) {
+            e1[0] = 1, e1[2] = 0;
+        } else {
+            for (double& x : e1) x /= l1;
+        }
         const double e2[3] = {axis[1] * e1[2] - axis[2] * e1[1], axis[2] * e1[0] - axis[0] * e1[2],
                               axis[0] * e1[1] - axis[1] * e1[0]};
         double p[3];
@@ -444,7 +453,7 @@ inline Shape union_of_round_cones(const char* name, Pose pose, const RoundCone* 
         }
         if (p[2] < z0 || p[2] > z1) continue;  // the open ends
         bool inside = false;
-        for (int o = 0; o < 3; ++o)
+        for (size_t o = 0; o < count; ++o)
             if (o != c && parts[o].distance(p) < 0) inside = true;
         if (inside) continue;
         s.add_local(std::atan2(p[1], p[0]), p[2], std::hypot(p[0], p[1]));
@@ -462,10 +471,11 @@ inline Shape union_of_round_cones(const char* name, Pose pose, const RoundCone* 
 // (+-1.1, 0, 3.5), their radius tapering from 0.3 to 0.03. Above the dome the cross-section
 // is two separate discs.
 inline Shape forked_tube(size_t n, Pose pose, uint64_t seed = 25) {
-    static const RoundCone parts[3] = {{{0, 0, -4}, {0, 0, 0.5}, 1.0, 1.0},
-                                       {{0.45, 0, 0.6}, {1.1, 0, 3.5}, 0.3, 0.03},
-                                       {{-0.45, 0, 0.6}, {-1.1, 0, 3.5}, 0.3, 0.03}};
-    return detail::union_of_round_cones("forked tube", pose, parts, -3, 3.53, n, seed);
+    return detail::union_of_round_cones("forked tube", pose,
+                                        {{{0, 0, -4}, {0, 0, 0.5}, 1.0, 1.0},
+                                         {{0.45, 0, 0.6}, {1.1, 0, 3.5}, 0.3, 0.03},
+                                         {{-0.45, 0, 0.6}, {-1.1, 0, 3.5}, 0.3, 0.03}},
+                                        -3, 3.53, n, seed);
 }
 
 // A tube closed at its bottom by two knobs side by side, as a femur by its condyles: a
@@ -474,10 +484,84 @@ inline Shape forked_tube(size_t n, Pose pose, uint64_t seed = 25) {
 // the trunk, their lowest points at z = -1.7. Below the trunk's pole the cross-section is
 // two discs 0.3 apart, and the notch between them rises to the pole.
 inline Shape knobbed_tube(size_t n, Pose pose, uint64_t seed = 26) {
-    static const RoundCone parts[3] = {{{0, 0, 0}, {0, 0, 4}, 1.0, 1.0},
-                                       {{0.65, 0, -1.2}, {0.65, 0, -0.2}, 0.5, 0.5},
-                                       {{-0.65, 0, -1.2}, {-0.65, 0, -0.2}, 0.5, 0.5}};
-    return detail::union_of_round_cones("knobbed tube", pose, parts, -1.7, 3, n, seed);
+    return detail::union_of_round_cones("knobbed tube", pose,
+                                        {{{0, 0, 0}, {0, 0, 4}, 1.0, 1.0},
+                                         {{0.65, 0, -1.2}, {0.65, 0, -0.2}, 0.5, 0.5},
+                                         {{-0.65, 0, -1.2}, {-0.65, 0, -0.2}, 0.5, 0.5}},
+                                        -1.7, 3, n, seed);
+}
+
+// Objects with limbs: unions of round cones, closed where a limb ends and open where the
+// cut at z0 crosses the trunk. Sizes in units of the trunk's radius.
+
+// A Y of tubes: a trunk up to z = 0, open at z = -3, and two arms of radius 0.6 rising
+// outward to (+-2.2, 0, 3.5).
+inline Shape y_of_tubes(size_t n, Pose pose, uint64_t seed = 31) {
+    return detail::union_of_round_cones("Y of tubes", pose,
+                                        {{{0, 0, -4}, {0, 0, 0}, 1.0, 1.0},
+                                         {{0, 0, 0}, {2.2, 0, 3.5}, 0.6, 0.6},
+                                         {{0, 0, 0}, {-2.2, 0, 3.5}, 0.6, 0.6}},
+                                        -3, 1e9, n, seed);
+}
+
+// A trunk open at z = 0 with three branches leaving its side at heights 2, 4.5 and 7 in
+// three directions, its top a dome.
+inline Shape branched_trunk(size_t n, Pose pose, uint64_t seed = 32) {
+    return detail::union_of_round_cones("branched trunk", pose,
+                                        {{{0, 0, -1}, {0, 0, 9}, 1.0, 1.0},
+                                         {{0, 0, 2}, {3.2, 0, 4}, 0.45, 0.4},
+                                         {{0, 0, 4.5}, {-2, 2.2, 6.5}, 0.45, 0.4},
+                                         {{0, 0, 7}, {0.6, -3, 8.5}, 0.4, 0.35}},
+                                        0, 1e9, n, seed);
+}
+
+// A hand: a forearm open at z = -2, a flat palm (two round cones side by side), four
+// fingers spreading from its top and a thumb standing out sideways.
+inline Shape hand(size_t n, Pose pose, uint64_t seed = 33) {
+    return detail::union_of_round_cones("hand", pose,
+                                        {{{0, 0, -3}, {0, 0, 0}, 0.8, 0.8},
+                                         {{-0.45, 0, 0.2}, {-0.5, 0, 1.9}, 0.6, 0.55},
+                                         {{0.45, 0, 0.2}, {0.5, 0, 1.9}, 0.6, 0.55},
+                                         {{-0.8, 0, 1.9}, {-1.5, 0, 3.9}, 0.22, 0.2},
+                                         {{-0.27, 0, 2.0}, {-0.45, 0, 4.4}, 0.22, 0.2},
+                                         {{0.27, 0, 2.0}, {0.45, 0, 4.4}, 0.22, 0.2},
+                                         {{0.8, 0, 1.9}, {1.5, 0, 3.9}, 0.22, 0.2},
+                                         {{0.9, 0, 0.7}, {2.6, 0, 1.5}, 0.26, 0.22}},
+                                        -2, 1e9, n, seed);
+}
+
+// A four-legged body: a horizontal body along x, four vertical legs under it, a neck and
+// a head in front. Closed all over.
+inline Shape four_legged(size_t n, Pose pose, uint64_t seed = 34) {
+    return detail::union_of_round_cones("four-legged body", pose,
+                                        {{{-3, 0, 0}, {3, 0, 0}, 1.0, 1.0},
+                                         {{2, 0.55, -0.3}, {2, 0.55, -3.5}, 0.3, 0.27},
+                                         {{2, -0.55, -0.3}, {2, -0.55, -3.5}, 0.3, 0.27},
+                                         {{-2, 0.55, -0.3}, {-2, 0.55, -3.5}, 0.3, 0.27},
+                                         {{-2, -0.55, -0.3}, {-2, -0.55, -3.5}, 0.3, 0.27},
+                                         {{2.8, 0, 0.3}, {3.8, 0, 1.9}, 0.45, 0.4},
+                                         {{3.7, 0, 2}, {4.9, 0, 1.8}, 0.6, 0.45}},
+                                        -1e9, 1e9, n, seed);
+}
+
+// A tee of pipes: a pipe along x and a narrower one rising from its middle along z, their
+// ends rounded.
+inline Shape tee(size_t n, Pose pose, uint64_t seed = 35) {
+    return detail::union_of_round_cones("tee", pose,
+                                        {{{-4, 0, 0}, {4, 0, 0}, 1.0, 1.0},
+                                         {{0, 0, 0}, {0, 0, 4}, 0.7, 0.7}},
+                                        -1e9, 1e9, n, seed);
+}
+
+// A Y whose right arm parts again into two twigs.
+inline Shape twice_forked(size_t n, Pose pose, uint64_t seed = 36) {
+    return detail::union_of_round_cones("twice forked", pose,
+                                        {{{0, 0, -4}, {0, 0, 0}, 1.0, 1.0},
+                                         {{0, 0, 0}, {-2, 0, 3.2}, 0.55, 0.5},
+                                         {{0, 0, 0}, {1.6, 0, 2.5}, 0.6, 0.55},
+                                         {{1.6, 0, 2.5}, {3.3, 0, 4.8}, 0.35, 0.3},
+                                         {{1.6, 0, 2.5}, {1.2, 0, 5.2}, 0.35, 0.3}},
+                                        -3, 1e9, n, seed);
 }
 
 // A cylindrical range scan: a regular (theta, z) grid on the unit cylinder over

@@ -100,6 +100,8 @@
 //                            - the finer peeling of loops where layers fold: where the
 //                              object forks at its end (horns), a web of triangles may
 //                              stay between the branches' tips;
+//                            - the measure of webs (Report::diagnostics' web fields
+//                              stay 0);
 //                            - the C interface, unless STRATMESH_C_API is 1;
 //                            - the flags drop_outliers, surface_flips and open_ends,
 //                              which also return not_compiled (filter the cloud before
@@ -117,10 +119,10 @@
 // As a guide: delaunay_2d needs 72 bytes per point plus about 10 KiB, and its output is at
 // most 2n - 5 triangles (24 bytes per point). reconstruct needs about 115 bytes per point
 // (the triangulation of its largest possible layer, the layer grouping and the boundary
-// loops), about 121 with close_ends (plus up to 32 KiB for the exhaustive search of a
-// cap), about 166 with a jobs runner; its output is at most 2n triangles plus 160 for the
-// junctions of branches. A stream needs about 190 bytes per point it holds at once,
-// whatever the size of the whole cloud.
+// loops; measuring the webs at the end takes less), about 121 with close_ends (plus up to
+// 32 KiB for the exhaustive search of a cap), about 166 with a jobs runner; its output is
+// at most 2n triangles plus 160 for the junctions of branches. A stream needs about 190
+// bytes per point it holds at once, whatever the size of the whole cloud.
 //
 // The whole workspace belongs to the call while it runs, including what it does not need:
 // without a runner, reconstruct keeps the points grouped by layer (24 bytes each) in spare
@@ -598,11 +600,34 @@ struct CapCounts {
                              // close_ends); 0 in STRATMESH_SMALL_CODE
 };
 
+// A web triangle (Diagnostics) has its longest edge over this many times the largest local
+// spacing of its corners: single columns then show none or a few, objects with limbs
+// meshed as one tube a few percent of their area or more.
+constexpr double kWebSpacings = 6.0;
+
 // Report::diagnostics: what a user checks before trusting the mesh.
 struct Diagnostics {
     size_t fold_count;             // output triangles whose normal faces the axis
     size_t illegal_removed_count;  // triangles removed by the manifold safety net
     size_t diagonal_swap_count;    // band diagonals swapped when stitching layers
+    // Webs: where one tube wraps limbs, fingers or branches, its triangles span the gaps
+    // between them, where the cloud has no surface; measured so that such a mesh does not
+    // pass silently. On ok, reconstruct() measures its output, caps left out (the last
+    // caps.triangle_count triangles span their loops by design). A vertex's local spacing
+    // is the median (the lower of two middles) of the lengths of the edges leaving it, one
+    // a triangle (so each of its edges once, but one of a boundary vertex's two boundary
+    // edges): the median, so that the long edges across a CT stack's slices and a few
+    // long edges at a web's border count as the vertex's own. A web triangle's longest
+    // edge exceeds kWebSpacings times the largest local spacing of its corners: the
+    // largest, so that a sparse region beside a dense one is no web. Lengths are measured
+    // in double and compared rounded to float; areas are summed in the triangles' order:
+    // the same bytes for every runner and platform. All 0 from the stream (it never holds
+    // the whole surface), cap_ends() and the reduced build (STRATMESH_SMALL_CODE).
+    size_t web_triangle_count;
+    double web_area;               // their area, in the cloud's units squared
+    double web_area_fraction;      // web_area over the surface's area, caps left out
+    double web_box_min[3];         // the bounding box of the web triangles' corners, to
+    double web_box_max[3];         // show where the gaps are (zeros without webs)
 };
 
 struct Report {
@@ -624,9 +649,10 @@ struct Report {
 // A size in bytes that is always enough workspace for reconstruct() of point_count
 // points with these options. It assumes the worst layout (every point in one layer);
 // Report::workspace_used_bytes tells what a run really needed, which follows its largest
-// layer (about a third of the bound on a tube of six or more layers). With
-// Options::run_jobs it also covers the layers triangulated ahead and the jobs' scratch.
-// 0 if no workspace can serve that many points (as for delaunay_2d_workspace_size).
+// layer, or the measure of webs at the end (60 bytes a point, about half of the bound, on
+// a tube of six or more layers). With Options::run_jobs it also covers the layers
+// triangulated ahead and the jobs' scratch. 0 if no workspace can serve that many points
+// (as for delaunay_2d_workspace_size).
 size_t reconstruct_workspace_size(size_t point_count, const Options& options);
 
 // The most triangles reconstruct() can produce for point_count points: 2n, plus four per
@@ -1206,7 +1232,16 @@ typedef struct stratmesh_diagnostics {
     size_t fold_count;             // output triangles whose normal faces the axis
     size_t illegal_removed_count;  // triangles removed by the manifold safety net
     size_t diagonal_swap_count;    // band diagonals swapped when stitching layers
+    size_t web_triangle_count;     // triangles spanning gaps: the longest edge over
+                                   // STRATMESH_WEB_SPACINGS local spacings (caps left out)
+    double web_area;               // their area, in the cloud's units squared
+    double web_area_fraction;      // of the surface's area, caps left out
+    double web_box_min[3];         // where they lie (zeros without webs)
+    double web_box_max[3];
 } stratmesh_diagnostics;
+
+// stratmesh::kWebSpacings.
+#define STRATMESH_WEB_SPACINGS 6.0
 
 // stratmesh::Report, its groups as nested structs, so that C code reads the same counts
 // under the same names. stratmesh_reconstruct fills it on every status, counts adding up,
@@ -1306,6 +1341,7 @@ stratmesh_status stratmesh_stream_close(stratmesh_stream* stream);
 //   >>stitch             the band between two layers' loops
 //   >>manifold           the safety net that keeps the surface a manifold
 //   >>caps               closing a boundary loop: pockets, lowered caps, fins
+//   >>webs               how much of a finished surface spans gaps (Diagnostics)
 //   >>reconstruct        one tube: chunks of layers, seam flips, parallel layers
 //   >>stream             the same surface, layer by layer, in bounded memory
 //   >>axis               the automatic axis
@@ -1396,6 +1432,7 @@ const bool kPeelFoldedEnds = false;
 const bool kFoldMerge = false;
 const uint32_t kFoldMergeReach = 0;
 const bool kFastLoops = false;
+const bool kMeasureWebs = false;
 #else
 const bool kNetShortcut = true;  // a chunk whose loop fans are whole skips the net
 const bool kStagePoints = true;  // reconstruct() keeps the grouped points in spare workspace
@@ -1439,6 +1476,8 @@ const uint32_t kFoldMergeReach = 2;
 // layer guess in layer_of, pseudo_angle without branches, floor by truncation in
 // exp_portable, the height range from choose_frame's extremes, count_folds' prefetching.
 const bool kFastLoops = true;
+// reconstruct() measures the webs of its output (Diagnostics; see >>webs).
+const bool kMeasureWebs = true;
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 
@@ -6856,6 +6895,235 @@ inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
     return Status::ok;
 }
 
+// >>webs ====================================================================================
+//
+// How much of a finished surface is web (Diagnostics): triangles far longer than the
+// spacing of the points they join, as where one tube wraps limbs and spans the gaps between
+// them. A vertex's local spacing is the median length of its edges, each counted once: the
+// edge that leaves it in each of its triangles (a boundary vertex misses one of its two
+// boundary edges). The median, not the shortest: a CT stack's edges across its slices are
+// far longer than those along a slice, and a vertex at a web's border has a few long edges
+// among its own. A triangle is web when its longest edge exceeds kWebSpacings times the
+// largest spacing of its corners: the largest, so that a triangle between a densely and a
+// sparsely sampled region is measured by the sparse one's. With 6, single columns (tubes,
+// heads, cones, capsules, CT slices, scan grids, noisy tubes, the bundled bust) show no web
+// triangle or a few, under 0.3% of their area, while objects with limbs meshed as one tube
+// show 2 to 12% of theirs. Far more of such a mesh is folded surface whose vertices have
+// only long edges (a fan of slivers from a foot to the body): the measure counts the
+// spans, which is enough to tell. The caps are left out: a cap spans its loop by design.
+//
+// The pass runs once the surface is final, when the layers' scratch is free: 60 bytes a
+// point (with 2 triangles a point), within reconstruct_workspace_size()'s bound. Lengths
+// are measured in the cloud's coordinates times a power of two that brings its extent near
+// 1 (exact), so that no square overflows or underflows.
+
+// A vertex's slot: where its lengths end while they are sorted, then its local spacing.
+union WebSlot {
+    size_t end;
+    float spacing;
+};
+
+// The vertices are numbered in the order the triangles first name them, their points
+// copied in that order, and the triangles renumbered in place (then restored): the passes
+// over the triangles then read nearby memory, whatever the cloud's order.
+struct WebMemory {
+    Vec3* points;      // a vertex's point (halved where the cloud spans more than a double)
+    WebSlot* slots;    // a slot a vertex
+    uint32_t* index;   // a vertex's index in the cloud
+    // While the vertices are numbered, a point's number (or kNoIndex); then, in the same
+    // memory, the lengths of the edges leaving each vertex, vertex after vertex.
+    uint32_t* id;
+    float* lengths;
+};
+
+inline bool allocate_webs(WebMemory& m, size_t point_count, size_t triangle_count,
+                          Arena& arena) {
+    m.points = arena.alloc<Vec3>(point_count);
+    m.slots = arena.alloc<WebSlot>(point_count);
+    m.index = arena.alloc<uint32_t>(point_count);
+    const size_t lengths = saturating_product(3, triangle_count);
+    void* shared = arena.take(lengths > point_count ? lengths : point_count, sizeof(float));
+    m.id = static_cast<uint32_t*>(shared);
+    m.lengths = static_cast<float*>(shared);
+    return !arena.failed;
+}
+
+// The workspace measure_webs() takes.
+inline size_t webs_workspace_size(size_t point_count, size_t triangle_count) {
+    Arena arena = Arena::measuring();
+    WebMemory m;
+    return allocate_webs(m, point_count, triangle_count, arena) ? arena.required_bytes() : 0;
+}
+
+// Edges in the cloud's coordinates times a power of two that brings the cloud's extent
+// near 1 (exact): no square overflows or underflows. Where the cloud spans more than the
+// largest double, the points are halved first, so that no difference overflows.
+struct WebFrame {
+    double scale;
+    bool halved;
+    Vec3 point(const CloudReader& reader, uint32_t i) const {
+        return halved ? scaled(reader.point(i), 0.5) : reader.point(i);
+    }
+    // ab, bc and ca of the triangle whose corners are numbered c.
+    void edges(const Vec3* points, const uint32_t* c, Vec3 e[3]) const {
+        const double s = halved ? 2 * scale : scale;
+        const Vec3 a = points[c[0]], b = points[c[1]], d = points[c[2]];
+        e[0] = scaled(b - a, s);
+        e[1] = scaled(d - b, s);
+        e[2] = scaled(a - d, s);
+    }
+};
+
+inline WebFrame web_frame(const CloudSums& s) {
+    const Vec3 low = {s.lowest[0], s.lowest[1], s.lowest[2]};
+    const Vec3 high = {s.highest[0], s.highest[1], s.highest[2]};
+    const Vec3 size = high - low, half = scaled(high, 0.5) - scaled(low, 0.5);
+    double extent = half.x > half.y ? half.x : half.y;
+    if (half.z > extent) extent = half.z;
+    return {scale_for_extent(extent), !(is_finite(size.x) && is_finite(size.y) && is_finite(size.z))};
+}
+
+// a, b in order (as min and max, which compile without a branch).
+inline void order(float& a, float& b) {
+    const float low = b < a ? b : a, high = a < b ? b : a;
+    a = low;
+    b = high;
+}
+
+// The lower median of v[0 .. count), count > 0: by a sorting network for a vertex's few
+// edges (no branch to mispredict), by heapsort for a large fan.
+inline float lower_median(float* v, size_t count) {
+    if (count > 8) {
+        heap_sort(v, count);
+        return v[(count - 1) / 2];
+    }
+    float s[8];
+    for (size_t i = 0; i < 8; ++i) s[i] = i < count ? v[i] : FLT_MAX;
+    order(s[0], s[2]), order(s[1], s[3]), order(s[4], s[6]), order(s[5], s[7]);
+    order(s[0], s[4]), order(s[1], s[5]), order(s[2], s[6]), order(s[3], s[7]);
+    order(s[0], s[1]), order(s[2], s[3]), order(s[4], s[5]), order(s[6], s[7]);
+    order(s[2], s[4]), order(s[3], s[5]);
+    order(s[1], s[4]), order(s[3], s[6]);
+    order(s[1], s[2]), order(s[3], s[4]), order(s[5], s[6]);
+    return s[(count - 1) / 2];
+}
+
+// Corners this far ahead are prefetched while the vertices are numbered: the triangles
+// name them in no order of the cloud's.
+const size_t kWebAhead = 16;
+
+// Numbers the vertices, copies their points, renumbers the triangles' corners and counts
+// the edges leaving each vertex; returns how many vertices there are.
+inline uint32_t number_vertices(const CloudReader& reader, const WebFrame& f, uint32_t* tri,
+                                size_t count, size_t point_count, const WebMemory& m) {
+    for (size_t v = 0; v < point_count; ++v) m.id[v] = kNoIndex;
+    uint32_t vertices = 0;
+    for (size_t k = 0; k < 3 * count; ++k) {
+        if (kFastLoops && k + kWebAhead < 3 * count) {
+            prefetch(m.id + tri[k + kWebAhead]);
+            prefetch(reader.base + tri[k + kWebAhead] * reader.stride);
+        }
+        uint32_t& id = m.id[tri[k]];
+        if (id == kNoIndex) {
+            id = vertices++;
+            m.points[id] = f.point(reader, tri[k]);
+            m.index[id] = tri[k];
+            m.slots[id].end = 0;
+        }
+        ++m.slots[id].end;
+        tri[k] = id;
+    }
+    size_t start = 0;  // the counts into starts
+    for (uint32_t v = 0; v < vertices; ++v) {
+        const size_t edges = m.slots[v].end;
+        m.slots[v].end = start;
+        start += edges;
+    }
+    return vertices;
+}
+
+// Each vertex's local spacing into its slot: the lengths of the edges leaving it, sorted
+// by vertex (a counting sort), and their median. Returns the triangles' area.
+inline double local_spacings(const WebFrame& f, const uint32_t* tri, size_t count,
+                             uint32_t vertices, const WebMemory& m) {
+    double area = 0;
+    for (size_t t = 0; t < count; ++t) {
+        const uint32_t* c = tri + 3 * t;
+        Vec3 e[3];
+        f.edges(m.points, c, e);
+        const Vec3 n = cross(e[0], e[1]);
+        area += std::sqrt(dot(n, n)) / 2;
+        for (size_t j = 0; j < 3; ++j)  // each start becomes an end
+            m.lengths[m.slots[c[j]].end++] = static_cast<float>(std::sqrt(dot(e[j], e[j])));
+    }
+    size_t first = 0;
+    for (uint32_t v = 0; v < vertices; ++v) {
+        const size_t end = m.slots[v].end;
+        m.slots[v].spacing = lower_median(m.lengths + first, end - first);
+        first = end;
+    }
+    return area;
+}
+
+// The web triangles among the renumbered triangles (see Diagnostics), into d; returns
+// their area.
+inline double find_webs(const WebFrame& f, const uint32_t* tri, size_t count,
+                        const WebMemory& m, Diagnostics& d) {
+    double web = 0;
+    Vec3 low = {DBL_MAX, DBL_MAX, DBL_MAX}, high = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+    for (size_t t = 0; t < count; ++t) {
+        const uint32_t* c = tri + 3 * t;
+        Vec3 e[3];
+        f.edges(m.points, c, e);
+        float longest = 0, spacing = 0;
+        for (size_t j = 0; j < 3; ++j) {
+            const float length = static_cast<float>(std::sqrt(dot(e[j], e[j])));
+            longest = length > longest ? length : longest;
+            spacing = m.slots[c[j]].spacing > spacing ? m.slots[c[j]].spacing : spacing;
+        }
+        if (!(static_cast<double>(longest) > kWebSpacings * static_cast<double>(spacing))) continue;
+        ++d.web_triangle_count;
+        const Vec3 n = cross(e[0], e[1]);
+        web += std::sqrt(dot(n, n)) / 2;
+        for (size_t j = 0; j < 3; ++j) {
+            const Vec3 p = m.points[c[j]];
+            low = {p.x < low.x ? p.x : low.x, p.y < low.y ? p.y : low.y, p.z < low.z ? p.z : low.z};
+            high = {p.x > high.x ? p.x : high.x, p.y > high.y ? p.y : high.y,
+                    p.z > high.z ? p.z : high.z};
+        }
+    }
+    const double unhalve = f.halved ? 2 : 1;  // the copied points are halved then
+    const double lows[3] = {low.x, low.y, low.z}, highs[3] = {high.x, high.y, high.z};
+    for (int k = 0; d.web_triangle_count > 0 && k < 3; ++k) {
+        d.web_box_min[k] = lows[k] * unhalve;
+        d.web_box_max[k] = highs[k] * unhalve;
+    }
+    return web;
+}
+
+// Measures the webs of triangles[0 .. count) less the last `caps` into rep.diagnostics;
+// the triangles are renumbered meanwhile and come back as they were. False if the
+// workspace is too small (nothing is measured).
+inline bool measure_webs(const CloudReader& reader, size_t point_count, const CloudSums& sums,
+                         uint32_t* triangles, size_t count, size_t caps, Arena& arena,
+                         Report& rep) {
+    const size_t walls = caps < count ? count - caps : 0;
+    const size_t mark = arena.mark();
+    WebMemory m;
+    if (!allocate_webs(m, point_count, walls, arena)) return false;
+    const WebFrame f = web_frame(sums);
+    const uint32_t vertices = number_vertices(reader, f, triangles, walls, point_count, m);
+    const double area = local_spacings(f, triangles, walls, vertices, m);
+    Diagnostics& d = rep.diagnostics;
+    const double web = find_webs(f, triangles, walls, m, d);
+    for (size_t k = 0; k < 3 * walls; ++k) triangles[k] = m.index[triangles[k]];
+    arena.rewind(mark);
+    if (d.web_triangle_count == 0) return true;
+    d.web_area = web / f.scale / f.scale;
+    d.web_area_fraction = area > 0 ? web / area : 0;
+    return true;
+}
+
 // >>reconstruct =============================================================================
 //
 // Validate, choose the frame and the layers, group the points by layer, then for each
@@ -8768,7 +9036,6 @@ struct Stream {
     TriangleCallback emit;
     void* emit_user;
     Report* user_report;
-    Report rep;
     size_t capacity;              // points the window holds
     uint32_t slot_capacity;       // pushes it holds
     detail::Vec3* points;         // the window: the last top loop, then the held pushes
@@ -8789,6 +9056,8 @@ struct Stream {
     detail::DistinctPoints distinct;  // among the points so far
     Status failure;               // sticky: a triangulation error
     bool closed;
+    Report rep;                   // last: the fields above stay near the start (shorter
+                                  // instructions reach them on 32-bit ARM)
 };
 
 namespace detail {
@@ -11125,6 +11394,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     TubeInput in = {};
     Options along;
     status = read_cloud(cloud, options, arena, rep, in);
+    const size_t read = arena.mark();  // the outliers' bitmap stays: the reader needs it
     // A cloud on a line up to rounding is refused whatever the axis: a line has no surface,
     // and along it a layer would only seem not to surround its axis.
     if (status == Status::ok && kDegenerateCheck && in.sums.distinct >= 3 && on_a_line(in, arena)) {
@@ -11135,6 +11405,14 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     if (status == Status::ok)
         status = mesh_cloud(cloud, in, along, arena, triangles, triangle_capacity,
                             triangle_count, rep);
+    if (kMeasureWebs) arena.rewind(read);  // the surface is final: the scratch is free
+    if (kMeasureWebs && status == Status::ok &&
+        !measure_webs(in.reader, in.count, in.sums, triangles, *triangle_count,
+                      rep.caps.triangle_count, arena, rep)) {
+        *triangle_count = 0;
+        rep.triangle_count = 0;
+        status = Status::out_of_memory;
+    }
     rep.workspace_used_bytes = arena.peak_from_buffer();
     return status;
 }
@@ -11156,12 +11434,18 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
     if (detail::kDropOutliers && (options.flags & drop_outliers))
         arena.alloc<unsigned char>(point_count / 8 + 1);
     const size_t read = arena.required_bytes();
-    size_t steps[2] = {0, 0};
+    size_t steps[detail::kMeasureWebs ? 3 : 2] = {};
     if (detail::kAxisTrials && options.axis == Axis::automatic)
         steps[0] = detail::axis_workspace_size(point_count, options);
 #if !defined(STRATMESH_SMALL_CODE)
     if (detail::searches_parts(options)) steps[1] = detail::parts_workspace_size(point_count, options);
 #endif
+    // The webs are measured once the surface is final (far less than meshing it takes).
+    if (detail::kMeasureWebs) {
+        steps[detail::kMeasureWebs ? 2 : 0] = detail::webs_workspace_size(
+            point_count, reconstruct_max_triangles(point_count, options));
+        if (steps[detail::kMeasureWebs ? 2 : 0] == 0) return 0;
+    }
     for (size_t bytes : steps) {
         if (bytes > SIZE_MAX - read) return 0;
         most = read + bytes > most ? read + bytes : most;
@@ -11177,11 +11461,14 @@ Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
         return Status::invalid_argument;
     Report local_report;
     Report& rep = report ? *report : local_report;
-    const LayerCounts layers = report ? report->layers : LayerCounts{};
+    // The caller's arrays, kept as they are (as two values, not copies of the groups: the
+    // small build's stack frame stays within a short instruction's reach).
+    LayerInfo* const layer_info = report ? report->layers.info : nullptr;
+    const size_t layer_capacity = layer_info ? report->layers.info_capacity : 0;
     const PartCounts parts = report ? report->parts : PartCounts{};
     std::memset(&rep, 0, sizeof rep);
-    rep.layers.info = layers.info;
-    rep.layers.info_capacity = layers.info ? layers.info_capacity : 0;
+    rep.layers.info = layer_info;
+    rep.layers.info_capacity = layer_capacity;
     if (detail::kFindParts) {
         rep.parts.info = parts.info;
         rep.parts.info_capacity = parts.info ? parts.info_capacity : 0;
@@ -11256,6 +11543,8 @@ STRATMESH_C_SAME(STRATMESH_PARTS_JOINED, stratmesh::PartsOutcome::joined)
 STRATMESH_C_SAME(STRATMESH_PARTS_KEPT_APART, stratmesh::PartsOutcome::kept_apart)
 STRATMESH_C_SAME(STRATMESH_PARTS_UNDONE, stratmesh::PartsOutcome::undone)
 #undef STRATMESH_C_SAME
+static_assert(STRATMESH_WEB_SPACINGS == stratmesh::kWebSpacings,
+              "STRATMESH_WEB_SPACINGS differs from stratmesh::kWebSpacings");
 
 // A status added to the list needs its C constant too.
 #define STRATMESH_C_COUNT(name, message) +1
@@ -11391,6 +11680,13 @@ inline void c_report(const Report& r, stratmesh_report& c) {
     c.diagnostics.fold_count = r.diagnostics.fold_count;
     c.diagnostics.illegal_removed_count = r.diagnostics.illegal_removed_count;
     c.diagnostics.diagonal_swap_count = r.diagnostics.diagonal_swap_count;
+    c.diagnostics.web_triangle_count = r.diagnostics.web_triangle_count;
+    c.diagnostics.web_area = r.diagnostics.web_area;
+    c.diagnostics.web_area_fraction = r.diagnostics.web_area_fraction;
+    for (int i = 0; i < 3; ++i) {
+        c.diagnostics.web_box_min[i] = r.diagnostics.web_box_min[i];
+        c.diagnostics.web_box_max[i] = r.diagnostics.web_box_max[i];
+    }
     c.detail = r.detail;
     c.workspace_used_bytes = r.workspace_used_bytes;
 }

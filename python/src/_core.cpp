@@ -145,7 +145,16 @@ py::object report_object(const stratmesh::Report& r, stratmesh::Status status) {
         py::arg("diagnostics") = ns(
             py::arg("fold_count") = r.diagnostics.fold_count,
             py::arg("illegal_removed_count") = r.diagnostics.illegal_removed_count,
-            py::arg("diagonal_swap_count") = r.diagnostics.diagonal_swap_count),
+            py::arg("diagonal_swap_count") = r.diagnostics.diagonal_swap_count,
+            py::arg("web_triangle_count") = r.diagnostics.web_triangle_count,
+            py::arg("web_area") = r.diagnostics.web_area,
+            py::arg("web_area_fraction") = r.diagnostics.web_area_fraction,
+            py::arg("web_box_min") = py::make_tuple(r.diagnostics.web_box_min[0],
+                                                    r.diagnostics.web_box_min[1],
+                                                    r.diagnostics.web_box_min[2]),
+            py::arg("web_box_max") = py::make_tuple(r.diagnostics.web_box_max[0],
+                                                    r.diagnostics.web_box_max[1],
+                                                    r.diagnostics.web_box_max[2])),
         py::arg("detail") = r.detail ? py::object(py::str(r.detail)) : py::object(py::none()),
         py::arg("workspace_used_bytes") = r.workspace_used_bytes);
 }

@@ -75,6 +75,13 @@ void check_same_report(const Report& r, const stratmesh_report& c, bool same_wor
     CHECK(c.diagnostics.fold_count == r.diagnostics.fold_count);
     CHECK(c.diagnostics.illegal_removed_count == r.diagnostics.illegal_removed_count);
     CHECK(c.diagnostics.diagonal_swap_count == r.diagnostics.diagonal_swap_count);
+    CHECK(c.diagnostics.web_triangle_count == r.diagnostics.web_triangle_count);
+    CHECK(c.diagnostics.web_area == r.diagnostics.web_area);
+    CHECK(c.diagnostics.web_area_fraction == r.diagnostics.web_area_fraction);
+    for (int k = 0; k < 3; ++k) {
+        CHECK(c.diagnostics.web_box_min[k] == r.diagnostics.web_box_min[k]);
+        CHECK(c.diagnostics.web_box_max[k] == r.diagnostics.web_box_max[k]);
+    }
     CHECK(c.detail == r.detail);
     if (same_workspace) CHECK(c.workspace_used_bytes == r.workspace_used_bytes);
 }
@@ -131,7 +138,8 @@ Run run_c(const Shape& s, const stratmesh_options& o, stratmesh_report& rep,
     return run;
 }
 
-void check_same_reconstruction(const Shape& s, const Options& o) {
+// Returns the C++ report (its layer array gone).
+Report check_same_reconstruction(const Shape& s, const Options& o) {
     Report rep;
     std::vector<stratmesh::LayerInfo> info;
     const Run cpp = run_cpp(s, o, rep, info);
@@ -150,6 +158,8 @@ void check_same_reconstruction(const Shape& s, const Options& o) {
     check_same_report(rep, crep);
     CHECK(crep.layers.info == cinfo.data());
     CHECK(std::memcmp(cinfo.data(), info.data(), kInfo * sizeof(stratmesh::LayerInfo)) == 0);
+    rep.layers.info = nullptr;
+    return rep;
 }
 
 TEST_CASE("C interface: reconstruct gives the C++ triangles and report") {
@@ -170,6 +180,12 @@ TEST_CASE("C interface: reconstruct gives the C++ triangles and report") {
     cut.cut_count = 3;
     cut.flags = stratmesh::close_ends;
     check_same_reconstruction(upright, cut);
+
+    // A fork meshed as one tube spans the gap between its prongs: the web fields too.
+    const Shape fork = shapes::forked_tube(3000, Pose::z);
+    Options one = {};
+    one.flags = stratmesh::one_tube;
+    CHECK(check_same_reconstruction(fork, one).diagnostics.web_triangle_count > 0);
 }
 
 TEST_CASE("C interface: a refusal gives the C++ status and report") {

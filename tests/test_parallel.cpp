@@ -80,6 +80,9 @@ void check_same(const Result& sequential, const Result& parallel) {
     CHECK(parallel.report.diagnostics.fold_count == sequential.report.diagnostics.fold_count);
     CHECK(parallel.report.diagnostics.diagonal_swap_count == sequential.report.diagnostics.diagonal_swap_count);
     CHECK(parallel.report.diagnostics.illegal_removed_count == sequential.report.diagnostics.illegal_removed_count);
+    // The webs too, bit for bit (the forked and knobbed tubes have some).
+    CHECK(std::memcmp(&parallel.report.diagnostics, &sequential.report.diagnostics,
+                      sizeof(stratmesh::Diagnostics)) == 0);
     REQUIRE(parallel.layers.size() == sequential.layers.size());
     for (size_t k = 0; k < parallel.layers.size(); ++k)
         CHECK(std::memcmp(&parallel.layers[k], &sequential.layers[k], sizeof(LayerInfo)) == 0);

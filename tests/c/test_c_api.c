@@ -175,6 +175,11 @@ static void test_reconstruct(const double* xyz, int close_ends) {
         if (k > 0) CHECK(layers[k - 1].top <= layers[k].bottom);
     }
     CHECK(report.diagnostics.fold_count == 0);
+    /* A tube spans no gap: no web triangle, and then no web box. */
+    CHECK(report.diagnostics.web_triangle_count == 0);
+    CHECK(report.diagnostics.web_area == 0 && report.diagnostics.web_area_fraction == 0);
+    CHECK(report.diagnostics.web_box_min[0] == 0 && report.diagnostics.web_box_max[2] == 0);
+    CHECK(STRATMESH_WEB_SPACINGS > 1);
     CHECK(report.parts.outcome == STRATMESH_PARTS_ONE_TUBE);
     if (close_ends) {
         CHECK(report.caps.closed_count == 2);

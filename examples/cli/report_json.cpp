@@ -242,7 +242,30 @@ void write_status(JsonWriter& j, const RunRecord& r) {
         j.null();
 }
 
-void write_counts(JsonWriter& j, const stratmesh::Report& rep, stratmesh::Status status) {
+// The triangles spanning gaps (Report::diagnostics): null with --stream, which does not
+// measure them; the box null without webs.
+void write_webs(JsonWriter& j, const stratmesh::Diagnostics& d, bool stream) {
+    j.key("webs");
+    if (stream) return j.null();
+    j.begin_object();
+    j.count_field("triangles", d.web_triangle_count);
+    j.number_field("area", d.web_area);
+    j.number_field("area_fraction", d.web_area_fraction);
+    j.number_field("spacings", stratmesh::kWebSpacings);
+    j.key("box");
+    if (d.web_triangle_count == 0) {
+        j.null();
+    } else {
+        j.begin_object();
+        j.numbers_field("min", d.web_box_min, 3);
+        j.numbers_field("max", d.web_box_max, 3);
+        j.end_object();
+    }
+    j.end_object();
+}
+
+void write_counts(JsonWriter& j, const stratmesh::Report& rep, stratmesh::Status status,
+                  bool stream) {
     j.key("points");
     j.begin_object();
     j.count_field("in", rep.points.in_count);
@@ -260,6 +283,7 @@ void write_counts(JsonWriter& j, const stratmesh::Report& rep, stratmesh::Status
     j.count_field("triangles", rep.triangle_count);
     j.count_field("illegal_removed", rep.diagnostics.illegal_removed_count);
     j.count_field("folds", rep.diagnostics.fold_count);
+    write_webs(j, rep.diagnostics, stream);
     j.key("caps");
     j.begin_object();
     j.count_field("closed", rep.caps.closed_count);
@@ -511,7 +535,7 @@ std::string run_record_json(const RunRecord& record) {
     write_options(j, record);
     j.flag_field("reconstructed", record.reconstructed);
     write_status(j, record);
-    write_counts(j, record.report, record.status);
+    write_counts(j, record.report, record.status, record.stream);
     write_layers(j, record);
     write_ends(j, record);
     // The warnings printed: a refused run's only warning is the input's faces.

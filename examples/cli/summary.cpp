@@ -172,6 +172,25 @@ std::string folds_warning(const RunRecord& r) {
                   "surface may bridge gaps or cross itself there";
 }
 
+// Triangles spanning gaps (Report::diagnostics), from kWebAreaFloor of the surface's area:
+// how many, their share of the area and their bounding box, so that a user can look there.
+std::string webs_warning(const RunRecord& r) {
+    const stratmesh::Diagnostics& d = r.report.diagnostics;
+    if (d.web_triangle_count == 0 || !(d.web_area_fraction >= kWebAreaFloor)) return "";
+    const double percent = 100 * d.web_area_fraction;
+    char share[32];
+    std::snprintf(share, sizeof share, percent < 10 ? "%.1f%%" : "%.0f%%", percent);
+    std::string box;
+    const char* names[] = {"x", "y", "z"};
+    for (int k = 0; k < 3; ++k)
+        box += std::string(k ? " " : "") + names[k] + " [" + number_text(d.web_box_min[k]) + ", " +
+               number_text(d.web_box_max[k]) + "]";
+    return "web: " + plural(d.web_triangle_count, "triangle spans", "triangles span") +
+           " more than " + number_text(stratmesh::kWebSpacings) + " local spacings, " + share +
+           " of the surface's area, within " + box +
+           ": the cloud may have limbs or a handle that one tube cannot follow";
+}
+
 // "above 12.5: 2 (750, 740 points); below: none (gap 0.8)".
 std::string parting_text(const stratmesh::Parting& p) {
     auto side = [](const char* name, double cut, const uint32_t* points, uint32_t branches) {
@@ -336,7 +355,8 @@ std::string faces_warning(const RunRecord& record) {
 std::vector<std::string> run_warnings(const RunRecord& record) {
     std::vector<std::string> warnings;
     for (const std::string& warning :
-         {folds_warning(record), branches_warning(record), left_out_warning(record),
+         {folds_warning(record), webs_warning(record), branches_warning(record),
+          left_out_warning(record),
           caps_warning(record), faces_warning(record), cuts_warning(record)})
         if (!warning.empty()) warnings.push_back(warning);
     return warnings;

@@ -15,9 +15,14 @@ namespace stratmesh_cli {
 // with the next one).
 const size_t kFewestLayerPoints = 16;
 
+// Webs (Report::diagnostics) under this share of the surface's area are not warned about:
+// a single column shows none or a few stray ones (under 0.3%), an object with limbs meshed
+// as one tube several percent.
+const double kWebAreaFloor = 0.005;
+
 // What a user should check before trusting the mesh, each a sentence without the
-// "stratmesh: warning: " prefix: folds, branches wrapped in one tube or left apart, points
-// left out, caps left open, input faces ignored, cuts outside the cloud.
+// "stratmesh: warning: " prefix: folds, webs, branches wrapped in one tube or left apart,
+// points left out, caps left open, input faces ignored, cuts outside the cloud.
 std::vector<std::string> run_warnings(const RunRecord& record);
 
 // The input faces left out of the cloud, or an empty string.

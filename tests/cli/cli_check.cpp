@@ -24,6 +24,7 @@
 //       report says
 #include "mini_json.h"
 #include "mini_mesh.h"
+#include "../support/shapes.h"
 
 #include <cctype>
 #include <cmath>
@@ -275,6 +276,9 @@ int make_inputs(const std::string& dir) {
               write_file(dir + "/cylinder.xyz", as_xyz(cylinder, 0)) &&
               write_file(dir + "/twin_tubes.xyz", as_xyz(twin_tube_points(3000), 0, "two cylinders")) &&
               write_file(dir + "/forked.xyz", as_xyz(forked_points(), 0, "a forked tube")) &&
+              write_file(dir + "/four_legged.xyz",
+                         as_xyz(shapes::four_legged(10000, shapes::Pose::z).xyz, 0,
+                                "a four-legged body")) &&
               write_file(dir + "/forked_speck.xyz",
                          as_xyz(forked_speck_points(), 0, "a forked tube and a speck")) &&
               write_file(dir + "/cylinder_nan.xyz", as_xyz(cylinder, 500)) &&

@@ -6,8 +6,8 @@
 //
 // A second digest, "full", covers what STRATMESH_SMALL_CODE leaves out or meshes
 // differently (closed ends, the crescent rule, caps, drop_outliers, cap_ends, the
-// surface_flips flag, bands that fold between peeled loops): it is printed by builds
-// without the macro (x86-64 and aarch64 in .ci/arm.sh), which must agree.
+// surface_flips flag, bands that fold between peeled loops, the measure of webs): it is
+// printed by builds without the macro (x86-64 and aarch64 in .ci/arm.sh), which must agree.
 //
 // The clouds come from tests/support/shapes.h, whose coordinates go through sin, cos and
 // log: C libraries may differ there in the last bit. To test the library and not the C
@@ -88,6 +88,13 @@ void reconstruct_case(const char* name, const std::vector<double>& raw, stratmes
                                                  tris.size() / 3, &count, &report);
     record(output, "reconstruct", name, n, s, tris.data(), count,
            {report.layers.used_count, report.points.rejected_count, report.caps.closed_count}, report.layers.used_count, "layers");
+    // The webs, which the small build does not measure: in the full digest only.
+    if (&output == &g_full) {
+        const stratmesh::Diagnostics& d = report.diagnostics;
+        output.u64(d.web_triangle_count);
+        for (double v : {d.web_area, d.web_area_fraction, d.web_box_min[0], d.web_box_max[2]})
+            output.f64(v);
+    }
 }
 
 void collect_triangles(void* user, const uint32_t* triangles, size_t count) {
@@ -284,6 +291,11 @@ int main(int argc, char** argv) {
                      g_full_input, g_full);
     // A first layer closed by the outline rule: a knobbed end (find_closed_ends).
     reconstruct_case("knobbed tube, 4 layers", shapes::knobbed_tube(3000, Pose::z).xyz, axis_z(4),
+                     g_full_input, g_full);
+    // One tube around a Y's two arms: webs across the gap (Report::diagnostics).
+    stratmesh::Options one_tube = axis_z();
+    one_tube.flags = stratmesh::one_tube;
+    reconstruct_case("Y of tubes, one tube", shapes::y_of_tubes(3000, Pose::z).xyz, one_tube,
                      g_full_input, g_full);
 #endif
 

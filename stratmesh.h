@@ -524,8 +524,9 @@ enum class PartsOutcome : uint32_t {
     one_tube = 0,  // one tube through every point: nothing parts, or the one_tube flag
     joined,        // the trunk and its branches meshed apart and joined into one surface
     kept_apart,    // with keep_parts: meshed apart, kept though not all joined
-    undone,        // meshed apart, but a side could not be joined, a part was refused or
-                   // points belong to no part: meshed as one tube instead
+    undone,        // meshed apart, but a side could not be joined, a part was refused,
+                   // points belong to no part, or the joined surface was no smaller than
+                   // the one tube's: meshed as one tube instead
 };
 
 // One part meshed apart (PartCounts::info).
@@ -642,14 +643,21 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // a small one around the axis (see ClosedEnd).
 //
 // In its steps: check the arguments and read the cloud (refusing NaN, a degenerate cloud);
-// choose the axis (Axis::automatic); look for where the cloud parts into branches (unless
-// one_tube) and, where it does, mesh the trunk along the axis and each branch along its
-// own automatic axis, and join them into one surface (see PartCounts and join_branches());
-// otherwise, or where the parts cannot all be joined (unless keep_parts), mesh one tube:
+// choose the axis (Axis::automatic); look for where the cloud parts into branches along it
+// (unless one_tube) and, where it does, mesh the trunk and each branch around its own
+// automatic axis (the trunk along the cloud's axis where the options lay out the layers:
+// cuts, layer_count or layer_height), and join them into one surface (see PartCounts and
+// join_branches()); otherwise, or where the parts cannot all be joined, or where the
+// joined surface is not smaller than the one tube's (unless keep_parts), mesh one tube:
 // layer by layer, each unrolled and triangulated, stitched to the layer below, passed
-// through the manifold safety net; then the caps (close_ends). The branch search runs on a
-// sample of 4,096 points first on larger clouds and in full only where the sample parts,
-// so a branch of fewer than about n / 64 points can go unseen in a cloud of n points.
+// through the manifold safety net; then the caps (close_ends). A tube that wraps branches
+// bridges the gaps between them with webs, which add area, and so does a join that folds,
+// so the smaller surface is the one kept; the comparison meshes the one tube too, which
+// roughly doubles the time on clouds that part. A point beyond a cut in no branch (a
+// sparse point of a thin branch's tip) goes to the part of the nearest point within two
+// gaps (Parting::gap). The branch search runs on a sample of 4,096 points first on larger
+// clouds and in full only where the sample parts, so a branch of fewer than about n / 64
+// points can go unseen in a cloud of n points.
 //
 // cloud           the points (see Cloud), at most 2^32 - 3. They are only read.
 // options         see Options; `Options options = {};` gives the defaults.

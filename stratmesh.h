@@ -11120,7 +11120,7 @@ inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in, const
         if (trunk_points >= kSmallestBranch) {
             adopt_stray_points(in, p.gap, m.labels);
             const Report before = rep;
-            double tube_area = INFINITY;
+            double tube_area = DBL_MAX;
             if (!(along.flags & keep_parts)) {
                 Report tube = before;
                 size_t count = 0;

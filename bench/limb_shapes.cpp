@@ -23,6 +23,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -83,7 +84,8 @@ int check(const std::string& name, const std::string& mesh) {
                      mesh.c_str(), s.size());
         return 2;
     }
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    const double far = std::numeric_limits<double>::infinity();
+    double lo[3] = {far, far, far}, hi[3] = {-far, -far, -far};
     for (size_t i = 0; i < s.size(); ++i)
         for (size_t k = 0; k < 3; ++k) {
             lo[k] = std::fmin(lo[k], s.xyz[3 * i + k]);

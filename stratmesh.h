@@ -11163,6 +11163,8 @@ inline size_t parts_workspace_size(size_t count, const Options& options) {
     plain.flags &= ~static_cast<uint32_t>(drop_outliers | close_ends);
     Options search = options;
     search.flags &= skip_invalid_points | drop_outliers;
+    Options tube = options;  // the one tube meshed for its area while the parts' memory is held
+    tube.flags &= ~static_cast<uint32_t>(drop_outliers);
     const size_t triangles = reconstruct_max_triangles(count, options);
     const size_t sample = count > kPartingSample
                               ? saturating_product(3 * sizeof(double), kPartingSample) + Arena::kAlign +
@@ -11174,7 +11176,8 @@ inline size_t parts_workspace_size(size_t count, const Options& options) {
     branch.layer_count = 0;
     branch.layer_height = 0;
     const size_t steps[] = {sample, find_parting_workspace_size(count, search),
-                            tube_workspace_size(count, plain), axis_workspace_size(count, branch),
+                            tube_workspace_size(count, plain), tube_workspace_size(count, tube),
+                            axis_workspace_size(count, branch),
                             tube_workspace_size(count, branch),
                             join_branches_workspace_size(count, triangles),
                             cap_ends_workspace_size(count, triangles)};

@@ -26,12 +26,14 @@ struct Meshed {
     Status status;
     Report report;
     std::vector<uint32_t> triangles;
+    size_t workspace_bytes;
 };
 
 Meshed mesh(const std::vector<double>& xyz, const Options& options) {
     Meshed r;
     const Cloud cloud = {xyz.data(), xyz.size() / 3, 0, Scalar::float64};
-    std::vector<unsigned char> work(stratmesh::reconstruct_workspace_size(cloud.count, options));
+    r.workspace_bytes = stratmesh::reconstruct_workspace_size(cloud.count, options);
+    std::vector<unsigned char> work(r.workspace_bytes);
     r.triangles.resize(3 * stratmesh::reconstruct_max_triangles(cloud.count, options));
     size_t count = 0;
     r.report = Report{};
@@ -157,12 +159,14 @@ TEST_CASE("limbs: parts joined are kept only where their surface is smaller than
     size_t joined = 0, undone = 0;
     for (const shapes::Shape& s : clouds) {
         CAPTURE(s.name);
-        for (bool automatic : {false, true}) {
-            CAPTURE(automatic);
-            Options options = automatic ? Options{} : along_z();
+        for (int variant = 0; variant < 3; ++variant) {
+            CAPTURE(variant);  // along z, automatic, along z with caps
+            Options options = variant == 1 ? Options{} : along_z();
+            if (variant == 2) options.flags = stratmesh::close_ends;
             const Meshed m = mesh(s.xyz, options);
             REQUIRE(m.status == Status::ok);
-            options.flags = stratmesh::one_tube;
+            CHECK(m.report.workspace_used_bytes <= m.workspace_bytes);
+            options.flags |= stratmesh::one_tube;
             const Meshed tube = mesh(s.xyz, options);
             REQUIRE(tube.status == Status::ok);
             switch (m.report.parts.outcome) {

@@ -526,8 +526,9 @@ enum class PartsOutcome : uint32_t {
     one_tube = 0,  // one tube through every point: nothing parts, or the one_tube flag
     joined,        // the trunk and its branches meshed apart and joined into one surface
     kept_apart,    // with keep_parts: meshed apart, kept though not all joined
-    undone,        // meshed apart, but a side could not be joined, a part was refused or
-                   // points belong to no part: meshed as one tube instead
+    undone,        // meshed apart, but a side could not be joined, a part was refused,
+                   // points belong to no part, or the joined surface was no smaller than
+                   // the one tube's: meshed as one tube instead
 };
 
 // One part meshed apart (PartCounts::info).
@@ -668,14 +669,21 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // a small one around the axis (see ClosedEnd).
 //
 // In its steps: check the arguments and read the cloud (refusing NaN, a degenerate cloud);
-// choose the axis (Axis::automatic); look for where the cloud parts into branches (unless
-// one_tube) and, where it does, mesh the trunk along the axis and each branch along its
-// own automatic axis, and join them into one surface (see PartCounts and join_branches());
-// otherwise, or where the parts cannot all be joined (unless keep_parts), mesh one tube:
+// choose the axis (Axis::automatic); look for where the cloud parts into branches along it
+// (unless one_tube) and, where it does, mesh the trunk and each branch around its own
+// automatic axis (the trunk along the cloud's axis where the options lay out the layers:
+// cuts, layer_count or layer_height), and join them into one surface (see PartCounts and
+// join_branches()); otherwise, or where the parts cannot all be joined, or where the
+// joined surface is not smaller than the one tube's (unless keep_parts), mesh one tube:
 // layer by layer, each unrolled and triangulated, stitched to the layer below, passed
-// through the manifold safety net; then the caps (close_ends). The branch search runs on a
-// sample of 4,096 points first on larger clouds and in full only where the sample parts,
-// so a branch of fewer than about n / 64 points can go unseen in a cloud of n points.
+// through the manifold safety net; then the caps (close_ends). A tube that wraps branches
+// bridges the gaps between them with webs, which add area, and so does a join that folds,
+// so the smaller surface is the one kept; the comparison meshes the one tube too, which
+// roughly doubles the time on clouds that part. A point beyond a cut in no branch (a
+// sparse point of a thin branch's tip) goes to the part of the nearest point within two
+// gaps (Parting::gap). The branch search runs on a sample of 4,096 points first on larger
+// clouds and in full only where the sample parts, so a branch of fewer than about n / 64
+// points can go unseen in a cloud of n points.
 //
 // cloud           the points (see Cloud), at most 2^32 - 3. They are only read.
 // options         see Options; `Options options = {};` gives the defaults.
@@ -11059,6 +11067,47 @@ inline TubeInput part_input(const TubeInput& whole, const PartsMemory& m, uint8_
     return in;
 }
 
+// A point beyond a cut in no branch is most often a sparse point of a branch whose nearest
+// neighbour lies more than a gap away (uniform sampling leaves a few in every ten thousand;
+// the thin tip of a horn more): within kAdoptionGaps gaps of a part's point, it goes to
+// the part of the nearest one, so that the split is kept and the point is a vertex. Farther
+// away it is a piece of its own (a speck, a patch a hole cut off), and the split is undone.
+// Sought among all points, so at most kMostStrayChecks distance checks in all.
+const double kAdoptionGaps = 2.0;
+const uint64_t kMostStrayChecks = uint64_t{1} << 26;
+
+inline void adopt_stray_points(const TubeInput& whole, double gap, uint8_t* labels) {
+    const double reach = kAdoptionGaps * gap;
+    uint64_t checks_left = kMostStrayChecks;
+    // Passes until none is adopted: a point can be adopted through one adopted before it
+    // (the sparse tip of a horn, point after point).
+    for (bool adopted = true; adopted;) {
+        adopted = false;
+        uint64_t strays = 0;
+        for (size_t i = 0; i < whole.count; ++i)
+            strays += labels[i] == kBeyondBranches && whole.reader.valid(i);
+        if (strays == 0 || strays > checks_left / whole.count) return;
+        checks_left -= strays * whole.count;
+        for (size_t i = 0; i < whole.count; ++i) {
+            if (labels[i] != kBeyondBranches || !whole.reader.valid(i)) continue;
+            const Vec3 p = whole.reader.point(i);
+            double nearest = reach * reach;
+            uint8_t label = kBeyondBranches;
+            for (size_t j = 0; j < whole.count; ++j) {
+                if (labels[j] == kBeyondBranches || !whole.reader.valid(j)) continue;
+                const Vec3 d = whole.reader.point(j) - p;
+                const double d2 = dot(d, d);
+                if (d2 <= nearest) {
+                    nearest = d2;
+                    label = labels[j];
+                }
+            }
+            adopted = adopted || label != kBeyondBranches;
+            labels[i] = label;
+        }
+    }
+}
+
 // Where branches stand on a closed end of the trunk (its end layer at a side that parts
 // is closed, as a skull's crown under horns), the cuts that merge that end layer with the
 // layers next to it until it is kPoleLayerRadii times the largest of their radii tall;
@@ -11184,8 +11233,25 @@ inline Status mesh_parts(const Cloud& cloud, const TubeInput& whole, const Optio
     Report trunk_report = {};
     const TubeInput trunk = part_input(whole, m, kInTrunk);
     size_t count = 0, merged = 0;
-    Status status = mesh_trunk(trunk, along, parting, m, arena, triangles, capacity, &count,
-                               trunk_report, &merged);
+    Options trunk_options = along;
+    Status status = Status::ok;
+    // The trunk around its own axis, as the branches (a body whose legs hang under it is
+    // meshed along the body), unless the caller laid out the layers.
+    if (along.cut_count == 0 && along.layer_count == 0 && !(along.layer_height > 0)) {
+        Options automatic = along;
+        automatic.axis = Axis::automatic;
+        const size_t mark = arena.mark();
+        status = resolve_axis(trunk, automatic, arena, trunk_options, trunk_report);
+        arena.rewind(mark);
+        // Pointing the parting's way, so that the trunk's top is on the side above.
+        const double* d = trunk_options.direction;
+        if (trunk_options.axis == Axis::direction &&
+            d[0] * parting.axis[0] + d[1] * parting.axis[1] + d[2] * parting.axis[2] < 0)
+            for (int k = 0; k < 3; ++k) trunk_options.direction[k] = -d[k];
+    }
+    if (status == Status::ok)
+        status = mesh_trunk(trunk, trunk_options, parting, m, arena, triangles, capacity, &count,
+                            trunk_report, &merged);
     record_part(rep, kInTrunk, status, trunk, trunk_report, count, merged);
     if (status != Status::ok) {
         rep.parts.outcome = PartsOutcome::undone;
@@ -11224,7 +11290,7 @@ inline Status mesh_parts(const Cloud& cloud, const TubeInput& whole, const Optio
         status = resolve_axis(branch, branch_options, arena, own, part);
         // The branch's end at the cut is a cut, not a closed end: its low end along its own
         // axis if that runs away from the trunk.
-        const Vec3 trunk_axis = {rep.axis[0], rep.axis[1], rep.axis[2]};
+        const Vec3 trunk_axis = {parting.axis[0], parting.axis[1], parting.axis[2]};
         const Vec3 own_axis = {own.direction[0], own.direction[1], own.direction[2]};
         const bool away = (dot(own_axis, trunk_axis) > 0) == above;
         TubeInput cut = branch;
@@ -11287,7 +11353,24 @@ inline Status mesh_parts(const Cloud& cloud, const TubeInput& whole, const Optio
     return Status::ok;
 }
 
-// reconstruct() with the search for branches: `in` is read and `along` has its axis.
+// The area of a surface whose triangles index the cloud.
+inline double surface_area(const CloudReader& reader, const uint32_t* triangles, size_t count) {
+    double area = 0;
+    for (size_t t = 0; t < count; ++t) {
+        const Vec3 a = reader.point(triangles[3 * t]);
+        const Vec3 n = cross(reader.point(triangles[3 * t + 1]) - a,
+                             reader.point(triangles[3 * t + 2]) - a);
+        area += std::sqrt(dot(n, n)) / 2;
+    }
+    return area;
+}
+
+// reconstruct() with the search for branches: `in` is read and `along` has its axis. Where
+// the cloud parts, the parts joined are kept only if their surface is smaller than the one
+// tube's (unless keep_parts): a tube that wraps branches bridges the gaps between them
+// with webs, which add area, and so does a join that folds where the parting misread the
+// cloud (a neck's torn rim taken for two branches). The tube is meshed first for its area,
+// and again if it wins.
 inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in, const Options& along,
                                   Arena& arena, uint32_t* triangles, size_t capacity,
                                   size_t* triangle_count, Report& rep) {
@@ -11304,14 +11387,36 @@ inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in, const
         if (p.above_branch_count + p.below_branch_count > 0)
             for (size_t i = 0; i < cloud.count; ++i) trunk_points += m.labels[i] == kInTrunk;
         if (trunk_points >= kSmallestBranch) {
+            adopt_stray_points(in, p.gap, m.labels);
             const Report before = rep;
+            double tube_area = DBL_MAX;
+            if (!(along.flags & keep_parts)) {
+                Report tube = before;
+                size_t count = 0;
+                const size_t tube_mark = arena.mark();
+                const Status status =
+                    mesh_tube(in, along, arena, triangles, capacity, &count, tube);
+                arena.rewind(tube_mark);
+                if (status == Status::out_of_memory) return status;
+                if (status == Status::ok) tube_area = surface_area(in.reader, triangles, count);
+            }
             const Status status =
                 mesh_parts(cloud, in, along, m, arena, triangles, capacity, triangle_count, rep);
-            if (status != Status::ok || rep.parts.outcome != PartsOutcome::undone) return status;
+            if (status != Status::ok) return status;
+            if (rep.parts.outcome != PartsOutcome::undone &&
+                (rep.parts.outcome == PartsOutcome::kept_apart ||
+                 surface_area(in.reader, triangles, *triangle_count) < tube_area))
+                return status;
             // Not kept: the counts start again, the parts' record stays.
-            const PartCounts parts = rep.parts;
+            PartCounts parts = rep.parts;
+            if (parts.outcome != PartsOutcome::undone) {
+                parts.outcome = PartsOutcome::undone;
+                rep.detail = "the branches joined made a larger surface than one tube";
+            }
+            const char* detail = rep.detail;
             rep = before;
             rep.parts = parts;
+            rep.detail = detail;
         }
         arena.rewind(mark);
     }
@@ -11327,6 +11432,8 @@ inline size_t parts_workspace_size(size_t count, const Options& options) {
     plain.flags &= ~static_cast<uint32_t>(drop_outliers | close_ends);
     Options search = options;
     search.flags &= skip_invalid_points | drop_outliers;
+    Options tube = options;  // the one tube meshed for its area while the parts' memory is held
+    tube.flags &= ~static_cast<uint32_t>(drop_outliers);
     const size_t triangles = reconstruct_max_triangles(count, options);
     const size_t sample = count > kPartingSample
                               ? saturating_product(3 * sizeof(double), kPartingSample) + Arena::kAlign +
@@ -11338,7 +11445,8 @@ inline size_t parts_workspace_size(size_t count, const Options& options) {
     branch.layer_count = 0;
     branch.layer_height = 0;
     const size_t steps[] = {sample, find_parting_workspace_size(count, search),
-                            tube_workspace_size(count, plain), axis_workspace_size(count, branch),
+                            tube_workspace_size(count, plain), tube_workspace_size(count, tube),
+                            axis_workspace_size(count, branch),
                             tube_workspace_size(count, branch),
                             join_branches_workspace_size(count, triangles),
                             cap_ends_workspace_size(count, triangles)};

@@ -314,8 +314,9 @@ void print_split(std::FILE* out, const RunRecord& r) {
     if (j.detail)
         std::fprintf(out, "             %s%s\n", j.joined_side_count ? "" : "left apart: ", j.detail);
     if (r.split_undone)
-        std::fprintf(out, "             not kept: meshed as one tube instead (--split-branches "
-                          "keeps the parts)\n");
+        std::fprintf(out, "             not kept%s%s: meshed as one tube instead (--split-branches "
+                          "keeps the parts)\n",
+                     r.report.detail ? ", " : "", r.report.detail ? r.report.detail : "");
 }
 
 void print_costs(std::FILE* out, const RunRecord& r) {

@@ -11311,6 +11311,9 @@ inline Status mesh_parts(const Cloud& cloud, const TubeInput& whole, const Optio
     }
     for (size_t i = 0; i < whole.count && whole_split; ++i)
         whole_split = m.labels[i] != kBeyondBranches;
+    if (!whole_split && !rep.detail)
+        rep.detail = "points beyond a cut belong to no branch (a piece more than two gaps "
+                     "from every part)";
     // The junctions.
     JoinReport join = {};
     const size_t join_bytes = join_branches_workspace_size(cloud.count, count);

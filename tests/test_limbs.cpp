@@ -5,6 +5,7 @@
 // kept only where they make a smaller surface than one tube.
 #include "stratmesh.h"
 #include "support/mesh_check.h"
+#include "support/reconstructed.h"
 #include "support/shapes.h"
 
 #include <doctest/doctest.h>
@@ -16,32 +17,12 @@ using stratmesh::Axis;
 using stratmesh::Cloud;
 using stratmesh::Options;
 using stratmesh::PartsOutcome;
-using stratmesh::Report;
-using stratmesh::Scalar;
 using stratmesh::Status;
 
 namespace {
 
-struct Meshed {
-    Status status;
-    Report report;
-    std::vector<uint32_t> triangles;
-    size_t workspace_bytes;
-};
-
-Meshed mesh(const std::vector<double>& xyz, const Options& options) {
-    Meshed r;
-    const Cloud cloud = {xyz.data(), xyz.size() / 3, 0, Scalar::float64};
-    r.workspace_bytes = stratmesh::reconstruct_workspace_size(cloud.count, options);
-    std::vector<unsigned char> work(r.workspace_bytes);
-    r.triangles.resize(3 * stratmesh::reconstruct_max_triangles(cloud.count, options));
-    size_t count = 0;
-    r.report = Report{};
-    r.status = stratmesh::reconstruct(cloud, options, work.data(), work.size(), r.triangles.data(),
-                                      r.triangles.size() / 3, &count, &r.report);
-    r.triangles.resize(3 * count);
-    return r;
-}
+using reconstructed::mesh;
+using Meshed = reconstructed::Mesh;
 
 mesh_check::Result check(const shapes::Shape& s, const Meshed& m) {
     mesh_check::Input in;
@@ -165,7 +146,7 @@ TEST_CASE("limbs: parts joined are kept only where their surface is smaller than
             if (variant == 2) options.flags = stratmesh::close_ends;
             const Meshed m = mesh(s.xyz, options);
             REQUIRE(m.status == Status::ok);
-            CHECK(m.report.workspace_used_bytes <= m.workspace_bytes);
+            CHECK(m.report.workspace_used_bytes <= m.bound);
             options.flags |= stratmesh::one_tube;
             const Meshed tube = mesh(s.xyz, options);
             REQUIRE(tube.status == Status::ok);

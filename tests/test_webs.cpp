@@ -4,6 +4,7 @@
 // lists sorted by vertex), and the report against runs with a job runner and at other
 // magnitudes.
 #include "stratmesh.h"
+#include "support/reconstructed.h"
 #include "support/shapes.h"
 
 #include <doctest/doctest.h>
@@ -35,30 +36,9 @@ using shapes::Shape;
 const double kNoWeb = 0.005;
 const double kWebbed = 3 * kNoWeb;
 
-struct Mesh {
-    Status status = Status::internal_error;
-    std::vector<uint32_t> triangles;
-    Report report{};
-    size_t bound = 0;
-};
-
-Mesh mesh(const Cloud& cloud, const Options& o) {
-    Mesh m;
-    m.bound = stratmesh::reconstruct_workspace_size(cloud.count, o);
-    std::vector<unsigned char> work(m.bound);
-    m.triangles.resize(3 * stratmesh::reconstruct_max_triangles(cloud.count, o));
-    size_t count = 0;
-    m.status = stratmesh::reconstruct(cloud, o, work.data(), work.size(), m.triangles.data(),
-                                      m.triangles.size() / 3, &count, &m.report);
-    m.triangles.resize(3 * count);
-    return m;
-}
-
-Cloud cloud_of(const std::vector<double>& xyz) {
-    return Cloud{xyz.data(), xyz.size() / 3, 0, Scalar::float64};
-}
-
-Mesh mesh(const std::vector<double>& xyz, const Options& o) { return mesh(cloud_of(xyz), o); }
+using reconstructed::cloud_of;
+using reconstructed::Mesh;
+using reconstructed::mesh;
 
 // ---- the measure, recomputed plainly ------------------------------------------------------
 

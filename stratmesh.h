@@ -921,9 +921,8 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 // is opened at its point nearest the trunk's centre (the two chains merged in the order of
 // their angle around the branch's centre, which crosses itself far less than shortest
 // diagonals first, as contour stitching does); and the crotch is closed by a triangle per
-// gap, from the
-// trunk's vertex there to the two branches' opening points, and a fan over those points
-// where three branches or more meet.
+// gap, from the trunk's vertex there to the two branches' opening points, and a fan over
+// those points where three branches or more meet.
 //
 //       trunk's loop   ... m0 ---- branch 1's arc ---- m1 ---- branch 2's arc ---- m0 ...
 //       branch loops   p1 (opened) around to p1        p2 (opened) around to p2
@@ -944,7 +943,10 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 // taken out as a disc that keeps every vertex on a triangle, and the hole's loop is zipped
 // to the branch's by angle around the branch's centre. The surface stays an oriented edge-
 // and vertex-manifold and every point stays a vertex; the band can cross the trunk's
-// triangles beside the stump where the stump's wall leans over the hole.
+// triangles beside the stump where the stump's wall leans over the hole. A graft needs the
+// cut square to the fork: with the axis tilted two degrees within the fork's plane, the
+// cut runs lower under one branch, no triangle of the trunk's end faces it under its loop,
+// and that side stays apart (across the fork's plane, eight degrees still join).
 struct JoinReport {
     uint32_t joined_side_count;      // 0, 1 or 2
     uint32_t apart_side_count;  // sides that part whose loops could not be joined (detail)

@@ -81,6 +81,29 @@ TEST_CASE("limbs: a Y of tubes meshed along its trunk is one oriented manifold t
     CHECK(check(y, tube).max_deviation() > 0.3);
 }
 
+TEST_CASE("limbs: the Y joins along an axis tilted across its fork's plane") {
+    // The arms spread along x: a tilt toward y keeps the cut square to the fork (see
+    // join_branches(); a tilt within the fork's plane is a documented limitation).
+    const shapes::Shape y = shapes::y_of_tubes(20000, shapes::Pose::z);
+    for (const double degrees : {1.0, 4.0, 8.0}) {
+        CAPTURE(degrees);
+        Options tilted = {};
+        tilted.axis = Axis::direction;
+        tilted.direction[1] = std::tan(degrees * 3.14159265358979323846 / 180);
+        tilted.direction[2] = 1;
+        const Meshed m = mesh(y.xyz, tilted);
+        REQUIRE(m.status == Status::ok);
+        CHECK(m.report.parts.outcome == PartsOutcome::joined);
+        const mesh_check::Result r = check(y, m);
+        INFO(r.summary());
+        CHECK(r.manifold());
+        CHECK(r.oriented());
+        CHECK(r.components == 1);
+        CHECK(r.unused_expected == 0);
+        CHECK(r.max_deviation() < 0.05);
+    }
+}
+
 TEST_CASE("limbs: a body with four legs under it: the legs are joined to a body meshed along its own axis") {
     const shapes::Shape body = shapes::four_legged(20000, shapes::Pose::z);
     const Meshed m = mesh(body.xyz, along_z());

@@ -681,9 +681,12 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // so the smaller surface is the one kept; the comparison meshes the one tube too, which
 // roughly doubles the time on clouds that part. A point beyond a cut in no branch (a
 // sparse point of a thin branch's tip) goes to the part of the nearest point within two
-// gaps (Parting::gap). The branch search runs on a sample of 4,096 points first on larger
-// clouds and in full only where the sample parts, so a branch of fewer than about n / 64
-// points can go unseen in a cloud of n points.
+// gaps (Parting::gap). Where the trunk's own axis leans from the axis by half a degree to
+// 30 degrees (a fork scanned askew), the parting is searched again until the cut is square
+// to the trunk, whose end must lie under every branch (Report::parts.parting.axis is the
+// axis of the cut kept). The branch search runs on a sample of 4,096 points first on
+// larger clouds and in full only where the sample parts, so a branch of fewer than about
+// n / 64 points can go unseen in a cloud of n points.
 //
 // cloud           the points (see Cloud), at most 2^32 - 3. They are only read.
 // options         see Options; `Options options = {};` gives the defaults.
@@ -946,7 +949,7 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 // triangles beside the stump where the stump's wall leans over the hole. A graft needs the
 // cut square to the fork: with the axis tilted two degrees within the fork's plane, the
 // cut runs lower under one branch, no triangle of the trunk's end faces it under its loop,
-// and that side stays apart (across the fork's plane, eight degrees still join).
+// and that side stays apart. reconstruct() therefore cuts square to the trunk's own axis.
 struct JoinReport {
     uint32_t joined_side_count;      // 0, 1 or 2
     uint32_t apart_side_count;  // sides that part whose loops could not be joined (detail)
@@ -11192,6 +11195,54 @@ inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const Opt
     return true;
 }
 
+// A fork scanned askew is cut obliquely, lower under one branch than under another, and a
+// graft needs the cut square to the fork (see join_branches()). Where the trunk's own axis
+// leans from the parting's by more than kSquareCutLeast (and less than kSquareCutMost:
+// beyond, the trunk runs another way than its branches, as a body whose legs hang under
+// it), the parting is searched again along the mean of the two axes, up to kSquareCutRounds
+// times: an oblique cut leaves more of one branch in the trunk, which leans the trunk's
+// axis the other way, so the mean comes closer each round. A round is kept only if it
+// finds as many branches on each side; `along` then takes its axis. Not where the caller
+// gave cuts, which are positions along the axis. False if the workspace is too small.
+const double kSquareCutLeast = 0.99996;  // cos 0.5 degree
+const double kSquareCutMost = 0.866;     // cos 30 degrees
+const int kSquareCutRounds = 4;
+
+inline bool square_cut_to_trunk(const Cloud& cloud, const TubeInput& whole, const PartsMemory& m,
+                                Arena& arena, Options& along, Parting& parting) {
+    for (int round = 0; round < kSquareCutRounds && along.cut_count == 0; ++round) {
+        Options automatic = along, own;
+        automatic.axis = Axis::automatic;
+        Report ignored = {};
+        const size_t mark = arena.mark();
+        const Status status = resolve_axis(part_input(whole, m, kInTrunk), automatic, arena,
+                                           own, ignored);
+        arena.rewind(mark);
+        if (status != Status::ok || own.axis != Axis::direction) break;
+        const Vec3 cut = {parting.axis[0], parting.axis[1], parting.axis[2]};
+        Vec3 trunk = {own.direction[0], own.direction[1], own.direction[2]};
+        trunk = scaled(trunk, 1 / std::sqrt(dot(trunk, trunk)));
+        const double lean = dot(trunk, cut);
+        if (!(std::fabs(lean) < kSquareCutLeast && std::fabs(lean) > kSquareCutMost)) break;
+        const Vec3 toward = scaled(trunk, lean < 0 ? -1 : 1);  // the parting's way
+        Options squared = along;
+        squared.axis = Axis::direction;
+        squared.direction[0] = cut.x + toward.x;
+        squared.direction[1] = cut.y + toward.y;
+        squared.direction[2] = cut.z + toward.z;
+        Parting again = {};
+        if (!search_parting(cloud, whole, squared, m, arena, again)) return false;
+        if (again.above_branch_count != parting.above_branch_count ||
+            again.below_branch_count != parting.below_branch_count) {
+            if (!search_parting(cloud, whole, along, m, arena, parting)) return false;
+            break;  // the last round's labels are back
+        }
+        along = squared;
+        parting = again;
+    }
+    return true;
+}
+
 // The trunk along the cloud's axis, its end layers under branches merged where they stand
 // on a closed end; its triangles start the output.
 inline Status mesh_trunk(const TubeInput& trunk, const Options& along, const Parting& parting,
@@ -11391,6 +11442,10 @@ inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in, const
         size_t trunk_points = 0;
         if (p.above_branch_count + p.below_branch_count > 0)
             for (size_t i = 0; i < cloud.count; ++i) trunk_points += m.labels[i] == kInTrunk;
+        Options cut_along = along;
+        if (trunk_points >= kSmallestBranch &&
+            !square_cut_to_trunk(cloud, in, m, arena, cut_along, rep.parts.parting))
+            return Status::out_of_memory;
         if (trunk_points >= kSmallestBranch) {
             adopt_stray_points(in, p.gap, m.labels);
             const Report before = rep;
@@ -11405,8 +11460,8 @@ inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in, const
                 if (status == Status::out_of_memory) return status;
                 if (status == Status::ok) tube_area = surface_area(in.reader, triangles, count);
             }
-            const Status status =
-                mesh_parts(cloud, in, along, m, arena, triangles, capacity, triangle_count, rep);
+            const Status status = mesh_parts(cloud, in, cut_along, m, arena, triangles,
+                                             capacity, triangle_count, rep);
             if (status != Status::ok) return status;
             if (rep.parts.outcome != PartsOutcome::undone &&
                 (rep.parts.outcome == PartsOutcome::kept_apart ||

@@ -6925,24 +6925,26 @@ inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
 // only long edges (a fan of slivers from a foot to the body): the measure counts the
 // spans, which is enough to tell. The caps are left out: a cap spans its loop by design.
 //
-// The pass runs once the surface is final, when the layers' scratch is free: 60 bytes a
+// The pass runs once the surface is final, when the layers' scratch is free: 72 bytes a
 // point (with 2 triangles a point), within reconstruct_workspace_size()'s bound. Lengths
 // are measured in the cloud's coordinates times a power of two that brings its extent near
 // 1 (exact), so that no square overflows or underflows.
 
-// A vertex's slot: where its lengths end while they are sorted, then its local spacing.
-union WebSlot {
-    size_t end;
-    float spacing;
-};
+// From the passes over all points as jobs (>>reconstruct).
+inline size_t run_start(size_t count, uint32_t k);
+template <class Pass> inline void run_pass(const Options& options, Pass& pass);
 
 // The vertices are numbered in the order the triangles first name them, their points
 // copied in that order, and the triangles renumbered in place (then restored): the passes
-// over the triangles then read nearby memory, whatever the cloud's order.
+// over the triangles then read nearby memory, whatever the cloud's order. The passes over
+// the vertices alone (copying their points, the medians) run as jobs where the caller gave
+// a runner; those over the triangles stay in order, as the areas are summed in it.
 struct WebMemory {
     Vec3* points;      // a vertex's point (halved where the cloud spans more than a double)
-    WebSlot* slots;    // a slot a vertex
+    size_t* ends;      // a vertex's count of edges, then where its lengths end once sorted
+    float* spacings;   // a vertex's local spacing
     uint32_t* index;   // a vertex's index in the cloud
+    float* longest;    // a triangle's longest edge
     // While the vertices are numbered, a point's number (or kNoIndex); then, in the same
     // memory, the lengths of the edges leaving each vertex, vertex after vertex.
     uint32_t* id;
@@ -6952,8 +6954,10 @@ struct WebMemory {
 inline bool allocate_webs(WebMemory& m, size_t point_count, size_t triangle_count,
                           Arena& arena) {
     m.points = arena.alloc<Vec3>(point_count);
-    m.slots = arena.alloc<WebSlot>(point_count);
+    m.ends = arena.alloc<size_t>(point_count);
+    m.spacings = arena.alloc<float>(point_count);
     m.index = arena.alloc<uint32_t>(point_count);
+    m.longest = arena.alloc<float>(triangle_count);
     const size_t lengths = saturating_product(3, triangle_count);
     void* shared = arena.take(lengths > point_count ? lengths : point_count, sizeof(float));
     m.id = static_cast<uint32_t*>(shared);
@@ -7021,44 +7025,72 @@ inline float lower_median(float* v, size_t count) {
     return s[(count - 1) / 2];
 }
 
-// Corners this far ahead are prefetched while the vertices are numbered: the triangles
-// name them in no order of the cloud's.
+// Corners this far ahead are prefetched while the vertices are numbered, and points while
+// they are copied: the triangles name them in no order of the cloud's.
 const size_t kWebAhead = 16;
 
-// Numbers the vertices, copies their points, renumbers the triangles' corners and counts
-// the edges leaving each vertex; returns how many vertices there are.
-inline uint32_t number_vertices(const CloudReader& reader, const WebFrame& f, uint32_t* tri,
-                                size_t count, size_t point_count, const WebMemory& m) {
+// Numbers the vertices, renumbers the triangles' corners and counts the edges leaving each
+// vertex, then turns the counts into starts; returns how many vertices there are.
+inline uint32_t number_vertices(uint32_t* tri, size_t count, size_t point_count,
+                                const WebMemory& m) {
     for (size_t v = 0; v < point_count; ++v) m.id[v] = kNoIndex;
     uint32_t vertices = 0;
     for (size_t k = 0; k < 3 * count; ++k) {
-        if (kFastLoops && k + kWebAhead < 3 * count) {
-            prefetch(m.id + tri[k + kWebAhead]);
-            prefetch(reader.base + tri[k + kWebAhead] * reader.stride);
-        }
+        if (kFastLoops && k + kWebAhead < 3 * count) prefetch(m.id + tri[k + kWebAhead]);
         uint32_t& id = m.id[tri[k]];
         if (id == kNoIndex) {
             id = vertices++;
-            m.points[id] = f.point(reader, tri[k]);
             m.index[id] = tri[k];
-            m.slots[id].end = 0;
+            m.ends[id] = 0;
         }
-        ++m.slots[id].end;
+        ++m.ends[id];
         tri[k] = id;
     }
-    size_t start = 0;  // the counts into starts
+    size_t start = 0;
     for (uint32_t v = 0; v < vertices; ++v) {
-        const size_t edges = m.slots[v].end;
-        m.slots[v].end = start;
+        const size_t edges = m.ends[v];
+        m.ends[v] = start;
         start += edges;
     }
     return vertices;
 }
 
-// Each vertex's local spacing into its slot: the lengths of the edges leaving it, sorted
-// by vertex (a counting sort), and their median. Returns the triangles' area.
-inline double local_spacings(const WebFrame& f, const uint32_t* tri, size_t count,
-                             uint32_t vertices, const WebMemory& m) {
+// The passes over the vertices, by runs of them (see run_pass) or all at once.
+struct WebVertexPass {
+    const CloudReader* reader;
+    const WebFrame* frame;
+    const WebMemory* m;
+    uint32_t vertices;
+    bool medians;  // else the points
+
+    void run(uint32_t k) { over(run_start(vertices, k), run_start(vertices, k + 1)); }
+    void over(size_t begin, size_t end) const {
+        if (!medians) {
+            for (size_t v = begin; v < end; ++v) {
+                if (kFastLoops && v + kWebAhead < end)
+                    prefetch(reader->base + m->index[v + kWebAhead] * reader->stride);
+                m->points[v] = frame->point(*reader, m->index[v]);
+            }
+            return;
+        }
+        for (size_t v = begin; v < end; ++v) {
+            const size_t first = v > 0 ? m->ends[v - 1] : 0;
+            m->spacings[v] = lower_median(m->lengths + first, m->ends[v] - first);
+        }
+    }
+};
+
+inline void run_vertex_pass(const Options& options, WebVertexPass& pass) {
+    if (kParallelLayers && options.run_jobs)
+        run_pass(options, pass);
+    else
+        pass.over(0, pass.vertices);
+}
+
+// The lengths of the edges leaving each vertex, sorted by vertex (a counting sort: each
+// start becomes an end), and each triangle's longest edge. Returns the triangles' area.
+inline double edge_lengths(const WebFrame& f, const uint32_t* tri, size_t count,
+                           const WebMemory& m) {
     double area = 0;
     for (size_t t = 0; t < count; ++t) {
         const uint32_t* c = tri + 3 * t;
@@ -7066,44 +7098,43 @@ inline double local_spacings(const WebFrame& f, const uint32_t* tri, size_t coun
         f.edges(m.points, c, e);
         const Vec3 n = cross(e[0], e[1]);
         area += std::sqrt(dot(n, n)) / 2;
-        for (size_t j = 0; j < 3; ++j)  // each start becomes an end
-            m.lengths[m.slots[c[j]].end++] = static_cast<float>(std::sqrt(dot(e[j], e[j])));
-    }
-    size_t first = 0;
-    for (uint32_t v = 0; v < vertices; ++v) {
-        const size_t end = m.slots[v].end;
-        m.slots[v].spacing = lower_median(m.lengths + first, end - first);
-        first = end;
+        float longest = 0;
+        for (size_t j = 0; j < 3; ++j) {
+            const float length = static_cast<float>(std::sqrt(dot(e[j], e[j])));
+            m.lengths[m.ends[c[j]]++] = length;
+            longest = length > longest ? length : longest;
+        }
+        m.longest[t] = longest;
     }
     return area;
 }
 
-// The web triangles among the renumbered triangles (see Diagnostics), into d; returns
-// their area.
-inline double find_webs(const WebFrame& f, const uint32_t* tri, size_t count,
-                        const WebMemory& m, Diagnostics& d) {
+// The web triangles among the renumbered triangles (see Diagnostics), into d, while their
+// corners are numbered back; returns their area.
+inline double find_webs(const WebFrame& f, uint32_t* tri, size_t count, const WebMemory& m,
+                        Diagnostics& d) {
     double web = 0;
     Vec3 low = {DBL_MAX, DBL_MAX, DBL_MAX}, high = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
     for (size_t t = 0; t < count; ++t) {
-        const uint32_t* c = tri + 3 * t;
-        Vec3 e[3];
-        f.edges(m.points, c, e);
-        float longest = 0, spacing = 0;
-        for (size_t j = 0; j < 3; ++j) {
-            const float length = static_cast<float>(std::sqrt(dot(e[j], e[j])));
-            longest = length > longest ? length : longest;
-            spacing = m.slots[c[j]].spacing > spacing ? m.slots[c[j]].spacing : spacing;
+        uint32_t* c = tri + 3 * t;
+        float spacing = 0;
+        for (size_t j = 0; j < 3; ++j)
+            spacing = m.spacings[c[j]] > spacing ? m.spacings[c[j]] : spacing;
+        if (static_cast<double>(m.longest[t]) > kWebSpacings * static_cast<double>(spacing)) {
+            ++d.web_triangle_count;
+            Vec3 e[3];
+            f.edges(m.points, c, e);
+            const Vec3 n = cross(e[0], e[1]);
+            web += std::sqrt(dot(n, n)) / 2;
+            for (size_t j = 0; j < 3; ++j) {
+                const Vec3 p = m.points[c[j]];
+                low = {p.x < low.x ? p.x : low.x, p.y < low.y ? p.y : low.y,
+                       p.z < low.z ? p.z : low.z};
+                high = {p.x > high.x ? p.x : high.x, p.y > high.y ? p.y : high.y,
+                        p.z > high.z ? p.z : high.z};
+            }
         }
-        if (!(static_cast<double>(longest) > kWebSpacings * static_cast<double>(spacing))) continue;
-        ++d.web_triangle_count;
-        const Vec3 n = cross(e[0], e[1]);
-        web += std::sqrt(dot(n, n)) / 2;
-        for (size_t j = 0; j < 3; ++j) {
-            const Vec3 p = m.points[c[j]];
-            low = {p.x < low.x ? p.x : low.x, p.y < low.y ? p.y : low.y, p.z < low.z ? p.z : low.z};
-            high = {p.x > high.x ? p.x : high.x, p.y > high.y ? p.y : high.y,
-                    p.z > high.z ? p.z : high.z};
-        }
+        for (size_t j = 0; j < 3; ++j) c[j] = m.index[c[j]];
     }
     const double unhalve = f.halved ? 2 : 1;  // the copied points are halved then
     const double lows[3] = {low.x, low.y, low.z}, highs[3] = {high.x, high.y, high.z};
@@ -7117,19 +7148,22 @@ inline double find_webs(const WebFrame& f, const uint32_t* tri, size_t count,
 // Measures the webs of triangles[0 .. count) less the last `caps` into rep.diagnostics;
 // the triangles are renumbered meanwhile and come back as they were. False if the
 // workspace is too small (nothing is measured).
-inline bool measure_webs(const CloudReader& reader, size_t point_count, const CloudSums& sums,
-                         uint32_t* triangles, size_t count, size_t caps, Arena& arena,
-                         Report& rep) {
+inline bool measure_webs(const Options& options, const CloudReader& reader, size_t point_count,
+                         const CloudSums& sums, uint32_t* triangles, size_t count, size_t caps,
+                         Arena& arena, Report& rep) {
     const size_t walls = caps < count ? count - caps : 0;
     const size_t mark = arena.mark();
     WebMemory m;
     if (!allocate_webs(m, point_count, walls, arena)) return false;
     const WebFrame f = web_frame(sums);
-    const uint32_t vertices = number_vertices(reader, f, triangles, walls, point_count, m);
-    const double area = local_spacings(f, triangles, walls, vertices, m);
+    WebVertexPass pass = {&reader, &f, &m, number_vertices(triangles, walls, point_count, m),
+                          false};
+    run_vertex_pass(options, pass);
+    const double area = edge_lengths(f, triangles, walls, m);
+    pass.medians = true;
+    run_vertex_pass(options, pass);
     Diagnostics& d = rep.diagnostics;
     const double web = find_webs(f, triangles, walls, m, d);
-    for (size_t k = 0; k < 3 * walls; ++k) triangles[k] = m.index[triangles[k]];
     arena.rewind(mark);
     if (d.web_triangle_count == 0) return true;
     d.web_area = web / f.scale / f.scale;
@@ -11575,7 +11609,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
                             triangle_count, rep);
     if (kMeasureWebs) arena.rewind(read);  // the surface is final: the scratch is free
     if (kMeasureWebs && status == Status::ok &&
-        !measure_webs(in.reader, in.count, in.sums, triangles, *triangle_count,
+        !measure_webs(options, in.reader, in.count, in.sums, triangles, *triangle_count,
                       rep.caps.triangle_count, arena, rep)) {
         *triangle_count = 0;
         rep.triangle_count = 0;

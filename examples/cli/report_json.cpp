@@ -322,6 +322,7 @@ void write_branches(JsonWriter& j, const RunRecord& r) {
     j.begin_object();
     j.text_field("status", status_name(r.parting_status));
     j.number_field("gap", p.gap);
+    j.numbers_field("axis", p.axis, 3);  // the cuts' axis
     write_parting_side(j, "above", p.above, p.above_point_counts, p.above_branch_count);
     write_parting_side(j, "below", p.below, p.below_point_counts, p.below_branch_count);
     j.end_object();

@@ -201,9 +201,15 @@ std::string parting_text(const stratmesh::Parting& p) {
             text += (k ? ", " : "") + std::to_string(points[k]);
         return text + " points)";
     };
+    // The cuts are positions along the parting's axis, which may lean from the run's where
+    // the cut was squared to the trunk: given as --axis takes it.
+    const std::string along = p.above_branch_count + p.below_branch_count == 0
+                                  ? ""
+                                  : ", cuts along " + number_text(p.axis[0]) + "," +
+                                        number_text(p.axis[1]) + "," + number_text(p.axis[2]);
     return side("above", p.above, p.above_point_counts, p.above_branch_count) + "; " +
            side("below", p.below, p.below_point_counts, p.below_branch_count) + " (gap " +
-           number_text(p.gap) + ")";
+           number_text(p.gap) + along + ")";
 }
 
 bool branches_found(const RunRecord& r) {

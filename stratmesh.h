@@ -11255,7 +11255,7 @@ inline bool square_cut_to_trunk(const Cloud& cloud, const TubeInput& whole, cons
         if (status != Status::ok || own.axis != Axis::direction) break;
         const Vec3 cut = {parting.axis[0], parting.axis[1], parting.axis[2]};
         Vec3 trunk = {own.direction[0], own.direction[1], own.direction[2]};
-        trunk = scaled(trunk, 1 / std::sqrt(dot(trunk, trunk)));
+        if (!normalize(trunk)) break;
         const double lean = dot(trunk, cut);
         if (!(std::fabs(lean) < kSquareCutLeast && std::fabs(lean) > kSquareCutMost)) break;
         const Vec3 toward = scaled(trunk, lean < 0 ? -1 : 1);  // the parting's way
@@ -11476,11 +11476,10 @@ inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in, const
         size_t trunk_points = 0;
         if (p.above_branch_count + p.below_branch_count > 0)
             for (size_t i = 0; i < cloud.count; ++i) trunk_points += m.labels[i] == kInTrunk;
-        Options cut_along = along;
-        if (trunk_points >= kSmallestBranch &&
-            !square_cut_to_trunk(cloud, in, m, arena, cut_along, rep.parts.parting))
-            return Status::out_of_memory;
         if (trunk_points >= kSmallestBranch) {
+            Options cut_along = along;
+            if (!square_cut_to_trunk(cloud, in, m, arena, cut_along, rep.parts.parting))
+                return Status::out_of_memory;
             adopt_stray_points(in, p.gap, m.labels);
             const Report before = rep;
             double tube_area = DBL_MAX;

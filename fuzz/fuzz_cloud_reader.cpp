@@ -44,7 +44,7 @@ std::vector<std::pair<size_t, size_t>> tokens_of(std::string_view line) {
 }
 
 // The first "element vertex N" of a PLY header (a byte-order mark skipped); false if the
-// header has none or N is not a plain decimal count.
+// header has none or N is not a plain decimal count below 10^19.
 bool declared_vertices(std::string_view text, uint64_t& count) {
     if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
     size_t at = 0;
@@ -57,7 +57,10 @@ bool declared_vertices(std::string_view text, uint64_t& count) {
         if (t.size() == 3 && word(0) == "element" && word(1) == "vertex") {
             std::string_view digits = word(2);
             if (digits[0] == '+') digits.remove_prefix(1);
-            if (digits.empty() || digits.size() > 19) return false;
+            if (digits.empty()) return false;
+            // Leading zeros add no value: "00000000000000000000" is a count of 0.
+            while (digits.size() > 1 && digits[0] == '0') digits.remove_prefix(1);
+            if (digits.size() > 19) return false;
             count = 0;
             for (char c : digits) {
                 if (c < '0' || c > '9') return false;

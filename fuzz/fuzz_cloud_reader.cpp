@@ -18,6 +18,7 @@
 
 #include "cloud_io.h"
 
+#include <cstdint>
 #include <cstring>
 #include <iterator>
 #include <string>
@@ -44,7 +45,7 @@ std::vector<std::pair<size_t, size_t>> tokens_of(std::string_view line) {
 }
 
 // The first "element vertex N" of a PLY header (a byte-order mark skipped); false if the
-// header has none or N is not a plain decimal count below 10^19.
+// header has none or N is not a plain decimal count that fits in 64 bits.
 bool declared_vertices(std::string_view text, uint64_t& count) {
     if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
     size_t at = 0;
@@ -58,13 +59,13 @@ bool declared_vertices(std::string_view text, uint64_t& count) {
             std::string_view digits = word(2);
             if (digits[0] == '+') digits.remove_prefix(1);
             if (digits.empty()) return false;
-            // Leading zeros add no value: "00000000000000000000" is a count of 0.
-            while (digits.size() > 1 && digits[0] == '0') digits.remove_prefix(1);
-            if (digits.size() > 19) return false;
+            // Any number of digits, as long as the value fits: "00000000000000000000" is 0.
             count = 0;
             for (char c : digits) {
                 if (c < '0' || c > '9') return false;
-                count = count * 10 + static_cast<uint64_t>(c - '0');
+                const uint64_t digit = static_cast<uint64_t>(c - '0');
+                if (count > (UINT64_MAX - digit) / 10) return false;
+                count = count * 10 + digit;
             }
             return true;
         }

@@ -110,6 +110,32 @@ TEST_CASE("limbs: the Y along an axis tilted from its trunk's is cut square to t
     }
 }
 
+TEST_CASE("limbs: the Y tilted toward its other arm is grafted where the trunk's end has a gap beside a stump") {
+    // Along these axes the trunk's end, meshed across its open top, keeps a small gap at the
+    // edge of one arm's footprint, on a corner of the long triangle under that arm's centre:
+    // the hole, which may not reach a boundary, missed the centre and the Y was one tube
+    // (each of these, before the gap was closed). Tilts in degrees, and the direction they
+    // lean toward, in degrees from x (the arm the tilt of the test above leans toward).
+    const shapes::Shape y = shapes::y_of_tubes(20000, shapes::Pose::z);
+    const double degree = 3.14159265358979323846 / 180;
+    const double tilts[7][2] = {{1, 165}, {1, 180}, {4, 180}, {15, 180}, {1, 195}, {4, 195}, {1, 210}};
+    for (const auto& tilt : tilts) {
+        CAPTURE(tilt[0]);
+        CAPTURE(tilt[1]);
+        Options tilted = {};
+        tilted.axis = Axis::direction;
+        tilted.direction[0] = std::tan(tilt[0] * degree) * std::cos(tilt[1] * degree);
+        tilted.direction[1] = std::tan(tilt[0] * degree) * std::sin(tilt[1] * degree);
+        tilted.direction[2] = 1;
+        const Meshed m = mesh(y.xyz, tilted);
+        REQUIRE(m.status == Status::ok);
+        CHECK(m.report.parts.outcome == PartsOutcome::joined);
+        CHECK(m.report.parts.grafted_branch_count == 2);
+        CHECK(m.report.workspace_used_bytes <= m.bound);
+        check_joined_y(check(y, m), 0.15);
+    }
+}
+
 TEST_CASE("limbs: a body with four legs under it: the legs are joined to a body meshed along its own axis") {
     const shapes::Shape body = shapes::four_legged(20000, shapes::Pose::z);
     const Meshed m = mesh(body.xyz, along_z());

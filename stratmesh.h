@@ -10701,7 +10701,7 @@ inline void write_junction(const SideJunction& side, const SideView& view, uint3
 // times a small gap; where a gap's vertex is a corner of the triangle under the branch's
 // centre, the disc cannot cover the centre. Then the gap is closed (fill_gap) and the
 // hole planned again: of 216 axes tilted 0.1 to 15 degrees every way from the trunk of
-// the tests' Y, 16 fell back to one tube that way before, none since. Refused (the
+// the tests' Y, 15 fell back to one tube that way before, none since. Refused (the
 // branch left apart) where no such triangle is free, where more than kGraftMaxTriangles
 // are under the loop, or where the hole or the branch's loop does not go once around the
 // branch's centre in the sense a junction's do.

@@ -11002,10 +11002,10 @@ inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_
     };
     bool planned = plan_hole();
     // A disc with no vertex inside never takes a triangle with a corner it may not take.
-    // Where such a corner is on a small gap in the trunk's end beside the stump (the
-    // manifold safety net leaves some on the end's long triangles) and that triangle covers
-    // the branch's centre, the hole misses the centre: the gap is closed and the hole
-    // planned again, free to take that triangle now.
+    // Where such a corner is on a small gap in the trunk's end beside the stump (an end
+    // meshed across a fork's open top keeps some among its long triangles) and that
+    // triangle covers the branch's centre, the hole misses the centre: the gap is closed
+    // and the hole planned again, free to take that triangle now.
     if (!planned && missed_centre) {
         const TracedLoop beside = gap_beside(m, entries, found, branch_of, view, cx, cy,
                                              kGapReach * std::sqrt(reach), low, high);

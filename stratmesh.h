@@ -178,7 +178,9 @@
 //   largest double) and the unrolled coordinates are bounded, so a far outlier or a cloud
 //   at 1e-300 cannot break a sign. A cloud whose surface would have no area (points on a
 //   line up to rounding, or a few points so far away that the rest collapse to one) is
-//   refused with Status::degenerate rather than meshed into slivers.
+//   refused with Status::degenerate rather than meshed into slivers, and one whose points
+//   form clusters so far apart that each collapses to a point with
+//   Status::separate_clusters.
 // - reconstruct's output is edge- and vertex-manifold and consistently oriented for every
 //   input it accepts: the layers and the bands between them form one annulus by
 //   construction, and a safety net, run on each layer with its band below as soon as they
@@ -223,9 +225,11 @@ namespace stratmesh {
     X(collinear, "all points lie on one line")                                            \
     X(invalid_axis, "the axis direction is zero, NaN, infinite, or too long or short to square") \
     X(invalid_layers, "a cut, the layer count or the layer height is NaN, infinite or negative") \
+    X(invalid_origin, "the given origin is NaN or infinite, or lies farther from the cloud than 2^32 times its size") \
     X(flat_cloud, "the cloud has no extent along the axis")                               \
     X(not_columnar, "the points do not surround the axis in any layer")                   \
     X(degenerate, "the surface through the points has no area: they lie on a line up to rounding, or a few lie so far from the rest that the rest collapse") \
+    X(separate_clusters, "the points form clusters so far apart that no one surface joins them: mesh each cluster on its own") \
     X(out_of_order, "a streamed layer is out of axis order: its top is below the previous one, or a point lies outside its heights") \
     /* memory */                                                                          \
     X(out_of_memory, "the workspace is smaller than its *_workspace_size() bound")         \
@@ -417,7 +421,7 @@ typedef void (*JobRunner)(void* user, uint32_t count, JobFunction job, void* con
 // All zero means defaults: `Options options = {};` is always valid.
 struct Options {
     Axis axis;
-    double direction[3];     // for Axis::direction; any length from 1.5e-154 to 1.3e154
+    double direction[3];     // for Axis::direction; any finite non-zero length
     // Layers, first match wins: explicit cut positions along the axis, as the coordinate
     // dot(point, axis) (with Axis::z, a cut at 68 is the plane z = 68; a point on a cut,
     // up to 2^-40 of the cloud's height, belongs to the layer above); any order,
@@ -707,21 +711,24 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 //                 when buffers overlap: see invalid_argument below).
 //
 // Returns ok; invalid_argument (a null pointer with a non-zero count, a stride smaller than
-// one point, an unknown Scalar, cut_count without cuts, a null triangle_count, a NaN or
-// infinite origin with origin_given,
-// or any two of the span of the cloud's
-// points, the workspace, the triangle array, *triangle_count, *report and the report's
-// layer array sharing a byte: then nothing at all is written, not even the report);
+// one point, an unknown Scalar, cut_count without cuts, a null triangle_count, or any two
+// of the span of the cloud's points, the workspace, the triangle array, *triangle_count,
+// *report and the report's layer array sharing a byte: then nothing at all is written, not
+// even the report); invalid_origin (with origin_given, an origin that is NaN or infinite,
+// or farther from the cloud's bounding box, along some coordinate, than 2^32 times the
+// box's largest side: seen from there the cloud's shape keeps too few digits to unroll);
 // too_many_points; invalid_point (Report::points.first_invalid_index, unless
-// skip_invalid_points); invalid_axis (an unknown Axis, or Axis::direction zero, NaN,
-// infinite, or of a length outside 1.5e-154 to 1.3e154);
-// invalid_layers (a NaN or infinite cut, more than 2^32 - 2 cuts, a negative or
+// skip_invalid_points); invalid_axis (an unknown Axis, or Axis::direction zero, NaN or
+// infinite); invalid_layers (a NaN or infinite cut, more than 2^32 - 2 cuts, a negative or
 // non-finite layer_height);
 // not_compiled (Axis::automatic, drop_outliers, surface_flips or open_ends in the reduced
 // build);
 // too_few_points (fewer than 3 valid points, or no surface spans them); degenerate (the
-// surface would have no area: see the robustness contract); flat_cloud (no extent along
-// the axis); not_columnar (no layer's points surround its centre: try another axis);
+// surface would have no area: see the robustness contract; Report::detail says whether the
+// points lie on a line or a few far points collapse the rest, which drop_outliers leaves
+// out); separate_clusters (the points form clusters so far apart that each collapses to a
+// point beside the others: mesh each on its own); flat_cloud (no extent along the axis);
+// not_columnar (no layer's points surround its centre: try another axis);
 // out_of_memory; triangle_capacity; internal_error.
 Status reconstruct(const Cloud& cloud, const Options& options,
                    void* workspace, size_t workspace_bytes,
@@ -789,8 +796,9 @@ size_t stream_workspace_size(size_t max_points_held, const Options& options);
 // and at close, and must stay valid until then (its layer array too). On success *stream
 // is the handle, valid until stream_close or until the workspace is reused.
 // Returns ok, invalid_argument (a null emit or stream, close_ends or drop_outliers, a null
-// workspace, a workspace that shares a byte with the report or its layer array, a NaN or
-// infinite origin), invalid_axis, out_of_memory (a workspace too small to hold 16 points).
+// workspace, a workspace that shares a byte with the report or its layer array),
+// invalid_origin (a NaN or infinite origin), invalid_axis, out_of_memory (a workspace too
+// small to hold 16 points).
 // The stream uses as many points as the workspace holds.
 Status stream_open(const Options& options, void* workspace, size_t workspace_bytes,
                    TriangleCallback emit, void* emit_user, Report* report, Stream** stream);
@@ -804,7 +812,9 @@ Status stream_open(const Options& options, void* workspace, size_t workspace_byt
 // Returns ok; invalid_argument (null stream, points in the workspace, a null pointer with a
 // non-zero count, a bad stride or scalar); invalid_point (NaN/Inf without
 // skip_invalid_points, or a point more than 2^60 times the first layer's size away);
-// invalid_layers (a NaN or infinite top); out_of_order; too_many_points (2^32 - 3 points in
+// invalid_layers (a NaN or infinite top); invalid_origin (the first push with valid points
+// lies farther from the given origin than reconstruct() accepts: see there);
+// out_of_order; too_many_points (2^32 - 3 points in
 // all); out_of_memory (more than the workspace can hold: the push is refused and the stream
 // unchanged); and, from triangulating, the errors of reconstruct(), after which the stream
 // only returns that status. A refused push changes nothing but Report::detail, which says
@@ -856,8 +866,9 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count);
 // invalid_argument (a null triangle_count, triangles or workspace where needed, a bad
 // stride or scalar, *triangle_count above triangle_capacity, an index outside the cloud or
 // naming an invalid point, buffers sharing a byte); too_many_points; invalid_point (a NaN
-// or infinite point without skip_invalid_points); invalid_axis; out_of_memory (a workspace
-// below cap_ends_workspace_size()); triangle_capacity (*triangle_count set to the
+// or infinite point without skip_invalid_points); invalid_axis; invalid_origin (as for
+// reconstruct()); out_of_memory (a workspace below cap_ends_workspace_size());
+// triangle_capacity (*triangle_count set to the
 // triangles needed; nothing written). On every status but ok the triangles are unchanged.
 Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
                 size_t workspace_bytes, uint32_t* triangles, size_t triangle_capacity,
@@ -1049,9 +1060,11 @@ typedef enum stratmesh_status {
     STRATMESH_STATUS_COLLINEAR,
     STRATMESH_STATUS_INVALID_AXIS,
     STRATMESH_STATUS_INVALID_LAYERS,
+    STRATMESH_STATUS_INVALID_ORIGIN,
     STRATMESH_STATUS_FLAT_CLOUD,
     STRATMESH_STATUS_NOT_COLUMNAR,
     STRATMESH_STATUS_DEGENERATE,
+    STRATMESH_STATUS_SEPARATE_CLUSTERS,
     STRATMESH_STATUS_OUT_OF_ORDER,
     STRATMESH_STATUS_OUT_OF_MEMORY,
     STRATMESH_STATUS_TRIANGLE_CAPACITY,
@@ -3403,6 +3416,9 @@ struct Frame {
     uint32_t cut_ends;
     // The valid points' lowest and highest coordinates (set by choose_frame with kFastLoops).
     Vec3 low, high;
+    // The cloud's own extent over the frame's, which also covers the way to a given origin:
+    // 1 without origin_given.
+    double cloud_share;
     // (p - origin) * scale, without overflow.
     Vec3 offset(Vec3 p) const {
         if (halved) return scaled(scaled(p, 0.5) - half_origin, 2 * scale);
@@ -3430,12 +3446,31 @@ inline double scale_for_extent(double extent) {
 
 // False unless v's squared length is a normal double (v's length between about 1.5e-154
 // and 1.3e154): a subnormal square has lost the bits that make the result unit.
+inline double largest_of(Vec3 v) {
+    const double xy = v.x > v.y ? v.x : v.y;
+    return xy > v.z ? xy : v.z;
+}
+
 inline bool normalize(Vec3& v) {
     const double square = dot(v, v);
     if (!(square >= DBL_MIN) || !is_finite(square)) return false;
     const double len = std::sqrt(square);
     v = scaled(v, 1.0 / len);
     return true;
+}
+
+// A direction of any finite non-zero length made unit: first scaled by the power of two
+// that brings its largest component into [1, 2) (exact: a component that falls below the
+// smallest subnormal is negligible beside it), so that its square neither overflows nor
+// underflows. False for zero, NaN or infinite components.
+inline bool unit_direction(Vec3& v) {
+    if (!is_finite(v.x) || !is_finite(v.y) || !is_finite(v.z)) return false;
+    const double largest = largest_of({abs_value(v.x), abs_value(v.y), abs_value(v.z)});
+    if (largest == 0) return false;
+    int exponent = 0;
+    std::frexp(largest, &exponent);
+    v = {std::ldexp(v.x, 1 - exponent), std::ldexp(v.y, 1 - exponent), std::ldexp(v.z, 1 - exponent)};
+    return normalize(v);
 }
 
 // The principal direction of a symmetric 3x3 matrix by power iteration from its largest
@@ -3509,6 +3544,40 @@ inline CloudSums sum_cloud(const CloudReader& cloud, size_t count) {
 
 // The frame of the points summed in `sums`: centroid origin, axis from the options (an
 // explicit one: Axis::automatic is resolved before, see choose_axis), e1/e2 completing it.
+// How far a given origin may lie from the cloud's bounding box, per coordinate, in
+// multiples of the box's largest side. Seen from farther, the whole cloud lies within
+// 2^-32 radians of one direction and its offsets from the origin keep fewer than 21 of
+// their 53 bits for the cloud's own shape: no unrolling around it means anything.
+const double kOriginReach = 0x1p32;
+
+// Whether `origin` lies within kOriginReach times the largest side of the box [low, high]
+// of it (halves, so that nothing overflows). A box of one point reaches everywhere.
+inline bool origin_in_reach(Vec3 origin, Vec3 low, Vec3 high) {
+    const Vec3 half_low = scaled(low, 0.5), half_high = scaled(high, 0.5);
+    const Vec3 half_origin = scaled(origin, 0.5);
+    const Vec3 side = half_high - half_low;
+    const Vec3 below = half_low - half_origin, above = half_origin - half_high;
+    const Vec3 way = {below.x > above.x ? below.x : above.x, below.y > above.y ? below.y : above.y,
+                      below.z > above.z ? below.z : above.z};
+    const double reach = largest_of(side);
+    return reach == 0 || largest_of(way) <= kOriginReach * reach;
+}
+
+// Why a given origin (origin_given) cannot serve as the frame's, or null if it can: it is
+// NaN or infinite, or lies beyond kOriginReach of the valid points summed in `sums`.
+inline const char* origin_refusal(const Options& options, const CloudSums& sums) {
+    if (!(options.flags & origin_given)) return nullptr;
+    const Vec3 given = {options.origin[0], options.origin[1], options.origin[2]};
+    if (!(is_finite(given.x) && is_finite(given.y) && is_finite(given.z)))
+        return "the given origin is NaN or infinite";
+    const Vec3 low = {sums.lowest[0], sums.lowest[1], sums.lowest[2]};
+    const Vec3 high = {sums.highest[0], sums.highest[1], sums.highest[2]};
+    if (sums.valid > 0 && !origin_in_reach(given, low, high))
+        return "the given origin lies farther from the cloud than 2^32 times the cloud's size: "
+               "no unrolling around it means anything (give a nearer origin, or none)";
+    return nullptr;
+}
+
 inline Status choose_frame(const CloudSums& sums, const Options& options, Frame& frame) {
     const size_t valid = sums.valid;
     const Vec3 sum = {sums.total[0], sums.total[1], sums.total[2]};
@@ -3525,10 +3594,10 @@ inline Status choose_frame(const CloudSums& sums, const Options& options, Frame&
         frame.origin = valid ? scaled(sum, 1.0 / static_cast<double>(valid)) : Vec3{0, 0, 0};
     Vec3 size = valid ? high - low : Vec3{0, 0, 0};
     Vec3 half_size = valid ? scaled(high, 0.5) - scaled(low, 0.5) : Vec3{0, 0, 0};
+    const double own_half_extent = largest_of(half_size);
     if (options.flags & origin_given) {
-        Vec3 given = {options.origin[0], options.origin[1], options.origin[2]};
-        if (!(is_finite(given.x) && is_finite(given.y) && is_finite(given.z)))
-            return Status::invalid_argument;
+        if (origin_refusal(options, sums)) return Status::invalid_origin;
+        const Vec3 given = {options.origin[0], options.origin[1], options.origin[2]};
         // The extent covers the way from the given origin to the cloud, so the frame's
         // coordinates stay near 1 however far the origin is.
         Vec3 way = scaled(frame.origin, 0.5) - scaled(given, 0.5);
@@ -3537,6 +3606,8 @@ inline Status choose_frame(const CloudSums& sums, const Options& options, Frame&
         size = {size.x + 2 * way.x, size.y + 2 * way.y, size.z + 2 * way.z};
         frame.origin = given;
     }
+    const double half_extent = largest_of(half_size);
+    frame.cloud_share = half_extent > 0 ? own_half_extent / half_extent : 1;
     frame.halved = !(is_finite(size.x) && is_finite(size.y) && is_finite(size.z));
     if (frame.halved) size = half_size;
     frame.half_origin = scaled(frame.origin, 0.5);
@@ -3550,8 +3621,7 @@ inline Status choose_frame(const CloudSums& sums, const Options& options, Frame&
     case Axis::z: axis = {0, 0, 1}; break;
     case Axis::direction:
         axis = {options.direction[0], options.direction[1], options.direction[2]};
-        if (!is_finite(axis.x) || !is_finite(axis.y) || !is_finite(axis.z) || !normalize(axis))
-            return Status::invalid_axis;
+        if (!unit_direction(axis)) return Status::invalid_axis;
         break;
     default: return Status::invalid_axis;
     }
@@ -8965,17 +9035,14 @@ inline Status triangulate_tube(const TubeInput& in, const Options& options, cons
 // A surface this much smaller than the square of the cloud's extent has no area: its
 // points lie on a line up to rounding, or a few points far away set the extent and the rest
 // collapse in the frame (a speck at 1e30 beside a tube of size 1). Its triangles would be
-// slivers of no area, so the cloud is refused instead (Status::degenerate).
+// slivers of no area, so the cloud is refused instead (Status::degenerate; see
+// explain_no_area() for why).
 const double kLeastArea = 0x1p-40;
 // The triangles whose areas estimate the surface's: enough to see area where there is some.
 const size_t kAreaSample = 1024;
 
-const char* const kNoAreaDetail =
-    "the surface through the points has no area: they lie on a line up to rounding, or a few "
-    "points far from the rest set the cloud's extent (drop_outliers leaves such points out)";
-
-// Whether the triangles, every k-th of them, have next to no area in the frame (where the
-// cloud's extent is about 1).
+// Whether the triangles, every k-th of them, have next to no area beside the square of the
+// cloud's own extent (about frame.cloud_share in the frame).
 inline bool has_no_area(const CloudReader& reader, const Frame& frame, const uint32_t* tri,
                         size_t count) {
     const size_t step = count > kAreaSample ? count / kAreaSample : 1;
@@ -8987,7 +9054,8 @@ inline bool has_no_area(const CloudReader& reader, const Frame& frame, const uin
                              scaled(reader.point(tri[3 * t + 2]), frame.scale) - a);
         area += std::sqrt(dot(n, n)) / 2;
     }
-    return seen > 0 && area * (static_cast<double>(count) / static_cast<double>(seen)) < kLeastArea;
+    return seen > 0 && area * (static_cast<double>(count) / static_cast<double>(seen)) <
+                           kLeastArea * frame.cloud_share * frame.cloud_share;
 }
 
 // Closes the tube's boundary loops with caps (close_ends) and fills the caps' report.
@@ -9048,10 +9116,8 @@ inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& aren
         rep.detail = "the triangle array is too small; triangle_count says how many are needed";
         return Status::triangle_capacity;
     }
-    if (kDegenerateCheck && has_no_area(in.reader, frame, triangles, sink.count)) {
-        rep.detail = kNoAreaDetail;
+    if (kDegenerateCheck && has_no_area(in.reader, frame, triangles, sink.count))
         return Status::degenerate;
-    }
     size_t count = sink.count;
     status = cap_tube(in, options, frame, arena, triangles, triangle_capacity, count,
                       triangle_count, rep);
@@ -9312,6 +9378,8 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     detail::Frame frame = s.chain.frame;
     if (!s.has_frame) {
         Status status = detail::choose_frame(sums, s.options, frame);
+        if (status == Status::invalid_origin)
+            return detail::refuse_push(s, status, detail::origin_refusal(s.options, sums));
         if (status != Status::ok) return status;
     }
     const double axis_origin = detail::dot(frame.origin, frame.axis);
@@ -9687,6 +9755,157 @@ inline bool on_a_line(const TubeInput& in, Arena& arena) {
     return !(m[0][0] + m[1][1] + m[2][2] - along > kLineVariance * along);
 }
 
+// Why a cloud's surface has no area (explain_no_area()).
+enum class NoArea : uint32_t { unexplained, line, few_far_points, far_clusters };
+
+// The bins along the bounding box's longest side in which why_no_area() looks for groups.
+const uint32_t kNoAreaBins = 4096;
+
+// A group whose largest side is under this share of the cloud's is a point beside the
+// cloud: its surface has no area there (kLeastArea is this share squared).
+const double kCollapsedShare = 0x1p-20;
+
+// One group of why_no_area(): its points' offsets from its first point (halved, so that
+// nothing overflows), their box, and their moments at the scale of that box (so that a
+// group far from the others keeps its own digits).
+struct PointGroup {
+    Vec3 first, low, high;
+    double scale;
+    double sum[3];
+    double products[3][3];
+    uint32_t count;
+};
+
+inline Vec3 half_offset(Vec3 p, Vec3 first) { return scaled(p, 0.5) - scaled(first, 0.5); }
+
+// Whether a group spans a surface of its own: 3 points or more, off one line.
+inline bool spans_surface(const PointGroup& g) {
+    if (g.count < 3) return false;
+    const double n = g.count;
+    double m[3][3];
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) m[r][c] = g.products[r][c] - g.sum[r] * g.sum[c] / n;
+    const double along = variance_along(m, principal_direction(m));
+    return along > 0 && m[0][0] + m[1][1] + m[2][2] - along > kLineVariance * along;
+}
+
+inline double coordinate(Vec3 p, int k) { return k == 0 ? p.x : k == 1 ? p.y : p.z; }
+
+// The points' positions along their bounding box's longest side, in up to kNoAreaBins bins.
+struct Binning {
+    int side;
+    double start, span;  // halved coordinates
+    uint32_t bins;
+    uint32_t of(Vec3 p) const {
+        const double t = (coordinate(p, side) * 0.5 - start) / span * bins;
+        return t >= bins ? bins - 1 : t > 0 ? static_cast<uint32_t>(t) : 0u;
+    }
+};
+
+// Adds a point's half offset to its group's box (first pass) or moments (second pass).
+inline void add_to_group(PointGroup& g, Vec3 p, int pass) {
+    if (pass == 0 && g.count++ == 0) g.first = p;
+    const Vec3 h = half_offset(p, g.first);
+    if (pass == 0) {
+        g.low = {h.x < g.low.x ? h.x : g.low.x, h.y < g.low.y ? h.y : g.low.y, h.z < g.low.z ? h.z : g.low.z};
+        g.high = {h.x > g.high.x ? h.x : g.high.x, h.y > g.high.y ? h.y : g.high.y,
+                  h.z > g.high.z ? h.z : g.high.z};
+        return;
+    }
+    const Vec3 d = scaled(h, g.scale);
+    const double c[3] = {d.x, d.y, d.z};
+    for (int r = 0; r < 3; ++r) {
+        g.sum[r] += c[r];
+        for (int s = 0; s < 3; ++s) g.products[r][s] += c[r] * c[s];
+    }
+}
+
+// The groups of why_no_area(): `group_of` numbers the runs of occupied bins from 1 (0:
+// empty); each point joins its bin's group, its box first, its moments after.
+inline uint32_t gather_groups(const TubeInput& in, const Binning& binning, uint32_t* group_of,
+                              PointGroup* groups) {
+    std::memset(group_of, 0, binning.bins * sizeof(uint32_t));
+    for (size_t i = 0; i < in.count; ++i)
+        if (in.reader.valid(i)) group_of[binning.of(in.reader.point(i))] = 1;
+    uint32_t count = 0;
+    for (uint32_t b = 0; b < binning.bins; ++b) {
+        const bool occupied = group_of[b] != 0;
+        if (occupied && (b == 0 || group_of[b - 1] == 0)) ++count;
+        group_of[b] = occupied ? count : 0;
+    }
+    std::memset(static_cast<void*>(groups), 0, count * sizeof(PointGroup));
+    for (int pass = 0; pass < 2; ++pass) {
+        for (size_t i = 0; i < in.count; ++i) {
+            if (!in.reader.valid(i)) continue;
+            const Vec3 p = in.reader.point(i);
+            add_to_group(groups[group_of[binning.of(p)] - 1], p, pass);
+        }
+        for (uint32_t k = 0; pass == 0 && k < count; ++k)
+            groups[k].scale = scale_for_extent(largest_of(groups[k].high - groups[k].low));
+    }
+    return count;
+}
+
+// Why the kept points of `in` span no area: binned along their bounding box's longest side,
+// they fall into groups (runs of occupied bins, so the points of a collapsed cluster share
+// one). None spans a surface (3 points off a line): a line. The largest that does is a
+// point beside the cloud (kCollapsedShare) and fewer than kOutlierNeighbours points lie
+// outside it: specks that drop_outliers leaves out; more: clusters far apart. Unexplained
+// otherwise, or when the workspace cannot hold the groups.
+inline NoArea why_no_area(const TubeInput& in, Arena& arena) {
+    const Vec3 low = {in.sums.lowest[0], in.sums.lowest[1], in.sums.lowest[2]};
+    const Vec3 high = {in.sums.highest[0], in.sums.highest[1], in.sums.highest[2]};
+    const Vec3 half_side = scaled(high, 0.5) - scaled(low, 0.5);
+    Binning binning;
+    binning.span = largest_of(half_side);
+    binning.side = binning.span == half_side.x ? 0 : binning.span == half_side.y ? 1 : 2;
+    binning.start = coordinate(low, binning.side) * 0.5;
+    binning.bins = in.sums.valid < kNoAreaBins ? static_cast<uint32_t>(in.sums.valid) : kNoAreaBins;
+    if (!(binning.span > 0) || binning.bins == 0) return NoArea::line;
+    const size_t mark = arena.mark();
+    uint32_t* group_of = arena.alloc<uint32_t>(binning.bins);
+    PointGroup* groups = arena.alloc<PointGroup>(binning.bins);
+    if (arena.failed) {
+        arena.rewind(mark);
+        return NoArea::unexplained;
+    }
+    const uint32_t count = gather_groups(in, binning, group_of, groups);
+    const PointGroup* largest = nullptr;
+    for (uint32_t g = 0; g < count; ++g)
+        if (spans_surface(groups[g]) && (!largest || groups[g].count > largest->count))
+            largest = &groups[g];
+    const bool collapsed =
+        largest && largest_of(largest->high - largest->low) < kCollapsedShare * binning.span;
+    const size_t outside = largest ? in.sums.valid - largest->count : 0;
+    arena.rewind(mark);
+    if (!largest) return NoArea::line;
+    if (!collapsed || outside == 0) return NoArea::unexplained;
+    return outside < kOutlierNeighbours ? NoArea::few_far_points : NoArea::far_clusters;
+}
+
+// The status and detail of a cloud refused as degenerate or not_columnar, where
+// why_no_area() tells a reason: the same status and detail where it tells none.
+inline Status explain_no_area(const TubeInput& in, Status status, Arena& arena, Report& rep) {
+    switch (why_no_area(in, arena)) {
+    case NoArea::line:
+        if (status != Status::degenerate) return status;
+        rep.detail = "the points lie on a line up to rounding: no surface passes through them";
+        return Status::degenerate;
+    case NoArea::few_far_points:
+        rep.detail = "a few points lie so far from the rest that the rest collapse to a point "
+                     "beside them: drop_outliers leaves such points out";
+        return Status::degenerate;
+    case NoArea::far_clusters:
+        rep.detail = "the points form clusters so far apart that each collapses to a point "
+                     "beside the others: mesh each cluster on its own";
+        return Status::separate_clusters;
+    default:
+        if (status != Status::degenerate) return status;
+        rep.detail = "the surface through the points has no area beside the cloud's extent";
+        return Status::degenerate;
+    }
+}
+
 // The options along the axis to use: Axis::automatic resolved by choose_axis().
 inline Status resolve_axis(const TubeInput& in, const Options& options, Arena& arena,
                            Options& along, Report& rep) {
@@ -9779,6 +9998,7 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
     if (status != Status::ok) return finish(status);
     detail::Frame frame;
     status = detail::choose_frame(sums, along, frame);
+    if (status == Status::invalid_origin) checks.detail = detail::origin_refusal(along, sums);
     if (status != Status::ok) return finish(status);
     status = detail::cap_boundary_loops(triangles, count, triangle_capacity, reader,
                                         cloud.count, frame, arena, caps, &needed);
@@ -11778,17 +11998,26 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     Options along;
     status = read_cloud(cloud, options, arena, rep, in);
     const size_t read = arena.mark();  // the outliers' bitmap stays: the reader needs it
+    const char* far_origin = status == Status::ok ? origin_refusal(options, in.sums) : nullptr;
+    if (far_origin) {
+        rep.detail = far_origin;
+        status = Status::invalid_origin;
+    }
     // A cloud on a line up to rounding is refused whatever the axis: a line has no surface,
     // and along it a layer would only seem not to surround its axis.
-    if (status == Status::ok && kDegenerateCheck && in.sums.distinct >= 3 && on_a_line(in, arena)) {
-        rep.detail = kNoAreaDetail;
+    if (status == Status::ok && kDegenerateCheck && in.sums.distinct >= 3 && on_a_line(in, arena))
         status = Status::degenerate;
-    }
     if (status == Status::ok) status = resolve_axis(in, options, arena, along, rep);
     if (status == Status::ok)
         status = mesh_cloud(cloud, in, along, arena, triangles, triangle_capacity,
                             triangle_count, rep);
     if (kMeasureWebs) arena.rewind(read);  // the surface is final: the scratch is free
+    // A few far points or far clusters collapse the rest, so that no layer surrounds its
+    // centre either: they are the reason then too.
+    if (kDegenerateCheck && (status == Status::degenerate || status == Status::not_columnar)) {
+        arena.rewind(read);
+        status = explain_no_area(in, status, arena, rep);
+    }
     if (kMeasureWebs && status == Status::ok &&
         !measure_webs(options, in.reader, in.count, in.sums, triangles, *triangle_count,
                       rep.caps.triangle_count, arena, rep)) {
@@ -11891,9 +12120,11 @@ STRATMESH_C_SAME(STRATMESH_STATUS_TOO_FEW_POINTS, stratmesh::Status::too_few_poi
 STRATMESH_C_SAME(STRATMESH_STATUS_COLLINEAR, stratmesh::Status::collinear)
 STRATMESH_C_SAME(STRATMESH_STATUS_INVALID_AXIS, stratmesh::Status::invalid_axis)
 STRATMESH_C_SAME(STRATMESH_STATUS_INVALID_LAYERS, stratmesh::Status::invalid_layers)
+STRATMESH_C_SAME(STRATMESH_STATUS_INVALID_ORIGIN, stratmesh::Status::invalid_origin)
 STRATMESH_C_SAME(STRATMESH_STATUS_FLAT_CLOUD, stratmesh::Status::flat_cloud)
 STRATMESH_C_SAME(STRATMESH_STATUS_NOT_COLUMNAR, stratmesh::Status::not_columnar)
 STRATMESH_C_SAME(STRATMESH_STATUS_DEGENERATE, stratmesh::Status::degenerate)
+STRATMESH_C_SAME(STRATMESH_STATUS_SEPARATE_CLUSTERS, stratmesh::Status::separate_clusters)
 STRATMESH_C_SAME(STRATMESH_STATUS_OUT_OF_ORDER, stratmesh::Status::out_of_order)
 STRATMESH_C_SAME(STRATMESH_STATUS_OUT_OF_MEMORY, stratmesh::Status::out_of_memory)
 STRATMESH_C_SAME(STRATMESH_STATUS_TRIANGLE_CAPACITY, stratmesh::Status::triangle_capacity)

@@ -28,6 +28,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cfloat>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -74,6 +75,10 @@ struct Run {
     bool workspace_guard_intact = true;  // nothing written past the workspace
     bool triangle_guard_intact = true;   // nothing written past the capacity
 };
+
+bool counts_add_up(const Report& r) {
+    return r.points.in_count == r.points.used_count + r.points.duplicate_count + r.points.rejected_count + r.points.unused_count;
+}
 
 // reconstruct() with reconstruct_workspace_size() bytes of workspace starting `misalign`
 // bytes into a buffer, reconstruct_max_triangles() triangles, and guard zones after both.
@@ -1856,6 +1861,83 @@ TEST_CASE("clouds whose surface would have no area are refused, not meshed into 
     }
 }
 
+TEST_CASE("a given origin: meshed from up to 2^32 times the cloud's size away, refused beyond") {
+    const Shape tube = shapes::bumpy_tube(kSmall, Pose::z);
+    double lo = DBL_MAX, hi = -DBL_MAX;  // the tube's largest side is along z
+    for (size_t i = 0; i < tube.size(); ++i) {
+        lo = std::min(lo, tube.xyz[3 * i + 2]);
+        hi = std::max(hi, tube.xyz[3 * i + 2]);
+    }
+    const double side = hi - lo;
+    for (double reach : {1e3, 1e9, 0x1p31, 0x1p33, 1e12, 1e300}) {
+        Options o = axis_options(tube);
+        o.flags |= stratmesh::origin_given;
+        o.origin[0] = reach * side;
+        const Run run = reconstruct_guarded(cloud_of(tube), o);
+        CAPTURE(reach);
+        if (reach <= 0x1p32) {
+            REQUIRE(run.status == Status::ok);
+            mesh_check::Result m = check_mesh(tube, run.triangles.data(), run.count, false);
+            INFO(m.summary());
+            CHECK(m.manifold());
+            CHECK(m.components == 1);
+            CHECK(m.unused_expected == 0);
+        } else {
+            CHECK(run.status == Status::invalid_origin);
+            CHECK(run.count == 0);
+            REQUIRE(run.report.detail != nullptr);
+            CHECK(std::string(run.report.detail).find("2^32") != std::string::npos);
+            CHECK(counts_add_up(run.report));
+        }
+    }
+}
+
+TEST_CASE("clouds with no area: a line, a few far points and far clusters each say which") {
+    const Shape tube = shapes::bumpy_tube(kSmall, Pose::z);
+    auto run_on = [](const std::vector<double>& xyz, const Options& o) {
+        return reconstruct_guarded(Cloud{xyz.data(), xyz.size() / 3, 0, Scalar::float64}, o);
+    };
+    auto detail_has = [](const Run& run, const char* words) {
+        return run.report.detail && std::string(run.report.detail).find(words) != std::string::npos;
+    };
+    SUBCASE("two tubes 1e9 apart, along any axis: separate_clusters") {
+        for (double apart : {1e9, 1e200}) {
+            std::vector<double> xyz;
+            for (double shift : {0.0, apart})
+                for (size_t i = 0; i < tube.size(); ++i)
+                    xyz.insert(xyz.end(), {tube.xyz[3 * i] + shift, tube.xyz[3 * i + 1], tube.xyz[3 * i + 2]});
+            for (Axis axis : {Axis::automatic, Axis::x, Axis::z}) {
+                Options o = {};
+                o.axis = axis;
+                const Run run = run_on(xyz, o);
+                CAPTURE(apart);
+                CHECK(run.status == Status::separate_clusters);
+                CHECK(detail_has(run, "mesh each cluster on its own"));
+                CHECK(counts_add_up(run.report));
+            }
+        }
+    }
+    SUBCASE("a tube and three points 1e30 away: degenerate, and drop_outliers meshes the tube") {
+        std::vector<double> xyz = tube.xyz;
+        for (int k = 0; k < 3; ++k) xyz.insert(xyz.end(), {1e30 + k, 0.0, 0.0});
+        const Run run = run_on(xyz, Options{});
+        CHECK(run.status == Status::degenerate);
+        CHECK(detail_has(run, "drop_outliers"));
+        Options dropping = {};
+        dropping.flags = stratmesh::drop_outliers;
+        const Run dropped = run_on(xyz, dropping);
+        CHECK(dropped.status == Status::ok);
+        CHECK(dropped.report.points.outlier_count == 3);
+    }
+    SUBCASE("points on a line: degenerate, saying so") {
+        std::vector<double> xyz;
+        for (int i = 0; i < 500; ++i) xyz.insert(xyz.end(), {i * 0x1p-4, i * 0x1p-3, 1.0});
+        const Run run = run_on(xyz, Options{});
+        CHECK(run.status == Status::degenerate);
+        CHECK(detail_has(run, "on a line"));
+    }
+}
+
 TEST_CASE("clouds that do not surround the axis: not_columnar, or ok with a manifold annulus") {
     SUBCASE("half-cylinder: ok, one manifold annulus through every point") {
         for (uint32_t layers : {1u, 6u}) {
@@ -1916,11 +1998,11 @@ TEST_CASE("statuses for bad arguments and options") {
         unknown.axis = static_cast<Axis>(17);
         CHECK(reconstruct_guarded(cloud, unknown).status == Status::invalid_axis);
     }
-    SUBCASE("a direction whose square is not a normal double: invalid_axis; any other length: the same triangles") {
-        // Scaling by a power of two is exact, so every length whose square is a normal
-        // double gives the unit direction's bits; a subnormal square has lost some (from
-        // 2^-515 to 2^-535 the call returned ok with other triangles before the check) and
-        // an infinite one has no length.
+    SUBCASE("a direction of any finite non-zero length: the same triangles as the unit one") {
+        // The direction is scaled by a power of two before it is normalised, which is exact:
+        // every length, from subnormal components to near the largest double, gives the unit
+        // direction's bits (without the scaling, a square below the smallest normal double
+        // lost bits and an infinite one had no length).
         double unit[3];
         s.axis_direction(unit);
         Options o = {};
@@ -1928,17 +2010,12 @@ TEST_CASE("statuses for bad arguments and options") {
         for (int k = 0; k < 3; ++k) o.direction[k] = unit[k];
         const Run reference = reconstruct_guarded(cloud, o);
         REQUIRE(reference.status == Status::ok);
-        for (int exponent : {-500, -20, 20, 500}) {
+        for (int exponent : {-1060, -540, -520, -20, 20, 520, 1000, 1023}) {
             CAPTURE(exponent);
             for (int k = 0; k < 3; ++k) o.direction[k] = std::ldexp(unit[k], exponent);
             const Run run = reconstruct_guarded(cloud, o);
             REQUIRE(run.status == Status::ok);
             CHECK(run.triangles == reference.triangles);
-        }
-        for (int exponent : {-520, -540, 520, 1000}) {
-            CAPTURE(exponent);
-            for (int k = 0; k < 3; ++k) o.direction[k] = std::ldexp(unit[k], exponent);
-            CHECK(reconstruct_guarded(cloud, o).status == Status::invalid_axis);
         }
     }
     SUBCASE("NaN cut, negative layer height: invalid_layers") {
@@ -1961,7 +2038,7 @@ TEST_CASE("statuses for bad arguments and options") {
         CHECK(stratmesh::reconstruct(cloud, o, work.data(), work.size(), tris.data(), tris.size() / 3, nullptr, nullptr) ==
               Status::invalid_argument);
     }
-    SUBCASE("cut_count without cuts, a NaN or infinite origin: invalid_argument") {
+    SUBCASE("cut_count without cuts: invalid_argument; a NaN or infinite origin: invalid_origin") {
         Options o = axis_options(s);
         o.cut_count = 2;
         CHECK(reconstruct_guarded(cloud, o).status == Status::invalid_argument);
@@ -1970,7 +2047,9 @@ TEST_CASE("statuses for bad arguments and options") {
             p.flags |= stratmesh::origin_given;
             p.origin[1] = bad;
             const Run run = reconstruct_guarded(cloud, p);
-            CHECK(run.status == Status::invalid_argument);
+            CHECK(run.status == Status::invalid_origin);
+            REQUIRE(run.report.detail != nullptr);
+            CHECK(std::string(run.report.detail).find("NaN or infinite") != std::string::npos);
             CHECK(run.count == 0);
             p.flags &= ~uint32_t(stratmesh::origin_given);  // without the flag the origin is not read
             CHECK(reconstruct_guarded(cloud, p).status == Status::ok);
@@ -2278,10 +2357,6 @@ TEST_CASE("workspace: the bound suffices, the reported peak is exact, one byte s
 // the status is ok.
 
 namespace {
-
-bool counts_add_up(const Report& r) {
-    return r.points.in_count == r.points.used_count + r.points.duplicate_count + r.points.rejected_count + r.points.unused_count;
-}
 
 // A unit-radius cylinder (reference_cylinder() unless given) scaled by `scale` about the
 // origin and moved by `offset`, with its analytic surface moved along (the radius is 1

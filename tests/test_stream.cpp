@@ -364,6 +364,33 @@ TEST_CASE("stream: malformed pushes are refused with their status and change not
     CHECK(*std::max_element(triangles.begin(), triangles.end()) < accepted);
 }
 
+TEST_CASE("stream: a NaN origin, or one beyond 2^32 times the first layer's size, is invalid_origin") {
+    const Shape s = shapes::cylinder(2000, Pose::z);
+    double axis[3];
+    s.axis_direction(axis);
+    const Layered l = layer_cloud(s.xyz, axis, equal_fractions(2));
+    Options o = shared_origin(s);
+    std::vector<unsigned char> work(stratmesh::stream_workspace_size(l.size(), o));
+    std::vector<uint32_t> triangles;
+    stratmesh::Stream* stream = nullptr;
+    o.origin[0] = std::nan("");
+    CHECK(stratmesh::stream_open(o, work.data(), work.size(), collect, &triangles, nullptr, &stream) ==
+          Status::invalid_origin);
+    o.origin[0] = 1e13;  // the cylinder is a few units across
+    Report report{};
+    REQUIRE(stratmesh::stream_open(o, work.data(), work.size(), collect, &triangles, &report, &stream) ==
+            Status::ok);
+    const Cloud first = {l.xyz.data(), l.start[1], 0, Scalar::float64};
+    CHECK(stratmesh::stream_push(stream, first, l.cuts[0]) == Status::invalid_origin);
+    CHECK(report.points.in_count == 0);
+    REQUIRE(report.detail != nullptr);
+    CHECK(std::string(report.detail).find("2^32") != std::string::npos);
+    o.origin[0] = 1e6;
+    REQUIRE(stratmesh::stream_open(o, work.data(), work.size(), collect, &triangles, &report, &stream) ==
+            Status::ok);
+    CHECK(stratmesh::stream_push(stream, first, l.cuts[0]) == Status::ok);
+}
+
 #if !defined(STRATMESH_SMALL_CODE)  // cap_ends() is left out there (see the header's Config)
 namespace {
 

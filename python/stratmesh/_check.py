@@ -10,7 +10,6 @@ import math
 import numbers
 import os
 import reprlib
-from collections.abc import Iterable
 
 import numpy as np
 
@@ -151,9 +150,12 @@ def heights(name, value, status):
 def flag_names(value, refused=()):
     """flags: a sequence of names from FLAGS (none of refused), not a string."""
     what = "a sequence of flag names such as ('open_ends',)"
-    if isinstance(value, (str, bytes)) or not isinstance(value, Iterable):
+    if isinstance(value, (str, bytes)):
         raise must(wrong_type, "invalid_argument", "flags", what, value)
-    names = list(value)
+    try:
+        names = list(value)
+    except TypeError:  # not iterable, as a number or a numpy array of no dimension
+        raise must(wrong_type, "invalid_argument", "flags", what, value) from None
     for name in names:
         if not isinstance(name, str):
             raise must(wrong_type, "invalid_argument", "flags", what, value)
@@ -181,8 +183,17 @@ def partition(name, value):
     return instance(name, value, (str, os.PathLike, np.ndarray), what)
 
 
+def cloud(name, value):
+    """value as an (n, 3) float32 or float64 array."""
+    try:
+        array = np.asarray(value)
+    except (TypeError, ValueError):  # ragged nesting
+        raise must(wrong_type, "invalid_argument", name, "an (n, 3) array", value) from None
+    return cloud_array(name, array)
+
+
 def cloud_array(name, array):
-    """An (n, 3) float32 or float64 array, as the library reads."""
+    """An (n, 3) float32 or float64 array (or dask array), as the library reads."""
     what = "an (n, 3) array of float32 or float64"
     if array.dtype.kind != "f" or array.dtype.itemsize not in (4, 8):
         raise wrong_type("invalid_argument", f"{name} must be {what}, not of {array.dtype}")

@@ -73,7 +73,7 @@ def _partitions(points):
 
 def _summary(part, i, unit, skip_invalid):
     """Count, height range and coordinate sum of partition i (of its finite points)."""
-    part = np.asarray(_check.cloud_array(f"points[{i}]", np.asarray(part)), dtype=np.float64)
+    part = np.asarray(_check.cloud(f"points[{i}]", part), dtype=np.float64)
     finite = np.isfinite(part).all(axis=1)
     if not skip_invalid and not finite.all():
         raise refuse("invalid_point", f"points[{i}]: a coordinate is NaN or infinite "
@@ -155,7 +155,7 @@ def layer_of(points, plan):
     """Each point's layer: the number of cuts at or below it (a point on a cut is above it).
     NaN heights land past the last layer and are pushed with it (the stream skips them)."""
     _check.instance("plan", plan, Plan, "a Plan from stratmesh.dask.plan()")
-    points = _check.cloud_array("points", np.asarray(points))
+    points = _check.cloud("points", points)
     heights = points.astype(np.float64, copy=False) @ np.array(plan.unit)
     return np.searchsorted(plan.cuts, heights, side="right")
 

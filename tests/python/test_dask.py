@@ -159,6 +159,8 @@ def test_mesh_takes_the_points_its_plan_measured():
         refused_argument(WRONG_TYPE, "invalid_argument", "plan", smd.layer_of, CLOUD, None)
         refused_argument(WRONG_VALUE, "invalid_argument", "points", smd.layer_of, CLOUD[:, :2],
                          plan)
+        refused_argument(WRONG_TYPE, "invalid_argument", "points", smd.layer_of,
+                         [[1.0, 2.0, 3.0], [4.0]], plan)
 
 
 def test_an_axis_of_any_length_plans_along_the_unit_axis():

@@ -101,6 +101,7 @@ OPTIONS = [
     (WRONG_TYPE, "invalid_argument", "origin", "abc"),
     (WRONG_TYPE, "invalid_argument", "flags", "close_ends"),
     (WRONG_TYPE, "invalid_argument", "flags", 3),
+    (WRONG_TYPE, "invalid_argument", "flags", np.array(3.0)),
     (WRONG_TYPE, "invalid_argument", "flags", (1,)),
     (WRONG_VALUE, "invalid_argument", "flags", ("no_such_flag",)),
     (WRONG_TYPE, "invalid_argument", "progress", 5),

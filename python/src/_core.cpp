@@ -68,17 +68,26 @@ const char* phase_name(stratmesh::Phase phase) {
     return "unknown";
 }
 
-[[noreturn]] void raise_error(stratmesh::Status status, const char* detail,
-                              py::object report) {
-    py::object error = py::module_::import("stratmesh._error").attr("Error")(
+// Raises stratmesh.<type> (Error, or ArgumentTypeError for an argument of the wrong type).
+[[noreturn]] void raise_as(const char* type, stratmesh::Status status, const char* detail,
+                           py::object report) {
+    py::object error = py::module_::import("stratmesh._error").attr(type)(
         status_name(status), status_message(status),
         detail ? py::object(py::str(detail)) : py::object(py::none()), report);
     PyErr_SetObject(reinterpret_cast<PyObject*>(Py_TYPE(error.ptr())), error.ptr());
     throw py::error_already_set();
 }
 
+[[noreturn]] void raise_error(stratmesh::Status status, const char* detail, py::object report) {
+    raise_as("Error", status, detail, report);
+}
+
 [[noreturn]] void raise_argument(const std::string& detail) {
     raise_error(stratmesh::Status::invalid_argument, detail.c_str(), py::none());
+}
+
+[[noreturn]] void raise_wrong_type(const std::string& detail) {
+    raise_as("ArgumentTypeError", stratmesh::Status::invalid_argument, detail.c_str(), py::none());
 }
 
 const char* parts_outcome_name(stratmesh::PartsOutcome outcome) {
@@ -170,21 +179,23 @@ struct Points {
 // otherwise copies it into a packed array, or refuses when copy is false.
 Points as_points(py::handle object, bool copy) {
     py::array a = py::array::ensure(object);
-    if (!a) raise_argument("points must be an (n, 3) array of float32 or float64");
-    if (a.ndim() != 2 || a.shape(1) != 3)
-        raise_argument("points must have shape (n, 3), not " +
-                       std::string(py::str(py::tuple(a.attr("shape")))));
+    if (!a) raise_wrong_type("points must be an (n, 3) array of float32 or float64");
     py::dtype dtype = a.dtype();
     if (dtype.kind() != 'f' || (dtype.itemsize() != 4 && dtype.itemsize() != 8))
-        raise_argument("points must be float32 or float64, not " + std::string(py::str(dtype)));
+        raise_wrong_type("points must be an (n, 3) array of float32 or float64, not of " +
+                         std::string(py::str(dtype)));
+    if (a.ndim() != 2 || a.shape(1) != 3)
+        raise_argument("points must be an (n, 3) array of float32 or float64, not of shape " +
+                       std::string(py::str(py::tuple(a.attr("shape")))));
     const py::ssize_t item = dtype.itemsize();
     const bool native = dtype.attr("isnative").cast<bool>();
     const bool in_place = native && a.strides(1) == item &&
                           (a.shape(0) <= 1 || a.strides(0) >= 3 * item);
     if (!in_place) {
         if (!copy)
-            raise_argument("the points' x, y, z are not adjacent in memory (or rows overlap, or "
-                           "the byte order is not native) and copy=False forbids a copy");
+            raise_argument("points: each point's x, y, z are not adjacent in memory (or rows "
+                           "overlap, or the byte order is not native) and copy=False forbids a "
+                           "copy");
         a = py::module_::import("numpy").attr("ascontiguousarray")(
             a, py::arg("dtype") = dtype.attr("newbyteorder")("="));
     }
@@ -281,7 +292,10 @@ uint32_t* allocate_triangles(size_t capacity) {
 // A *_workspace_size() of 0 means no workspace can serve that many points.
 void check_workspace_size(size_t bytes, size_t points) {
     if (bytes == 0 && points > 0)
-        raise_error(stratmesh::Status::too_many_points, "no workspace can serve that many points",
+        raise_error(stratmesh::Status::too_many_points,
+                    ("points holds " + std::to_string(points) +
+                     ", more than one workspace serves (the library addresses 2^32 - 2)")
+                        .c_str(),
                     py::none());
 }
 
@@ -301,7 +315,7 @@ public:
     class Lease {
     public:
         Lease(Workspace& w, size_t bytes, size_t points) : w_(w) {
-            if (w.busy_) raise_argument("the workspace is in use by another call");
+            if (w.busy_) raise_argument("workspace is in use by another call");
             check_workspace_size(bytes, points);
             if (bytes > w.size_) {
                 w.data_ = allocate_workspace(bytes, points);
@@ -339,6 +353,7 @@ py::tuple reconstruct(py::handle object, const py::dict& option_dict, py::object
     }
     const size_t n = points.cloud.count;
     const size_t bytes = stratmesh::reconstruct_workspace_size(n, options);
+    check_workspace_size(bytes, n);  // before the arrays sized by n are allocated
     const size_t capacity = stratmesh::reconstruct_max_triangles(n, options);
     // Every layer holds 16 distinct points or more, so this many entries hold every layer;
     // left uninitialised, the pages the library does not fill are never touched.
@@ -404,13 +419,15 @@ py::tuple cap_ends(py::handle object, py::handle triangles_in, const py::dict& o
 class Stream {
 public:
     Stream(const py::dict& option_dict, size_t max_points, size_t layer_info)
-        : layers_(layer_info) {
+        // Not value-initialised: the report shows only the entries the library fills, so
+        // a large layer_info costs address space, not pages.
+        : layers_(new stratmesh::LayerInfo[layer_info]) {
         OptionSet set;
         read_options(option_dict, set);
         const size_t bytes = stratmesh::stream_workspace_size(max_points, set.options);
         workspace_ = allocate_workspace(bytes, max_points);
-        report_.layers.info = layers_.data();
-        report_.layers.info_capacity = layers_.size();
+        report_.layers.info = layers_.get();
+        report_.layers.info_capacity = layer_info;
         stratmesh::Status status = stratmesh::stream_open(set.options, workspace_.get(), bytes,
                                                           emit, this, &report_, &stream_);
         if (status != stratmesh::Status::ok)
@@ -457,7 +474,7 @@ private:
                                      out->data(), owner);
     }
 
-    std::vector<stratmesh::LayerInfo> layers_;
+    std::unique_ptr<stratmesh::LayerInfo[]> layers_;
     std::unique_ptr<unsigned char[]> workspace_;
     stratmesh::Report report_ = {};
     stratmesh::Stream* stream_ = nullptr;

@@ -17,18 +17,20 @@ import dask
 import dask.array as da
 import numpy as np
 
-from . import STATUSES, Error, Stream
+from . import Error, Stream, _check
+from ._check import refuse
 
 _UNIT = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 _CLOSED_BOTTOM, _CLOSED_TOP = 1, 2  # the header's ClosedEnd bits in LayerInfo::closed_ends
 _LEAST_HELD = 16                    # a stream's workspace holds at least this many points
+_MOST_LAYERS = 2**28                # the most a stream forms (and its layer_info keeps)
 
 
 @dataclass(frozen=True)
 class Plan:
     """What every worker needs to mesh its range in the same frame as the others."""
 
-    axis: object            # as given to the stream: "x", "y", "z" or a 3-vector
+    axis: object            # as given to the streams: "x", "y", "z" or the unit vector
     unit: tuple             # the unit axis the heights are measured along
     origin: tuple           # the shared frame origin (the cloud's centroid)
     cuts: np.ndarray        # heights between layers: layer j lies in [cuts[j-1], cuts[j])
@@ -52,43 +54,75 @@ class Plan:
         return np.uint32 if self.count < 2**32 else np.uint64
 
 
-def _unit(axis):
-    if isinstance(axis, str):
-        if axis not in _UNIT:
-            raise Error("invalid_axis", STATUSES["invalid_axis"],
-                        f"the stream needs axis 'x', 'y', 'z' or a 3-vector, not {axis!r}")
-        return np.array(_UNIT[axis])
-    v = np.asarray(axis, dtype=np.float64)
-    norm = np.linalg.norm(v) if v.shape == (3,) else 0.0
-    if not np.isfinite(norm) or norm == 0.0:
-        raise Error("invalid_axis", STATUSES["invalid_axis"], f"no direction in {axis!r}")
-    return v / norm
-
-
 def _partitions(points):
     """The cloud as a list of delayed (n_i, 3) arrays, in the global order."""
     if isinstance(points, da.Array):
-        if points.ndim != 2 or points.shape[1] != 3 or len(points.chunks[1]) != 1:
-            raise Error("invalid_argument", STATUSES["invalid_argument"],
-                        "a dask array of points has shape (n, 3) and is chunked by rows only")
+        _check.cloud_array("points", points)
+        if len(points.chunks[1]) != 1:
+            raise refuse("invalid_argument", "points, a dask array, must be chunked by rows only")
         return list(points.to_delayed().ravel())
-    return [dask.delayed(np.load)(p, mmap_mode="r") if isinstance(p, str)
+    if not isinstance(points, (list, tuple)):
+        raise _check.must(_check.wrong_type, "invalid_argument", "points",
+                          "a dask array or a list of partitions", points)
+    for i, p in enumerate(points):
+        if isinstance(_check.partition(f"points[{i}]", p), np.ndarray):
+            _check.cloud_array(f"points[{i}]", p)
+    return [dask.delayed(np.load)(p, mmap_mode="r") if not isinstance(p, np.ndarray)
             else dask.delayed(p) for p in points]
 
 
-def _summary(part, unit, skip_invalid):
-    """Count, height range and coordinate sum of one partition (of its finite points)."""
-    part = np.asarray(part, dtype=np.float64)
+def _summary(part, i, unit, skip_invalid):
+    """Count, height range and coordinate sum of partition i (of its finite points)."""
+    part = np.asarray(_check.cloud(f"points[{i}]", part), dtype=np.float64)
     finite = np.isfinite(part).all(axis=1)
     if not skip_invalid and not finite.all():
-        raise Error("invalid_point", STATUSES["invalid_point"],
-                    "a coordinate is NaN or infinite (skip_invalid=True skips such points)")
+        raise refuse("invalid_point", f"points[{i}]: a coordinate is NaN or infinite "
+                     "(skip_invalid=True skips such points)")
     good = part[finite]
     h = good @ unit
     low, high = (h.min(), h.max()) if len(h) else (np.inf, -np.inf)
     return len(part), low, high, good.sum(axis=0), len(good)
 
 
+def _layer_arguments(layers, layer_height):
+    """layers and layer_height, checked; at least one is given."""
+    if layers is not None:
+        layers = _check.whole("layers", layers, 1, _MOST_LAYERS, "invalid_layers")
+    if layer_height is not None:
+        layer_height = _check.real("layer_height", layer_height, "invalid_layers", "above 0")
+    elif layers is None:
+        raise refuse("invalid_layers", "layers or layer_height must be given")
+    return layers, layer_height
+
+
+def _layer_count(low, high, layers, layer_height):
+    """layers, or the whole number of equal layers nearest layer_height over [low, high]."""
+    if layers is not None:
+        return layers
+    count = max(1.0, round((high - low) / layer_height))
+    if count > _MOST_LAYERS:
+        raise refuse("invalid_layers", f"layer_height {layer_height} makes {count:.3g} layers "
+                     f"of the cloud's height {high - low:.6g}, more than 2^28")
+    return int(count)
+
+
+def _measure(parts, unit, skip_invalid):
+    """The lowest and highest height, the centroid and each partition's point count."""
+    stats = dask.compute(*[dask.delayed(_summary)(p, i, unit, skip_invalid)
+                           for i, p in enumerate(parts)])
+    valid = sum(s[4] for s in stats)
+    if valid < 3:
+        raise refuse("too_few_points", f"points: {valid} valid points")
+    low = min(s[1] for s in stats)
+    high = max(s[2] for s in stats)
+    if not high > low:
+        raise refuse("flat_cloud", "points: every point at one height")
+    # Summed in partition order, so the origin is the same bits on every run.
+    origin = tuple(float(c) for c in np.sum([s[3] for s in stats], axis=0) / valid)
+    return low, high, origin, [s[0] for s in stats]
+
+
+@_check.signature_checked
 def plan(points, *, axis, layer_height=None, layers=None, ranges=None, skip_invalid=False,
          surface_flips=False, open_ends=False):
     """Measures the cloud in parallel and fixes the layers, the ranges and the origin.
@@ -97,52 +131,45 @@ def plan(points, *, axis, layer_height=None, layers=None, ranges=None, skip_inva
     whole number of equal layers of about that height. ranges: how many ranges of whole
     layers are meshed in parallel (default: one per partition, at most one per layer).
     """
-    unit = _unit(axis)
+    name, unit = _check.direction(axis, automatic=False)
+    layers, layer_height = _layer_arguments(layers, layer_height)
+    if ranges is not None:
+        ranges = _check.whole("ranges", ranges, 1, _MOST_LAYERS)
+    options = {"skip_invalid": _check.switch("skip_invalid", skip_invalid),
+               "surface_flips": _check.switch("surface_flips", surface_flips),
+               "open_ends": _check.switch("open_ends", open_ends)}
     parts = _partitions(points)
-    stats = dask.compute(*[dask.delayed(_summary)(p, unit, skip_invalid) for p in parts])
-    counts = [s[0] for s in stats]
-    low = min(s[1] for s in stats)
-    high = max(s[2] for s in stats)
-    valid = sum(s[4] for s in stats)
-    if valid < 3:
-        raise Error("too_few_points", STATUSES["too_few_points"], f"{valid} valid points")
-    if not high > low:
-        raise Error("flat_cloud", STATUSES["flat_cloud"], "every point at one height")
-    # Summed in partition order, so the origin is the same bits on every run.
-    origin = tuple(float(c) for c in np.sum([s[3] for s in stats], axis=0) / valid)
-    if layers is None:
-        if layer_height is None or not layer_height > 0:
-            raise Error("invalid_layers", STATUSES["invalid_layers"],
-                        "give layers or a positive layer_height")
-        layers = max(1, int(round((high - low) / layer_height)))
-    layers = int(layers)
-    if layers < 1:
-        raise Error("invalid_layers", STATUSES["invalid_layers"], "layers must be 1 or more")
+    unit = _UNIT[name] if name else unit
+    low, high, origin, counts = _measure(parts, np.array(unit), options["skip_invalid"])
+    layers = _layer_count(low, high, layers, layer_height)
     cuts = low + (high - low) * np.arange(1, layers) / layers
-    ranges = min(layers, len(parts) if ranges is None else int(ranges))
-    if ranges < 1:
-        raise Error("invalid_argument", STATUSES["invalid_argument"], "ranges must be 1 or more")
+    ranges = min(layers, len(parts) if ranges is None else ranges)
     bounds = tuple(int(b) for b in np.linspace(0, layers, ranges + 1).round())
-    return Plan(axis=axis, unit=tuple(unit), origin=origin, cuts=cuts,
+    return Plan(axis=name or unit, unit=unit, origin=origin, cuts=cuts,
                 height_min=float(low), height_max=float(high), bounds=bounds,
-                offsets=tuple(int(o) for o in np.cumsum([0] + counts)),
-                options={"skip_invalid": skip_invalid, "surface_flips": surface_flips,
-                         "open_ends": open_ends})
+                offsets=tuple(int(o) for o in np.cumsum([0] + counts)), options=options)
 
 
+@_check.signature_checked
 def layer_of(points, plan):
     """Each point's layer: the number of cuts at or below it (a point on a cut is above it).
     NaN heights land past the last layer and are pushed with it (the stream skips them)."""
-    heights = np.asarray(points, dtype=np.float64) @ np.array(plan.unit)
+    _check.instance("plan", plan, Plan, "a Plan from stratmesh.dask.plan()")
+    points = _check.cloud("points", points)
+    heights = points.astype(np.float64, copy=False) @ np.array(plan.unit)
     return np.searchsorted(plan.cuts, heights, side="right")
 
 
-def _split(part, offset, plan):
-    """One partition cut into the pieces each range needs, as (points, global indices): its
+def _split(part, i, plan):
+    """Partition i cut into the pieces each range needs, as (points, global indices): its
     own layers and one more on each side (the layers that the bands at its edges join to)."""
     part = np.asarray(part)
+    offset, end = plan.offsets[i], plan.offsets[i + 1]
+    if len(part) != end - offset:
+        raise refuse("invalid_argument", f"points[{i}] has {len(part)} points where the plan "
+                     f"counted {end - offset}: mesh() takes the points plan() measured")
     layer = layer_of(part, plan)
-    index = np.arange(offset, offset + len(part), dtype=plan.index_dtype)
+    index = np.arange(offset, end, dtype=plan.index_dtype)
     pieces = []
     for lo, hi in zip(plan.bounds[:-1], plan.bounds[1:]):
         take = (layer >= lo - 1) & (layer <= hi)
@@ -175,14 +202,14 @@ def _check_edges(report, lo, hi, first, last, plan):
         # The report's tops come back from the stream's frame, rounded.
         tolerance = 1e-9 * (plan.height_max - plan.height_min + abs(plan.cuts[c]))
         if not (abs(tops - plan.cuts[c]) <= tolerance).any():
-            raise Error("invalid_layers", STATUSES["invalid_layers"],
-                        f"the layer below height {plan.cuts[c]} merged with its neighbour at "
-                        "a range's edge: choose a larger layer_height or fewer ranges")
+            raise refuse("invalid_layers",
+                         f"the layer below height {plan.cuts[c]} merged with its neighbour at "
+                         "a range's edge: choose a larger layer_height or fewer ranges")
     info = report.layers.info
     if ((first < lo and info[0].closed_ends & _CLOSED_BOTTOM)
             or (last > hi - 1 and info[-1].closed_ends & _CLOSED_TOP)):
-        raise Error("not_columnar", STATUSES["not_columnar"],
-                    "a range's edge was taken for a closed end: mesh with open_ends=True")
+        raise refuse("not_columnar",
+                     "a range's edge was taken for a closed end: mesh with open_ends=True")
 
 
 def _mesh_range(k, plan, *pieces):
@@ -213,12 +240,17 @@ def _mesh_range(k, plan, *pieces):
     return index[kept]
 
 
+@_check.signature_checked
 def mesh(points, plan):
-    """The triangles as a lazy dask array (m, 3) of global indices, one chunk per range."""
+    """The triangles as a lazy dask array (m, 3) of global indices, one chunk per range.
+    points are the partitions plan() measured, in the same order."""
+    _check.instance("plan", plan, Plan, "a Plan from stratmesh.dask.plan()")
     parts = _partitions(points)
+    if len(parts) != len(plan.offsets) - 1:
+        raise refuse("invalid_argument", f"points has {len(parts)} partitions where the plan "
+                     f"has {len(plan.offsets) - 1}: mesh() takes the points plan() measured")
     ranges = len(plan.bounds) - 1
-    pieces = [dask.delayed(_split, nout=ranges)(p, plan.offsets[i], plan)
-              for i, p in enumerate(parts)]
+    pieces = [dask.delayed(_split, nout=ranges)(p, i, plan) for i, p in enumerate(parts)]
     chunks = [da.from_delayed(dask.delayed(_mesh_range)(k, plan, *[pc[k] for pc in pieces]),
                               shape=(np.nan, 3), dtype=plan.index_dtype)
               for k in range(ranges)]

@@ -2,6 +2,11 @@
 import numpy as np
 import pytest
 
+import stratmesh
+
+# The two kinds of refusal: an argument of the wrong type, or of a wrong value.
+WRONG_TYPE, WRONG_VALUE = stratmesh.ArgumentTypeError, stratmesh.Error
+
 
 def bumpy_tube(n, seed=7, height=2 * np.pi, dtype=np.float64):
     """Points on r = 1 + 0.25 sin(5 theta) cos(z), in random order."""
@@ -32,6 +37,17 @@ def assert_manifold(triangles):
     undirected = np.sort(directed, axis=1)
     _, uses = np.unique(undirected[:, 0] * (2**32) + undirected[:, 1], return_counts=True)
     assert uses.max() <= 2, "an edge of three triangles or more"
+
+
+def refused_argument(kind, status, name, call, *args, **kwargs):
+    """call(*args, **kwargs) raises exactly kind with status, its message naming name."""
+    with pytest.raises(stratmesh.Error) as e:
+        call(*args, **kwargs)
+    assert type(e.value) is kind
+    assert isinstance(e.value, TypeError) == (kind is WRONG_TYPE)
+    assert e.value.status == status and e.value.report is None
+    assert e.value.detail.startswith(name), e.value.detail
+    assert str(e.value) == f"{status}: {e.value.detail}"
 
 
 @pytest.fixture(scope="module")

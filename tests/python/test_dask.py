@@ -2,7 +2,8 @@ import numpy as np
 import pytest
 
 import stratmesh
-from conftest import assert_manifold, bumpy_tube, canonical
+from conftest import (WRONG_TYPE, WRONG_VALUE, assert_manifold, bumpy_tube, canonical,
+                      refused_argument)
 
 dask = pytest.importorskip("dask")
 distributed = pytest.importorskip("distributed")
@@ -69,11 +70,11 @@ def test_without_the_layer_beyond_each_edge_the_union_differs(monkeypatch):
     parts = np.array_split(cloud, 4)
     split = smd._split
 
-    def split_short(part, offset, plan):
+    def split_short(part, i, plan):
         short = []
-        for (p, i), hi in zip(split(part, offset, plan), plan.bounds[1:]):
+        for (p, index), hi in zip(split(part, i, plan), plan.bounds[1:]):
             below = smd.layer_of(p, plan) < hi
-            short.append((p[below], i[below]))
+            short.append((p[below], index[below]))
         return short
 
     with dask.config.set(scheduler="sync"):
@@ -96,16 +97,78 @@ def test_layers_too_thin_to_stand_alone_at_an_edge_are_refused(client):
     assert "merged" in e.value.detail
 
 
-def test_plan_refusals():
-    with pytest.raises(stratmesh.Error) as e:
-        smd.plan([bumpy_tube(100)], axis="auto", layers=2)
-    assert e.value.status == "invalid_axis"
-    with pytest.raises(stratmesh.Error) as e:
-        smd.plan([bumpy_tube(100)], axis="z")
-    assert e.value.status == "invalid_layers"
-    nan = bumpy_tube(100)
-    nan[5, 0] = np.nan
+CLOUD = bumpy_tube(1_000)
+
+PLAN_ARGUMENTS = [
+    (WRONG_TYPE, "invalid_argument", "points", {"points": CLOUD}),
+    (WRONG_TYPE, "invalid_argument", "points", {"points": "cloud.npy"}),
+    (WRONG_TYPE, "invalid_argument", "points[1]", {"points": [CLOUD, 5]}),
+    (WRONG_TYPE, "invalid_argument", "points[0]", {"points": [CLOUD.astype(np.int64)]}),
+    (WRONG_VALUE, "invalid_argument", "points[0]", {"points": [CLOUD[:, :2]]}),
+    (WRONG_VALUE, "invalid_argument", "points", {"points": da.from_array(CLOUD.ravel())}),
+    (WRONG_VALUE, "invalid_argument", "points", {"points": da.from_array(CLOUD, chunks=(500, 2))}),
+    (WRONG_VALUE, "invalid_axis", "axis", {"axis": "auto"}),
+    (WRONG_VALUE, "invalid_axis", "axis", {"axis": (0, 0, 0)}),
+    (WRONG_TYPE, "invalid_axis", "axis", {"axis": ("0", "0", "1")}),
+    (WRONG_VALUE, "invalid_layers", "layers", {"layers": 0}),
+    (WRONG_VALUE, "invalid_layers", "layers", {"layers": 2**28 + 1}),
+    (WRONG_TYPE, "invalid_layers", "layers", {"layers": 2.0}),
+    (WRONG_VALUE, "invalid_layers", "layers", {"layers": None}),
+    (WRONG_VALUE, "invalid_layers", "layer_height", {"layers": None, "layer_height": 0.0}),
+    (WRONG_VALUE, "invalid_layers", "layer_height", {"layers": None, "layer_height": np.nan}),
+    (WRONG_TYPE, "invalid_layers", "layer_height", {"layers": None, "layer_height": "1"}),
+    (WRONG_VALUE, "invalid_layers", "layer_height", {"layers": None, "layer_height": 1e-300}),
+    (WRONG_VALUE, "invalid_argument", "ranges", {"ranges": 0}),
+    (WRONG_TYPE, "invalid_argument", "ranges", {"ranges": 1.5}),
+    (WRONG_TYPE, "invalid_argument", "skip_invalid", {"skip_invalid": "yes"}),
+    (WRONG_TYPE, "invalid_argument", "surface_flips", {"surface_flips": 1}),
+    (WRONG_TYPE, "invalid_argument", "open_ends", {"open_ends": None}),
+    (WRONG_TYPE, "invalid_argument", "plan", {"layer": 2}),
+]
+
+
+@pytest.mark.parametrize("kind, status, name, changed", PLAN_ARGUMENTS)
+def test_each_plan_argument_is_checked(kind, status, name, changed):
+    arguments = {"points": [CLOUD], "axis": "z", "layers": 2, **changed}
     with dask.config.set(scheduler="sync"):
-        with pytest.raises(stratmesh.Error) as e:
-            smd.plan([nan], axis="z", layers=2)
-    assert e.value.status == "invalid_point"
+        refused_argument(kind, status, name, smd.plan, **arguments)
+
+
+def test_plan_refuses_the_data_naming_the_partition(tmp_path):
+    nan = CLOUD.copy()
+    nan[5, 0] = np.nan
+    integers = str(tmp_path / "integers.npy")
+    np.save(integers, CLOUD.astype(np.int32))
+    with dask.config.set(scheduler="sync"):
+        refused_argument(WRONG_VALUE, "invalid_point", "points[1]", smd.plan, [CLOUD, nan],
+                         axis="z", layers=2)
+        refused_argument(WRONG_TYPE, "invalid_argument", "points[0]", smd.plan, [integers],
+                         axis="z", layers=2)
+        refused_argument(WRONG_VALUE, "too_few_points", "points", smd.plan, [], axis="z",
+                         layers=2)
+
+
+def test_mesh_takes_the_points_its_plan_measured():
+    parts = np.array_split(CLOUD, 2)
+    with dask.config.set(scheduler="sync"):
+        plan = smd.plan(parts, axis="z", layers=2)
+        refused_argument(WRONG_TYPE, "invalid_argument", "plan", smd.mesh, parts, vars(plan))
+        refused_argument(WRONG_VALUE, "invalid_argument", "points", smd.mesh, parts[:1], plan)
+        refused_argument(WRONG_VALUE, "invalid_argument", "points[1]",
+                         lambda: smd.mesh([parts[0], parts[1][1:]], plan).compute())
+        refused_argument(WRONG_TYPE, "invalid_argument", "plan", smd.layer_of, CLOUD, None)
+        refused_argument(WRONG_VALUE, "invalid_argument", "points", smd.layer_of, CLOUD[:, :2],
+                         plan)
+        refused_argument(WRONG_TYPE, "invalid_argument", "points", smd.layer_of,
+                         [[1.0, 2.0, 3.0], [4.0]], plan)
+
+
+def test_an_axis_of_any_length_plans_along_the_unit_axis():
+    with dask.config.set(scheduler="sync"):
+        unit = smd.plan([CLOUD], axis="z", layers=4)
+        for length in (1e200, 1e-300):
+            scaled = smd.plan([CLOUD], axis=(0, 0, length), layers=4)
+            assert scaled.unit == unit.unit == (0.0, 0.0, 1.0)
+            assert np.array_equal(scaled.cuts, unit.cuts)
+            assert np.array_equal(canonical(smd.mesh([CLOUD], scaled).compute()),
+                                  canonical(smd.mesh([CLOUD], unit).compute()))

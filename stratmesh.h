@@ -873,6 +873,9 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count);
 Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
                 size_t workspace_bytes, uint32_t* triangles, size_t triangle_capacity,
                 size_t* triangle_count, Report* report);
+#endif
+
+#if !defined(STRATMESH_SMALL_CODE)
 
 // ---- Where the cloud parts into branches ----
 //
@@ -1358,42 +1361,47 @@ stratmesh_status stratmesh_stream_close(stratmesh_stream* stream);
 // ==== Implementation =======================================================================
 // ===========================================================================================
 //
-// Sections in the order the data flows; search for ">>name" to jump to one.
+// Sections in the order the data flows; search for ">>name" to jump to one. Each is a file
+// of src/ in the repository, from which tools/amalgamate.py writes this header.
 //
-//   >>config             build switches: what STRATMESH_SMALL_CODE leaves out
-//   >>arena              the bump allocator over the caller's workspace
-//   >>predicates         orient2d and incircle: filter, integer and expansion stages
-//   >>spatial sort       the insertion order of the Delaunay triangulation
-//   >>delaunay           the incremental 2D Delaunay triangulation (delaunay_2d)
-//   >>layers             the frame, the outliers, grouping by layer, automatic layers
-//   >>unroll             a layer onto its annulus (cylinder and closed ends)
-//   >>layer triangulation  one layer: its triangulation, closed ends, the centre search,
-//                        flips on the surface
-//   >>stitch             the band between two layers' loops
-//   >>manifold           the safety net that keeps the surface a manifold
-//   >>caps               closing a boundary loop: pockets, lowered caps, fins
-//   >>webs               how much of a finished surface spans gaps (Diagnostics)
-//   >>reconstruct        one tube: chunks of layers, seam flips, parallel layers
-//   >>stream             the same surface, layer by layer, in bounded memory
-//   >>axis               the automatic axis
-//   >>cap ends           cap_ends() for a surface the caller holds
-//   >>parting            find_parting(): where the cloud parts into branches
-//   >>join branches      join_branches(): zips and grafts
-//   >>parts              reconstruct()'s default: trunk and branches, meshed and joined
-//   >>reconstruct entry  reconstruct() in its steps: validate, axis, parts or one tube
-//   >>c interface        the C functions over the C++ ones
+//   >>config              build switches: what STRATMESH_SMALL_CODE leaves out; the
+//                         floating-point environment
+//   >>arena               the bump allocator over the caller's workspace
+//   >>predicates          orient2d and incircle: filter, integer and expansion stages
+//   >>spatial sort        the insertion order of the Delaunay triangulation
+//   >>delaunay            the incremental 2D Delaunay triangulation (delaunay_2d)
+//   >>layers              the frame, the outliers, grouping by layer, automatic layers
+//   >>unroll              a layer onto its annulus (cylinder and closed ends)
+//   >>layer triangulation one layer: its triangulation, closed ends, the centre search,
+//                         flips on the surface
+//   >>stitch              the band between two layers' loops
+//   >>manifold            the safety net that keeps the surface a manifold
+//   >>caps                closing a boundary loop: pockets, lowered caps, fins
+//   >>webs                how much of a finished surface spans gaps (Diagnostics)
+//   >>reconstruct         one tube: chunks of layers, seam flips, parallel layers
+//   >>stream              the same surface, layer by layer, in bounded memory
+//   >>axis                the automatic axis
+//   >>cap ends            cap_ends() for a surface the caller holds
+//   >>parting             find_parting(): where the cloud parts into branches
+//   >>join branches       join_branches(): zips and grafts
+//   >>parts               reconstruct()'s default: trunk and branches, meshed and joined
+//   >>reconstruct entry   reconstruct() in its steps: validate, axis, parts or one tube
+//   >>c interface         the C functions over the C++ ones
+//   >>config restore      undoes what >>config set: its helper macros and the pinned
+//                         contraction
 
 #if defined(STRATMESH_IMPLEMENTATION) && !defined(__cplusplus)
 #error "the stratmesh implementation is C++17: compile stratmesh.cpp with a C++ compiler and link it; C files include stratmesh.h without STRATMESH_IMPLEMENTATION"
 #elif defined(STRATMESH_IMPLEMENTATION) && !defined(STRATMESH_IMPLEMENTATION_DONE)
 #define STRATMESH_IMPLEMENTATION_DONE
 
+// >>config ==================================================================================
+// Build switches: what STRATMESH_SMALL_CODE leaves out; the floating-point environment.
+
 #include <cfloat>
 #include <climits>
 #include <cmath>
 #include <cstring>
-
-// >>config ==================================================================================
 
 #ifndef STRATMESH_ASSERT
 #define STRATMESH_ASSERT(cond) ((void)0)
@@ -1576,11 +1584,18 @@ inline double read_double(const unsigned char* p) {
     return v;
 }
 
+}  // namespace detail
+}  // namespace stratmesh
+
 // >>arena ===================================================================================
+// The bump allocator over the caller's workspace.
 //
 // A bump allocator over the caller's buffer. A "measuring" arena (null base) only adds up
 // sizes, so *_workspace_size() runs the very allocation sequence the real call runs and
 // the two cannot disagree.
+
+namespace stratmesh {
+namespace detail {
 
 struct Arena {
     static const size_t kAlign = 16;
@@ -1691,7 +1706,11 @@ inline bool any_overlap(const ByteRange* ranges, size_t count) {
     return false;
 }
 
+}  // namespace detail
+}  // namespace stratmesh
+
 // >>predicates ==============================================================================
+// orient2d and incircle: filter, integer and expansion stages.
 //
 // This work is based on:
 //   J. R. Shewchuk, "Adaptive Precision Floating-Point Arithmetic and Fast Robust Geometric
@@ -1704,6 +1723,9 @@ inline bool any_overlap(const ByteRange* ranges, size_t count) {
 // Error bounds use eps = 2^-53 (half an ulp of 1) and are derived in Shewchuk's paper:
 // for a determinant evaluated in floating point, |computed - exact| <= bound * permanent,
 // where the permanent is the same expression with absolute values everywhere.
+
+namespace stratmesh {
+namespace detail {
 
 constexpr double kEps = DBL_EPSILON / 2;
 constexpr double kSplitter = 134217729.0; // 2^27 + 1: splits a double into two 26-bit halves
@@ -2382,7 +2404,11 @@ double incircle(const double a[2], const double b[2], const double c[2], const d
 
 namespace detail {
 
+}  // namespace detail
+}  // namespace stratmesh
+
 // >>spatial sort ============================================================================
+// The insertion order of the Delaunay triangulation.
 //
 // This work is based on:
 //   N. Amenta, S. Choi, G. Rote, "Incremental constructions con BRIO", SoCG 2003.
@@ -2394,6 +2420,9 @@ namespace detail {
 // costs about 40% more flips). The "random" round of a point is a hash of its
 // coordinates, so exact duplicates share a round and a curve cell, and the stable sort
 // keeps them in input order: the first inserted is the lowest index.
+
+namespace stratmesh {
+namespace detail {
 
 const uint32_t kHilbertBits = 13;  // per axis; 5 bits of the 32-bit key are left for rounds
 
@@ -2551,7 +2580,11 @@ inline bool spatial_order(const unsigned char* xy, size_t stride, size_t count,
     return true;
 }
 
+}  // namespace detail
+}  // namespace stratmesh
+
 // >>delaunay ================================================================================
+// The incremental 2D Delaunay triangulation (delaunay_2d).
 //
 // This work is based on:
 //   C. L. Lawson, "Software for C1 surface interpolation", 1977 (edge flips).
@@ -2566,6 +2599,9 @@ inline bool spatial_order(const unsigned char* xy, size_t stride, size_t count,
 // inserted like any other: a ghost (a, b, G) "contains" p when orient(a, b, p) > 0, and
 // an edge to G is flipped when p sees the next hull edge. With m points there are always
 // 2m - 2 triangles, ghosts included.
+
+namespace stratmesh {
+namespace detail {
 
 static const uint32_t kGhost = kNoIndex;
 
@@ -3005,12 +3041,19 @@ Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
 
 namespace detail {
 
+}  // namespace detail
+}  // namespace stratmesh
+
 // >>layers ==================================================================================
+// The frame, the outliers, grouping by layer, automatic layers.
 //
 // The cloud is read in place (float or double, any stride) and expressed in a frame whose
 // third axis is the stacking axis and whose origin is the centroid, so that clouds far
 // from the origin (georeferenced scans) keep their millimetres. Layers are height ranges
 // along the axis; the points are grouped by layer, in input order within a layer.
+
+namespace stratmesh {
+namespace detail {
 
 struct Vec3 {
     double x, y, z;
@@ -3960,7 +4003,11 @@ inline uint32_t layer_of(const LayerPlan& plan, double h, double per_height) {
     return lo;
 }
 
+}  // namespace detail
+}  // namespace stratmesh
+
 // >>unroll ==================================================================================
+// A layer onto its annulus (cylinder and closed ends).
 //
 // Each layer is projected on a cylinder around its own centre, unrolled to (u, v) =
 // (r theta, h) and rolled up again by the conformal map exp((v - v0)/r + i theta) onto a
@@ -3994,6 +4041,9 @@ inline uint32_t layer_of(const LayerPlan& plan, double h, double per_height) {
 // rim, and the end is meshed across. On a flat-ended cylinder of 10,000 points the mean
 // distance to the true surface fell 7.5 times with one layer (to CGAL's advancing front's),
 // 5.6 times over 1 to 24 layers; on half-sphere ends 20%. Open ends are not touched.
+
+namespace stratmesh {
+namespace detail {
 
 const uint32_t kSectors = 32;
 
@@ -4308,7 +4358,14 @@ struct TriangleSink {
     }
 };
 
+}  // namespace detail
+}  // namespace stratmesh
+
 // >>layer triangulation =====================================================================
+// One layer: its triangulation, closed ends, the centre search, flips on the surface.
+
+namespace stratmesh {
+namespace detail {
 
 struct LayerLoops {
     uint32_t* bottom;  // layer-local indices, counter-clockwise on the annulus
@@ -5190,7 +5247,11 @@ inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Ar
     return Status::ok;
 }
 
+}  // namespace detail
+}  // namespace stratmesh
+
 // >>stitch ==================================================================================
+// The band between two layers' loops.
 //
 // Two neighbouring layers meet at a cut: the top loop A of the lower layer and the bottom
 // loop B of the upper one are closed loops around the axis. Both are unrolled onto one
@@ -5213,6 +5274,9 @@ inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Ar
 // >>layer triangulation): they hug the cut, so the band's triangles join points about one
 // spacing apart; where a band between peeled loops still folds, add_group stitches it again
 // from the loops as they were, with the peeled triangles put back.
+
+namespace stratmesh {
+namespace detail {
 
 // Rotates loop[0..n) and its strip coordinates so that entry `first` comes first; the
 // entries moved to the end are shifted by `turn` (one period of the strip), so angles
@@ -5667,7 +5731,11 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
     return true;
 }
 
+}  // namespace detail
+}  // namespace stratmesh
+
 // >>manifold ================================================================================
+// The safety net that keeps the surface a manifold.
 //
 // The paper's step 5, as a safety net: by construction the layers and bands already form a
 // manifold, so on sound input this removes nothing. Around every vertex v, each triangle
@@ -5697,6 +5765,9 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
 // relabelling and sorting, most of its cost, is skipped. A layer emits its triangles at
 // the bottom loop last, so those fans are read from one stretch of the chunk, its border
 // and band (chunk_is_sound); the rest of the chunk is only renamed.
+
+namespace stratmesh {
+namespace detail {
 
 // In-place sort of packed (key, value) pairs: insertion sort for the small fans of almost
 // every vertex, heap sort (O(n log n), no recursion) for large ones.
@@ -5965,7 +6036,11 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
     return removed;
 }
 
+}  // namespace detail
+}  // namespace stratmesh
+
 // >>caps ====================================================================================
+// Closing a boundary loop: pockets, lowered caps, fins.
 //
 // With the close_ends flag, each boundary loop of the final surface is closed by a cap made
 // of triangles over the loop's own vertices. The loop is triangulated in its projection
@@ -5998,6 +6073,9 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
 // The loops of a star-shaped layer run monotonically in angle around its centre (see the
 // unroll section), so their projections are simple but for rounding or the safety net's
 // removals.
+
+namespace stratmesh {
+namespace detail {
 
 // The surface's directed edges between boundary vertices, grouped by first vertex, each
 // group sorted; and per vertex the far end of its boundary edge. The output is
@@ -6983,7 +7061,11 @@ inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
     return Status::ok;
 }
 
+}  // namespace detail
+}  // namespace stratmesh
+
 // >>webs ====================================================================================
+// How much of a finished surface spans gaps (Diagnostics).
 //
 // How much of a finished surface is web (Diagnostics): triangles far longer than the
 // spacing of the points they join, as where one tube wraps limbs and spans the gaps between
@@ -7004,6 +7086,9 @@ inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
 // point (with 2 triangles a point), within reconstruct_workspace_size()'s bound. Lengths
 // are measured in the cloud's coordinates times a power of two that brings its extent near
 // 1 (exact), so that no square overflows or underflows.
+
+namespace stratmesh {
+namespace detail {
 
 // From the passes over all points as jobs (>>reconstruct).
 inline size_t run_start(size_t count, uint32_t k);
@@ -7246,13 +7331,20 @@ inline bool measure_webs(const Options& options, const CloudReader& reader, size
     return true;
 }
 
+}  // namespace detail
+}  // namespace stratmesh
+
 // >>reconstruct =============================================================================
+// One tube: chunks of layers, seam flips, parallel layers.
 //
 // Validate, choose the frame and the layers, group the points by layer, then for each
 // layer: fit its cylinder, triangulate it on its annulus, stitch it to the layer below.
 // A layer that cannot be triangulated around its axis (too few points, or a gap in its
 // angular coverage) is merged with the next one; trailing points that never form such a
 // layer stay unused and are reported. Last, the manifold safety net.
+
+namespace stratmesh {
+namespace detail {
 
 // ---- the surface, chunk by chunk -----------------------------------------------------------
 //
@@ -9139,13 +9231,17 @@ inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& aren
 
 }  // namespace detail
 
+}  // namespace stratmesh
 
 // >>stream ==================================================================================
+// The same surface, layer by layer, in bounded memory.
 //
 // The stream is reconstruct()'s loop over planned layers, driven by pushes: each push is
 // appended to a window of held points as one planned layer, and add_group runs for as long
 // as it can decide. A finished group's chunk goes to the callback; then the window keeps
 // only that group's top loop (moved to the front) and the pushes after it.
+
+namespace stratmesh {
 
 struct Stream {
     detail::Arena arena;          // the scratch, after everything below
@@ -9487,7 +9583,10 @@ Status stream_close(Stream* stream) {
     return status;
 }
 
+}  // namespace stratmesh
+
 // >>axis ====================================================================================
+// The automatic axis.
 //
 // The automatic axis. The method needs the direction along which the cloud's sections are
 // loops around one centre line, and the direction of largest variance is often another: a
@@ -9499,6 +9598,8 @@ Status stream_close(Stream* stream) {
 // meshes the sample and the one whose surface is smallest wins: where the layers cannot
 // follow the surface they fold and bridge gaps with webs, and both add area. The samples
 // are every k-th kept point in input order, so the choice is deterministic.
+
+namespace stratmesh {
 
 namespace detail {
 
@@ -9933,11 +10034,16 @@ inline Status resolve_axis(const TubeInput& in, const Options& options, Arena& a
 
 }  // namespace detail
 
-#if !defined(STRATMESH_SMALL_CODE)
+}  // namespace stratmesh
+
 // >>cap ends ================================================================================
+// cap_ends() for a surface the caller holds.
 //
 // cap_ends() is reconstruct()'s last step on a surface the caller holds: the same checks of
 // the cloud, the same frame (chosen from the whole cloud), the same caps.
+
+#if !defined(STRATMESH_SMALL_CODE)
+namespace stratmesh {
 
 size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count) {
     if (point_count > detail::kMaxPoints - 1) return 0;
@@ -10011,7 +10117,11 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
     return finish(status);
 }
 
+}  // namespace stratmesh
+#endif  // STRATMESH_SMALL_CODE
+
 // >>parting =================================================================================
+// find_parting(): where the cloud parts into branches.
 //
 // find_parting(): the cuts lie every half gap along the axis (at most one per point), and
 // each point falls in the step between two of them. Two sweeps, one from the top down for
@@ -10024,6 +10134,9 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
 // first, so that a point's neighbours are near in memory and their blocks were just used.
 // After each step, the pieces that count are checked for branches at the cut the step
 // reaches; the points within two gaps of it are those of the last four steps.
+
+#if !defined(STRATMESH_SMALL_CODE)
+namespace stratmesh {
 
 namespace detail {
 
@@ -10562,7 +10675,11 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
                                      branch_of, kSmallestBranch);
 }
 
+}  // namespace stratmesh
+#endif  // STRATMESH_SMALL_CODE
+
 // >>join branches ===========================================================================
+// join_branches(): zips and grafts.
 //
 // join_branches(): the boundary loops of the caller's surface are traced as the caps trace
 // them (build_cap_graph, trace_boundary_loops: each loop in cap order, the boundary
@@ -10572,6 +10689,9 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 // trunk's loop in cap order runs the way the branches' boundary runs: each band is then
 // the same zipper, whose triangles (a, a', b) and (a, b', b) run the trunk's loop in cap
 // order and the branch's loop against its boundary.
+
+#if !defined(STRATMESH_SMALL_CODE)
+namespace stratmesh {
 
 namespace detail {
 
@@ -11442,7 +11562,11 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
     return finish(Status::ok);
 }
 
+}  // namespace stratmesh
+#endif  // STRATMESH_SMALL_CODE
+
 // >>parts ===================================================================================
+// reconstruct()'s default: trunk and branches, meshed and joined.
 //
 // reconstruct()'s default where the cloud parts into branches (PartCounts). One tube wraps
 // branches and the gaps between them, so where find_parting() finds a cut, the trunk (the
@@ -11458,6 +11582,9 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
 // so a cloud of more than kPartingSample points is searched on a sample first (every k-th
 // kept point) and in full only where the sample parts: a branch of fewer than about
 // kSmallestBranch * n / kPartingSample points can go unseen.
+
+#if !defined(STRATMESH_SMALL_CODE)
+namespace stratmesh {
 
 namespace detail {
 
@@ -11955,12 +12082,17 @@ inline size_t parts_workspace_size(size_t count, const Options& options) {
 }
 
 }  // namespace detail
-#endif
+
+}  // namespace stratmesh
+#endif  // STRATMESH_SMALL_CODE
 
 // >>reconstruct entry ======================================================================
+// reconstruct() in its steps: validate, axis, parts or one tube.
 //
 // reconstruct() in its steps: check the arguments, read the cloud, choose the axis, then
 // one tube or the parts (where the build has them and the one_tube flag is not given).
+
+namespace stratmesh {
 
 namespace detail {
 
@@ -12098,6 +12230,7 @@ Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
 }  // namespace stratmesh
 
 // >>c interface =============================================================================
+// The C functions over the C++ ones.
 //
 // The C functions convert their structs field for field and call the C++ ones; the enum
 // values are asserted equal, so a status, an axis or a flag passes as it is. The layer
@@ -12493,6 +12626,9 @@ stratmesh_status stratmesh_stream_close(stratmesh_stream* stream) {
 }
 
 #endif  // STRATMESH_C_API
+
+// >>config restore ==========================================================================
+// Undoes what >>config set: its helper macros and the pinned contraction.
 
 #undef STRATMESH_SMALL_NOINLINE
 #undef STRATMESH_FAST_NOINLINE

@@ -1,0 +1,174 @@
+// ==== Surface reconstruction ===============================================================
+
+enum class Scalar : uint32_t { float64 = 0, float32 = 1 };
+
+// A point cloud in the caller's memory: x, y, z of the first point at `xyz`, each next
+// point `stride_bytes` further (0 means packed: 3 scalars). No alignment needed, so
+// interleaved scanner records (normals, colours, intensity) are read in place.
+struct Cloud {
+    const void* xyz;
+    size_t count;
+    size_t stride_bytes;
+    Scalar scalar;
+};
+
+// The direction the layers are stacked along.
+enum class Axis : uint32_t {
+    // The direction along which the cloud's sections are loops around one centre line:
+    // the first principal direction where a sample's surface runs along it (a tube, a
+    // limb), else whichever of the principal directions and x, y, z gives a sample the
+    // smallest surface (a layer that cannot follow the surface folds and adds area). The
+    // reduced build (STRATMESH_SMALL_CODE) returns Status::not_compiled.
+    automatic = 0,
+    x,
+    y,
+    z,
+    direction       // Options::direction
+};
+
+enum Flags : uint32_t {
+    // NaN/Inf points are skipped and counted (Report::points.rejected_count) instead of refused with
+    // Status::invalid_point.
+    skip_invalid_points = 1u << 0,
+    // Closes the surface's boundary loops with caps, so a tube becomes a closed, edge- and
+    // vertex-manifold, consistently oriented surface (Euler characteristic 2, normals
+    // outward: the bottom cap faces -axis, the top one +axis). A cap triangulates its loop
+    // over the loop's own vertices (no new vertex), as seen across the axis: pockets of the
+    // loop along the wall are closed first, then the rest by a triangulation lowered (bottom)
+    // or raised (top) along the axis as far as the loop allows, so that a wall leaning over
+    // a ragged loop stays clear of it, and Delaunay where the loop is planar. No cap repeats
+    // an edge of the surface; where the surface's fins (triangles with two edges on the
+    // loop) leave no such cap, the edge under a fin may be flipped (two triangles change in
+    // place, same corners, same count; Report::caps.wall_flip_count). A loop whose
+    // projection is not a simple polygon, or that no cap closes, stays open: the call
+    // still returns ok, Report::caps.open_count counts it and Report::detail says so.
+    // reconstruct_max_triangles() still suffices (a closed surface through V vertices has
+    // 2V - 4 triangles). The stream refuses the flag: cap_ends() caps its surface afterwards.
+    close_ends = 1u << 1,
+    // The frame's reference point is Options::origin instead of the centroid of the cloud
+    // (reconstruct) or of the first layer (the stream). The reference point changes only
+    // rounding, but a stream and a reconstruct() that are to give the same triangles need
+    // the same one.
+    origin_given = 1u << 2,
+    // Points far from the rest of the cloud (stray returns, flying pixels, specks of fewer
+    // than 8 points) are left out before anything else and counted (outlier_count, part of
+    // rejected_count in Report::points), so they neither tilt the automatic axis nor stretch
+    // the layers nor become spikes: a point with fewer than 8 points, itself included,
+    // within 4 to 12 times the distance that nine points in ten have to their nearest
+    // neighbour. For raw sensor clouds; off by default, since without it every valid point
+    // is a vertex. Assumes that fewer than a tenth of the points are outliers. The
+    // workspace bound grows by a bit per point. The stream refuses it (invalid_argument);
+    // the reduced build returns not_compiled.
+    drop_outliers = 1u << 3,
+    // After each layer is triangulated on its unrolled annulus (the paper's method), its
+    // edges are flipped on the surface itself: by the empty-circle rule with angles
+    // measured in 3D, and toward the direction in which the surface curves least. The
+    // unrolling squeezes whatever lies almost across the axis (the underside of an ear, a
+    // chin, a crease); there the flips join the points that are near on the surface. Each
+    // seam between layers is flipped the same way once the layers are stitched. No vertex
+    // or loop changes; a flip never makes a fold nor an angle over 150 degrees (unless it
+    // narrows one) and is checked against crossing the nearby triangles; the stream gives
+    // the same triangles as reconstruct() with it. Closer to the true surface (by about
+    // 10% on scans, 30 to 45% on smooth analytic tubes), for about three times the time:
+    // off by default. The reduced build returns not_compiled.
+    surface_flips = 1u << 4,
+    // No end of the surface is taken for a closed one (see ClosedEnd): the end layers are
+    // unrolled on the cylinder like the others, never around a pole, so the surface's loops
+    // lie where the cylinder's picture puts them (a flat end's points on its rim, a dome
+    // up to its highest points). For a cloud cut out of a larger object (a region of
+    // interest, a branch meshed on its own), whose ends are cuts however many points lie
+    // across them. The reduced build, which has no closed ends, returns not_compiled.
+    open_ends = 1u << 5,
+    // reconstruct() meshes the cloud as one tube without looking for where it parts into
+    // branches (see PartCounts): the paper's single column, and the search's time saved
+    // (a few percent on a cloud that does not part). The stream always meshes one tube.
+    one_tube = 1u << 6,
+    // reconstruct() keeps the trunk and branches meshed apart even where a side could not
+    // be joined or points past a cut belong to no branch (left apart or unused, as
+    // Report::parts says), instead of meshing the cloud as one tube then.
+    keep_parts = 1u << 7,
+};
+
+// Phases reported to Options::progress, in the order they run. Each layer is stitched to
+// the one below as soon as it is triangulated, so stitching time falls within
+// `triangulate`; `stitch` is announced once, when the last band is done. The caps of
+// close_ends are made within `manifold`.
+enum class Phase : uint32_t { validate = 0, layers, triangulate, stitch, manifold, done };
+
+// One job of a batch run by Options::run_jobs: job(context, index).
+typedef void (*JobFunction)(void* context, uint32_t index);
+
+// Runs job(context, i) once for every i in [0, count), in any order, on any threads (the
+// caller's pool, RTOS tasks, std::thread, or a plain loop), and returns when all have
+// finished. Jobs are independent: each writes only its own part of the workspace. A
+// runner that skips a job only loses time (its layers are done in order afterwards), one
+// that runs a job again after it finished changes nothing, and an index outside
+// [0, count) is ignored; the same job on two threads at once is a data race.
+typedef void (*JobRunner)(void* user, uint32_t count, JobFunction job, void* context);
+
+// All zero means defaults: `Options options = {};` is always valid.
+struct Options {
+    Axis axis;
+    double direction[3];     // for Axis::direction; any finite non-zero length
+    // Layers, first match wins: explicit cut positions along the axis, as the coordinate
+    // dot(point, axis) (with Axis::z, a cut at 68 is the plane z = 68; a point on a cut,
+    // up to 2^-40 of the cloud's height, belongs to the layer above); any order,
+    // repeats and cuts outside the cloud are ignored; else layer_count equal-height
+    // layers; else layers of about layer_height; else automatic: the fewest layers such
+    // that one centre line serves each layer, none is taller than 24 of its radii and none
+    // holds more than an eighth of the points (or 65,536, if that is more, so that large
+    // clouds come in layers that jobs can triangulate side by side), cut where the
+    // cross-section changes least and not through dense detail (the paper's rule).
+    // Planned layers are then merged where the method needs it: a layer with fewer than
+    // 16 points, thinner than about one and a half rows of points around its radius, or
+    // whose points do not surround its centre joins the next one (a remainder like that
+    // joins the last); a layer next to a slanted end of the tube (a crescent: an arc with a
+    // gap of over 34 degrees that the two layers together narrow) joins it; a layer with
+    // triangles facing the axis is joined with the next one or two where that leaves
+    // fewer. Report::layers gives the planned and used counts and the layers used.
+    const double* cuts;
+    size_t cut_count;
+    uint32_t layer_count;
+    double layer_height;
+    uint32_t flags;          // Flags bits
+    double origin[3];        // with the origin_given flag
+    // Optional progress callback: called with each phase as it starts, and with the
+    // fraction of that phase done from time to time. Must not call back into stratmesh.
+    void (*progress)(void* user, Phase phase, double fraction);
+    void* progress_user;
+    // Optional, reconstruct() only: with a runner, the layers are triangulated as
+    // independent jobs (at most kMaxJobs of them, each over a run of consecutive layers with
+    // its own scratch in the workspace); grouping layers, stitching them and the safety net
+    // stay in order. The triangles and the report are the same bytes whatever the runner
+    // does (see JobRunner), Report::layers.parallel_count aside.
+    // reconstruct_workspace_size() grows with a runner (see there); a workspace too small
+    // for the jobs' scratch runs them in order instead (Report::layers.parallel_count says how
+    // many layers were triangulated by jobs). Jobs call no user code, not even progress.
+    JobRunner run_jobs;
+    void* jobs_user;
+};
+
+// The most jobs reconstruct() hands to Options::run_jobs at once.
+const uint32_t kMaxJobs = 64;
+
+// LayerInfo::closed_ends. The surface's first layer (closed_bottom) or last layer
+// (closed_top) that holds a closed end of the object (a dome, a skull, a flat base: points
+// across the end, not only around its rim) is meshed across that end, up to a small loop
+// around its pole: the layer is unrolled around a pole inside the end rather than on the
+// cylinder, which would fold the end's points onto its rim. The small loop is a boundary
+// (close_ends caps it). An end left open as a tube's rim, any other layer, and every layer
+// of the reduced build report 0.
+enum ClosedEnd : uint32_t { closed_bottom = 1u << 0, closed_top = 1u << 1 };
+
+struct LayerInfo {
+    double bottom, top;      // extent along the axis, as dot(point, axis)
+    double centre[3];        // the axis of the unrolling cylinder passes through this
+                             // (the fitted centre, or the one the centre search chose)
+    double radius;           // the unrolling cylinder's radius: the layer's mean distance
+                             // from its centre line, at least a 24th of its height
+    uint32_t point_count;    // distinct valid points in the layer
+    uint32_t triangle_count; // the layer's own triangles plus the band joining it to the
+                             // layer below, before the safety net
+    uint32_t fold_count;     // of those, triangles facing the axis
+    uint32_t closed_ends;    // ClosedEnd bits: which of the layer's ends closes the surface
+};

@@ -1,0 +1,142 @@
+// >>reconstruct entry ======================================================================
+// reconstruct() in its steps: validate, axis, parts or one tube.
+//
+// reconstruct() in its steps: check the arguments, read the cloud, choose the axis, then
+// one tube or the parts (where the build has them and the one_tube flag is not given).
+
+namespace stratmesh {
+
+namespace detail {
+
+// Whether reconstruct() looks for branches with these options.
+inline bool searches_parts(const Options& options) {
+    return kFindParts && !(options.flags & one_tube);
+}
+
+inline Status mesh_cloud(const Cloud& cloud, const TubeInput& in, const Options& along,
+                         Arena& arena, uint32_t* triangles, size_t capacity,
+                         size_t* triangle_count, Report& rep) {
+#if !defined(STRATMESH_SMALL_CODE)
+    if (searches_parts(along))
+        return reconstruct_default(cloud, in, along, arena, triangles, capacity, triangle_count,
+                                   rep);
+#else
+    (void)cloud;
+#endif
+    return mesh_tube(in, along, arena, triangles, capacity, triangle_count, rep);
+}
+
+// reconstruct()'s body; `rep` arrives zeroed but for its caller's arrays.
+// Report::points.unused_count is left to the caller, who derives it so the counts add up on
+// every path.
+inline Status run_reconstruction(const Cloud& cloud, const Options& options, void* workspace,
+                                 size_t workspace_bytes, uint32_t* triangles,
+                                 size_t triangle_capacity, size_t* triangle_count,
+                                 Report& rep) {
+    Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
+                                                triangle_count, workspace, rep);
+    if (status != Status::ok) return status;
+    notify(options, Phase::validate, 0);
+    Arena arena = Arena::over(workspace, workspace_bytes);
+    TubeInput in = {};
+    Options along;
+    status = read_cloud(cloud, options, arena, rep, in);
+    const size_t read = arena.mark();  // the outliers' bitmap stays: the reader needs it
+    const char* far_origin = status == Status::ok ? origin_refusal(options, in.sums) : nullptr;
+    if (far_origin) {
+        rep.detail = far_origin;
+        status = Status::invalid_origin;
+    }
+    // A cloud on a line up to rounding is refused whatever the axis: a line has no surface,
+    // and along it a layer would only seem not to surround its axis.
+    if (status == Status::ok && kDegenerateCheck && in.sums.distinct >= 3 && on_a_line(in, arena))
+        status = Status::degenerate;
+    if (status == Status::ok) status = resolve_axis(in, options, arena, along, rep);
+    if (status == Status::ok)
+        status = mesh_cloud(cloud, in, along, arena, triangles, triangle_capacity,
+                            triangle_count, rep);
+    if (kMeasureWebs) arena.rewind(read);  // the surface is final: the scratch is free
+    // A few far points or far clusters collapse the rest, so that no layer surrounds its
+    // centre either: they are the reason then too.
+    if (kDegenerateCheck && (status == Status::degenerate || status == Status::not_columnar)) {
+        arena.rewind(read);
+        status = explain_no_area(in, status, arena, rep);
+    }
+    if (kMeasureWebs && status == Status::ok &&
+        !measure_webs(options, in.reader, in.count, in.sums, triangles, *triangle_count,
+                      rep.caps.triangle_count, arena, rep)) {
+        *triangle_count = 0;
+        rep.triangle_count = 0;
+        status = Status::out_of_memory;
+    }
+    rep.workspace_used_bytes = arena.peak_from_buffer();
+    return status;
+}
+
+}  // namespace detail
+
+size_t reconstruct_max_triangles(size_t point_count, const Options& options) {
+    // A manifold surface through V vertices, open or closed, has at most 2V triangles; the
+    // junctions of branches add at most four per branch beyond that.
+    const size_t junctions = detail::searches_parts(options) ? 8 * size_t{kMaxBranches} : 0;
+    return point_count > (SIZE_MAX - junctions) / 2 ? 0 : 2 * point_count + junctions;
+}
+
+size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
+    size_t most = detail::tube_workspace_size(point_count, options);
+    if (most == 0) return 0;
+    // The axis is chosen, and the parts meshed, once the outliers are known.
+    detail::Arena arena = detail::Arena::measuring();
+    if (detail::kDropOutliers && (options.flags & drop_outliers))
+        arena.alloc<unsigned char>(point_count / 8 + 1);
+    const size_t read = arena.required_bytes();
+    size_t steps[detail::kMeasureWebs ? 3 : 2] = {};
+    if (detail::kAxisTrials && options.axis == Axis::automatic)
+        steps[0] = detail::axis_workspace_size(point_count, options);
+#if !defined(STRATMESH_SMALL_CODE)
+    if (detail::searches_parts(options)) steps[1] = detail::parts_workspace_size(point_count, options);
+#endif
+    // The webs are measured once the surface is final (far less than meshing it takes).
+    if (detail::kMeasureWebs) {
+        steps[detail::kMeasureWebs ? 2 : 0] = detail::webs_workspace_size(
+            point_count, reconstruct_max_triangles(point_count, options));
+        if (steps[detail::kMeasureWebs ? 2 : 0] == 0) return 0;
+    }
+    for (size_t bytes : steps) {
+        if (bytes > SIZE_MAX - read) return 0;
+        most = read + bytes > most ? read + bytes : most;
+    }
+    return most;
+}
+
+Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
+                   size_t workspace_bytes, uint32_t* triangles, size_t triangle_capacity,
+                   size_t* triangle_count, Report* report) {
+    if (detail::reconstruct_buffers_overlap(cloud, workspace, workspace_bytes, triangles,
+                                            triangle_capacity, triangle_count, report))
+        return Status::invalid_argument;
+    Report local_report;
+    Report& rep = report ? *report : local_report;
+    // The caller's arrays, kept as they are (as two values, not copies of the groups: the
+    // small build's stack frame stays within a short instruction's reach).
+    LayerInfo* const layer_info = report ? report->layers.info : nullptr;
+    const size_t layer_capacity = layer_info ? report->layers.info_capacity : 0;
+    const PartCounts parts = report ? report->parts : PartCounts{};
+    std::memset(&rep, 0, sizeof rep);
+    rep.layers.info = layer_info;
+    rep.layers.info_capacity = layer_capacity;
+    if (detail::kFindParts) {
+        rep.parts.info = parts.info;
+        rep.parts.info_capacity = parts.info ? parts.info_capacity : 0;
+    }
+    rep.points.in_count = cloud.count;
+    if (triangle_count) *triangle_count = 0;
+    Status status = detail::run_reconstruction(cloud, options, workspace, workspace_bytes,
+                                               triangles, triangle_capacity, triangle_count,
+                                               rep);
+    rep.points.unused_count = rep.points.in_count - rep.points.used_count -
+                              rep.points.duplicate_count - rep.points.rejected_count;
+    return status;
+}
+
+}  // namespace stratmesh

@@ -1370,22 +1370,47 @@ stratmesh_status stratmesh_stream_close(stratmesh_stream* stream);
 //   >>predicates          orient2d and incircle: filter, integer and expansion stages
 //   >>spatial sort        the insertion order of the Delaunay triangulation
 //   >>delaunay            the incremental 2D Delaunay triangulation (delaunay_2d)
-//   >>layers              the frame, the outliers, grouping by layer, automatic layers
+//   >>points              the cloud's points as the library reads them, and the vector
+//                         arithmetic on them
+//   >>outliers            points far from the rest of the cloud, left out with
+//                         drop_outliers
+//   >>cloud               reading the cloud: invalid points refused or counted, outliers
+//                         left out, sums
+//   >>frame               the frame the layers are cut in: its axis, origin and scale
+//   >>jobs                the caller's callbacks: progress, and passes split into jobs for
+//                         the runner
+//   >>layer plan          cuts along the axis: explicit, equal, by height or automatic;
+//                         points grouped by layer
 //   >>unroll              a layer onto its annulus (cylinder and closed ends)
-//   >>layer triangulation one layer: its triangulation, closed ends, the centre search,
-//                         flips on the surface
+//   >>layer               one layer loaded on its annulus: its loops and their peeling,
+//                         closed ends, the centre search
 //   >>stitch              the band between two layers' loops
 //   >>manifold            the safety net that keeps the surface a manifold
+//   >>chain               the surface as a chain of chunks: a group of layers with its
+//                         band, sealed to the one below
+//   >>flips               flips on the surface: within a layer, and across the seam
+//                         between layers
+//   >>layer triangulation one layer triangulated on its annulus, its loops peeled and its
+//                         edges flipped
+//   >>surface loops       the boundary loops of a surface, traced from its triangles
+//   >>polygon             simple polygons on the exact predicates: crossing edges,
+//                         containment
 //   >>caps                closing a boundary loop: pockets, lowered caps, fins
 //   >>webs                how much of a finished surface spans gaps (Diagnostics)
-//   >>reconstruct         one tube: chunks of layers, seam flips, parallel layers
+//   >>group               a group of layers: triangulated, stitched to the loop below,
+//                         flipped and sealed
+//   >>parallel layers     layers triangulated ahead as jobs on the caller's runner
+//   >>tube                one tube: its layers triangulated, stitched and sealed group by
+//                         group, then capped
 //   >>stream              the same surface, layer by layer, in bounded memory
 //   >>axis                the automatic axis
+//   >>no area             why a surface through the points would have no area: a line, far
+//                         points, far clusters
 //   >>cap ends            cap_ends() for a surface the caller holds
 //   >>parting             find_parting(): where the cloud parts into branches
 //   >>join branches       join_branches(): zips and grafts
 //   >>parts               reconstruct()'s default: trunk and branches, meshed and joined
-//   >>reconstruct entry   reconstruct() in its steps: validate, axis, parts or one tube
+//   >>reconstruct         reconstruct() in its steps: validate, axis, parts or one tube
 //   >>c interface         the C functions over the C++ ones
 //   >>config restore      undoes what >>config set: its helper macros and the pinned
 //                         contraction
@@ -1587,7 +1612,7 @@ inline double read_double(const unsigned char* p) {
 }  // namespace detail
 }  // namespace stratmesh
 
-// >>arena ===================================================================================
+// >>arena ================================================================================
 // The bump allocator over the caller's workspace.
 //
 // A bump allocator over the caller's buffer. A "measuring" arena (null base) only adds up
@@ -1709,7 +1734,7 @@ inline bool any_overlap(const ByteRange* ranges, size_t count) {
 }  // namespace detail
 }  // namespace stratmesh
 
-// >>predicates ==============================================================================
+// >>predicates ===========================================================================
 // orient2d and incircle: filter, integer and expansion stages.
 //
 // This work is based on:
@@ -1728,8 +1753,11 @@ namespace stratmesh {
 namespace detail {
 
 constexpr double kEps = DBL_EPSILON / 2;
+
 constexpr double kSplitter = 134217729.0; // 2^27 + 1: splits a double into two 26-bit halves
+
 constexpr double kOrientBoundA = (3.0 + 16.0 * kEps) * kEps;
+
 constexpr double kIncircleBoundA = (10.0 + 96.0 * kEps) * kEps;
 
 // a + b = x + y exactly, with x = fl(a + b).
@@ -2392,6 +2420,9 @@ STRATMESH_SMALL_NOINLINE inline int incircle_perturbed(const double* a, const do
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 double orient2d(const double a[2], const double b[2], const double c[2]) {
     return detail::orient2d_robust(a, b, c);
@@ -2402,12 +2433,9 @@ double incircle(const double a[2], const double b[2], const double c[2], const d
     return detail::incircle_robust(a, b, c, d, scratch);
 }
 
-namespace detail {
-
-}  // namespace detail
 }  // namespace stratmesh
 
-// >>spatial sort ============================================================================
+// >>spatial sort =========================================================================
 // The insertion order of the Delaunay triangulation.
 //
 // This work is based on:
@@ -2583,7 +2611,7 @@ inline bool spatial_order(const unsigned char* xy, size_t stride, size_t count,
 }  // namespace detail
 }  // namespace stratmesh
 
-// >>delaunay ================================================================================
+// >>delaunay =============================================================================
 // The incremental 2D Delaunay triangulation (delaunay_2d).
 //
 // This work is based on:
@@ -2606,6 +2634,7 @@ namespace detail {
 static const uint32_t kGhost = kNoIndex;
 
 inline uint32_t next_edge(uint32_t e) { return e % 3 == 2 ? e - 2 : e + 1; }
+
 inline uint32_t prev_edge(uint32_t e) { return e % 3 == 0 ? e + 2 : e - 1; }
 
 struct Triangulation {
@@ -2930,6 +2959,9 @@ inline bool plan_delaunay_2d(Delaunay2dMemory& m, size_t count, Arena& arena,
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 size_t delaunay_2d_workspace_size(size_t point_count) {
     if (point_count > detail::kMaxPoints) return 0;
@@ -2944,6 +2976,9 @@ size_t delaunay_2d_max_triangles(size_t point_count) {
     return point_count >= 3 ? 2 * point_count - 5 : 0;
 }
 
+}  // namespace stratmesh
+
+namespace stratmesh {
 namespace detail {
 
 // True if any two of the caller's buffers share a byte: checked before anything is
@@ -2964,6 +2999,9 @@ inline bool delaunay_buffers_overlap(const double* xy, size_t point_count, size_
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
                    void* workspace, size_t workspace_bytes,
@@ -3039,18 +3077,13 @@ Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
     return Status::ok;
 }
 
-namespace detail {
-
-}  // namespace detail
 }  // namespace stratmesh
 
-// >>layers ==================================================================================
-// The frame, the outliers, grouping by layer, automatic layers.
+// >>points ===============================================================================
+// The cloud's points as the library reads them, and the vector arithmetic on them.
 //
-// The cloud is read in place (float or double, any stride) and expressed in a frame whose
-// third axis is the stacking axis and whose origin is the centroid, so that clouds far
-// from the origin (georeferenced scans) keep their millimetres. Layers are height ranges
-// along the axis; the points are grouped by layer, in input order within a layer.
+// The cloud is read in place (float or double, any stride): CloudReader turns point i into
+// doubles and says whether it is valid (finite, and not left out as an outlier).
 
 namespace stratmesh {
 namespace detail {
@@ -3060,10 +3093,13 @@ struct Vec3 {
 };
 
 inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+
 inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
 inline Vec3 cross(Vec3 a, Vec3 b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
+
 inline Vec3 scaled(Vec3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
 
 struct CloudReader {
@@ -3093,6 +3129,44 @@ struct CloudReader {
     }
 };
 
+// False unless v's squared length is a normal double (v's length between about 1.5e-154
+// and 1.3e154): a subnormal square has lost the bits that make the result unit.
+inline double largest_of(Vec3 v) {
+    const double xy = v.x > v.y ? v.x : v.y;
+    return xy > v.z ? xy : v.z;
+}
+
+inline bool normalize(Vec3& v) {
+    const double square = dot(v, v);
+    if (!(square >= DBL_MIN) || !is_finite(square)) return false;
+    const double len = std::sqrt(square);
+    v = scaled(v, 1.0 / len);
+    return true;
+}
+
+// A direction of any finite non-zero length made unit: first scaled by the power of two
+// that brings its largest component into [1, 2) (exact: a component that falls below the
+// smallest subnormal is negligible beside it), so that its square neither overflows nor
+// underflows. False for zero, NaN or infinite components.
+inline bool unit_direction(Vec3& v) {
+    if (!is_finite(v.x) || !is_finite(v.y) || !is_finite(v.z)) return false;
+    const double largest = largest_of({abs_value(v.x), abs_value(v.y), abs_value(v.z)});
+    if (largest == 0) return false;
+    int exponent = 0;
+    std::frexp(largest, &exponent);
+    v = {std::ldexp(v.x, 1 - exponent), std::ldexp(v.y, 1 - exponent), std::ldexp(v.z, 1 - exponent)};
+    return normalize(v);
+}
+
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>outliers =============================================================================
+// Points far from the rest of the cloud, left out with drop_outliers.
+
+namespace stratmesh {
+namespace detail {
+
 // ---- outliers ----
 //
 // With drop_outliers, points far from the rest of the cloud (stray returns, flying pixels at
@@ -3120,14 +3194,23 @@ struct CloudReader {
 // block around it: d = 2.2 mm), none of the bust's own points (nor any of the real clouds'
 // or the test shapes'); about 0.1 s on 300,000 points, a third of the reconstruction.
 const uint32_t kOutlierNeighbours = 8;
+
 const double kOutlierReach = 4.0;
+
 const uint32_t kOutlierRounds = 3;
+
 const uint32_t kGridTries = 8;
+
 const uint32_t kCrowdedCell = 8;
+
 const uint32_t kNearestCandidates = 64;
+
 const size_t kDecileSample = 16384;
+
 const uint32_t kNearestBins = 64;  // half-octaves of the squared distance, the last: none
+
 const uint32_t kCellBits = 21;     // per axis, so a cell key takes 63 bits
+
 const uint64_t kCellTop = (uint64_t{1} << kCellBits) - 1;
 
 struct GridItem {
@@ -3436,6 +3519,195 @@ inline size_t drop_outliers_of(CloudReader& reader, size_t count, unsigned char*
     return total;
 }
 
+// The drop_outliers step: the bitmap stays in `arena` for the whole call (reader.dropped),
+// the grid's scratch is given back. False if the workspace is too small.
+inline bool find_outliers(CloudReader& reader, size_t count, Arena& arena, Report& rep) {
+    unsigned char* dropped = arena.alloc<unsigned char>(count / 8 + 1);
+    const size_t mark = arena.mark();
+    CellScratch g = allocate_cell_scratch(arena, count);
+    if (arena.failed) return false;
+    std::memset(dropped, 0, count / 8 + 1);
+    rep.points.outlier_count = drop_outliers_of(reader, count, dropped, g);
+    rep.points.rejected_count += rep.points.outlier_count;
+    arena.rewind(mark);
+    return true;
+}
+
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>cloud ================================================================================
+// Reading the cloud: invalid points refused or counted, outliers left out, sums.
+
+namespace stratmesh {
+namespace detail {
+
+// What one pass over the cloud learns, for reject_invalid_points and choose_frame: how many
+// points are valid, how many distinct positions they take (counted up to 3), and their sums
+// and extremes. Coordinates near the top of the double range overflow the sum: then the
+// sum of the points scaled down by 2^-40 (exactly), which leaves room for 2^32 points, is
+// used.
+struct CloudSums {
+    size_t valid;
+    uint32_t distinct;
+    double total[3], small_total[3], lowest[3], highest[3];
+};
+
+// Counts the distinct positions among points given one by one, up to 3 (two are kept: the
+// third ends the count).
+struct DistinctPoints {
+    uint32_t count;
+    Vec3 seen[2];
+    void add(Vec3 p) {
+        if (count >= 3) return;
+        for (uint32_t k = 0; k < count; ++k)
+            if (p.x == seen[k].x && p.y == seen[k].y && p.z == seen[k].z) return;
+        if (count < 2) seen[count] = p;
+        ++count;
+    }
+};
+
+inline CloudSums sum_cloud(const CloudReader& cloud, size_t count) {
+    CloudSums s = {0, 0, {0, 0, 0}, {0, 0, 0}, {DBL_MAX, DBL_MAX, DBL_MAX},
+                   {-DBL_MAX, -DBL_MAX, -DBL_MAX}};
+    DistinctPoints distinct = {0, {}};
+    for (size_t i = 0; i < count; ++i) {
+        if (!cloud.valid(i)) continue;
+        const Vec3 p = cloud.point(i);
+        distinct.add(p);
+        const double c[3] = {p.x, p.y, p.z};
+        for (int k = 0; k < 3; ++k) {
+            s.total[k] += c[k];
+            s.small_total[k] += c[k] * 0x1p-40;
+            if (c[k] < s.lowest[k]) s.lowest[k] = c[k];
+            if (c[k] > s.highest[k]) s.highest[k] = c[k];
+        }
+        ++s.valid;
+    }
+    s.distinct = distinct.count;
+    return s;
+}
+
+// The bytes the cloud's coordinates lie in.
+inline ByteRange cloud_bytes(const Cloud& cloud) {
+    const size_t point_bytes = 3 * (cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double));
+    return strided_range(cloud.xyz, cloud.count, cloud.stride_bytes ? cloud.stride_bytes : point_bytes,
+                         point_bytes);
+}
+
+// True if any two of the caller's buffers share a byte (the report and its layer array
+// included): checked before anything is written. A count beyond the limit is refused as
+// too_many_points instead.
+inline bool reconstruct_buffers_overlap(const Cloud& cloud, void* workspace,
+                                        size_t workspace_bytes, uint32_t* triangles,
+                                        size_t triangle_capacity, size_t* triangle_count,
+                                        const Report* report) {
+    if (cloud.count > kMaxPoints - 1) return false;
+    const ByteRange buffers[] = {
+        cloud_bytes(cloud),
+        byte_range(workspace, workspace_bytes),
+        byte_range(triangles, saturating_product(triangle_capacity, 3 * sizeof(uint32_t))),
+        byte_range(triangle_count, sizeof(size_t)),
+        byte_range(report, sizeof(Report)),
+        byte_range(report ? report->layers.info : nullptr,
+                   report ? saturating_product(report->layers.info_capacity, sizeof(LayerInfo)) : 0),
+        byte_range(kFindParts && report ? report->parts.info : nullptr,
+                   kFindParts && report ? saturating_product(report->parts.info_capacity, sizeof(PartInfo)) : 0)};
+    return any_overlap(buffers, 7);
+}
+
+inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangles,
+                                          size_t triangle_capacity, size_t* triangle_count,
+                                          void* workspace, Report& rep) {
+    rep.detail = "an argument is invalid: a null pointer with a non-zero count, a stride "
+                 "smaller than one point, an unknown scalar type or a null triangle_count";
+    if (!triangle_count) return Status::invalid_argument;
+    if (cloud.count > kMaxPoints - 1) {
+        rep.detail = "more points than 32-bit triangle indices can address";
+        return Status::too_many_points;
+    }
+    size_t scalar = cloud.scalar == Scalar::float32 ? sizeof(float)
+                  : cloud.scalar == Scalar::float64 ? sizeof(double) : 0;
+    if (scalar == 0) return Status::invalid_argument;
+    if (cloud.stride_bytes != 0 && cloud.stride_bytes < 3 * scalar)
+        return Status::invalid_argument;
+    if (cloud.count > 0 && (!cloud.xyz || !workspace)) return Status::invalid_argument;
+    if (triangle_capacity > 0 && !triangles) return Status::invalid_argument;
+    rep.detail = nullptr;
+    return Status::ok;
+}
+
+// Reads a cloud that passed check_reconstruct_arguments.
+inline CloudReader reader_of(const Cloud& cloud) {
+    size_t scalar = cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double);
+    return {static_cast<const unsigned char*>(cloud.xyz),
+            cloud.stride_bytes ? cloud.stride_bytes : 3 * scalar, cloud.scalar == Scalar::float32, nullptr};
+}
+
+const char* const kInvalidPointDetail =
+    "a point has a NaN or infinite coordinate (see first_invalid_index; the "
+    "skip_invalid_points flag skips such points instead)";
+
+// Where a cloud of `count` points (`sums` is its sum_cloud) is refused with invalid_point:
+// at its first point with a NaN or infinite coordinate, unless the skip_invalid_points flag
+// is given. `count` if it is not refused.
+inline size_t refused_at(const CloudReader& reader, size_t count, const CloudSums& sums,
+                         const Options& options) {
+    if (sums.valid == count || (options.flags & skip_invalid_points)) return count;
+    size_t first = 0;
+    while (reader.valid(first)) ++first;
+    return first;
+}
+
+// Counts the points with a NaN or infinite coordinate in rep.points.rejected_count, or refuses the
+// cloud (see refused_at).
+inline Status reject_invalid_points(const CloudReader& reader, size_t count,
+                                    const CloudSums& sums, const Options& options, Report& rep) {
+    const size_t first = refused_at(reader, count, sums, options);
+    if (first < count) {
+        rep.points.first_invalid_index = first;
+        rep.points.rejected_count = count;
+        rep.detail = kInvalidPointDetail;
+        return Status::invalid_point;
+    }
+    rep.points.rejected_count += count - sums.valid;
+    return Status::ok;
+}
+
+// A cloud as a tube reads it: in place, the points left out (outliers, or the points of
+// other parts) marked in the reader's optional bitmap, and the sums of the points kept.
+struct TubeInput {
+    CloudReader reader;
+    size_t count;
+    CloudSums sums;
+    uint32_t cut_ends;  // ends that are cuts, never closed (Frame::cut_ends), besides open_ends
+};
+
+// Whether this build holds every feature the flags ask for (STRATMESH_SMALL_CODE leaves
+// some out).
+inline bool flags_compiled(const Options& options) {
+    const uint32_t f = options.flags;
+    return (kDropOutliers || !(f & drop_outliers)) && (kSurfaceFlips || !(f & surface_flips)) &&
+           (kClosedEnds || !(f & open_ends));
+}
+
+const char* const kNotCompiledDetail =
+    "the options ask for a feature this build leaves out (STRATMESH_SMALL_CODE)";
+
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>frame ================================================================================
+// The frame the layers are cut in: its axis, origin and scale.
+//
+// The cloud is read in place (float or double, any stride) and expressed in a frame whose
+// third axis is the stacking axis and whose origin is the centroid, so that clouds far
+// from the origin (georeferenced scans) keep their millimetres. Layers are height ranges
+// along the axis; the points are grouped by layer, in input order within a layer.
+
+namespace stratmesh {
+namespace detail {
+
 // Coordinates in the reconstruction frame: (x, y) across the axis, h along it.
 struct Local {
     double x, y, h;
@@ -3487,35 +3759,6 @@ inline double scale_for_extent(double extent) {
     return std::ldexp(1.0, -exponent);
 }
 
-// False unless v's squared length is a normal double (v's length between about 1.5e-154
-// and 1.3e154): a subnormal square has lost the bits that make the result unit.
-inline double largest_of(Vec3 v) {
-    const double xy = v.x > v.y ? v.x : v.y;
-    return xy > v.z ? xy : v.z;
-}
-
-inline bool normalize(Vec3& v) {
-    const double square = dot(v, v);
-    if (!(square >= DBL_MIN) || !is_finite(square)) return false;
-    const double len = std::sqrt(square);
-    v = scaled(v, 1.0 / len);
-    return true;
-}
-
-// A direction of any finite non-zero length made unit: first scaled by the power of two
-// that brings its largest component into [1, 2) (exact: a component that falls below the
-// smallest subnormal is negligible beside it), so that its square neither overflows nor
-// underflows. False for zero, NaN or infinite components.
-inline bool unit_direction(Vec3& v) {
-    if (!is_finite(v.x) || !is_finite(v.y) || !is_finite(v.z)) return false;
-    const double largest = largest_of({abs_value(v.x), abs_value(v.y), abs_value(v.z)});
-    if (largest == 0) return false;
-    int exponent = 0;
-    std::frexp(largest, &exponent);
-    v = {std::ldexp(v.x, 1 - exponent), std::ldexp(v.y, 1 - exponent), std::ldexp(v.z, 1 - exponent)};
-    return normalize(v);
-}
-
 // The principal direction of a symmetric 3x3 matrix by power iteration from its largest
 // column; a fixed number of steps keeps the cost bounded and the result deterministic.
 inline Vec3 principal_direction(const double m[3][3]) {
@@ -3537,52 +3780,6 @@ inline Vec3 principal_direction(const double m[3][3]) {
     if (abs_value(v.y) > abs_value(big)) big = v.y;
     if (abs_value(v.z) > abs_value(big)) big = v.z;
     return big < 0 ? scaled(v, -1.0) : v;
-}
-
-// What one pass over the cloud learns, for reject_invalid_points and choose_frame: how many
-// points are valid, how many distinct positions they take (counted up to 3), and their sums
-// and extremes. Coordinates near the top of the double range overflow the sum: then the
-// sum of the points scaled down by 2^-40 (exactly), which leaves room for 2^32 points, is
-// used.
-struct CloudSums {
-    size_t valid;
-    uint32_t distinct;
-    double total[3], small_total[3], lowest[3], highest[3];
-};
-
-// Counts the distinct positions among points given one by one, up to 3 (two are kept: the
-// third ends the count).
-struct DistinctPoints {
-    uint32_t count;
-    Vec3 seen[2];
-    void add(Vec3 p) {
-        if (count >= 3) return;
-        for (uint32_t k = 0; k < count; ++k)
-            if (p.x == seen[k].x && p.y == seen[k].y && p.z == seen[k].z) return;
-        if (count < 2) seen[count] = p;
-        ++count;
-    }
-};
-
-inline CloudSums sum_cloud(const CloudReader& cloud, size_t count) {
-    CloudSums s = {0, 0, {0, 0, 0}, {0, 0, 0}, {DBL_MAX, DBL_MAX, DBL_MAX},
-                   {-DBL_MAX, -DBL_MAX, -DBL_MAX}};
-    DistinctPoints distinct = {0, {}};
-    for (size_t i = 0; i < count; ++i) {
-        if (!cloud.valid(i)) continue;
-        const Vec3 p = cloud.point(i);
-        distinct.add(p);
-        const double c[3] = {p.x, p.y, p.z};
-        for (int k = 0; k < 3; ++k) {
-            s.total[k] += c[k];
-            s.small_total[k] += c[k] * 0x1p-40;
-            if (c[k] < s.lowest[k]) s.lowest[k] = c[k];
-            if (c[k] > s.highest[k]) s.highest[k] = c[k];
-        }
-        ++s.valid;
-    }
-    s.distinct = distinct.count;
-    return s;
 }
 
 // The frame of the points summed in `sums`: centroid origin, axis from the options (an
@@ -3682,6 +3879,99 @@ inline Status choose_frame(const CloudSums& sums, const Options& options, Frame&
     return Status::ok;
 }
 
+// The lowest and highest frame height of the valid points.
+inline void height_range(const CloudReader& cloud, size_t count, const Frame& frame, double* lo,
+                         double* hi) {
+    for (size_t i = 0; i < count; ++i) {
+        if (!cloud.valid(i)) continue;
+        const double h = frame.height(cloud.point(i));
+        if (h < *lo) *lo = h;
+        if (h > *hi) *hi = h;
+    }
+}
+
+// height_range without a pass over the cloud, where the axis is a coordinate axis (and
+// the frame not halved): a height is then (p_k - origin_k) * scale plus zeros, exactly
+// that value, and rounding keeps the order, so the lowest and highest coordinates along
+// the axis give the same two heights, bit for bit. False otherwise.
+inline bool height_range_from_extremes(const Frame& frame, double* lo, double* hi) {
+    const double axis[3] = {frame.axis.x, frame.axis.y, frame.axis.z};
+    const double low[3] = {frame.low.x, frame.low.y, frame.low.z};
+    const double high[3] = {frame.high.x, frame.high.y, frame.high.z};
+    const double origin[3] = {frame.origin.x, frame.origin.y, frame.origin.z};
+    for (int k = 0; k < 3; ++k) {
+        if (frame.halved || axis[k] != 1 || axis[(k + 1) % 3] != 0 || axis[(k + 2) % 3] != 0)
+            continue;
+        *lo = (low[k] - origin[k]) * frame.scale;
+        *hi = (high[k] - origin[k]) * frame.scale;
+        return true;
+    }
+    return false;
+}
+
+STRATMESH_SMALL_NOINLINE inline void report_frame(const Frame& frame, Report& rep) {
+    rep.axis[0] = frame.axis.x;
+    rep.axis[1] = frame.axis.y;
+    rep.axis[2] = frame.axis.z;
+    rep.axis_origin[0] = frame.origin.x;
+    rep.axis_origin[1] = frame.origin.y;
+    rep.axis_origin[2] = frame.origin.z;
+}
+
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>jobs =================================================================================
+// The caller's callbacks: progress, and passes split into jobs for the runner.
+
+namespace stratmesh {
+namespace detail {
+
+inline void notify(const Options& options, Phase phase, double fraction) {
+    if (options.progress) options.progress(options.progress_user, phase, fraction);
+}
+
+// ---- passes over all points as jobs ----
+//
+// With Options::run_jobs, a pass over all points that gives the same bits in any order
+// (grouping the points by layer) is cut into kPassRuns runs of consecutive points, run as
+// jobs. As for the layers' jobs (see JobRunner), a run the runner skips is done in order
+// afterwards, and a run done again changes nothing.
+const uint32_t kPassRuns = 16;
+
+// The first point of run k of `count` points.
+inline size_t run_start(size_t count, uint32_t k) {
+    return static_cast<size_t>(static_cast<uint64_t>(count) * k / kPassRuns);
+}
+
+template <class Pass> struct PassJobs {
+    Pass* pass;
+    bool done[kPassRuns];
+};
+
+template <class Pass> inline void run_pass_job(void* context, uint32_t index) {
+    PassJobs<Pass>& jobs = *static_cast<PassJobs<Pass>*>(context);
+    if (index >= kPassRuns) return;  // a runner's mistake: no run of ours
+    jobs.pass->run(index);
+    jobs.done[index] = true;
+}
+
+template <class Pass> inline void run_pass(const Options& options, Pass& pass) {
+    PassJobs<Pass> jobs = {&pass, {}};
+    options.run_jobs(options.jobs_user, kPassRuns, run_pass_job<Pass>, &jobs);
+    for (uint32_t k = 0; k < kPassRuns; ++k)
+        if (!jobs.done[k]) pass.run(k);
+}
+
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>layer plan ===========================================================================
+// Cuts along the axis: explicit, equal, by height or automatic; points grouped by layer.
+
+namespace stratmesh {
+namespace detail {
+
 // Layer boundaries: bounds[0] = lowest height, bounds[count] = highest, layer i holds the
 // heights in [bounds[i] - tolerance, bounds[i+1] - tolerance) (the last layer includes its
 // top). The tolerance (2^-40 of the height range) puts a point that lies on a cut up to
@@ -3697,12 +3987,15 @@ struct LayerPlan {
 const double kCutTolerance = 0x1p-40;
 
 const size_t kMaxAutomaticLayers = 256;
+
 // Heights are divided by at least layer height / kMaxTurns when unrolled, so exp() stays
 // far from overflow and the annulus from extreme ratios in very tall, thin layers; a layer
 // up to kMaxTurns radii tall unrolls undistorted (see >>unroll).
 const double kMaxTurns = 24.0;
+
 // A layer with fewer points is merged with the next one (the last layer only needs 3).
 const size_t kMinLayerPoints = 16;
+
 // A layer also needs about one and a half rows of points: thinner ones make bands of a few
 // points that fold and cross. With n points over height h around radius r (the layer's
 // own), the spacing is about sqrt(2 pi r h / n), so the rows number sqrt(h n / (2 pi r)).
@@ -3810,10 +4103,15 @@ inline void plan_layers(const Options& options, double lo, double hi, size_t poi
 // the points plus O(bins^2) on the profile, deterministic.
 
 const uint32_t kProfileSectors = 8;
+
 const double kCentreDrift = 0.75;
+
 const size_t kLayerPointsShare = 8;
+
 const size_t kFewestLayerPoints = size_t{1} << 16;
+
 const size_t kPointsPerProfileBin = 256;
+
 const double kDensityWeight = 0.5;
 
 struct ProfileBin {
@@ -4003,10 +4301,104 @@ inline uint32_t layer_of(const LayerPlan& plan, double h, double per_height) {
     return lo;
 }
 
+// Groups the valid points by layer (input order within a layer): a counting sort, with each
+// point's layer kept in `layer` (count entries of scratch) between its two passes. With
+// `staged` (optional, as many entries as valid points), the points in frame coordinates
+// go there in the same order.
+inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& frame,
+                           const LayerPlan& plan, uint32_t* layer, Local* staged,
+                           uint32_t* layer_start, uint32_t* order) {
+    std::memset(layer_start, 0, sizeof(uint32_t) * (plan.count + 2));
+    const double per_height =
+        kFastLoops ? plan.count / (plan.bounds[plan.count] - plan.bounds[0]) : 0;
+    for (size_t i = 0; i < count; ++i) {
+        layer[i] = cloud.valid(i) ? layer_of(plan, frame.height(cloud.point(i)), per_height)
+                                  : kNoIndex;
+        if (layer[i] != kNoIndex) ++layer_start[layer[i] + 2];
+    }
+    for (uint32_t k = 0; k < plan.count; ++k) layer_start[k + 2] += layer_start[k + 1];
+    for (size_t i = 0; i < count; ++i) {
+        if (layer[i] == kNoIndex) continue;
+        const uint32_t position = layer_start[layer[i] + 1]++;
+        order[position] = static_cast<uint32_t>(i);
+        if (staged) staged[position] = frame.local(cloud.point(i));
+    }
+}
+
+// group_by_layer's counting sort, run by run: first each point's layer and each run's count
+// per layer, then (once `first` holds each run's first position per layer) the scatter. The
+// positions come out as in group_by_layer.
+struct GroupingPass {
+    const CloudReader* cloud;
+    const Frame* frame;
+    const LayerPlan* plan;
+    double per_height;
+    size_t count;
+    uint32_t* layer;
+    uint32_t* order;
+    uint32_t* counts;    // per run, per layer: its points there
+    uint32_t* first;     // per run, per layer: its first position there
+    uint32_t* next;      // per run, per layer: the scatter's next position
+    bool scatter;
+
+    void run(uint32_t k) {
+        const size_t layers = plan->count, begin = run_start(count, k), end = run_start(count, k + 1);
+        if (!scatter) {
+            uint32_t* c = counts + k * layers;
+            std::memset(c, 0, layers * sizeof(uint32_t));
+            for (size_t i = begin; i < end; ++i) {
+                layer[i] = cloud->valid(i) ? layer_of(*plan, frame->height(cloud->point(i)), per_height)
+                                           : kNoIndex;
+                if (layer[i] != kNoIndex) ++c[layer[i]];
+            }
+            return;
+        }
+        uint32_t* n = next + k * layers;
+        std::memcpy(n, first + k * layers, layers * sizeof(uint32_t));
+        for (size_t i = begin; i < end; ++i)
+            if (layer[i] != kNoIndex) order[n[layer[i]]++] = static_cast<uint32_t>(i);
+    }
+};
+
+// group_by_layer without staging, as jobs; false (nothing done) where its three tables of a
+// count per run and layer would take more than one count per point, or do not fit.
+inline bool group_by_layer_in_jobs(const Options& options, const CloudReader& cloud,
+                                   size_t count, const Frame& frame, const LayerPlan& plan,
+                                   uint32_t* layer, uint32_t* layer_start, uint32_t* order,
+                                   Arena& arena) {
+    const size_t table = kPassRuns * static_cast<size_t>(plan.count);
+    if (!kParallelLayers || !options.run_jobs || 3 * table > count) return false;
+    const size_t mark = arena.mark();
+    GroupingPass pass = {&cloud, &frame, &plan, 0, count, layer, order,
+                         arena.alloc<uint32_t>(table), arena.alloc<uint32_t>(table),
+                         arena.alloc<uint32_t>(table), false};
+    if (arena.failed) {
+        arena.failed = false;
+        arena.rewind(mark);
+        return false;
+    }
+    pass.per_height = kFastLoops ? plan.count / (plan.bounds[plan.count] - plan.bounds[0]) : 0;
+    run_pass(options, pass);
+    // Layer by layer, run by run: the positions of a counting sort in input order.
+    uint32_t position = 0;
+    for (uint32_t l = 0; l < plan.count; ++l) {
+        layer_start[l] = position;
+        for (uint32_t k = 0; k < kPassRuns; ++k) {
+            pass.first[k * plan.count + l] = position;
+            position += pass.counts[k * plan.count + l];
+        }
+    }
+    layer_start[plan.count] = position;
+    pass.scatter = true;
+    run_pass(options, pass);
+    arena.rewind(mark);
+    return true;
+}
+
 }  // namespace detail
 }  // namespace stratmesh
 
-// >>unroll ==================================================================================
+// >>unroll ===============================================================================
 // A layer onto its annulus (cylinder and closed ends).
 //
 // Each layer is projected on a cylinder around its own centre, unrolled to (u, v) =
@@ -4361,8 +4753,8 @@ struct TriangleSink {
 }  // namespace detail
 }  // namespace stratmesh
 
-// >>layer triangulation =====================================================================
-// One layer: its triangulation, closed ends, the centre search, flips on the surface.
+// >>layer ================================================================================
+// One layer loaded on its annulus: its loops and their peeling, closed ends, the centre search.
 
 namespace stratmesh {
 namespace detail {
@@ -4408,13 +4800,19 @@ struct LayerDuplicates {
 
 // Per vertex of a layer's triangulation, in triangulate_layer (the flip stack's room).
 const uint32_t kOnBottomLoop = 1, kEmitted = 2, kOnTopLoop = 4;
+
 const uint32_t kFlippedBefore = 8, kFlippedNow = 16;  // see flip_layer_on_surface
+
 const uint32_t kPassShift = 8;  // above it: the peeling pass that put a vertex on its loop
+
 const uint32_t kPassBit = 3;    // where LayerLoops::bottom_flags and top_flags keep that pass
+
 const unsigned char kPassBits = static_cast<unsigned char>(0xF << kPassBit);
+
 // The last pass those 4 bits hold. Only an end loop of a layer that folds peels further,
 // and no band puts its peeled triangles back: its later passes are kept as this one.
 const uint32_t kLastPass = 0xF;
+
 const unsigned char kUnpeeled = 0x80;  // in those flags: the band puts the peeled triangle back
 
 // Collects the link of the centre (vertex 0) counter-clockwise into loop, one entry per link
@@ -4493,13 +4891,18 @@ inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* count, 
 // (put_back_peeled), and if it still folds, between the loops as they were, with all the
 // triangles peeled off both put back: the seam as without peeling.
 const uint32_t kPeelPasses = 8;
+
 // Stitches of a band (see add_group): the first between the peeled loops; where it folds,
 // with kLocalUnpeel, up to two more with the peel groups around the folds put back, then
 // one with all; without kLocalUnpeel, one with all.
 const uint32_t kUnpeelRounds = kLocalUnpeel ? 4 : 2;
+
 const double kPeelSlope = 1.0;
+
 const double kInnerPeelSlope = 2.0;
+
 const uint32_t kFoldedEndPeelPasses = 64;
+
 const double kFoldedEndPeelSlope = 1e6;
 
 // Whether the triangle of loop entry g (see centre_link and hull_loop) is peeled.
@@ -4644,7 +5047,9 @@ inline uint32_t layer_sectors(const LoadedLayer& layer) {
 // alone left the femur's top open (a flat cut, few points across), and without the
 // octants' rule a bent tube's open ends, which pass beside the axis, were taken for closed.
 const double kPoleDepth = 1.0;
+
 const double kEndSlab = 0.5;
+
 const double kAcrossEnd = 0.5;
 
 inline void find_closed_ends(LoadedLayer& layer, uint32_t ends) {
@@ -4746,7 +5151,9 @@ inline void find_closed_ends(LoadedLayer& layer, uint32_t ends) {
 // gives scans no fewer self-intersections.
 
 const size_t kCentreSamplePoints = 1024;
+
 const int32_t kCentreRings = 2;  // the candidates: a 5 x 5 grid around the fitted centre
+
 const double kCentreStep = 0.3;
 
 // The folds of the sample points[0], points[stride], ... (count of them) rolled around
@@ -4809,448 +5216,10 @@ inline void choose_centre(LoadedLayer& layer, Arena& arena) {
             }
 }
 
-// ---- flips on the surface ----
-//
-// With the surface_flips flag. The unrolling squeezes whatever lies almost across the axis:
-// the underside of an ear, the crease where it meets the head, a chin. There the annulus's
-// Delaunay triangles, good in the plane, are long and thin on the surface and run across
-// the crease: on a synthetic bust with ears (bench/horned_bust.py --no-horns) the ears had
-// 14% of the area and 57% of the distance to the true surface, 2.7 times the distance of
-// CGAL's advancing front there, as close as it elsewhere. So once a layer is triangulated
-// and its loops are settled, its surface edges are flipped on the surface itself, by two
-// rules. An edge ab between triangles abp and baq is flipped to pq
-//  - by the empty-circle rule, where the angles at p and q, measured in 3D, sum to more
-//    than 180 degrees (in a plane: q inside the circle through a, b, p), unless pq bends
-//    the surface more than kBendVeto times what ab did;
-//  - for the bend alone, where pq bends it kBendGain times less than ab.
-// The bend of an edge ab is |(b - a) . (n_b - n_a)| with n the vertex normals (the mean of
-// the unit normals of the triangles around): 8 times the sag at the middle of a curve
-// through a and b normal to n_a and n_b. An edge along the direction in which the surface
-// curves least bends least, and triangles along it lie nearest the surface: on a cone,
-// along its generatrices. The empty-circle rule alone, which wants fat triangles, turned
-// the annulus's triangles across that direction on smooth surfaces of revolution (one
-// layer, mean distance to the analytic surface: vase 13% and cone 27% farther than
-// without flips); with both rules the vase is 3% and the cone 47% closer, the bumpy tube
-// 44% (10% with the empty-circle rule alone), the bust with ears 25% (18%). Since
-// kBendVeto <= kBendGain, the two rules never flip one quad back and forth with the same
-// normals; the normals are estimated anew at the start of each of the first
-// kNormalSweeps sweeps and then kept, so that the flips settle (the clouds measured: at
-// most 2 flips in the last sweep).
-// A flip is kept only if neither new triangle faces the axis (no new fold) nor is
-// degenerate, the new triangles' widest angle is at most 150 degrees (kWidestAngle) or
-// less wide than the old ones' (the bend alone makes needles: without that limit 17% of
-// the bust's triangles had an angle under 5 degrees, with it 2%, as without flips), pq is
-// not already an edge nor a chord of a loop (where close_ends puts its cap), and, unless
-// both new normals are within 26 degrees of the old pair's (kGentleFlip: the new
-// triangles cover about the same place as the old), neither new triangle meets a surface
-// triangle around the quad's corners (the test is in floating point, on triangles shrunk
-// by a millionth about their centroids, so that shared corners and edges do not count;
-// testing the triangles around the corners' neighbours too changed nothing on the
-// synthetic bust). Loop edges are never flipped, so the loops, the bands and the peeled
-// triangles that add_group may put back are the same as without the flips (the band and
-// the triangles at its loops are flipped later, see "flips across the seam"). The first
-// sweep visits every edge; later sweeps only the triangles the sweep before changed. The
-// sweeps are bounded (kSurfaceFlipSweeps).
-const uint32_t kSurfaceFlipSweeps = 8;
-const uint32_t kNormalSweeps = 4;  // the sweeps that start with the normals estimated anew
-const uint32_t kFanLimit = 64;  // a vertex with more neighbours keeps its edges
-const double kFlipMargin = 1e-9;
-const double kGentleFlip = 0.9;  // cosine of the largest angle between a new and the mean normal
-const double kShrink = 1e-6;
-const double kBendVeto = 3;  // a flip by the empty-circle rule may bend at most 3 times more
-const double kBendGain = 3;  // a flip for the bend alone must bend 3 times less
-const double kWidestAngle = -0.86602540378443865;  // cosine of 150 degrees
-
-inline Vec3 vec_of(const Local& p) { return Vec3{p.x, p.y, p.h}; }
-
-struct Box3 {
-    Vec3 low, high;
-    bool meets(const Box3& o) const {
-        return low.x <= o.high.x && o.low.x <= high.x && low.y <= o.high.y &&
-               o.low.y <= high.y && low.z <= o.high.z && o.low.z <= high.z;
-    }
-};
-
-inline Box3 box_of(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
-    Box3 box = {a, a};
-    const Vec3 rest[3] = {b, c, d};
-    for (const Vec3& p : rest) {
-        box.low = Vec3{p.x < box.low.x ? p.x : box.low.x, p.y < box.low.y ? p.y : box.low.y,
-                       p.z < box.low.z ? p.z : box.low.z};
-        box.high = Vec3{p.x > box.high.x ? p.x : box.high.x, p.y > box.high.y ? p.y : box.high.y,
-                        p.z > box.high.z ? p.z : box.high.z};
-    }
-    return box;
-}
-
-// Whether the angles at p and q facing the segment ab sum to more than 180 degrees: then
-// sin(angle_p + angle_q), a sum of sine-cosine products, is negative. Two acute angles
-// (most edges) are settled by two dot products.
-inline bool flip_helps(Vec3 a, Vec3 b, Vec3 p, Vec3 q) {
-    const Vec3 pa = a - p, pb = b - p, qa = a - q, qb = b - q;
-    const double cos_p = dot(pa, pb), cos_q = dot(qa, qb);
-    if (cos_p >= 0 && cos_q >= 0) return false;
-    const Vec3 np = cross(pa, pb), nq = cross(qa, qb);
-    const double sin_p = std::sqrt(dot(np, np)), sin_q = std::sqrt(dot(nq, nq));
-    const double lengths = std::sqrt(dot(pa, pa) * dot(pb, pb) * dot(qa, qa) * dot(qb, qb));
-    return sin_p * cos_q + cos_p * sin_q < -kFlipMargin * lengths;
-}
-
-// Whether triangles u and v, each shrunk by kShrink about its centroid, overlap along every
-// axis that could separate them: their normals, the cross products of their edges, and
-// each normal crossed with the triangle's own edges (for coplanar triangles).
-inline bool triangles_meet(const Vec3* u, const Vec3* v) {
-    Vec3 s[3], t[3];
-    const Vec3 cu = scaled(Vec3{u[0].x + u[1].x + u[2].x, u[0].y + u[1].y + u[2].y,
-                                u[0].z + u[1].z + u[2].z}, 1.0 / 3);
-    const Vec3 cv = scaled(Vec3{v[0].x + v[1].x + v[2].x, v[0].y + v[1].y + v[2].y,
-                                v[0].z + v[1].z + v[2].z}, 1.0 / 3);
-    for (int k = 0; k < 3; ++k) {
-        const Vec3 du = u[k] - cu, dv = v[k] - cv;
-        s[k] = Vec3{cu.x + du.x * (1 - kShrink), cu.y + du.y * (1 - kShrink),
-                    cu.z + du.z * (1 - kShrink)};
-        t[k] = Vec3{cv.x + dv.x * (1 - kShrink), cv.y + dv.y * (1 - kShrink),
-                    cv.z + dv.z * (1 - kShrink)};
-    }
-    Vec3 es[3], et[3];
-    for (int k = 0; k < 3; ++k) {
-        es[k] = s[(k + 1) % 3] - s[k];
-        et[k] = t[(k + 1) % 3] - t[k];
-    }
-    const Vec3 ns = cross(es[0], es[1]), nt = cross(et[0], et[1]);
-    auto separates = [&s, &t](Vec3 axis) {
-        double s_lo = dot(s[0], axis), s_hi = s_lo, t_lo = dot(t[0], axis), t_hi = t_lo;
-        for (int k = 1; k < 3; ++k) {
-            const double ds = dot(s[k], axis), dt = dot(t[k], axis);
-            s_lo = ds < s_lo ? ds : s_lo;
-            s_hi = ds > s_hi ? ds : s_hi;
-            t_lo = dt < t_lo ? dt : t_lo;
-            t_hi = dt > t_hi ? dt : t_hi;
-        }
-        return s_hi < t_lo || t_hi < s_lo;
-    };
-    if (separates(ns) || separates(nt)) return false;
-    for (int i = 0; i < 3; ++i) {
-        if (separates(cross(ns, es[i])) || separates(cross(nt, et[i]))) return false;
-        for (int j = 0; j < 3; ++j)
-            if (separates(cross(es[i], et[j]))) return false;
-    }
-    return true;
-}
-
-// Calls visit(g) for each half-edge g leaving the start of half-edge `from`, counter-clockwise
-// around it, until visit returns false. False if a visit did, or the vertex has more than
-// kFanLimit neighbours.
-template <class Visit>
-inline bool around_vertex(const Triangulation& tr, uint32_t from, Visit visit) {
-    uint32_t e = from;
-    for (uint32_t steps = 0; steps < kFanLimit; ++steps) {
-        if (!visit(e)) return false;
-        e = tr.twin[prev_edge(e)];
-        if (e == from) return true;
-    }
-    return false;
-}
-
-// The vertex normals, kept in the room of the annulus coordinates (two doubles a vertex,
-// free once the loops are settled) as three floats, copied in and out so that no type is
-// read through another: the sum of the unit normals of the surface triangles around the
-// vertex, made unit.
-struct VertexNormals {
-    double* room;
-    // The unit normal at vertex v; zero if it has no surface triangle of nonzero area.
-    Vec3 at(uint32_t v) const {
-        float n[3];
-        std::memcpy(n, room + 2 * static_cast<size_t>(v), sizeof n);
-        return Vec3{static_cast<double>(n[0]), static_cast<double>(n[1]),
-                    static_cast<double>(n[2])};
-    }
-    void estimate(const Triangulation& tr, const Local* points, size_t vertices) {
-        std::memset(room, 0, 2 * vertices * sizeof(double));
-        for (uint32_t t = 0; t < tr.triangle_count; ++t) {
-            if (!on_surface(tr, t)) continue;
-            const uint32_t* v = tr.vertex + 3 * t;
-            Vec3 n = normal_of(points[v[0] - 1], points[v[1] - 1], points[v[2] - 1]);
-            const double length = std::sqrt(dot(n, n));
-            if (length == 0) continue;
-            n = scaled(n, 1 / length);
-            for (uint32_t k = 0; k < 3; ++k) {
-                float sum[3];
-                std::memcpy(sum, room + 2 * static_cast<size_t>(v[k]), sizeof sum);
-                sum[0] += static_cast<float>(n.x);
-                sum[1] += static_cast<float>(n.y);
-                sum[2] += static_cast<float>(n.z);
-                std::memcpy(room + 2 * static_cast<size_t>(v[k]), sum, sizeof sum);
-            }
-        }
-        for (size_t v = 0; v < vertices; ++v) {
-            const Vec3 sum = at(static_cast<uint32_t>(v));
-            const double length = std::sqrt(dot(sum, sum));
-            if (length == 0) continue;
-            const float unit[3] = {static_cast<float>(sum.x / length),
-                                   static_cast<float>(sum.y / length),
-                                   static_cast<float>(sum.z / length)};
-            std::memcpy(room + 2 * v, unit, sizeof unit);
-        }
-    }
-};
-
-// How much the surface bends along edge ab, with unit normals na and nb at its ends (see
-// above).
-inline double bend_along(Vec3 a, Vec3 b, Vec3 na, Vec3 nb) {
-    return std::fabs(dot(b - a, nb - na));
-}
-
-// The cosine of the widest angle of triangle abc.
-inline double widest_angle_cosine(Vec3 a, Vec3 b, Vec3 c) {
-    const Vec3 corner[3] = {a, b, c};
-    double widest = 1;
-    for (int k = 0; k < 3; ++k) {
-        const Vec3 u = corner[(k + 1) % 3] - corner[k], v = corner[(k + 2) % 3] - corner[k];
-        const double lengths = std::sqrt(dot(u, u) * dot(v, v));
-        const double cosine = lengths > 0 ? dot(u, v) / lengths : -1;
-        widest = cosine < widest ? cosine : widest;
-    }
-    return widest;
-}
-
-// Whether the surface wants ab of triangles abp and baq turned into pq, by the two rules
-// (see above; na .. nq the corners' unit normals, none zero) without an angle wider than
-// kWidestAngle (unless the old pair had a wider one).
-inline bool flip_wanted(const Local& la, const Local& lb, const Local& lp, const Local& lq,
-                        Vec3 na, Vec3 nb, Vec3 np, Vec3 nq) {
-    if (dot(na, na) == 0 || dot(nb, nb) == 0 || dot(np, np) == 0 || dot(nq, nq) == 0)
-        return false;
-    const double bend_before = bend_along(vec_of(la), vec_of(lb), na, nb);
-    const double bend_after = bend_along(vec_of(lp), vec_of(lq), np, nq);
-    if (flip_helps(vec_of(la), vec_of(lb), vec_of(lp), vec_of(lq))
-            ? bend_after > kBendVeto * bend_before
-            : !(kBendGain * bend_after < bend_before))
-        return false;
-    const double widest_after =
-        std::fmin(widest_angle_cosine(vec_of(lp), vec_of(la), vec_of(lq)),
-                  widest_angle_cosine(vec_of(lq), vec_of(lb), vec_of(lp)));
-    return !(widest_after < kWidestAngle &&
-             widest_after < std::fmin(widest_angle_cosine(vec_of(la), vec_of(lb), vec_of(lp)),
-                                      widest_angle_cosine(vec_of(lb), vec_of(la), vec_of(lq))));
-}
-
-// Whether both new triangles (p, a, q) and (q, b, p) of that flip have normals within
-// kGentleFlip of the old pair's mean.
-inline bool gentle_flip(const Local& la, const Local& lb, const Local& lp, const Local& lq) {
-    Vec3 mean = normal_of(la, lb, lp);
-    const Vec3 other_normal = normal_of(lb, la, lq);
-    mean = Vec3{mean.x + other_normal.x, mean.y + other_normal.y, mean.z + other_normal.z};
-    const Vec3 n1 = normal_of(lp, la, lq), n2 = normal_of(lq, lb, lp);
-    return dot(n1, mean) > kGentleFlip * std::sqrt(dot(n1, n1) * dot(mean, mean)) &&
-           dot(n2, mean) > kGentleFlip * std::sqrt(dot(n2, n2) * dot(mean, mean));
-}
-
-// Flips half-edge e of a layer's triangulation on the surface if that helps (see above).
-inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32_t* flags,
-                            VertexNormals& normals, const Cylinder& cyl, uint32_t e) {
-    const uint32_t f = tr.twin[e];
-    const uint32_t t = e / 3, u = f / 3;
-    if (!on_surface(tr, u)) return false;
-    const uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)], p = tr.vertex[prev_edge(e)];
-    const uint32_t q = tr.vertex[prev_edge(f)];
-    // A chord of a loop would stand where close_ends puts its cap.
-    if (p == q || (flags[p] & flags[q] & (kOnBottomLoop | kOnTopLoop))) return false;
-    const Local &la = points[a - 1], &lb = points[b - 1], &lp = points[p - 1], &lq = points[q - 1];
-    if (!flip_wanted(la, lb, lp, lq, normals.at(a), normals.at(b), normals.at(p), normals.at(q)))
-        return false;
-    // The new triangles (p, a, q) and (q, b, p), counter-clockwise on the annulus.
-    if (faces_axis(lq, la, lp, cyl) || faces_axis(lp, lb, lq, cyl) ||
-        doubled_area(lp, la, lq) == 0 || doubled_area(lq, lb, lp) == 0)
-        return false;
-    if (!around_vertex(tr, prev_edge(e), [&tr, q](uint32_t g) {
-            return tr.vertex[next_edge(g)] != q;
-        }))
-        return false;
-    // A flip in a gently curved quad, convex seen along its normal, covers about the
-    // same place as before: nothing else to check.
-    if (!gentle_flip(la, lb, lp, lq)) {
-        const Vec3 first[3] = {vec_of(lp), vec_of(la), vec_of(lq)};
-        const Vec3 second[3] = {vec_of(lq), vec_of(lb), vec_of(lp)};
-        const Box3 quad = box_of(first[0], first[1], first[2], second[1]);
-        auto clear_of = [&](uint32_t g) {
-            const uint32_t s = g / 3;
-            if (s == t || s == u || !on_surface(tr, s)) return true;
-            const uint32_t* v = tr.vertex + 3 * s;
-            const Vec3 other[3] = {vec_of(points[v[0] - 1]), vec_of(points[v[1] - 1]),
-                                   vec_of(points[v[2] - 1])};
-            return !quad.meets(box_of(other[0], other[1], other[2], other[2])) ||
-                   (!triangles_meet(first, other) && !triangles_meet(second, other));
-        };
-        // The triangles around the quad's corners.
-        const uint32_t corners[4] = {e, f, prev_edge(e), prev_edge(f)};
-        for (uint32_t corner : corners)
-            if (!around_vertex(tr, corner, clear_of)) return false;
-    }
-    flip_edge<false>(tr, e, nullptr);
-    return true;
-}
-
-// Flips the surface edges of a layer's triangulation, sweep after sweep, until a sweep
-// flips none or kSurfaceFlipSweeps have run; after the first sweep, only edges between
-// two corners of quads flipped in the sweep before (the edges whose triangles changed).
-// `flags` holds a word per vertex (see triangulate_layer); the bits kFlippedBefore and
-// kFlippedNow are used here and cleared. `room` is the annulus coordinates, two doubles a
-// vertex, overwritten. Returns the number of flips.
-inline size_t flip_layer_on_surface(Triangulation& tr, const Local* points, const Cylinder& cyl,
-                                    uint32_t* flags, double* room, size_t vertices) {
-    VertexNormals normals = {room};
-    size_t flips = 0;
-    for (uint32_t sweep = 0; sweep < kSurfaceFlipSweeps; ++sweep) {
-        if (sweep < kNormalSweeps) normals.estimate(tr, points, vertices);
-        size_t flipped = 0;
-        for (uint32_t t = 0; t < tr.triangle_count; ++t) {
-            if (!on_surface(tr, t)) continue;
-            const uint32_t* v = tr.vertex + 3 * t;
-            // After the first sweep: at least two corners flipped before.
-            if (sweep > 0 && ((flags[v[0]] & kFlippedBefore) + (flags[v[1]] & kFlippedBefore) +
-                              (flags[v[2]] & kFlippedBefore)) < 2 * kFlippedBefore)
-                continue;
-            for (uint32_t e = 3 * t; e < 3 * t + 3; ++e) {
-                // Each edge once a sweep, from the side of its larger half-edge.
-                const uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)];
-                if (tr.twin[e] > e || (sweep > 0 && !(flags[a] & flags[b] & kFlippedBefore)) ||
-                    !flip_on_surface(tr, points, flags, normals, cyl, e))
-                    continue;
-                ++flipped;
-                // t is (p, a, q) after the flip, and the twin's triangle (q, b, p).
-                flags[tr.vertex[3 * t]] |= kFlippedNow;
-                flags[tr.vertex[3 * t + 1]] |= kFlippedNow;
-                flags[tr.vertex[3 * t + 2]] |= kFlippedNow;
-                flags[b] |= kFlippedNow;
-                break;
-            }
-        }
-        for (size_t v = 0; v < vertices; ++v)
-            flags[v] = (flags[v] & ~(kFlippedBefore | kFlippedNow)) |
-                       ((flags[v] & kFlippedNow) ? kFlippedBefore : 0);
-        flips += flipped;
-        if (flipped == 0) break;
-    }
-    for (size_t v = 0; v < vertices; ++v) flags[v] &= ~kFlippedBefore;
-    return flips;
-}
-
-// Triangulates a loaded layer rolled onto the annulus of its cylinder plus the centre (the
-// centre moved first if the layer folds less around another: see choose_centre).
-// Emits the surface triangles and fills the loops, in layer-local indices. Returns ok,
-// not_columnar (the layer does not surround its axis, or is degenerate: the caller merges
-// it with the next one), out_of_memory or internal_error. Its scratch is released; the
-// layer's points are left in insertion order (layer.points[k] is layer-local point
-// order[k], an order not kept).
-inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Arena& arena,
-                                TriangleSink& sink, LayerLoops& loops, LayerCounts& counts) {
-    const size_t count = layer.count, total = count + 1;  // vertex 0 is the centre
-    choose_centre(layer, arena);
-    Local* points = layer.points;
-    const Cylinder& cyl = layer.cyl;
-    size_t mark = arena.mark();
-    uint32_t* order = arena.alloc<uint32_t>(count);  // vertex - 1 -> layer-local index
-    double* xy = arena.alloc<double>(2 * total);
-    if (arena.failed) return Status::out_of_memory;
-    // The insertion order is taken on the unrolled strip (angle, height), where the points
-    // are spread evenly: on the annulus their density falls off with the radius squared
-    // and a curve over its bounding box would lump the inner rings together. The strip has
-    // the cylinder's proportions (angle in radians, height over the radius), as the curve's
-    // cells are square. The centre goes first.
-    const double quarter_turn = 1.57079632679489661923;  // pseudo_angle's unit, in radians
-    BoundingBox2d box = {{0, 0}, {4 * quarter_turn, 0}};
-    double* strip = xy + 2;
-    for (size_t i = 0; i < count; ++i) {
-        const Local& p = points[i];
-        strip[2 * i] = quarter_turn * pseudo_angle(p.x - cyl.cx, p.y - cyl.cy);
-        strip[2 * i + 1] = (p.h - cyl.h0) * cyl.scale;
-        if (strip[2 * i + 1] > box.max[1]) box.max[1] = strip[2 * i + 1];
-    }
-    if (!spatial_order(reinterpret_cast<const unsigned char*>(strip), 2 * sizeof(double), count,
-                       box, order, arena))
-        return Status::out_of_memory;
-    // The points in insertion order, so that unrolling them and the fold test below read
-    // them in sequence, not at random (the copy's room is free again before the
-    // triangulation takes it).
-    size_t copy_mark = arena.mark();
-    Local* sorted = arena.alloc<Local>(count);
-    if (arena.failed) return Status::out_of_memory;
-    for (size_t k = 0; k < count; ++k) sorted[k] = points[order[k]];
-    std::memcpy(points, sorted, count * sizeof(Local));
-    arena.rewind(copy_mark);
-    xy[0] = xy[1] = 0;
-    for (size_t k = 0; k < count; ++k) roll(cyl, points[k], xy + 2 * (k + 1));
-    Triangulation tr;
-    tr.xy = xy;
-    if (!allocate_triangulation(tr, total, arena)) return Status::out_of_memory;
-    counts = LayerCounts{0, 0};
-    LayerDuplicates classify = {&cloud, layer.ids, order, &counts};
-    DuplicateSink duplicates = {LayerDuplicates::report, &classify};
-    uint32_t inserted = 0;
-    Status status = triangulate_points(tr, static_cast<uint32_t>(total), duplicates, &inserted);
-    if (status == Status::internal_error) return status;
-    // The flip stack's room is free now: a flag per vertex (kOnBottomLoop, kOnTopLoop,
-    // kEmitted).
-    uint32_t* flags = tr.stack;
-    std::memset(flags, 0, total * sizeof(uint32_t));
-    if (status != Status::ok || !centre_link(tr, loops.bottom, &loops.bottom_count, flags)) {
-        arena.rewind(mark);
-        return Status::not_columnar;
-    }
-    hull_loop(tr, loops.top, &loops.top_count, flags);
-    size_t folds = count_folds(tr, points, 1, cyl, nullptr);
-    if (folds == 0 || kPeelFoldedEnds) {
-        const uint32_t capacity = static_cast<uint32_t>(count);
-        // The passes and the slope of a loop (see "peeling"): the surface's end loops of a
-        // layer that folds peel further; its other loops not at all.
-        auto passes = [&layer, folds](uint32_t end) {
-            if (folds == 0) return kPeelPasses;
-            return (layer.ends & end) ? kFoldedEndPeelPasses : 0;
-        };
-        auto slope = [&layer, folds](uint32_t end) {
-            if (!(layer.ends & end)) return kInnerPeelSlope;
-            return folds == 0 ? kPeelSlope : kFoldedEndPeelSlope;
-        };
-        loops.bottom_count = peel_loop(tr, points, flags, loops.bottom, loops.bottom_count,
-                                       capacity, false, slope(kLowPole), passes(kLowPole));
-        loops.top_count = peel_loop(tr, points, flags, loops.top, loops.top_count, capacity,
-                                    true, slope(kHighPole), passes(kHighPole));
-    }
-    name_loop(tr, order, flags, loops.bottom, loops.bottom_count, loops.bottom_flags, false);
-    name_loop(tr, order, flags, loops.top, loops.top_count, loops.top_flags, true);
-    if (kSurfaceFlips && layer.surface_flips &&
-        flip_layer_on_surface(tr, points, cyl, flags, xy, total) && folds)
-        folds = count_folds(tr, points, 1, cyl, nullptr);
-    // The triangles at the bottom loop (the border) go last, so that a chunk's triangles at
-    // its loop vertices are one stretch of the sink with the band (see chunk_is_sound).
-    for (uint32_t at_border = 0; at_border < 2; ++at_border) {
-        if (at_border) loops.border_start = sink.count;
-        for (uint32_t t = 0; t < tr.triangle_count; ++t) {
-            const uint32_t* v = tr.vertex + 3 * t;
-            if (!on_surface(tr, t) ||
-                ((flags[v[0]] | flags[v[1]] | flags[v[2]]) & kOnBottomLoop) != at_border)
-                continue;
-            if (kNetShortcut) {
-                flags[v[0]] |= kEmitted;
-                flags[v[1]] |= kEmitted;
-                flags[v[2]] |= kEmitted;
-            }
-            sink.write(order[v[0] - 1], order[v[1] - 1], order[v[2] - 1]);
-        }
-    }
-    sink.folds += folds;
-    loops.interior_used = 0;
-    for (size_t v = 1; kNetShortcut && v < total; ++v)
-        loops.interior_used += (flags[v] & (kOnBottomLoop | kEmitted)) == kEmitted;
-    arena.rewind(mark);
-    return Status::ok;
-}
-
 }  // namespace detail
 }  // namespace stratmesh
 
-// >>stitch ==================================================================================
+// >>stitch ===============================================================================
 // The band between two layers' loops.
 //
 // Two neighbouring layers meet at a cut: the top loop A of the lower layer and the bottom
@@ -5734,7 +5703,7 @@ inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cy
 }  // namespace detail
 }  // namespace stratmesh
 
-// >>manifold ================================================================================
+// >>manifold =============================================================================
 // The safety net that keeps the surface a manifold.
 //
 // The paper's step 5, as a safety net: by construction the layers and bands already form a
@@ -6039,1303 +6008,8 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
 }  // namespace detail
 }  // namespace stratmesh
 
-// >>caps ====================================================================================
-// Closing a boundary loop: pockets, lowered caps, fins.
-//
-// With the close_ends flag, each boundary loop of the final surface is closed by a cap made
-// of triangles over the loop's own vertices. The loop is triangulated in its projection
-// across the axis: first checked to be a simple polygon (a sweep over its edges sorted by x,
-// exact orient2d), then ear clipping, then flips of the cap's diagonals. A triangulation of
-// a simple polygon lifts to a surface that is a graph over it, so the cap's triangles cannot
-// cross one another; but they can cross the wall where it leans over the cap near a ragged
-// loop (a bust's shoulders, the noisy end of a scan). So the flips make the bottom cap as
-// low as the loop allows and the top cap as high: a diagonal is flipped when the other one,
-// with every vertex at its height along the axis, lies more than kCapHeightTie below it
-// (above, on the top cap): the lower or upper envelope of the loop, where the quadrilaterals
-// allow. On ties (a planar loop, a CT contour) the Delaunay criterion decides, so planar
-// caps are the constrained Delaunay triangulation (ear clipping alone leaves slivers).
-// Delaunay caps alone cross a wall leaning over a ragged loop several times as often. The
-// flips are bounded (kCapFlipsPerCorner per loop vertex): any triangulation of the polygon is
-// valid, so stopping early only leaves a cap less low. STRATMESH_SMALL_CODE leaves the
-// heights out: Delaunay caps.
-//
-// Each cap triangle runs the loop's edges against the surface's direction, so the closed
-// surface stays consistently oriented (the bottom cap faces -axis, the top one +axis). A
-// diagonal that is already an edge of the surface would join three triangles: ears and
-// flips that would make one are skipped. Where the wall has fins (triangles with two edges
-// on the loop: a scan rounded to a grid makes them), the fin's middle corner has no way
-// into the cap but a diagonal to a corner it sees across the loop, which ear clipping
-// never makes; so a loop that no clipping closes, of at most kCapSearchCorners corners, is
-// searched exhaustively (search_cap). Where fins leave no cap at all, the wall's edges under
-// them may be flipped (see "fins flipped out of the way" below). A loop whose projection
-// is not simple, or that none of these closes, stays open.
-//
-// The loops of a star-shaped layer run monotonically in angle around its centre (see the
-// unroll section), so their projections are simple but for rounding or the safety net's
-// removals.
-
-namespace stratmesh {
-namespace detail {
-
-// The surface's directed edges between boundary vertices, grouped by first vertex, each
-// group sorted; and per vertex the far end of its boundary edge. The output is
-// vertex-manifold, so a vertex has at most one boundary edge leaving it.
-struct CapGraph {
-    size_t* offsets;          // point_count + 1: each vertex's range in `targets`
-    uint32_t* targets;        // at most 3 per triangle
-    uint32_t* boundary_next;  // per vertex, or kNoIndex
-
-    bool leads_to(uint32_t a, uint32_t b) const {
-        size_t lo = offsets[a], hi = offsets[a + 1];
-        while (lo < hi) {
-            size_t mid = lo + (hi - lo) / 2;
-            if (targets[mid] < b) lo = mid + 1; else hi = mid;
-        }
-        return lo < offsets[a + 1] && targets[lo] == b;
-    }
-    // For boundary vertices a and b only.
-    bool has_edge(uint32_t a, uint32_t b) const { return leads_to(a, b) || leads_to(b, a); }
-};
-
-// The simplicity sweep keys a loop edge by its smaller x and its index, packed in 64 bits:
-// the high 32 bits of an unsigned integer that orders as x does (finite, -0 as +0), then
-// the index. Coarser than x, the key still never orders an edge before one whose smaller x
-// is below its own, so the sweep meets every pair whose x ranges overlap (and a few more,
-// which the exact test settles).
-inline uint32_t sweep_key(double x) {
-    x += 0.0;
-    uint64_t bits;
-    std::memcpy(&bits, &x, sizeof bits);
-    bits = (bits >> 63) ? ~bits : bits | (uint64_t{1} << 63);
-    return static_cast<uint32_t>(bits >> 32);
-}
-
-// The arrays of one loop, sized for all boundary vertices together (every loop fits).
-// Positions are the loop's vertices in cap order, 0 .. length - 1.
-struct CapLoop {
-    uint32_t* ids;            // all loops one after another, each in cap order
-    unsigned char* starts;    // per entry of `ids`: kLoopStart, kLoopBroken or 0
-    double* xy;               // per position: the projection, mirrored to turn counter-clockwise
-    double* height;           // per position, for the flips: the height along the axis (in
-                              // the clipping arrays' memory)
-    unsigned char* flags;     // per position while clipping, per cap triangle while flipping
-    double* scratch;          // for incircle
-    uint64_t* sweep;          // per edge (sweep_key); shares its memory with the arrays below
-    uint32_t* prev;           // per position: the neighbours in the polygon left to clip
-    uint32_t* next;
-    uint32_t* reflex;         // positions that were not strictly convex when last checked
-    uint32_t* owner;          // per position p: the cap triangle edge (3 t + k) beyond the
-                              // polygon edge p -> next[p], or kNoIndex on the loop itself
-    uint32_t* corners;        // per cap triangle: 3 positions, counter-clockwise
-    uint32_t* across;         // per cap triangle edge k (corner k to k + 1): the edge beyond
-    uint32_t* stack;          // cap triangles whose edges are to be checked
-    uint8_t* search;          // per pair of positions i < j: the cap search's choice, k - i
-                              // (allocated, and read, only where kCapSearchCorners > 0)
-};
-
-const unsigned char kLoopStart = 1, kLoopBroken = 2;
-const unsigned char kRemoved = 1, kReflex = 2, kQueued = 4;
-const unsigned char kFinSeen = 1, kFinFlippable = 2, kFinWaived = 4, kFinUsed = 8;
-
-// The allocation sequences of the cap phase: the call runs them with its real sizes,
-// reconstruct_workspace_size with the largest possible ones, so the two cannot disagree.
-inline bool allocate_cap_graph(CapGraph& g, size_t point_count, size_t triangle_count,
-                               Arena& arena) {
-    g.offsets = arena.alloc<size_t>(point_count + 1);
-    g.targets = arena.alloc<uint32_t>(3 * triangle_count);
-    g.boundary_next = arena.alloc<uint32_t>(point_count);
-    return !arena.failed;
-}
-
-inline bool allocate_cap_loop(CapLoop& c, size_t length, Arena& arena) {
-    c.ids = arena.alloc<uint32_t>(length);
-    c.starts = arena.alloc<unsigned char>(length);
-    c.xy = arena.alloc<double>(2 * length);
-    c.flags = arena.alloc<unsigned char>(length);
-    c.scratch = arena.alloc<double>(kIncircleScratch);
-    // The sweep is over before clipping starts: the clipping arrays reuse its memory; and
-    // the heights, filled once the clipping is over, reuse the clipping arrays'.
-    size_t mark = arena.mark();
-    c.sweep = arena.alloc<uint64_t>(length);
-    arena.rewind(mark);
-    c.height = arena.alloc<double>(length);
-    arena.rewind(mark);
-    c.prev = arena.alloc<uint32_t>(length);
-    c.next = arena.alloc<uint32_t>(length);
-    c.reflex = arena.alloc<uint32_t>(length);
-    c.owner = arena.alloc<uint32_t>(length);
-    c.corners = arena.alloc<uint32_t>(3 * length);
-    c.across = arena.alloc<uint32_t>(3 * length);
-    c.stack = arena.alloc<uint32_t>(length);
-    if (kCapSearchCorners > 0) {
-        const size_t searched = length < kCapSearchCorners ? length : kCapSearchCorners;
-        c.search = arena.alloc<uint8_t>(searched * (searched - 1) / 2);
-    }
-    return !arena.failed;
-}
-
-// Fills the graph from the triangles; returns the number of boundary vertices. Only edges
-// between boundary vertices are kept (the diagonals of a cap join boundary vertices), so
-// on a tube the graph is small and built in three streaming passes.
-inline size_t build_cap_graph(const uint32_t* tri, size_t count, size_t point_count,
-                              CapGraph& g) {
-    // Around an inner vertex the triangles leave towards the same vertices they arrive
-    // from; around a boundary vertex (one fan, a chain) the two sets differ by the far
-    // ends of its two boundary edges. So the xor of all of them is 0 exactly at inner
-    // vertices: the ends differ, since a loop has at least 3 vertices.
-    uint32_t* side = g.boundary_next;
-    std::memset(side, 0, sizeof(uint32_t) * point_count);
-    for (size_t t = 0; t < count; ++t) {
-        const uint32_t* c = tri + 3 * t;
-        side[c[0]] ^= c[1] ^ c[2];
-        side[c[1]] ^= c[2] ^ c[0];
-        side[c[2]] ^= c[0] ^ c[1];
-    }
-    auto kept = [&](uint32_t a, uint32_t b) { return side[a] != 0 && side[b] != 0; };
-    std::memset(g.offsets, 0, sizeof(size_t) * (point_count + 1));
-    for (size_t k = 0; k < 3 * count; ++k) {
-        uint32_t to = tri[k - k % 3 + (k + 1) % 3];
-        if (kept(tri[k], to)) ++g.offsets[tri[k] + 1];
-    }
-    for (size_t v = 0; v < point_count; ++v) g.offsets[v + 1] += g.offsets[v];
-    size_t total = g.offsets[point_count];
-    // Filled from the end of each range, so offsets[v + 1] ends as the start of v's.
-    for (size_t k = 3 * count; k-- > 0;) {
-        uint32_t to = tri[k - k % 3 + (k + 1) % 3];
-        if (kept(tri[k], to)) g.targets[--g.offsets[tri[k] + 1]] = to;
-    }
-    for (size_t v = 0; v < point_count; ++v) g.offsets[v] = g.offsets[v + 1];
-    g.offsets[point_count] = total;
-    size_t boundary = 0;
-    for (size_t v = 0; v < point_count; ++v) {
-        uint32_t* group = g.targets + g.offsets[v];
-        size_t size = g.offsets[v + 1] - g.offsets[v];
-        if (size <= 16) {
-            for (size_t i = 1; i < size; ++i)
-                for (size_t j = i; j > 0 && group[j - 1] > group[j]; --j) {
-                    uint32_t s = group[j];
-                    group[j] = group[j - 1];
-                    group[j - 1] = s;
-                }
-        } else {
-            heap_sort(group, size);
-        }
-    }
-    // Every group is sorted: now the boundary edge leaving each boundary vertex, the one
-    // no triangle runs backwards. `side` is read for v just before it is overwritten.
-    for (size_t v = 0; v < point_count; ++v) {
-        uint32_t a = static_cast<uint32_t>(v);
-        uint32_t next = kNoIndex;
-        if (side[v] != 0)
-            for (size_t k = g.offsets[v]; k < g.offsets[v + 1]; ++k)
-                if (!g.leads_to(g.targets[k], a)) next = g.targets[k];
-        g.boundary_next[v] = next;
-        boundary += next != kNoIndex;
-    }
-    return boundary;
-}
-
-// Chains the boundary edges into loops, stored one after another in cap order (the
-// boundary reversed); a chain that does not come back to its start is marked broken.
-// Returns the cap triangles all the unbroken loops would need.
-inline size_t trace_boundary_loops(CapGraph& g, size_t point_count, CapLoop& c,
-                                   size_t* loop_entries) {
-    size_t filled = 0, triangles = 0;
-    for (size_t v = 0; v < point_count; ++v) {
-        if (g.boundary_next[v] == kNoIndex) continue;
-        size_t start = filled;
-        uint32_t at = static_cast<uint32_t>(v);
-        while (g.boundary_next[at] != kNoIndex) {  // each boundary vertex is taken once
-            c.ids[filled] = at;
-            c.starts[filled++] = 0;
-            uint32_t to = g.boundary_next[at];
-            g.boundary_next[at] = kNoIndex;
-            at = to;
-        }
-        size_t length = filled - start;
-        bool closed = at == v && length >= 3;
-        c.starts[start] = closed ? kLoopStart : kLoopBroken;
-        for (size_t i = start, j = filled - 1; i < j; ++i, --j) {
-            uint32_t t = c.ids[i];
-            c.ids[i] = c.ids[j];
-            c.ids[j] = t;
-        }
-        if (closed) triangles += length - 2;
-    }
-    *loop_entries = filled;
-    return triangles;
-}
-
-inline bool same_point(const double* a, const double* b) { return a[0] == b[0] && a[1] == b[1]; }
-
-// For p collinear with a and b: whether it lies on the closed segment ab.
-inline bool on_segment(const double* a, const double* b, const double* p) {
-    for (int k = 0; k < 2; ++k) {
-        double low = a[k] < b[k] ? a[k] : b[k], high = a[k] < b[k] ? b[k] : a[k];
-        if (p[k] < low || p[k] > high) return false;
-    }
-    return true;
-}
-
-// -1, 0 or 1 as x is below, at or above y: the sign of x - y, without rounding.
-inline int compare(double x, double y) { return (x > y) - (x < y); }
-
-// Whether the closed segments pq and rs share a point.
-inline bool segments_meet(const double* p, const double* q, const double* r, const double* s) {
-    double d1 = orient2d_robust(r, s, p), d2 = orient2d_robust(r, s, q);
-    double d3 = orient2d_robust(p, q, r), d4 = orient2d_robust(p, q, s);
-    if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0)))
-        return true;
-    return (d1 == 0 && on_segment(r, s, p)) || (d2 == 0 && on_segment(r, s, q)) ||
-           (d3 == 0 && on_segment(p, q, r)) || (d4 == 0 && on_segment(p, q, s));
-}
-
-// Whether the closed polygon xy[0 .. length) is simple: no repeated point, no edge folding
-// back onto the next, no two other edges meeting. Edges are swept in order of their
-// smaller x; each is tested against those whose x range reaches into its own.
-inline bool polygon_is_simple(const double* xy, uint32_t length, uint64_t* sweep) {
-    if (length < 3) return false;
-    auto at = [&](uint32_t i) { return xy + 2 * static_cast<size_t>(i); };
-    for (uint32_t i = 0; i < length; ++i) {
-        const double* a = at(i == 0 ? length - 1 : i - 1);
-        const double* b = at(i);
-        const double* c = at(i + 1 == length ? 0 : i + 1);
-        if (same_point(b, c)) return false;
-        // Collinear neighbours on the same side of b: the two edges overlap.
-        if (orient2d_robust(a, b, c) == 0 && compare(a[0], b[0]) == compare(c[0], b[0]) &&
-            compare(a[1], b[1]) == compare(c[1], b[1]))
-            return false;
-    }
-    for (uint32_t e = 0; e < length; ++e) {
-        const double* a = at(e);
-        const double* b = at(e + 1 == length ? 0 : e + 1);
-        sweep[e] = uint64_t{sweep_key(a[0] < b[0] ? a[0] : b[0])} << 32 | e;
-    }
-    heap_sort(sweep, length);
-    for (uint32_t i = 0; i < length; ++i) {
-        uint32_t e = static_cast<uint32_t>(sweep[i]), e_end = e + 1 == length ? 0 : e + 1;
-        const double* a = at(e);
-        const double* b = at(e_end);
-        const uint32_t right = sweep_key(a[0] < b[0] ? b[0] : a[0]);
-        double low = a[1] < b[1] ? a[1] : b[1], high = a[1] < b[1] ? b[1] : a[1];
-        for (uint32_t j = i + 1; j < length && (sweep[j] >> 32) <= right; ++j) {
-            uint32_t f = static_cast<uint32_t>(sweep[j]), f_end = f + 1 == length ? 0 : f + 1;
-            if (f == e_end || f_end == e) continue;  // neighbours: checked above
-            const double* c = at(f);
-            const double* d = at(f_end);
-            if ((c[1] < low && d[1] < low) || (c[1] > high && d[1] > high)) continue;
-            if (segments_meet(a, b, c, d)) return false;
-        }
-    }
-    return true;
-}
-
-// Whether p lies in the closed triangle abc (counter-clockwise).
-inline bool in_closed_triangle(const double* a, const double* b, const double* c, const double* p) {
-    return orient2d_robust(a, b, p) >= 0 && orient2d_robust(b, c, p) >= 0 &&
-           orient2d_robust(c, a, p) >= 0;
-}
-
-// Heights closer than this to a plane count as on it (frame units: the frame scales the
-// cloud to an extent of about 1). A planar loop turned into the frame by a tilted axis gets
-// heights that differ by rounding: those are ties, for the Delaunay criterion.
-const double kCapHeightTie = 0x1p-40;
-
-// How far d lies below the plane through a, b and w (counter-clockwise across the axis),
-// each at its height (heights: a's, b's, w's, d's): the plane's height at d's place, the
-// heights weighted by the triangles d makes with the opposite edges, less d's own.
-inline double depth_below_plane(const double* a, const double* b, const double* w,
-                                const double* d, const double* heights) {
-    auto orient = [d](const double* p, const double* q) {
-        return (p[0] - d[0]) * (q[1] - d[1]) - (p[1] - d[1]) * (q[0] - d[0]);
-    };
-    double oa = orient(b, w), ob = orient(w, a), ow = orient(a, b);
-    return ((heights[0] - heights[3]) * oa + (heights[1] - heights[3]) * ob +
-            (heights[2] - heights[3]) * ow) /
-           (oa + ob + ow);
-}
-
-const uint32_t kCapFlipsPerCorner = 64;
-
-// Ear clipping is greedy: where the surface holds some of a loop's diagonals (its
-// triangles with three corners on the loop), the ears taken first can leave a remainder
-// whose every ear would repeat one, where another order would not (the bundled bust's
-// neck loop, whose single layer's loops are peeled: 6 corners left of 249). So a failed
-// clipping starts again from other corners, kCapEarStarts spread around the loop in all
-// (see the configuration; 1 with STRATMESH_SMALL_CODE).
-
-// Triangulates one loop, already checked simple and counter-clockwise. ids: the loop's
-// vertices, whose diagonals must not be edges of the surface; lower: the cap is a bottom
-// one (it faces -axis), to be made as low as the loop allows (a top one as high). Returns
-// false if no ear is left (every one would repeat an edge of the surface).
-class CapTriangulation {
-public:
-    CapTriangulation(CapLoop& c, const uint32_t* ids, uint32_t length, const CapGraph& g,
-                     bool lower)
-        : c_(c), ids_(ids), length_(length), g_(g), lower_(lower) {}
-
-    // Ear clipping from kCapEarStarts corners, then the search; false if neither closes.
-    bool triangulate() {
-        for (uint32_t k = 0; k < kCapEarStarts; ++k)
-            if (clip_ears(static_cast<uint32_t>(uint64_t{k} * length_ / kCapEarStarts))) return true;
-        return kCapSearchCorners > 0 && search_cap();
-    }
-
-    // From now on the chords of the fins marked in `fins` (per position, kFinWaived) are
-    // allowed as diagonals: the wall's edge there is to be flipped away (see flip_used_fins).
-    void waive(const unsigned char* fins) { waived_ = fins; }
-
-    // The fin whose chord is a - b (positions): the position between them, if it is a
-    // waived fin; else kNoIndex.
-    uint32_t waived_fin(uint32_t a, uint32_t b) const {
-        if (!kCapFinFlips || waived_ == nullptr) return kNoIndex;
-        const uint32_t after_a = a + 1 == length_ ? 0 : a + 1, after_b = b + 1 == length_ ? 0 : b + 1;
-        const uint32_t mid = (after_a + 1 == length_ ? 0 : after_a + 1) == b ? after_a
-                           : (after_b + 1 == length_ ? 0 : after_b + 1) == a ? after_b
-                                                                             : kNoIndex;
-        return mid != kNoIndex && (waived_[mid] & kFinWaived) ? mid : kNoIndex;
-    }
-
-    bool clip_ears(uint32_t start) {
-        uint32_t reflex_count = 0;
-        for (uint32_t i = 0; i < length_; ++i) {
-            c_.prev[i] = i == 0 ? length_ - 1 : i - 1;
-            c_.next[i] = i + 1 == length_ ? 0 : i + 1;
-            c_.owner[i] = kNoIndex;
-            c_.flags[i] = 0;
-        }
-        for (uint32_t i = 0; i < length_; ++i) {
-            if (convex(i)) continue;
-            c_.flags[i] = kReflex;
-            c_.reflex[reflex_count++] = i;
-        }
-        uint32_t remaining = length_, v = start, misses = 0;
-        triangles_ = 0;
-        while (remaining > 3) {
-            if (!is_ear(v, reflex_count)) {
-                v = c_.next[v];
-                if (++misses > remaining) return false;
-                continue;
-            }
-            uint32_t p = c_.prev[v], n = c_.next[v];
-            uint32_t t = add_triangle(p, v, n);
-            c_.owner[p] = 3 * t + 2;  // the new polygon edge p -> n has t beyond it
-            c_.next[p] = n;
-            c_.prev[n] = p;
-            c_.flags[v] = kRemoved;
-            // Clipping only narrows the corners at p and n: a reflex one may turn convex.
-            settle_corner(p);
-            settle_corner(n);
-            --remaining;
-            misses = 0;
-            v = p;
-        }
-        if (!convex(v)) return false;
-        uint32_t p = c_.prev[v], n = c_.next[v];
-        uint32_t t = add_triangle(p, v, n);
-        link(3 * t + 2, c_.owner[n]);
-        return true;
-    }
-
-    // Flips until no diagonal would be lower (higher, on a top cap) flipped, nor, where the
-    // heights cannot tell, more Delaunay (or the flip would repeat an edge of the surface),
-    // or until the budget of flips is spent.
-    void settle_diagonals() {
-        uint32_t depth = 0;
-        // No overflow: a loop takes more than 64 bytes of workspace per vertex.
-        size_t budget = static_cast<size_t>(kCapFlipsPerCorner) * length_;
-        for (uint32_t t = 0; t < triangles_; ++t) c_.flags[t] = 0;
-        for (uint32_t t = 0; t < triangles_; ++t) queue(t, depth);
-        while (depth > 0 && budget > 0) {
-            uint32_t t = c_.stack[--depth];
-            c_.flags[t] = 0;
-            for (uint32_t k = 0; k < 3; ++k) {
-                uint32_t u = flip_if_better(t, k);
-                if (u == kNoIndex) continue;
-                --budget;
-                queue(t, depth);
-                queue(u, depth);
-                break;
-            }
-        }
-    }
-
-    // Triangulates the loop by searching all its triangulations for one whose diagonals
-    // are no edges of the surface (dynamic programming over the pairs of corners: the
-    // polygon i, i + 1, ..., j closed by diagonal i - j has one if some corner k between
-    // makes a triangle i, k, j with both sides closable): what ear clipping misses where
-    // fins of the wall leave a corner nothing to join but a corner across the loop. For
-    // loops of at most kCapSearchCorners corners (cubic time: about 0.1 s for 256);
-    // false if there are more, or none is found.
-    bool search_cap() {
-        const uint32_t m = length_;
-        if (m > kCapSearchCorners || m < 3) return false;
-        // choice(i, j): the corner k, stored as k - i, of a triangle i, k, j from which the
-        // polygon i .. j closes; 0 if it does not (i - j no diagonal, or no such k).
-        auto choice = [this](uint32_t i, uint32_t j) -> uint8_t& {
-            return c_.search[static_cast<size_t>(j) * (j - 1) / 2 + i];
-        };
-        auto closes = [&choice](uint32_t i, uint32_t j) { return j == i + 1 || choice(i, j) != 0; };
-        for (uint32_t span = 2; span < m; ++span)
-            for (uint32_t i = 0; i + span < m; ++i) {
-                const uint32_t j = i + span;
-                uint8_t& best = choice(i, j);
-                best = 0;
-                // i - j must be a diagonal (the loop edge m - 1 -> 0 closes the whole).
-                if ((j != m - 1 || i != 0) &&
-                    (joined(i, j) || !diagonal_inside(i, j)))
-                    continue;
-                for (uint32_t k = i + 1; k < j && best == 0; ++k)
-                    if (closes(i, k) && closes(k, j)) best = static_cast<uint8_t>(k - i);
-            }
-        if (choice(0, m - 1) == 0) return false;
-        // The triangles, from the outermost in: each job is a pair (i, j) and the edge of
-        // the triangle already made beyond its side j -> i (kNoIndex for the loop edge).
-        triangles_ = 0;
-        uint32_t depth = 0;
-        auto push = [this, &depth](uint32_t i, uint32_t j, uint32_t beyond) {
-            c_.prev[depth] = i;
-            c_.next[depth] = j;
-            c_.owner[depth++] = beyond;
-        };
-        push(0, m - 1, kNoIndex);
-        while (depth > 0) {
-            --depth;
-            const uint32_t i = c_.prev[depth], j = c_.next[depth], beyond = c_.owner[depth];
-            const uint32_t k = i + choice(i, j);
-            const uint32_t t = triangles_++;
-            uint32_t* corner = c_.corners + 3 * static_cast<size_t>(t);
-            corner[0] = i;
-            corner[1] = k;
-            corner[2] = j;
-            for (uint32_t e = 0; e < 3; ++e) c_.across[3 * static_cast<size_t>(t) + e] = kNoIndex;
-            link(3 * t + 2, beyond);
-            if (k > i + 1) push(i, k, 3 * t);
-            if (j > k + 1) push(k, j, 3 * t + 1);
-        }
-        return true;
-    }
-
-    // Whether i - j (positions on the loop) runs inside the polygon: within the corners at
-    // both ends and clear of every loop edge that does not end at i or j.
-    bool diagonal_inside(uint32_t i, uint32_t j) const {
-        auto within_corner = [this](uint32_t a, uint32_t b) {
-            const double* pa = point(a);
-            const double* pb = point(b);
-            const double* before = point(a == 0 ? length_ - 1 : a - 1);
-            const double* after = point(a + 1 == length_ ? 0 : a + 1);
-            if (orient2d_robust(before, pa, after) > 0)
-                return orient2d_robust(pa, pb, before) > 0 && orient2d_robust(pb, pa, after) > 0;
-            return !(orient2d_robust(pa, pb, after) >= 0 && orient2d_robust(pb, pa, before) >= 0);
-        };
-        if (!within_corner(i, j) || !within_corner(j, i)) return false;
-        const double* pi = point(i);
-        const double* pj = point(j);
-        for (uint32_t a = 0; a < length_; ++a) {
-            const uint32_t b = a + 1 == length_ ? 0 : a + 1;
-            if (a == i || a == j || b == i || b == j) continue;
-            const double oa = orient2d_robust(pi, pj, point(a));
-            const double ob = orient2d_robust(pi, pj, point(b));
-            if ((oa > 0 && ob > 0) || (oa < 0 && ob < 0)) continue;
-            const double oi = orient2d_robust(point(a), point(b), pi);
-            const double oj = orient2d_robust(point(a), point(b), pj);
-            if ((oi > 0 && oj > 0) || (oi < 0 && oj < 0)) continue;
-            return false;  // the segments cross or touch
-        }
-        return true;
-    }
-
-    uint32_t triangles() const { return triangles_; }
-
-private:
-    const double* point(uint32_t i) const { return c_.xy + 2 * static_cast<size_t>(i); }
-
-    // Whether positions a and b are joined by an edge of the surface that stays there.
-    bool joined(uint32_t a, uint32_t b) const {
-        return g_.has_edge(ids_[a], ids_[b]) && waived_fin(a, b) == kNoIndex;
-    }
-
-    bool convex(uint32_t i) const {
-        return orient2d_robust(point(c_.prev[i]), point(i), point(c_.next[i])) > 0;
-    }
-
-    void settle_corner(uint32_t i) {
-        if ((c_.flags[i] & kReflex) && convex(i)) c_.flags[i] = 0;
-    }
-
-    void queue(uint32_t t, uint32_t& depth) {
-        if (c_.flags[t] & kQueued) return;
-        c_.flags[t] = kQueued;
-        c_.stack[depth++] = t;
-    }
-
-    // Strictly convex, a diagonal that is no edge of the surface, and no other corner in
-    // the closed triangle. Only non-convex corners need testing (in a simple polygon, a
-    // triangle holding a corner holds a reflex one); those turned convex leave the list.
-    bool is_ear(uint32_t v, uint32_t& reflex_count) {
-        if (c_.flags[v] & kReflex) return false;
-        uint32_t p = c_.prev[v], n = c_.next[v];
-        if (joined(p, n)) return false;
-        bool empty = true;
-        uint32_t kept = 0;
-        for (uint32_t k = 0; k < reflex_count; ++k) {
-            uint32_t r = c_.reflex[k];
-            if (c_.flags[r] != kReflex) continue;
-            c_.reflex[kept++] = r;
-            if (empty && r != p && r != n && in_closed_triangle(point(p), point(v), point(n), point(r)))
-                empty = false;
-        }
-        reflex_count = kept;
-        return empty;
-    }
-
-    // Adds triangle (p, v, n) and links its edges p -> v and v -> n to the triangles beyond.
-    uint32_t add_triangle(uint32_t p, uint32_t v, uint32_t n) {
-        uint32_t t = triangles_++;
-        uint32_t* corner = c_.corners + 3 * static_cast<size_t>(t);
-        corner[0] = p;
-        corner[1] = v;
-        corner[2] = n;
-        link(3 * t, c_.owner[p]);
-        link(3 * t + 1, c_.owner[v]);
-        c_.across[3 * static_cast<size_t>(t) + 2] = kNoIndex;
-        return t;
-    }
-
-    void link(uint32_t edge, uint32_t other) {
-        c_.across[edge] = other;
-        if (other != kNoIndex) c_.across[other] = edge;
-    }
-
-    // Flips the diagonal on edge k of t if the other diagonal lies lower (higher on a top
-    // cap), or on a tie if the vertex beyond lies in t's circumcircle; only where the
-    // quadrilateral is strictly convex and the new diagonal is no edge of the surface.
-    // Returns the other triangle, or kNoIndex if nothing was flipped.
-    uint32_t flip_if_better(uint32_t t, uint32_t k) {
-        uint32_t beyond = c_.across[3 * t + k];
-        if (beyond == kNoIndex) return kNoIndex;
-        uint32_t u = beyond / 3, j = beyond % 3;
-        uint32_t* ct = c_.corners + 3 * static_cast<size_t>(t);
-        uint32_t* cu = c_.corners + 3 * static_cast<size_t>(u);
-        uint32_t a = ct[k], b = ct[(k + 1) % 3], w = ct[(k + 2) % 3], d = cu[(j + 2) % 3];
-        const double heights[4] = {c_.height[a], c_.height[b], c_.height[w], c_.height[d]};
-        // How much lower (higher, on a top cap) the other diagonal lies: flip if clearly
-        // so; on a tie, by the Delaunay criterion. A NaN (a sliver abw) flips nothing.
-        double gain =
-            kLiftedCaps ? depth_below_plane(point(a), point(b), point(w), point(d), heights) : 0;
-        if (!lower_) gain = -gain;
-        if (!(gain > kCapHeightTie ||
-              (gain >= -kCapHeightTie &&
-               incircle_perturbed(point(a), point(b), point(w), point(d), c_.scratch) > 0)))
-            return kNoIndex;
-        if (orient2d_robust(point(a), point(d), point(w)) <= 0 ||
-            orient2d_robust(point(d), point(b), point(w)) <= 0 || joined(w, d))
-            return kNoIndex;
-        uint32_t beyond_bw = c_.across[3 * t + (k + 1) % 3], beyond_wa = c_.across[3 * t + (k + 2) % 3];
-        uint32_t beyond_ad = c_.across[3 * u + (j + 1) % 3], beyond_db = c_.across[3 * u + (j + 2) % 3];
-        // t becomes a -> d -> w (d -> w the new diagonal), u becomes d -> b -> w.
-        ct[0] = a;
-        ct[1] = d;
-        ct[2] = w;
-        cu[0] = d;
-        cu[1] = b;
-        cu[2] = w;
-        link(3 * t, beyond_ad);
-        link(3 * t + 2, beyond_wa);
-        link(3 * u, beyond_db);
-        link(3 * u + 1, beyond_bw);
-        link(3 * t + 1, 3 * u + 2);
-        return u;
-    }
-
-    CapLoop& c_;
-    const uint32_t* ids_;
-    uint32_t length_;
-    const CapGraph& g_;
-    bool lower_;
-    uint32_t triangles_ = 0;
-    const unsigned char* waived_ = nullptr;
-};
-
-struct CapCounts {
-    size_t closed, left_open, triangles, wall_flips;
-};
-
-// Report::detail for the caps, from reconstruct() and cap_ends() alike.
-const char* const kCapsTooLargeDetail =
-    "the triangle array is too small for the caps; triangle_count says how many are needed";
-const char* const kNotCompiledDetail =
-    "the options ask for a feature this build leaves out (STRATMESH_SMALL_CODE)";
-const char* const kLoopLeftOpenDetail =
-    "a boundary loop's projection across the axis is not a simple polygon (or every cap "
-    "found for it would repeat an edge of the surface): it is left open";
-
-// ---- fins flipped out of the way
-//
-// A loop with fins can have no cap at all: each fin's middle corner needs a diagonal to a
-// corner it sees across the loop, and with fins close together those diagonals cross or
-// see nothing (a fin under every other edge: most loops the search leaves open on
-// sparsely sampled ends). Then the wall gives way: the fin (u, v, m)
-// and the wall triangle beyond its chord, (v, u, x), become (u, x, m) and (x, v, m) (m,
-// the fin's middle corner, has no other triangle, so m - x is a new edge and the surface
-// stays a manifold), and the chord u - v is free for the cap. Only fins whose x is on no
-// loop (no new chord) and whose two new triangles face the way the old pair does are
-// offered, and only those whose chord the cap then takes are flipped: a loop that closed
-// before closes as before, and one that stays open leaves the wall as it was.
-
-// The per point key of a loop's fin chords: at the chord's first corner (position i - 1),
-// the fin's position i, for the fins with a flag in `wanted`. `key` is all kNoIndex outside
-// these calls: clear_fin_chords puts it back.
-inline void key_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length,
-                           const unsigned char* fins, unsigned char wanted) {
-    for (uint32_t i = 0; i < length; ++i)
-        if (fins[i] & wanted) key[ids[i == 0 ? length - 1 : i - 1]] = i;
-}
-
-inline void clear_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length) {
-    for (uint32_t i = 0; i < length; ++i) key[ids[i]] = kNoIndex;
-}
-
-// The fin position whose chord is a - b (either way round), or kNoIndex.
-inline uint32_t keyed_fin(const uint32_t* key, const uint32_t* ids, uint32_t length,
-                          uint32_t a, uint32_t b) {
-    for (int side = 0; side < 2; ++side) {
-        const uint32_t i = key[side == 0 ? a : b];
-        if (i != kNoIndex && ids[i + 1 == length ? 0 : i + 1] == (side == 0 ? b : a)) return i;
-    }
-    return kNoIndex;
-}
-
-// Whether (u, x, m) and (x, v, m) face the way (u, v, m) and (v, u, x) do together.
-inline bool fin_flip_keeps_facing(const CloudReader& cloud, const Frame& frame, uint32_t u,
-                                  uint32_t v, uint32_t m, uint32_t x) {
-    const Vec3 pu = frame.offset(cloud.point(u)), pv = frame.offset(cloud.point(v));
-    const Vec3 pm = frame.offset(cloud.point(m)), px = frame.offset(cloud.point(x));
-    const Vec3 fin = cross(pv - pu, pm - pu), beyond = cross(pu - pv, px - pv);
-    const Vec3 first = cross(px - pu, pm - pu), second = cross(pv - px, pm - px);
-    return dot(first, fin) + dot(first, beyond) > 0 && dot(second, fin) + dot(second, beyond) > 0;
-}
-
-// Marks kFinWaived the fins of the loop ids[0 .. length) that may be flipped (above),
-// scanning the wall tri[0 .. 3 wall); returns how many.
-inline uint32_t mark_flippable_fins(const uint32_t* tri, size_t wall, const CloudReader& cloud,
-                                    const Frame& frame, const CapGraph& g, uint32_t* key,
-                                    const uint32_t* ids, uint32_t length, unsigned char* fins) {
-    if (length <= 4) return 0;  // a chord two corners apart either way: no single fin
-    for (uint32_t i = 0; i < length; ++i)
-        fins[i] = g.has_edge(ids[i == 0 ? length - 1 : i - 1], ids[i + 1 == length ? 0 : i + 1])
-                      ? kFinSeen | kFinFlippable : 0;
-    key_fin_chords(key, ids, length, fins, kFinSeen);
-    for (uint32_t i = 0; i < length; ++i) fins[i] = 0;
-    for (size_t t = 0; t < wall; ++t) {
-        const uint32_t* c = tri + 3 * t;
-        for (uint32_t k = 0; k < 3; ++k) {
-            const uint32_t a = c[k], b = c[(k + 1) % 3], o = c[(k + 2) % 3];
-            const uint32_t i = keyed_fin(key, ids, length, a, b);
-            if (i == kNoIndex) continue;
-            if (o == ids[i]) {
-                fins[i] |= kFinSeen;
-            } else if (g.offsets[o + 1] == g.offsets[o] &&  // o is on no loop
-                       fin_flip_keeps_facing(cloud, frame, b, a, ids[i], o)) {
-                fins[i] |= kFinFlippable;  // beyond a -> b: the fin runs b -> a -> ids[i]
-            }
-        }
-    }
-    clear_fin_chords(key, ids, length);
-    uint32_t marked = 0;
-    for (uint32_t i = 0; i < length; ++i) {
-        const bool both = fins[i] == (kFinSeen | kFinFlippable);
-        fins[i] = both ? kFinWaived : 0;
-        marked += both;
-    }
-    return marked;
-}
-
-// Flips the wall's edge under each fin marked kFinUsed; returns how many it flipped. slots:
-// two size_t per position (in the memory of the loop's projection, free once its cap is made).
-inline size_t flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const uint32_t* ids,
-                             uint32_t length, const unsigned char* fins, double* slots) {
-    auto slot = [slots](uint32_t i, uint32_t which) { return slots + 2 * static_cast<size_t>(i) + which; };
-    static_assert(sizeof(size_t) <= sizeof(double), "a slot holds a triangle index");
-    const size_t unset = ~size_t{0};
-    for (uint32_t i = 0; i < length; ++i) {
-        std::memcpy(slot(i, 0), &unset, sizeof unset);
-        std::memcpy(slot(i, 1), &unset, sizeof unset);
-    }
-    key_fin_chords(key, ids, length, fins, kFinUsed);
-    size_t flipped_count = 0;
-    for (size_t t = 0; t < wall; ++t) {
-        const uint32_t* c = tri + 3 * t;
-        for (uint32_t k = 0; k < 3; ++k) {
-            const uint32_t i = keyed_fin(key, ids, length, c[k], c[(k + 1) % 3]);
-            if (i != kNoIndex) std::memcpy(slot(i, c[(k + 2) % 3] == ids[i] ? 0 : 1), &t, sizeof t);
-        }
-    }
-    for (uint32_t i = 0; i < length; ++i) {
-        if (!(fins[i] & kFinUsed)) continue;
-        size_t fin = 0, beyond = 0;
-        std::memcpy(&fin, slot(i, 0), sizeof fin);
-        std::memcpy(&beyond, slot(i, 1), sizeof beyond);
-        if (fin == unset || beyond == unset) continue;  // a soup given to cap_ends() only
-        uint32_t* f = tri + 3 * fin;
-        uint32_t* w = tri + 3 * beyond;
-        uint32_t k = 0;  // w's edge k -> k + 1 is the chord, v -> u
-        while (k < 2 && keyed_fin(key, ids, length, w[k], w[(k + 1) % 3]) != i) ++k;
-        const uint32_t v = w[k], u = w[(k + 1) % 3], x = w[(k + 2) % 3], m = ids[i];
-        const uint32_t flipped[6] = {u, x, m, x, v, m};
-        std::memcpy(f, flipped, 3 * sizeof(uint32_t));
-        std::memcpy(w, flipped + 3, 3 * sizeof(uint32_t));
-        ++flipped_count;
-    }
-    clear_fin_chords(key, ids, length);
-    return flipped_count;
-}
-
-// ---- pockets closed before a cap ----
-//
-// A loop is ragged along the axis: its points dip a little below its highest ones, and
-// where the wall flares out toward the end (its lower points inside the loop, seen along
-// the axis), a cap over the loop dips with them and crosses the wall's top row (a tilted
-// tube widening at its top: 24 to 65 crossing pairs with 60,000 points). So the cap spans
-// the loop's upper hull in the loop's own unrolled picture (the angle around its centroid,
-// and the height; the lower hull for a bottom loop), which lies above the wall, and each
-// pocket between a hull chord and the points dipping under it is first closed by
-// triangles of its own, along the wall. Only for a loop that runs once around its
-// centroid, monotonically; a pocket whose chord or diagonal would repeat an edge of the
-// surface is left for the cap as it is. The pockets and the cap together triangulate the
-// loop, so the caps' triangle count is the same.
-
-// The widest pocket closed, in angle around the loop's centroid: a loop's ragged dips span
-// a few of its points; wider ones (the low side of a slanted end) are the cap's.
-const double kPocketTurn = 3.14159265358979323846 / 8;
-
-// The loop (positions in cap order, the first its highest: see fill_pockets) in its
-// annulus picture, as the layers unroll (see >>unroll): around its centroid across the
-// axis, at a radius exp((h - h_first) / r) for the height h (-h for a bottom loop) and the
-// loop's mean radius r, mirrored so that the loop turns clockwise. False if it does not
-// run once around its centroid monotonically.
-inline bool unroll_loop(const CloudReader& cloud, const Frame& frame, const uint32_t* ids,
-                        uint32_t length, bool lower, double* xy) {
-    double cx = 0, cy = 0, radius = 0;
-    for (uint32_t i = 0; i < length; ++i) {
-        const Local p = frame.local(cloud.point(ids[i]));
-        cx += p.x;
-        cy += p.y;
-    }
-    cx /= length;
-    cy /= length;
-    const double pi = 3.14159265358979323846;
-    double turned = 0, previous = 0;
-    for (uint32_t i = 0; i <= length; ++i) {
-        const Local p = frame.local(cloud.point(ids[i % length]));
-        const double dx = p.x - cx, dy = p.y - cy, angle = std::atan2(dy, dx);
-        double step = i == 0 ? 0 : angle - previous;
-        step = step > pi ? step - 2 * pi : step < -pi ? step + 2 * pi : step;
-        if (i > 0 && !(step * (turned == 0 ? step : turned) > 0)) return false;
-        turned += step;
-        previous = angle;
-        if (i < length) {
-            radius += std::sqrt(dx * dx + dy * dy);
-            xy[2 * i] = dx;
-            xy[2 * i + 1] = lower ? -p.h : p.h;
-        }
-    }
-    if (!(abs_value(abs_value(turned) - 2 * pi) < 1e-9) || !(radius > 0)) return false;
-    radius /= length;
-    const double first = xy[1];
-    for (uint32_t i = 0; i < length; ++i) {
-        const Local p = frame.local(cloud.point(ids[i]));
-        const double dx = p.x - cx, dy = p.y - cy, d = std::sqrt(dx * dx + dy * dy);
-        const double rho = exp_portable((xy[2 * i + 1] - first) / radius);
-        const double u = d > 0 ? dx / d : 1, v = d > 0 ? dy / d : 0;
-        // Clockwise: mirrored where the loop turns counter-clockwise.
-        xy[2 * i] = (turned > 0 ? -u : u) * rho;
-        xy[2 * i + 1] = v * rho;
-    }
-    return true;
-}
-
-// Closes the pocket [from, to] of positions (to may be `length`: the first position again)
-// by ear clipping in the annulus picture, where it turns counter-clockwise; appends its
-// triangles at tri[3 * count] as the cap writes its own (in loop order). False, with count
-// unchanged, where no ear is left whose diagonal is not already an edge of the surface.
-inline bool close_pocket(uint32_t* tri, size_t& count, const CapGraph& g, const uint32_t* ids,
-                         uint32_t length, const double* xy, uint32_t from, uint32_t to,
-                         uint32_t* prev, uint32_t* next) {
-    const uint32_t n = to - from + 1;
-    auto point = [&](uint32_t k) { return xy + 2 * ((from + k) % length); };
-    for (uint32_t k = 0; k < n; ++k) {
-        prev[k] = k == 0 ? n - 1 : k - 1;
-        next[k] = k + 1 == n ? 0 : k + 1;
-    }
-    size_t added = count;
-    uint32_t v = 1, remaining = n, misses = 0;
-    while (remaining > 2) {
-        const uint32_t a = prev[v], b = next[v];
-        bool ear = orient2d_robust(point(a), point(v), point(b)) > 0 &&
-                   (remaining == 3 || !g.has_edge(ids[(from + a) % length], ids[(from + b) % length]));
-        for (uint32_t k = next[b]; ear && k != a; k = next[k])
-            ear = !(orient2d_robust(point(a), point(v), point(k)) >= 0 &&
-                    orient2d_robust(point(v), point(b), point(k)) >= 0 &&
-                    orient2d_robust(point(b), point(a), point(k)) >= 0);
-        if (!ear) {
-            v = b;
-            if (++misses > remaining) return false;
-            continue;
-        }
-        tri[3 * added] = ids[(from + a) % length];
-        tri[3 * added + 1] = ids[(from + v) % length];
-        tri[3 * added + 2] = ids[(from + b) % length];
-        ++added;
-        next[a] = b;
-        prev[b] = a;
-        v = a;
-        --remaining;
-        misses = 0;
-    }
-    count = added;
-    return true;
-}
-
-// Closes the pockets of the loop ids[0 .. length) (see above), rotating ids so that its
-// highest position (its lowest, for a bottom loop) comes first, and keeps in ids, in order,
-// the positions left for the cap; returns their number. The cap loop's arrays serve as
-// scratch.
-inline uint32_t fill_pockets(uint32_t* tri, size_t& count, const CapGraph& g, CapLoop& c,
-                             const CloudReader& cloud, const Frame& frame, uint32_t* ids,
-                             uint32_t length, bool lower) {
-    uint32_t top = 0;
-    for (uint32_t i = 1; i < length; ++i) {
-        const double h = frame.height(cloud.point(ids[i])), best = frame.height(cloud.point(ids[top]));
-        if (lower ? h < best : h > best) top = i;
-    }
-    // Rotated by three reversals, in place.
-    auto reverse = [ids](uint32_t first, uint32_t end) {
-        for (; first + 1 < end; ++first, --end) {
-            const uint32_t t = ids[first];
-            ids[first] = ids[end - 1];
-            ids[end - 1] = t;
-        }
-    };
-    reverse(0, top);
-    reverse(top, length);
-    reverse(0, length);
-    double* xy = c.xy;
-    if (!unroll_loop(cloud, frame, ids, length, lower, xy)) return length;
-    // The convex hull of the clockwise loop from its first position (on the hull, being the
-    // farthest out) round to it again: a Graham scan in the loop's order.
-    // The first position closes the hull again: scanned last, but not stored twice.
-    uint32_t* hull = c.reflex;
-    uint32_t hull_count = 0;
-    for (uint32_t j = 0; j <= length; ++j) {
-        const double* pj = xy + 2 * (j % length);
-        while (hull_count >= 2 &&
-               orient2d_robust(xy + 2 * hull[hull_count - 2], xy + 2 * hull[hull_count - 1], pj) >= 0)
-            --hull_count;  // not a strict right turn: off the hull
-        if (j < length) hull[hull_count++] = j;
-    }
-    if (hull_count < 3) return length;  // the cap needs three corners at least
-    unsigned char* gone = c.flags;
-    std::memset(gone, 0, length);
-    for (uint32_t k = 0; k < hull_count; ++k) {
-        const uint32_t from = hull[k], to = k + 1 < hull_count ? hull[k + 1] : length;
-        const double* pa = xy + 2 * from;
-        const double* pb = xy + 2 * (to % length);
-        const double span = std::atan2(abs_value(pa[0] * pb[1] - pa[1] * pb[0]),
-                                       pa[0] * pb[0] + pa[1] * pb[1]);
-        if (to - from < 2 || !(span < kPocketTurn) || g.has_edge(ids[from], ids[to % length]) ||
-            !close_pocket(tri, count, g, ids, length, xy, from, to, c.prev, c.next))
-            continue;
-        for (uint32_t j = from + 1; j < to; ++j) gone[j] = 1;
-    }
-    uint32_t kept = 0;
-    for (uint32_t i = 0; i < length; ++i)
-        if (!gone[i]) ids[kept++] = ids[i];
-    return kept;
-}
-
-// Caps every boundary loop of the surface tri[0 .. 3 count) over the cloud's points,
-// appending the cap triangles (count grows) and counting into caps (zeroed by the caller);
-// each loop is projected across the frame's axis. Returns ok; out_of_memory; or
-// triangle_capacity with *needed the triangles every cap closing would take, and nothing
-// written.
-inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
-                                 const CloudReader& cloud, size_t point_count,
-                                 const Frame& frame, Arena& arena, CapCounts& caps,
-                                 size_t* needed) {
-    auto project = [&](uint32_t id, double* xy, double* height) {
-        const Local p = frame.local(cloud.point(id));
-        xy[0] = p.x;
-        xy[1] = p.y;
-        *height = p.h;
-    };
-    const size_t wall = count;
-    size_t mark = arena.mark();
-    CapGraph g;
-    if (!allocate_cap_graph(g, point_count, count, arena)) return Status::out_of_memory;
-    size_t boundary = build_cap_graph(tri, count, point_count, g);
-    if (boundary == 0) {
-        arena.rewind(mark);
-        return Status::ok;
-    }
-    CapLoop c;
-    if (!allocate_cap_loop(c, boundary, arena)) return Status::out_of_memory;
-    size_t entries = 0;
-    size_t cap_triangles = trace_boundary_loops(g, point_count, c, &entries);
-    if (cap_triangles > capacity - count) {
-        *needed = count + cap_triangles;
-        return Status::triangle_capacity;
-    }
-    for (size_t start = 0; start < entries;) {
-        size_t end = start + 1;
-        while (end < entries && c.starts[end] == 0) ++end;
-        uint32_t* ids = c.ids + start;
-        // Cap triangle edges are numbered 3 t + k in 32 bits.
-        const bool usable = c.starts[start] == kLoopStart && end - start <= (kNoIndex - 1) / 3;
-        uint32_t length = static_cast<uint32_t>(end - start);
-        start = end;
-        // The loop's projection across the axis, checked to be a simple polygon, and its
-        // turning direction (0: not simple); then the same for the positions its pockets
-        // leave to the cap.
-        double turn = 0;
-        for (bool pockets = kLiftedCaps; usable; pockets = false) {
-            double height = 0;
-            for (uint32_t i = 0; i < length; ++i)
-                project(ids[i], c.xy + 2 * static_cast<size_t>(i), &height);
-            if (!polygon_is_simple(c.xy, length, c.sweep)) break;
-            // The lexicographically lowest corner is convex: it gives the turning direction.
-            uint32_t lowest = 0;
-            for (uint32_t i = 1; i < length; ++i)
-                if (lex_less(c.xy + 2 * static_cast<size_t>(i), c.xy + 2 * static_cast<size_t>(lowest)))
-                    lowest = i;
-            turn = orient2d_robust(c.xy + 2 * static_cast<size_t>(lowest == 0 ? length - 1 : lowest - 1),
-                                   c.xy + 2 * static_cast<size_t>(lowest),
-                                   c.xy + 2 * static_cast<size_t>(lowest + 1 == length ? 0 : lowest + 1));
-            if (!pockets || turn == 0) break;
-            const size_t before = count;
-            length = fill_pockets(tri, count, g, c, cloud, frame, ids, length, turn < 0);
-            caps.triangles += count - before;
-            turn = 0;
-        }
-        if (turn == 0) {
-            ++caps.left_open;
-            continue;
-        }
-        if (turn < 0)
-            for (uint32_t i = 0; i < length; ++i) c.xy[2 * static_cast<size_t>(i)] = -c.xy[2 * static_cast<size_t>(i)];
-        // A loop turning clockwise seen from +axis is capped facing -axis: a bottom cap.
-        CapTriangulation cap(c, ids, length, g, turn < 0);
-        bool clipped = cap.triangulate();
-        // The loop's start markers are read no more: its fins' flags take their place.
-        unsigned char* fins = c.starts + (ids - c.ids);
-        bool waived = false;
-        if (kCapFinFlips && !clipped &&
-            mark_flippable_fins(tri, wall, cloud, frame, g, g.boundary_next, ids, length, fins) > 0) {
-            cap.waive(fins);
-            waived = true;
-            clipped = cap.triangulate();
-        }
-        if (!clipped) {
-            ++caps.left_open;
-            continue;
-        }
-        double xy[2];  // c.xy holds them, mirrored
-        for (uint32_t i = 0; kLiftedCaps && i < length; ++i) project(ids[i], xy, c.height + i);
-        cap.settle_diagonals();
-        bool flips = false;
-        for (size_t k = 0; k < 3 * static_cast<size_t>(cap.triangles()); ++k) {
-            tri[3 * count + k] = ids[c.corners[k]];
-            const uint32_t fin = waived ? cap.waived_fin(c.corners[k], c.corners[k - k % 3 + (k + 1) % 3]) : kNoIndex;
-            if (fin != kNoIndex) {
-                fins[fin] |= kFinUsed;
-                flips = true;
-            }
-        }
-        if (flips)
-            caps.wall_flips += flip_used_fins(tri, wall, g.boundary_next, ids, length, fins, c.xy);
-        count += cap.triangles();
-        caps.triangles += cap.triangles();
-        ++caps.closed;
-    }
-    arena.rewind(mark);
-    return Status::ok;
-}
-
-}  // namespace detail
-}  // namespace stratmesh
-
-// >>webs ====================================================================================
-// How much of a finished surface spans gaps (Diagnostics).
-//
-// How much of a finished surface is web (Diagnostics): triangles far longer than the
-// spacing of the points they join, as where one tube wraps limbs and spans the gaps between
-// them. A vertex's local spacing is the median length of its edges, each counted once: the
-// edge that leaves it in each of its triangles (a boundary vertex misses one of its two
-// boundary edges). The median, not the shortest: a CT stack's edges across its slices are
-// far longer than those along a slice, and a vertex at a web's border has a few long edges
-// among its own. A triangle is web when its longest edge exceeds kWebSpacings times the
-// largest spacing of its corners: the largest, so that a triangle between a densely and a
-// sparsely sampled region is measured by the sparse one's. With 6, single columns (tubes,
-// heads, cones, capsules, CT slices, scan grids, noisy tubes, the bundled bust) show no web
-// triangle or a few, under 0.3% of their area, while objects with limbs meshed as one tube
-// show 2 to 12% of theirs. Far more of such a mesh is folded surface whose vertices have
-// only long edges (a fan of slivers from a foot to the body): the measure counts the
-// spans, which is enough to tell. The caps are left out: a cap spans its loop by design.
-//
-// The pass runs once the surface is final, when the layers' scratch is free: 72 bytes a
-// point (with 2 triangles a point), within reconstruct_workspace_size()'s bound. Lengths
-// are measured in the cloud's coordinates times a power of two that brings its extent near
-// 1 (exact), so that no square overflows or underflows.
-
-namespace stratmesh {
-namespace detail {
-
-// From the passes over all points as jobs (>>reconstruct).
-inline size_t run_start(size_t count, uint32_t k);
-template <class Pass> inline void run_pass(const Options& options, Pass& pass);
-
-// The vertices are numbered in the order the triangles first name them, their points
-// copied in that order, and the triangles renumbered in place (then restored): the passes
-// over the triangles then read nearby memory, whatever the cloud's order. The passes over
-// the vertices alone (copying their points, the medians) run as jobs where the caller gave
-// a runner; those over the triangles stay in order, as the areas are summed in it.
-struct WebMemory {
-    Vec3* points;      // a vertex's point (halved where the cloud spans more than a double)
-    size_t* ends;      // a vertex's count of edges, then where its lengths end once sorted
-    float* spacings;   // a vertex's local spacing
-    uint32_t* index;   // a vertex's index in the cloud
-    float* longest;    // a triangle's longest edge
-    // While the vertices are numbered, a point's number (or kNoIndex); then, in the same
-    // memory, the lengths of the edges leaving each vertex, vertex after vertex.
-    uint32_t* id;
-    float* lengths;
-};
-
-inline bool allocate_webs(WebMemory& m, size_t point_count, size_t triangle_count,
-                          Arena& arena) {
-    m.points = arena.alloc<Vec3>(point_count);
-    m.ends = arena.alloc<size_t>(point_count);
-    m.spacings = arena.alloc<float>(point_count);
-    m.index = arena.alloc<uint32_t>(point_count);
-    m.longest = arena.alloc<float>(triangle_count);
-    const size_t lengths = saturating_product(3, triangle_count);
-    void* shared = arena.take(lengths > point_count ? lengths : point_count, sizeof(float));
-    m.id = static_cast<uint32_t*>(shared);
-    m.lengths = static_cast<float*>(shared);
-    return !arena.failed;
-}
-
-// The workspace measure_webs() takes.
-inline size_t webs_workspace_size(size_t point_count, size_t triangle_count) {
-    Arena arena = Arena::measuring();
-    WebMemory m;
-    return allocate_webs(m, point_count, triangle_count, arena) ? arena.required_bytes() : 0;
-}
-
-// Edges in the cloud's coordinates times a power of two that brings the cloud's extent
-// near 1 (exact): no square overflows or underflows. Where the cloud spans more than the
-// largest double, the points are halved first, so that no difference overflows.
-struct WebFrame {
-    double scale;
-    bool halved;
-    Vec3 point(const CloudReader& reader, uint32_t i) const {
-        return halved ? scaled(reader.point(i), 0.5) : reader.point(i);
-    }
-    // ab, bc and ca of the triangle whose corners are numbered c.
-    void edges(const Vec3* points, const uint32_t* c, Vec3 e[3]) const {
-        const double s = halved ? 2 * scale : scale;
-        const Vec3 a = points[c[0]], b = points[c[1]], d = points[c[2]];
-        e[0] = scaled(b - a, s);
-        e[1] = scaled(d - b, s);
-        e[2] = scaled(a - d, s);
-    }
-};
-
-inline WebFrame web_frame(const CloudSums& s) {
-    const Vec3 low = {s.lowest[0], s.lowest[1], s.lowest[2]};
-    const Vec3 high = {s.highest[0], s.highest[1], s.highest[2]};
-    const Vec3 size = high - low, half = scaled(high, 0.5) - scaled(low, 0.5);
-    double extent = half.x > half.y ? half.x : half.y;
-    if (half.z > extent) extent = half.z;
-    return {scale_for_extent(extent), !(is_finite(size.x) && is_finite(size.y) && is_finite(size.z))};
-}
-
-// a, b in order (as min and max, which compile without a branch).
-inline void order(float& a, float& b) {
-    const float low = b < a ? b : a, high = a < b ? b : a;
-    a = low;
-    b = high;
-}
-
-// The lower median of v[0 .. count), count > 0: by a sorting network for a vertex's few
-// edges (no branch to mispredict), by heapsort for a large fan.
-inline float lower_median(float* v, size_t count) {
-    if (count > 8) {
-        heap_sort(v, count);
-        return v[(count - 1) / 2];
-    }
-    float s[8];
-    for (size_t i = 0; i < 8; ++i) s[i] = i < count ? v[i] : FLT_MAX;
-    order(s[0], s[2]), order(s[1], s[3]), order(s[4], s[6]), order(s[5], s[7]);
-    order(s[0], s[4]), order(s[1], s[5]), order(s[2], s[6]), order(s[3], s[7]);
-    order(s[0], s[1]), order(s[2], s[3]), order(s[4], s[5]), order(s[6], s[7]);
-    order(s[2], s[4]), order(s[3], s[5]);
-    order(s[1], s[4]), order(s[3], s[6]);
-    order(s[1], s[2]), order(s[3], s[4]), order(s[5], s[6]);
-    return s[(count - 1) / 2];
-}
-
-// Corners this far ahead are prefetched while the vertices are numbered, and points while
-// they are copied: the triangles name them in no order of the cloud's.
-const size_t kWebAhead = 16;
-
-// Numbers the vertices, renumbers the triangles' corners and counts the edges leaving each
-// vertex, then turns the counts into starts; returns how many vertices there are.
-inline uint32_t number_vertices(uint32_t* tri, size_t count, size_t point_count,
-                                const WebMemory& m) {
-    for (size_t v = 0; v < point_count; ++v) m.id[v] = kNoIndex;
-    uint32_t vertices = 0;
-    for (size_t k = 0; k < 3 * count; ++k) {
-        if (kFastLoops && k + kWebAhead < 3 * count) prefetch(m.id + tri[k + kWebAhead]);
-        uint32_t& id = m.id[tri[k]];
-        if (id == kNoIndex) {
-            id = vertices++;
-            m.index[id] = tri[k];
-            m.ends[id] = 0;
-        }
-        ++m.ends[id];
-        tri[k] = id;
-    }
-    size_t start = 0;
-    for (uint32_t v = 0; v < vertices; ++v) {
-        const size_t edges = m.ends[v];
-        m.ends[v] = start;
-        start += edges;
-    }
-    return vertices;
-}
-
-// The passes over the vertices, by runs of them (see run_pass) or all at once.
-struct WebVertexPass {
-    const CloudReader* reader;
-    const WebFrame* frame;
-    const WebMemory* m;
-    uint32_t vertices;
-    bool medians;  // else the points
-
-    void run(uint32_t k) { over(run_start(vertices, k), run_start(vertices, k + 1)); }
-    void over(size_t begin, size_t end) const {
-        if (!medians) {
-            for (size_t v = begin; v < end; ++v) {
-                if (kFastLoops && v + kWebAhead < end)
-                    prefetch(reader->base + m->index[v + kWebAhead] * reader->stride);
-                m->points[v] = frame->point(*reader, m->index[v]);
-            }
-            return;
-        }
-        for (size_t v = begin; v < end; ++v) {
-            const size_t first = v > 0 ? m->ends[v - 1] : 0;
-            m->spacings[v] = lower_median(m->lengths + first, m->ends[v] - first);
-        }
-    }
-};
-
-inline void run_vertex_pass(const Options& options, WebVertexPass& pass) {
-    if (kParallelLayers && options.run_jobs)
-        run_pass(options, pass);
-    else
-        pass.over(0, pass.vertices);
-}
-
-// The lengths of the edges leaving each vertex, sorted by vertex (a counting sort: each
-// start becomes an end), and each triangle's longest edge. Returns the triangles' area.
-inline double edge_lengths(const WebFrame& f, const uint32_t* tri, size_t count,
-                           const WebMemory& m) {
-    double area = 0;
-    for (size_t t = 0; t < count; ++t) {
-        const uint32_t* c = tri + 3 * t;
-        Vec3 e[3];
-        f.edges(m.points, c, e);
-        const Vec3 n = cross(e[0], e[1]);
-        area += std::sqrt(dot(n, n)) / 2;
-        float longest = 0;
-        for (size_t j = 0; j < 3; ++j) {
-            const float length = static_cast<float>(std::sqrt(dot(e[j], e[j])));
-            m.lengths[m.ends[c[j]]++] = length;
-            longest = length > longest ? length : longest;
-        }
-        m.longest[t] = longest;
-    }
-    return area;
-}
-
-// The web triangles among the renumbered triangles (see Diagnostics), into d, while their
-// corners are numbered back; returns their area.
-inline double find_webs(const WebFrame& f, uint32_t* tri, size_t count, const WebMemory& m,
-                        Diagnostics& d) {
-    double web = 0;
-    Vec3 low = {DBL_MAX, DBL_MAX, DBL_MAX}, high = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
-    for (size_t t = 0; t < count; ++t) {
-        uint32_t* c = tri + 3 * t;
-        float spacing = 0;
-        for (size_t j = 0; j < 3; ++j)
-            spacing = m.spacings[c[j]] > spacing ? m.spacings[c[j]] : spacing;
-        if (static_cast<double>(m.longest[t]) > kWebSpacings * static_cast<double>(spacing)) {
-            ++d.web_triangle_count;
-            Vec3 e[3];
-            f.edges(m.points, c, e);
-            const Vec3 n = cross(e[0], e[1]);
-            web += std::sqrt(dot(n, n)) / 2;
-            for (size_t j = 0; j < 3; ++j) {
-                const Vec3 p = m.points[c[j]];
-                low = {p.x < low.x ? p.x : low.x, p.y < low.y ? p.y : low.y,
-                       p.z < low.z ? p.z : low.z};
-                high = {p.x > high.x ? p.x : high.x, p.y > high.y ? p.y : high.y,
-                        p.z > high.z ? p.z : high.z};
-            }
-        }
-        for (size_t j = 0; j < 3; ++j) c[j] = m.index[c[j]];
-    }
-    const double unhalve = f.halved ? 2 : 1;  // the copied points are halved then
-    const double lows[3] = {low.x, low.y, low.z}, highs[3] = {high.x, high.y, high.z};
-    for (int k = 0; d.web_triangle_count > 0 && k < 3; ++k) {
-        d.web_box_min[k] = lows[k] * unhalve;
-        d.web_box_max[k] = highs[k] * unhalve;
-    }
-    return web;
-}
-
-// Measures the webs of triangles[0 .. count) less the last `caps` into rep.diagnostics;
-// the triangles are renumbered meanwhile and come back as they were. False if the
-// workspace is too small (nothing is measured).
-inline bool measure_webs(const Options& options, const CloudReader& reader, size_t point_count,
-                         const CloudSums& sums, uint32_t* triangles, size_t count, size_t caps,
-                         Arena& arena, Report& rep) {
-    const size_t walls = caps < count ? count - caps : 0;
-    const size_t mark = arena.mark();
-    WebMemory m;
-    if (!allocate_webs(m, point_count, walls, arena)) return false;
-    const WebFrame f = web_frame(sums);
-    WebVertexPass pass = {&reader, &f, &m, number_vertices(triangles, walls, point_count, m),
-                          false};
-    run_vertex_pass(options, pass);
-    const double area = edge_lengths(f, triangles, walls, m);
-    pass.medians = true;
-    run_vertex_pass(options, pass);
-    Diagnostics& d = rep.diagnostics;
-    const double web = find_webs(f, triangles, walls, m, d);
-    arena.rewind(mark);
-    if (d.web_triangle_count == 0) return true;
-    d.web_area = web / f.scale / f.scale;
-    d.web_area_fraction = area > 0 ? web / area : 0;
-    return true;
-}
-
-}  // namespace detail
-}  // namespace stratmesh
-
-// >>reconstruct =============================================================================
-// One tube: chunks of layers, seam flips, parallel layers.
+// >>chain ================================================================================
+// The surface as a chain of chunks: a group of layers with its band, sealed to the one below.
 //
 // Validate, choose the frame and the layers, group the points by layer, then for each
 // layer: fit its cylinder, triangulate it on its annulus, stitch it to the layer below.
@@ -7749,6 +6423,350 @@ inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerL
     return sound;
 }
 
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>flips ================================================================================
+// Flips on the surface: within a layer, and across the seam between layers.
+
+namespace stratmesh {
+namespace detail {
+
+// ---- flips on the surface ----
+//
+// With the surface_flips flag. The unrolling squeezes whatever lies almost across the axis:
+// the underside of an ear, the crease where it meets the head, a chin. There the annulus's
+// Delaunay triangles, good in the plane, are long and thin on the surface and run across
+// the crease: on a synthetic bust with ears (bench/horned_bust.py --no-horns) the ears had
+// 14% of the area and 57% of the distance to the true surface, 2.7 times the distance of
+// CGAL's advancing front there, as close as it elsewhere. So once a layer is triangulated
+// and its loops are settled, its surface edges are flipped on the surface itself, by two
+// rules. An edge ab between triangles abp and baq is flipped to pq
+//  - by the empty-circle rule, where the angles at p and q, measured in 3D, sum to more
+//    than 180 degrees (in a plane: q inside the circle through a, b, p), unless pq bends
+//    the surface more than kBendVeto times what ab did;
+//  - for the bend alone, where pq bends it kBendGain times less than ab.
+// The bend of an edge ab is |(b - a) . (n_b - n_a)| with n the vertex normals (the mean of
+// the unit normals of the triangles around): 8 times the sag at the middle of a curve
+// through a and b normal to n_a and n_b. An edge along the direction in which the surface
+// curves least bends least, and triangles along it lie nearest the surface: on a cone,
+// along its generatrices. The empty-circle rule alone, which wants fat triangles, turned
+// the annulus's triangles across that direction on smooth surfaces of revolution (one
+// layer, mean distance to the analytic surface: vase 13% and cone 27% farther than
+// without flips); with both rules the vase is 3% and the cone 47% closer, the bumpy tube
+// 44% (10% with the empty-circle rule alone), the bust with ears 25% (18%). Since
+// kBendVeto <= kBendGain, the two rules never flip one quad back and forth with the same
+// normals; the normals are estimated anew at the start of each of the first
+// kNormalSweeps sweeps and then kept, so that the flips settle (the clouds measured: at
+// most 2 flips in the last sweep).
+// A flip is kept only if neither new triangle faces the axis (no new fold) nor is
+// degenerate, the new triangles' widest angle is at most 150 degrees (kWidestAngle) or
+// less wide than the old ones' (the bend alone makes needles: without that limit 17% of
+// the bust's triangles had an angle under 5 degrees, with it 2%, as without flips), pq is
+// not already an edge nor a chord of a loop (where close_ends puts its cap), and, unless
+// both new normals are within 26 degrees of the old pair's (kGentleFlip: the new
+// triangles cover about the same place as the old), neither new triangle meets a surface
+// triangle around the quad's corners (the test is in floating point, on triangles shrunk
+// by a millionth about their centroids, so that shared corners and edges do not count;
+// testing the triangles around the corners' neighbours too changed nothing on the
+// synthetic bust). Loop edges are never flipped, so the loops, the bands and the peeled
+// triangles that add_group may put back are the same as without the flips (the band and
+// the triangles at its loops are flipped later, see "flips across the seam"). The first
+// sweep visits every edge; later sweeps only the triangles the sweep before changed. The
+// sweeps are bounded (kSurfaceFlipSweeps).
+const uint32_t kSurfaceFlipSweeps = 8;
+
+const uint32_t kNormalSweeps = 4;  // the sweeps that start with the normals estimated anew
+
+const uint32_t kFanLimit = 64;  // a vertex with more neighbours keeps its edges
+
+const double kFlipMargin = 1e-9;
+
+const double kGentleFlip = 0.9;  // cosine of the largest angle between a new and the mean normal
+
+const double kShrink = 1e-6;
+
+const double kBendVeto = 3;  // a flip by the empty-circle rule may bend at most 3 times more
+
+const double kBendGain = 3;  // a flip for the bend alone must bend 3 times less
+
+const double kWidestAngle = -0.86602540378443865;  // cosine of 150 degrees
+
+inline Vec3 vec_of(const Local& p) { return Vec3{p.x, p.y, p.h}; }
+
+struct Box3 {
+    Vec3 low, high;
+    bool meets(const Box3& o) const {
+        return low.x <= o.high.x && o.low.x <= high.x && low.y <= o.high.y &&
+               o.low.y <= high.y && low.z <= o.high.z && o.low.z <= high.z;
+    }
+};
+
+inline Box3 box_of(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
+    Box3 box = {a, a};
+    const Vec3 rest[3] = {b, c, d};
+    for (const Vec3& p : rest) {
+        box.low = Vec3{p.x < box.low.x ? p.x : box.low.x, p.y < box.low.y ? p.y : box.low.y,
+                       p.z < box.low.z ? p.z : box.low.z};
+        box.high = Vec3{p.x > box.high.x ? p.x : box.high.x, p.y > box.high.y ? p.y : box.high.y,
+                        p.z > box.high.z ? p.z : box.high.z};
+    }
+    return box;
+}
+
+// Whether the angles at p and q facing the segment ab sum to more than 180 degrees: then
+// sin(angle_p + angle_q), a sum of sine-cosine products, is negative. Two acute angles
+// (most edges) are settled by two dot products.
+inline bool flip_helps(Vec3 a, Vec3 b, Vec3 p, Vec3 q) {
+    const Vec3 pa = a - p, pb = b - p, qa = a - q, qb = b - q;
+    const double cos_p = dot(pa, pb), cos_q = dot(qa, qb);
+    if (cos_p >= 0 && cos_q >= 0) return false;
+    const Vec3 np = cross(pa, pb), nq = cross(qa, qb);
+    const double sin_p = std::sqrt(dot(np, np)), sin_q = std::sqrt(dot(nq, nq));
+    const double lengths = std::sqrt(dot(pa, pa) * dot(pb, pb) * dot(qa, qa) * dot(qb, qb));
+    return sin_p * cos_q + cos_p * sin_q < -kFlipMargin * lengths;
+}
+
+// Whether triangles u and v, each shrunk by kShrink about its centroid, overlap along every
+// axis that could separate them: their normals, the cross products of their edges, and
+// each normal crossed with the triangle's own edges (for coplanar triangles).
+inline bool triangles_meet(const Vec3* u, const Vec3* v) {
+    Vec3 s[3], t[3];
+    const Vec3 cu = scaled(Vec3{u[0].x + u[1].x + u[2].x, u[0].y + u[1].y + u[2].y,
+                                u[0].z + u[1].z + u[2].z}, 1.0 / 3);
+    const Vec3 cv = scaled(Vec3{v[0].x + v[1].x + v[2].x, v[0].y + v[1].y + v[2].y,
+                                v[0].z + v[1].z + v[2].z}, 1.0 / 3);
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 du = u[k] - cu, dv = v[k] - cv;
+        s[k] = Vec3{cu.x + du.x * (1 - kShrink), cu.y + du.y * (1 - kShrink),
+                    cu.z + du.z * (1 - kShrink)};
+        t[k] = Vec3{cv.x + dv.x * (1 - kShrink), cv.y + dv.y * (1 - kShrink),
+                    cv.z + dv.z * (1 - kShrink)};
+    }
+    Vec3 es[3], et[3];
+    for (int k = 0; k < 3; ++k) {
+        es[k] = s[(k + 1) % 3] - s[k];
+        et[k] = t[(k + 1) % 3] - t[k];
+    }
+    const Vec3 ns = cross(es[0], es[1]), nt = cross(et[0], et[1]);
+    auto separates = [&s, &t](Vec3 axis) {
+        double s_lo = dot(s[0], axis), s_hi = s_lo, t_lo = dot(t[0], axis), t_hi = t_lo;
+        for (int k = 1; k < 3; ++k) {
+            const double ds = dot(s[k], axis), dt = dot(t[k], axis);
+            s_lo = ds < s_lo ? ds : s_lo;
+            s_hi = ds > s_hi ? ds : s_hi;
+            t_lo = dt < t_lo ? dt : t_lo;
+            t_hi = dt > t_hi ? dt : t_hi;
+        }
+        return s_hi < t_lo || t_hi < s_lo;
+    };
+    if (separates(ns) || separates(nt)) return false;
+    for (int i = 0; i < 3; ++i) {
+        if (separates(cross(ns, es[i])) || separates(cross(nt, et[i]))) return false;
+        for (int j = 0; j < 3; ++j)
+            if (separates(cross(es[i], et[j]))) return false;
+    }
+    return true;
+}
+
+// Calls visit(g) for each half-edge g leaving the start of half-edge `from`, counter-clockwise
+// around it, until visit returns false. False if a visit did, or the vertex has more than
+// kFanLimit neighbours.
+template <class Visit>
+inline bool around_vertex(const Triangulation& tr, uint32_t from, Visit visit) {
+    uint32_t e = from;
+    for (uint32_t steps = 0; steps < kFanLimit; ++steps) {
+        if (!visit(e)) return false;
+        e = tr.twin[prev_edge(e)];
+        if (e == from) return true;
+    }
+    return false;
+}
+
+// The vertex normals, kept in the room of the annulus coordinates (two doubles a vertex,
+// free once the loops are settled) as three floats, copied in and out so that no type is
+// read through another: the sum of the unit normals of the surface triangles around the
+// vertex, made unit.
+struct VertexNormals {
+    double* room;
+    // The unit normal at vertex v; zero if it has no surface triangle of nonzero area.
+    Vec3 at(uint32_t v) const {
+        float n[3];
+        std::memcpy(n, room + 2 * static_cast<size_t>(v), sizeof n);
+        return Vec3{static_cast<double>(n[0]), static_cast<double>(n[1]),
+                    static_cast<double>(n[2])};
+    }
+    void estimate(const Triangulation& tr, const Local* points, size_t vertices) {
+        std::memset(room, 0, 2 * vertices * sizeof(double));
+        for (uint32_t t = 0; t < tr.triangle_count; ++t) {
+            if (!on_surface(tr, t)) continue;
+            const uint32_t* v = tr.vertex + 3 * t;
+            Vec3 n = normal_of(points[v[0] - 1], points[v[1] - 1], points[v[2] - 1]);
+            const double length = std::sqrt(dot(n, n));
+            if (length == 0) continue;
+            n = scaled(n, 1 / length);
+            for (uint32_t k = 0; k < 3; ++k) {
+                float sum[3];
+                std::memcpy(sum, room + 2 * static_cast<size_t>(v[k]), sizeof sum);
+                sum[0] += static_cast<float>(n.x);
+                sum[1] += static_cast<float>(n.y);
+                sum[2] += static_cast<float>(n.z);
+                std::memcpy(room + 2 * static_cast<size_t>(v[k]), sum, sizeof sum);
+            }
+        }
+        for (size_t v = 0; v < vertices; ++v) {
+            const Vec3 sum = at(static_cast<uint32_t>(v));
+            const double length = std::sqrt(dot(sum, sum));
+            if (length == 0) continue;
+            const float unit[3] = {static_cast<float>(sum.x / length),
+                                   static_cast<float>(sum.y / length),
+                                   static_cast<float>(sum.z / length)};
+            std::memcpy(room + 2 * v, unit, sizeof unit);
+        }
+    }
+};
+
+// How much the surface bends along edge ab, with unit normals na and nb at its ends (see
+// above).
+inline double bend_along(Vec3 a, Vec3 b, Vec3 na, Vec3 nb) {
+    return std::fabs(dot(b - a, nb - na));
+}
+
+// The cosine of the widest angle of triangle abc.
+inline double widest_angle_cosine(Vec3 a, Vec3 b, Vec3 c) {
+    const Vec3 corner[3] = {a, b, c};
+    double widest = 1;
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 u = corner[(k + 1) % 3] - corner[k], v = corner[(k + 2) % 3] - corner[k];
+        const double lengths = std::sqrt(dot(u, u) * dot(v, v));
+        const double cosine = lengths > 0 ? dot(u, v) / lengths : -1;
+        widest = cosine < widest ? cosine : widest;
+    }
+    return widest;
+}
+
+// Whether the surface wants ab of triangles abp and baq turned into pq, by the two rules
+// (see above; na .. nq the corners' unit normals, none zero) without an angle wider than
+// kWidestAngle (unless the old pair had a wider one).
+inline bool flip_wanted(const Local& la, const Local& lb, const Local& lp, const Local& lq,
+                        Vec3 na, Vec3 nb, Vec3 np, Vec3 nq) {
+    if (dot(na, na) == 0 || dot(nb, nb) == 0 || dot(np, np) == 0 || dot(nq, nq) == 0)
+        return false;
+    const double bend_before = bend_along(vec_of(la), vec_of(lb), na, nb);
+    const double bend_after = bend_along(vec_of(lp), vec_of(lq), np, nq);
+    if (flip_helps(vec_of(la), vec_of(lb), vec_of(lp), vec_of(lq))
+            ? bend_after > kBendVeto * bend_before
+            : !(kBendGain * bend_after < bend_before))
+        return false;
+    const double widest_after =
+        std::fmin(widest_angle_cosine(vec_of(lp), vec_of(la), vec_of(lq)),
+                  widest_angle_cosine(vec_of(lq), vec_of(lb), vec_of(lp)));
+    return !(widest_after < kWidestAngle &&
+             widest_after < std::fmin(widest_angle_cosine(vec_of(la), vec_of(lb), vec_of(lp)),
+                                      widest_angle_cosine(vec_of(lb), vec_of(la), vec_of(lq))));
+}
+
+// Whether both new triangles (p, a, q) and (q, b, p) of that flip have normals within
+// kGentleFlip of the old pair's mean.
+inline bool gentle_flip(const Local& la, const Local& lb, const Local& lp, const Local& lq) {
+    Vec3 mean = normal_of(la, lb, lp);
+    const Vec3 other_normal = normal_of(lb, la, lq);
+    mean = Vec3{mean.x + other_normal.x, mean.y + other_normal.y, mean.z + other_normal.z};
+    const Vec3 n1 = normal_of(lp, la, lq), n2 = normal_of(lq, lb, lp);
+    return dot(n1, mean) > kGentleFlip * std::sqrt(dot(n1, n1) * dot(mean, mean)) &&
+           dot(n2, mean) > kGentleFlip * std::sqrt(dot(n2, n2) * dot(mean, mean));
+}
+
+// Flips half-edge e of a layer's triangulation on the surface if that helps (see above).
+inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32_t* flags,
+                            VertexNormals& normals, const Cylinder& cyl, uint32_t e) {
+    const uint32_t f = tr.twin[e];
+    const uint32_t t = e / 3, u = f / 3;
+    if (!on_surface(tr, u)) return false;
+    const uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)], p = tr.vertex[prev_edge(e)];
+    const uint32_t q = tr.vertex[prev_edge(f)];
+    // A chord of a loop would stand where close_ends puts its cap.
+    if (p == q || (flags[p] & flags[q] & (kOnBottomLoop | kOnTopLoop))) return false;
+    const Local &la = points[a - 1], &lb = points[b - 1], &lp = points[p - 1], &lq = points[q - 1];
+    if (!flip_wanted(la, lb, lp, lq, normals.at(a), normals.at(b), normals.at(p), normals.at(q)))
+        return false;
+    // The new triangles (p, a, q) and (q, b, p), counter-clockwise on the annulus.
+    if (faces_axis(lq, la, lp, cyl) || faces_axis(lp, lb, lq, cyl) ||
+        doubled_area(lp, la, lq) == 0 || doubled_area(lq, lb, lp) == 0)
+        return false;
+    if (!around_vertex(tr, prev_edge(e), [&tr, q](uint32_t g) {
+            return tr.vertex[next_edge(g)] != q;
+        }))
+        return false;
+    // A flip in a gently curved quad, convex seen along its normal, covers about the
+    // same place as before: nothing else to check.
+    if (!gentle_flip(la, lb, lp, lq)) {
+        const Vec3 first[3] = {vec_of(lp), vec_of(la), vec_of(lq)};
+        const Vec3 second[3] = {vec_of(lq), vec_of(lb), vec_of(lp)};
+        const Box3 quad = box_of(first[0], first[1], first[2], second[1]);
+        auto clear_of = [&](uint32_t g) {
+            const uint32_t s = g / 3;
+            if (s == t || s == u || !on_surface(tr, s)) return true;
+            const uint32_t* v = tr.vertex + 3 * s;
+            const Vec3 other[3] = {vec_of(points[v[0] - 1]), vec_of(points[v[1] - 1]),
+                                   vec_of(points[v[2] - 1])};
+            return !quad.meets(box_of(other[0], other[1], other[2], other[2])) ||
+                   (!triangles_meet(first, other) && !triangles_meet(second, other));
+        };
+        // The triangles around the quad's corners.
+        const uint32_t corners[4] = {e, f, prev_edge(e), prev_edge(f)};
+        for (uint32_t corner : corners)
+            if (!around_vertex(tr, corner, clear_of)) return false;
+    }
+    flip_edge<false>(tr, e, nullptr);
+    return true;
+}
+
+// Flips the surface edges of a layer's triangulation, sweep after sweep, until a sweep
+// flips none or kSurfaceFlipSweeps have run; after the first sweep, only edges between
+// two corners of quads flipped in the sweep before (the edges whose triangles changed).
+// `flags` holds a word per vertex (see triangulate_layer); the bits kFlippedBefore and
+// kFlippedNow are used here and cleared. `room` is the annulus coordinates, two doubles a
+// vertex, overwritten. Returns the number of flips.
+inline size_t flip_layer_on_surface(Triangulation& tr, const Local* points, const Cylinder& cyl,
+                                    uint32_t* flags, double* room, size_t vertices) {
+    VertexNormals normals = {room};
+    size_t flips = 0;
+    for (uint32_t sweep = 0; sweep < kSurfaceFlipSweeps; ++sweep) {
+        if (sweep < kNormalSweeps) normals.estimate(tr, points, vertices);
+        size_t flipped = 0;
+        for (uint32_t t = 0; t < tr.triangle_count; ++t) {
+            if (!on_surface(tr, t)) continue;
+            const uint32_t* v = tr.vertex + 3 * t;
+            // After the first sweep: at least two corners flipped before.
+            if (sweep > 0 && ((flags[v[0]] & kFlippedBefore) + (flags[v[1]] & kFlippedBefore) +
+                              (flags[v[2]] & kFlippedBefore)) < 2 * kFlippedBefore)
+                continue;
+            for (uint32_t e = 3 * t; e < 3 * t + 3; ++e) {
+                // Each edge once a sweep, from the side of its larger half-edge.
+                const uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)];
+                if (tr.twin[e] > e || (sweep > 0 && !(flags[a] & flags[b] & kFlippedBefore)) ||
+                    !flip_on_surface(tr, points, flags, normals, cyl, e))
+                    continue;
+                ++flipped;
+                // t is (p, a, q) after the flip, and the twin's triangle (q, b, p).
+                flags[tr.vertex[3 * t]] |= kFlippedNow;
+                flags[tr.vertex[3 * t + 1]] |= kFlippedNow;
+                flags[tr.vertex[3 * t + 2]] |= kFlippedNow;
+                flags[b] |= kFlippedNow;
+                break;
+            }
+        }
+        for (size_t v = 0; v < vertices; ++v)
+            flags[v] = (flags[v] & ~(kFlippedBefore | kFlippedNow)) |
+                       ((flags[v] & kFlippedNow) ? kFlippedBefore : 0);
+        flips += flipped;
+        if (flipped == 0) break;
+    }
+    for (size_t v = 0; v < vertices; ++v) flags[v] &= ~kFlippedBefore;
+    return flips;
+}
+
 // ---- flips across the seam ----
 //
 // With the surface_flips flag. A layer's flips on the surface (see "flips on the surface")
@@ -8042,6 +7060,1445 @@ inline bool flip_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
     return true;
 }
 
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>layer triangulation ==================================================================
+// One layer triangulated on its annulus, its loops peeled and its edges flipped.
+
+namespace stratmesh {
+namespace detail {
+
+// Triangulates a loaded layer rolled onto the annulus of its cylinder plus the centre (the
+// centre moved first if the layer folds less around another: see choose_centre).
+// Emits the surface triangles and fills the loops, in layer-local indices. Returns ok,
+// not_columnar (the layer does not surround its axis, or is degenerate: the caller merges
+// it with the next one), out_of_memory or internal_error. Its scratch is released; the
+// layer's points are left in insertion order (layer.points[k] is layer-local point
+// order[k], an order not kept).
+inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Arena& arena,
+                                TriangleSink& sink, LayerLoops& loops, LayerCounts& counts) {
+    const size_t count = layer.count, total = count + 1;  // vertex 0 is the centre
+    choose_centre(layer, arena);
+    Local* points = layer.points;
+    const Cylinder& cyl = layer.cyl;
+    size_t mark = arena.mark();
+    uint32_t* order = arena.alloc<uint32_t>(count);  // vertex - 1 -> layer-local index
+    double* xy = arena.alloc<double>(2 * total);
+    if (arena.failed) return Status::out_of_memory;
+    // The insertion order is taken on the unrolled strip (angle, height), where the points
+    // are spread evenly: on the annulus their density falls off with the radius squared
+    // and a curve over its bounding box would lump the inner rings together. The strip has
+    // the cylinder's proportions (angle in radians, height over the radius), as the curve's
+    // cells are square. The centre goes first.
+    const double quarter_turn = 1.57079632679489661923;  // pseudo_angle's unit, in radians
+    BoundingBox2d box = {{0, 0}, {4 * quarter_turn, 0}};
+    double* strip = xy + 2;
+    for (size_t i = 0; i < count; ++i) {
+        const Local& p = points[i];
+        strip[2 * i] = quarter_turn * pseudo_angle(p.x - cyl.cx, p.y - cyl.cy);
+        strip[2 * i + 1] = (p.h - cyl.h0) * cyl.scale;
+        if (strip[2 * i + 1] > box.max[1]) box.max[1] = strip[2 * i + 1];
+    }
+    if (!spatial_order(reinterpret_cast<const unsigned char*>(strip), 2 * sizeof(double), count,
+                       box, order, arena))
+        return Status::out_of_memory;
+    // The points in insertion order, so that unrolling them and the fold test below read
+    // them in sequence, not at random (the copy's room is free again before the
+    // triangulation takes it).
+    size_t copy_mark = arena.mark();
+    Local* sorted = arena.alloc<Local>(count);
+    if (arena.failed) return Status::out_of_memory;
+    for (size_t k = 0; k < count; ++k) sorted[k] = points[order[k]];
+    std::memcpy(points, sorted, count * sizeof(Local));
+    arena.rewind(copy_mark);
+    xy[0] = xy[1] = 0;
+    for (size_t k = 0; k < count; ++k) roll(cyl, points[k], xy + 2 * (k + 1));
+    Triangulation tr;
+    tr.xy = xy;
+    if (!allocate_triangulation(tr, total, arena)) return Status::out_of_memory;
+    counts = LayerCounts{0, 0};
+    LayerDuplicates classify = {&cloud, layer.ids, order, &counts};
+    DuplicateSink duplicates = {LayerDuplicates::report, &classify};
+    uint32_t inserted = 0;
+    Status status = triangulate_points(tr, static_cast<uint32_t>(total), duplicates, &inserted);
+    if (status == Status::internal_error) return status;
+    // The flip stack's room is free now: a flag per vertex (kOnBottomLoop, kOnTopLoop,
+    // kEmitted).
+    uint32_t* flags = tr.stack;
+    std::memset(flags, 0, total * sizeof(uint32_t));
+    if (status != Status::ok || !centre_link(tr, loops.bottom, &loops.bottom_count, flags)) {
+        arena.rewind(mark);
+        return Status::not_columnar;
+    }
+    hull_loop(tr, loops.top, &loops.top_count, flags);
+    size_t folds = count_folds(tr, points, 1, cyl, nullptr);
+    if (folds == 0 || kPeelFoldedEnds) {
+        const uint32_t capacity = static_cast<uint32_t>(count);
+        // The passes and the slope of a loop (see "peeling"): the surface's end loops of a
+        // layer that folds peel further; its other loops not at all.
+        auto passes = [&layer, folds](uint32_t end) {
+            if (folds == 0) return kPeelPasses;
+            return (layer.ends & end) ? kFoldedEndPeelPasses : 0;
+        };
+        auto slope = [&layer, folds](uint32_t end) {
+            if (!(layer.ends & end)) return kInnerPeelSlope;
+            return folds == 0 ? kPeelSlope : kFoldedEndPeelSlope;
+        };
+        loops.bottom_count = peel_loop(tr, points, flags, loops.bottom, loops.bottom_count,
+                                       capacity, false, slope(kLowPole), passes(kLowPole));
+        loops.top_count = peel_loop(tr, points, flags, loops.top, loops.top_count, capacity,
+                                    true, slope(kHighPole), passes(kHighPole));
+    }
+    name_loop(tr, order, flags, loops.bottom, loops.bottom_count, loops.bottom_flags, false);
+    name_loop(tr, order, flags, loops.top, loops.top_count, loops.top_flags, true);
+    if (kSurfaceFlips && layer.surface_flips &&
+        flip_layer_on_surface(tr, points, cyl, flags, xy, total) && folds)
+        folds = count_folds(tr, points, 1, cyl, nullptr);
+    // The triangles at the bottom loop (the border) go last, so that a chunk's triangles at
+    // its loop vertices are one stretch of the sink with the band (see chunk_is_sound).
+    for (uint32_t at_border = 0; at_border < 2; ++at_border) {
+        if (at_border) loops.border_start = sink.count;
+        for (uint32_t t = 0; t < tr.triangle_count; ++t) {
+            const uint32_t* v = tr.vertex + 3 * t;
+            if (!on_surface(tr, t) ||
+                ((flags[v[0]] | flags[v[1]] | flags[v[2]]) & kOnBottomLoop) != at_border)
+                continue;
+            if (kNetShortcut) {
+                flags[v[0]] |= kEmitted;
+                flags[v[1]] |= kEmitted;
+                flags[v[2]] |= kEmitted;
+            }
+            sink.write(order[v[0] - 1], order[v[1] - 1], order[v[2] - 1]);
+        }
+    }
+    sink.folds += folds;
+    loops.interior_used = 0;
+    for (size_t v = 1; kNetShortcut && v < total; ++v)
+        loops.interior_used += (flags[v] & (kOnBottomLoop | kEmitted)) == kEmitted;
+    arena.rewind(mark);
+    return Status::ok;
+}
+
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>surface loops ========================================================================
+// The boundary loops of a surface, traced from its triangles.
+
+namespace stratmesh {
+namespace detail {
+
+// The surface's directed edges between boundary vertices, grouped by first vertex, each
+// group sorted; and per vertex the far end of its boundary edge. The output is
+// vertex-manifold, so a vertex has at most one boundary edge leaving it.
+struct CapGraph {
+    size_t* offsets;          // point_count + 1: each vertex's range in `targets`
+    uint32_t* targets;        // at most 3 per triangle
+    uint32_t* boundary_next;  // per vertex, or kNoIndex
+
+    bool leads_to(uint32_t a, uint32_t b) const {
+        size_t lo = offsets[a], hi = offsets[a + 1];
+        while (lo < hi) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (targets[mid] < b) lo = mid + 1; else hi = mid;
+        }
+        return lo < offsets[a + 1] && targets[lo] == b;
+    }
+    // For boundary vertices a and b only.
+    bool has_edge(uint32_t a, uint32_t b) const { return leads_to(a, b) || leads_to(b, a); }
+};
+
+// The simplicity sweep keys a loop edge by its smaller x and its index, packed in 64 bits:
+// the high 32 bits of an unsigned integer that orders as x does (finite, -0 as +0), then
+// the index. Coarser than x, the key still never orders an edge before one whose smaller x
+// is below its own, so the sweep meets every pair whose x ranges overlap (and a few more,
+// which the exact test settles).
+inline uint32_t sweep_key(double x) {
+    x += 0.0;
+    uint64_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    bits = (bits >> 63) ? ~bits : bits | (uint64_t{1} << 63);
+    return static_cast<uint32_t>(bits >> 32);
+}
+
+// The arrays of one loop, sized for all boundary vertices together (every loop fits).
+// Positions are the loop's vertices in cap order, 0 .. length - 1.
+struct CapLoop {
+    uint32_t* ids;            // all loops one after another, each in cap order
+    unsigned char* starts;    // per entry of `ids`: kLoopStart, kLoopBroken or 0
+    double* xy;               // per position: the projection, mirrored to turn counter-clockwise
+    double* height;           // per position, for the flips: the height along the axis (in
+                              // the clipping arrays' memory)
+    unsigned char* flags;     // per position while clipping, per cap triangle while flipping
+    double* scratch;          // for incircle
+    uint64_t* sweep;          // per edge (sweep_key); shares its memory with the arrays below
+    uint32_t* prev;           // per position: the neighbours in the polygon left to clip
+    uint32_t* next;
+    uint32_t* reflex;         // positions that were not strictly convex when last checked
+    uint32_t* owner;          // per position p: the cap triangle edge (3 t + k) beyond the
+                              // polygon edge p -> next[p], or kNoIndex on the loop itself
+    uint32_t* corners;        // per cap triangle: 3 positions, counter-clockwise
+    uint32_t* across;         // per cap triangle edge k (corner k to k + 1): the edge beyond
+    uint32_t* stack;          // cap triangles whose edges are to be checked
+    uint8_t* search;          // per pair of positions i < j: the cap search's choice, k - i
+                              // (allocated, and read, only where kCapSearchCorners > 0)
+};
+
+const unsigned char kLoopStart = 1, kLoopBroken = 2;
+
+const unsigned char kRemoved = 1, kReflex = 2, kQueued = 4;
+
+const unsigned char kFinSeen = 1, kFinFlippable = 2, kFinWaived = 4, kFinUsed = 8;
+
+// The allocation sequences of the cap phase: the call runs them with its real sizes,
+// reconstruct_workspace_size with the largest possible ones, so the two cannot disagree.
+inline bool allocate_cap_graph(CapGraph& g, size_t point_count, size_t triangle_count,
+                               Arena& arena) {
+    g.offsets = arena.alloc<size_t>(point_count + 1);
+    g.targets = arena.alloc<uint32_t>(3 * triangle_count);
+    g.boundary_next = arena.alloc<uint32_t>(point_count);
+    return !arena.failed;
+}
+
+inline bool allocate_cap_loop(CapLoop& c, size_t length, Arena& arena) {
+    c.ids = arena.alloc<uint32_t>(length);
+    c.starts = arena.alloc<unsigned char>(length);
+    c.xy = arena.alloc<double>(2 * length);
+    c.flags = arena.alloc<unsigned char>(length);
+    c.scratch = arena.alloc<double>(kIncircleScratch);
+    // The sweep is over before clipping starts: the clipping arrays reuse its memory; and
+    // the heights, filled once the clipping is over, reuse the clipping arrays'.
+    size_t mark = arena.mark();
+    c.sweep = arena.alloc<uint64_t>(length);
+    arena.rewind(mark);
+    c.height = arena.alloc<double>(length);
+    arena.rewind(mark);
+    c.prev = arena.alloc<uint32_t>(length);
+    c.next = arena.alloc<uint32_t>(length);
+    c.reflex = arena.alloc<uint32_t>(length);
+    c.owner = arena.alloc<uint32_t>(length);
+    c.corners = arena.alloc<uint32_t>(3 * length);
+    c.across = arena.alloc<uint32_t>(3 * length);
+    c.stack = arena.alloc<uint32_t>(length);
+    if (kCapSearchCorners > 0) {
+        const size_t searched = length < kCapSearchCorners ? length : kCapSearchCorners;
+        c.search = arena.alloc<uint8_t>(searched * (searched - 1) / 2);
+    }
+    return !arena.failed;
+}
+
+// Fills the graph from the triangles; returns the number of boundary vertices. Only edges
+// between boundary vertices are kept (the diagonals of a cap join boundary vertices), so
+// on a tube the graph is small and built in three streaming passes.
+inline size_t build_cap_graph(const uint32_t* tri, size_t count, size_t point_count,
+                              CapGraph& g) {
+    // Around an inner vertex the triangles leave towards the same vertices they arrive
+    // from; around a boundary vertex (one fan, a chain) the two sets differ by the far
+    // ends of its two boundary edges. So the xor of all of them is 0 exactly at inner
+    // vertices: the ends differ, since a loop has at least 3 vertices.
+    uint32_t* side = g.boundary_next;
+    std::memset(side, 0, sizeof(uint32_t) * point_count);
+    for (size_t t = 0; t < count; ++t) {
+        const uint32_t* c = tri + 3 * t;
+        side[c[0]] ^= c[1] ^ c[2];
+        side[c[1]] ^= c[2] ^ c[0];
+        side[c[2]] ^= c[0] ^ c[1];
+    }
+    auto kept = [&](uint32_t a, uint32_t b) { return side[a] != 0 && side[b] != 0; };
+    std::memset(g.offsets, 0, sizeof(size_t) * (point_count + 1));
+    for (size_t k = 0; k < 3 * count; ++k) {
+        uint32_t to = tri[k - k % 3 + (k + 1) % 3];
+        if (kept(tri[k], to)) ++g.offsets[tri[k] + 1];
+    }
+    for (size_t v = 0; v < point_count; ++v) g.offsets[v + 1] += g.offsets[v];
+    size_t total = g.offsets[point_count];
+    // Filled from the end of each range, so offsets[v + 1] ends as the start of v's.
+    for (size_t k = 3 * count; k-- > 0;) {
+        uint32_t to = tri[k - k % 3 + (k + 1) % 3];
+        if (kept(tri[k], to)) g.targets[--g.offsets[tri[k] + 1]] = to;
+    }
+    for (size_t v = 0; v < point_count; ++v) g.offsets[v] = g.offsets[v + 1];
+    g.offsets[point_count] = total;
+    size_t boundary = 0;
+    for (size_t v = 0; v < point_count; ++v) {
+        uint32_t* group = g.targets + g.offsets[v];
+        size_t size = g.offsets[v + 1] - g.offsets[v];
+        if (size <= 16) {
+            for (size_t i = 1; i < size; ++i)
+                for (size_t j = i; j > 0 && group[j - 1] > group[j]; --j) {
+                    uint32_t s = group[j];
+                    group[j] = group[j - 1];
+                    group[j - 1] = s;
+                }
+        } else {
+            heap_sort(group, size);
+        }
+    }
+    // Every group is sorted: now the boundary edge leaving each boundary vertex, the one
+    // no triangle runs backwards. `side` is read for v just before it is overwritten.
+    for (size_t v = 0; v < point_count; ++v) {
+        uint32_t a = static_cast<uint32_t>(v);
+        uint32_t next = kNoIndex;
+        if (side[v] != 0)
+            for (size_t k = g.offsets[v]; k < g.offsets[v + 1]; ++k)
+                if (!g.leads_to(g.targets[k], a)) next = g.targets[k];
+        g.boundary_next[v] = next;
+        boundary += next != kNoIndex;
+    }
+    return boundary;
+}
+
+// Chains the boundary edges into loops, stored one after another in cap order (the
+// boundary reversed); a chain that does not come back to its start is marked broken.
+// Returns the cap triangles all the unbroken loops would need.
+inline size_t trace_boundary_loops(CapGraph& g, size_t point_count, CapLoop& c,
+                                   size_t* loop_entries) {
+    size_t filled = 0, triangles = 0;
+    for (size_t v = 0; v < point_count; ++v) {
+        if (g.boundary_next[v] == kNoIndex) continue;
+        size_t start = filled;
+        uint32_t at = static_cast<uint32_t>(v);
+        while (g.boundary_next[at] != kNoIndex) {  // each boundary vertex is taken once
+            c.ids[filled] = at;
+            c.starts[filled++] = 0;
+            uint32_t to = g.boundary_next[at];
+            g.boundary_next[at] = kNoIndex;
+            at = to;
+        }
+        size_t length = filled - start;
+        bool closed = at == v && length >= 3;
+        c.starts[start] = closed ? kLoopStart : kLoopBroken;
+        for (size_t i = start, j = filled - 1; i < j; ++i, --j) {
+            uint32_t t = c.ids[i];
+            c.ids[i] = c.ids[j];
+            c.ids[j] = t;
+        }
+        if (closed) triangles += length - 2;
+    }
+    *loop_entries = filled;
+    return triangles;
+}
+
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>polygon ==============================================================================
+// Simple polygons on the exact predicates: crossing edges, containment.
+
+namespace stratmesh {
+namespace detail {
+
+inline bool same_point(const double* a, const double* b) { return a[0] == b[0] && a[1] == b[1]; }
+
+// For p collinear with a and b: whether it lies on the closed segment ab.
+inline bool on_segment(const double* a, const double* b, const double* p) {
+    for (int k = 0; k < 2; ++k) {
+        double low = a[k] < b[k] ? a[k] : b[k], high = a[k] < b[k] ? b[k] : a[k];
+        if (p[k] < low || p[k] > high) return false;
+    }
+    return true;
+}
+
+// -1, 0 or 1 as x is below, at or above y: the sign of x - y, without rounding.
+inline int compare(double x, double y) { return (x > y) - (x < y); }
+
+// Whether the closed segments pq and rs share a point.
+inline bool segments_meet(const double* p, const double* q, const double* r, const double* s) {
+    double d1 = orient2d_robust(r, s, p), d2 = orient2d_robust(r, s, q);
+    double d3 = orient2d_robust(p, q, r), d4 = orient2d_robust(p, q, s);
+    if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0)))
+        return true;
+    return (d1 == 0 && on_segment(r, s, p)) || (d2 == 0 && on_segment(r, s, q)) ||
+           (d3 == 0 && on_segment(p, q, r)) || (d4 == 0 && on_segment(p, q, s));
+}
+
+// Whether the closed polygon xy[0 .. length) is simple: no repeated point, no edge folding
+// back onto the next, no two other edges meeting. Edges are swept in order of their
+// smaller x; each is tested against those whose x range reaches into its own.
+inline bool polygon_is_simple(const double* xy, uint32_t length, uint64_t* sweep) {
+    if (length < 3) return false;
+    auto at = [&](uint32_t i) { return xy + 2 * static_cast<size_t>(i); };
+    for (uint32_t i = 0; i < length; ++i) {
+        const double* a = at(i == 0 ? length - 1 : i - 1);
+        const double* b = at(i);
+        const double* c = at(i + 1 == length ? 0 : i + 1);
+        if (same_point(b, c)) return false;
+        // Collinear neighbours on the same side of b: the two edges overlap.
+        if (orient2d_robust(a, b, c) == 0 && compare(a[0], b[0]) == compare(c[0], b[0]) &&
+            compare(a[1], b[1]) == compare(c[1], b[1]))
+            return false;
+    }
+    for (uint32_t e = 0; e < length; ++e) {
+        const double* a = at(e);
+        const double* b = at(e + 1 == length ? 0 : e + 1);
+        sweep[e] = uint64_t{sweep_key(a[0] < b[0] ? a[0] : b[0])} << 32 | e;
+    }
+    heap_sort(sweep, length);
+    for (uint32_t i = 0; i < length; ++i) {
+        uint32_t e = static_cast<uint32_t>(sweep[i]), e_end = e + 1 == length ? 0 : e + 1;
+        const double* a = at(e);
+        const double* b = at(e_end);
+        const uint32_t right = sweep_key(a[0] < b[0] ? b[0] : a[0]);
+        double low = a[1] < b[1] ? a[1] : b[1], high = a[1] < b[1] ? b[1] : a[1];
+        for (uint32_t j = i + 1; j < length && (sweep[j] >> 32) <= right; ++j) {
+            uint32_t f = static_cast<uint32_t>(sweep[j]), f_end = f + 1 == length ? 0 : f + 1;
+            if (f == e_end || f_end == e) continue;  // neighbours: checked above
+            const double* c = at(f);
+            const double* d = at(f_end);
+            if ((c[1] < low && d[1] < low) || (c[1] > high && d[1] > high)) continue;
+            if (segments_meet(a, b, c, d)) return false;
+        }
+    }
+    return true;
+}
+
+// Whether p lies in the closed triangle abc (counter-clockwise).
+inline bool in_closed_triangle(const double* a, const double* b, const double* c, const double* p) {
+    return orient2d_robust(a, b, p) >= 0 && orient2d_robust(b, c, p) >= 0 &&
+           orient2d_robust(c, a, p) >= 0;
+}
+
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>caps =================================================================================
+// Closing a boundary loop: pockets, lowered caps, fins.
+//
+// With the close_ends flag, each boundary loop of the final surface is closed by a cap made
+// of triangles over the loop's own vertices. The loop is triangulated in its projection
+// across the axis: first checked to be a simple polygon (a sweep over its edges sorted by x,
+// exact orient2d), then ear clipping, then flips of the cap's diagonals. A triangulation of
+// a simple polygon lifts to a surface that is a graph over it, so the cap's triangles cannot
+// cross one another; but they can cross the wall where it leans over the cap near a ragged
+// loop (a bust's shoulders, the noisy end of a scan). So the flips make the bottom cap as
+// low as the loop allows and the top cap as high: a diagonal is flipped when the other one,
+// with every vertex at its height along the axis, lies more than kCapHeightTie below it
+// (above, on the top cap): the lower or upper envelope of the loop, where the quadrilaterals
+// allow. On ties (a planar loop, a CT contour) the Delaunay criterion decides, so planar
+// caps are the constrained Delaunay triangulation (ear clipping alone leaves slivers).
+// Delaunay caps alone cross a wall leaning over a ragged loop several times as often. The
+// flips are bounded (kCapFlipsPerCorner per loop vertex): any triangulation of the polygon is
+// valid, so stopping early only leaves a cap less low. STRATMESH_SMALL_CODE leaves the
+// heights out: Delaunay caps.
+//
+// Each cap triangle runs the loop's edges against the surface's direction, so the closed
+// surface stays consistently oriented (the bottom cap faces -axis, the top one +axis). A
+// diagonal that is already an edge of the surface would join three triangles: ears and
+// flips that would make one are skipped. Where the wall has fins (triangles with two edges
+// on the loop: a scan rounded to a grid makes them), the fin's middle corner has no way
+// into the cap but a diagonal to a corner it sees across the loop, which ear clipping
+// never makes; so a loop that no clipping closes, of at most kCapSearchCorners corners, is
+// searched exhaustively (search_cap). Where fins leave no cap at all, the wall's edges under
+// them may be flipped (see "fins flipped out of the way" below). A loop whose projection
+// is not simple, or that none of these closes, stays open.
+//
+// The loops of a star-shaped layer run monotonically in angle around its centre (see the
+// unroll section), so their projections are simple but for rounding or the safety net's
+// removals.
+
+namespace stratmesh {
+namespace detail {
+
+// Heights closer than this to a plane count as on it (frame units: the frame scales the
+// cloud to an extent of about 1). A planar loop turned into the frame by a tilted axis gets
+// heights that differ by rounding: those are ties, for the Delaunay criterion.
+const double kCapHeightTie = 0x1p-40;
+
+// How far d lies below the plane through a, b and w (counter-clockwise across the axis),
+// each at its height (heights: a's, b's, w's, d's): the plane's height at d's place, the
+// heights weighted by the triangles d makes with the opposite edges, less d's own.
+inline double depth_below_plane(const double* a, const double* b, const double* w,
+                                const double* d, const double* heights) {
+    auto orient = [d](const double* p, const double* q) {
+        return (p[0] - d[0]) * (q[1] - d[1]) - (p[1] - d[1]) * (q[0] - d[0]);
+    };
+    double oa = orient(b, w), ob = orient(w, a), ow = orient(a, b);
+    return ((heights[0] - heights[3]) * oa + (heights[1] - heights[3]) * ob +
+            (heights[2] - heights[3]) * ow) /
+           (oa + ob + ow);
+}
+
+const uint32_t kCapFlipsPerCorner = 64;
+
+// Ear clipping is greedy: where the surface holds some of a loop's diagonals (its
+// triangles with three corners on the loop), the ears taken first can leave a remainder
+// whose every ear would repeat one, where another order would not (the bundled bust's
+// neck loop, whose single layer's loops are peeled: 6 corners left of 249). So a failed
+// clipping starts again from other corners, kCapEarStarts spread around the loop in all
+// (see the configuration; 1 with STRATMESH_SMALL_CODE).
+
+// Triangulates one loop, already checked simple and counter-clockwise. ids: the loop's
+// vertices, whose diagonals must not be edges of the surface; lower: the cap is a bottom
+// one (it faces -axis), to be made as low as the loop allows (a top one as high). Returns
+// false if no ear is left (every one would repeat an edge of the surface).
+class CapTriangulation {
+public:
+    CapTriangulation(CapLoop& c, const uint32_t* ids, uint32_t length, const CapGraph& g,
+                     bool lower)
+        : c_(c), ids_(ids), length_(length), g_(g), lower_(lower) {}
+
+    // Ear clipping from kCapEarStarts corners, then the search; false if neither closes.
+    bool triangulate() {
+        for (uint32_t k = 0; k < kCapEarStarts; ++k)
+            if (clip_ears(static_cast<uint32_t>(uint64_t{k} * length_ / kCapEarStarts))) return true;
+        return kCapSearchCorners > 0 && search_cap();
+    }
+
+    // From now on the chords of the fins marked in `fins` (per position, kFinWaived) are
+    // allowed as diagonals: the wall's edge there is to be flipped away (see flip_used_fins).
+    void waive(const unsigned char* fins) { waived_ = fins; }
+
+    // The fin whose chord is a - b (positions): the position between them, if it is a
+    // waived fin; else kNoIndex.
+    uint32_t waived_fin(uint32_t a, uint32_t b) const {
+        if (!kCapFinFlips || waived_ == nullptr) return kNoIndex;
+        const uint32_t after_a = a + 1 == length_ ? 0 : a + 1, after_b = b + 1 == length_ ? 0 : b + 1;
+        const uint32_t mid = (after_a + 1 == length_ ? 0 : after_a + 1) == b ? after_a
+                           : (after_b + 1 == length_ ? 0 : after_b + 1) == a ? after_b
+                                                                             : kNoIndex;
+        return mid != kNoIndex && (waived_[mid] & kFinWaived) ? mid : kNoIndex;
+    }
+
+    bool clip_ears(uint32_t start) {
+        uint32_t reflex_count = 0;
+        for (uint32_t i = 0; i < length_; ++i) {
+            c_.prev[i] = i == 0 ? length_ - 1 : i - 1;
+            c_.next[i] = i + 1 == length_ ? 0 : i + 1;
+            c_.owner[i] = kNoIndex;
+            c_.flags[i] = 0;
+        }
+        for (uint32_t i = 0; i < length_; ++i) {
+            if (convex(i)) continue;
+            c_.flags[i] = kReflex;
+            c_.reflex[reflex_count++] = i;
+        }
+        uint32_t remaining = length_, v = start, misses = 0;
+        triangles_ = 0;
+        while (remaining > 3) {
+            if (!is_ear(v, reflex_count)) {
+                v = c_.next[v];
+                if (++misses > remaining) return false;
+                continue;
+            }
+            uint32_t p = c_.prev[v], n = c_.next[v];
+            uint32_t t = add_triangle(p, v, n);
+            c_.owner[p] = 3 * t + 2;  // the new polygon edge p -> n has t beyond it
+            c_.next[p] = n;
+            c_.prev[n] = p;
+            c_.flags[v] = kRemoved;
+            // Clipping only narrows the corners at p and n: a reflex one may turn convex.
+            settle_corner(p);
+            settle_corner(n);
+            --remaining;
+            misses = 0;
+            v = p;
+        }
+        if (!convex(v)) return false;
+        uint32_t p = c_.prev[v], n = c_.next[v];
+        uint32_t t = add_triangle(p, v, n);
+        link(3 * t + 2, c_.owner[n]);
+        return true;
+    }
+
+    // Flips until no diagonal would be lower (higher, on a top cap) flipped, nor, where the
+    // heights cannot tell, more Delaunay (or the flip would repeat an edge of the surface),
+    // or until the budget of flips is spent.
+    void settle_diagonals() {
+        uint32_t depth = 0;
+        // No overflow: a loop takes more than 64 bytes of workspace per vertex.
+        size_t budget = static_cast<size_t>(kCapFlipsPerCorner) * length_;
+        for (uint32_t t = 0; t < triangles_; ++t) c_.flags[t] = 0;
+        for (uint32_t t = 0; t < triangles_; ++t) queue(t, depth);
+        while (depth > 0 && budget > 0) {
+            uint32_t t = c_.stack[--depth];
+            c_.flags[t] = 0;
+            for (uint32_t k = 0; k < 3; ++k) {
+                uint32_t u = flip_if_better(t, k);
+                if (u == kNoIndex) continue;
+                --budget;
+                queue(t, depth);
+                queue(u, depth);
+                break;
+            }
+        }
+    }
+
+    // Triangulates the loop by searching all its triangulations for one whose diagonals
+    // are no edges of the surface (dynamic programming over the pairs of corners: the
+    // polygon i, i + 1, ..., j closed by diagonal i - j has one if some corner k between
+    // makes a triangle i, k, j with both sides closable): what ear clipping misses where
+    // fins of the wall leave a corner nothing to join but a corner across the loop. For
+    // loops of at most kCapSearchCorners corners (cubic time: about 0.1 s for 256);
+    // false if there are more, or none is found.
+    bool search_cap() {
+        const uint32_t m = length_;
+        if (m > kCapSearchCorners || m < 3) return false;
+        // choice(i, j): the corner k, stored as k - i, of a triangle i, k, j from which the
+        // polygon i .. j closes; 0 if it does not (i - j no diagonal, or no such k).
+        auto choice = [this](uint32_t i, uint32_t j) -> uint8_t& {
+            return c_.search[static_cast<size_t>(j) * (j - 1) / 2 + i];
+        };
+        auto closes = [&choice](uint32_t i, uint32_t j) { return j == i + 1 || choice(i, j) != 0; };
+        for (uint32_t span = 2; span < m; ++span)
+            for (uint32_t i = 0; i + span < m; ++i) {
+                const uint32_t j = i + span;
+                uint8_t& best = choice(i, j);
+                best = 0;
+                // i - j must be a diagonal (the loop edge m - 1 -> 0 closes the whole).
+                if ((j != m - 1 || i != 0) &&
+                    (joined(i, j) || !diagonal_inside(i, j)))
+                    continue;
+                for (uint32_t k = i + 1; k < j && best == 0; ++k)
+                    if (closes(i, k) && closes(k, j)) best = static_cast<uint8_t>(k - i);
+            }
+        if (choice(0, m - 1) == 0) return false;
+        // The triangles, from the outermost in: each job is a pair (i, j) and the edge of
+        // the triangle already made beyond its side j -> i (kNoIndex for the loop edge).
+        triangles_ = 0;
+        uint32_t depth = 0;
+        auto push = [this, &depth](uint32_t i, uint32_t j, uint32_t beyond) {
+            c_.prev[depth] = i;
+            c_.next[depth] = j;
+            c_.owner[depth++] = beyond;
+        };
+        push(0, m - 1, kNoIndex);
+        while (depth > 0) {
+            --depth;
+            const uint32_t i = c_.prev[depth], j = c_.next[depth], beyond = c_.owner[depth];
+            const uint32_t k = i + choice(i, j);
+            const uint32_t t = triangles_++;
+            uint32_t* corner = c_.corners + 3 * static_cast<size_t>(t);
+            corner[0] = i;
+            corner[1] = k;
+            corner[2] = j;
+            for (uint32_t e = 0; e < 3; ++e) c_.across[3 * static_cast<size_t>(t) + e] = kNoIndex;
+            link(3 * t + 2, beyond);
+            if (k > i + 1) push(i, k, 3 * t);
+            if (j > k + 1) push(k, j, 3 * t + 1);
+        }
+        return true;
+    }
+
+    // Whether i - j (positions on the loop) runs inside the polygon: within the corners at
+    // both ends and clear of every loop edge that does not end at i or j.
+    bool diagonal_inside(uint32_t i, uint32_t j) const {
+        auto within_corner = [this](uint32_t a, uint32_t b) {
+            const double* pa = point(a);
+            const double* pb = point(b);
+            const double* before = point(a == 0 ? length_ - 1 : a - 1);
+            const double* after = point(a + 1 == length_ ? 0 : a + 1);
+            if (orient2d_robust(before, pa, after) > 0)
+                return orient2d_robust(pa, pb, before) > 0 && orient2d_robust(pb, pa, after) > 0;
+            return !(orient2d_robust(pa, pb, after) >= 0 && orient2d_robust(pb, pa, before) >= 0);
+        };
+        if (!within_corner(i, j) || !within_corner(j, i)) return false;
+        const double* pi = point(i);
+        const double* pj = point(j);
+        for (uint32_t a = 0; a < length_; ++a) {
+            const uint32_t b = a + 1 == length_ ? 0 : a + 1;
+            if (a == i || a == j || b == i || b == j) continue;
+            const double oa = orient2d_robust(pi, pj, point(a));
+            const double ob = orient2d_robust(pi, pj, point(b));
+            if ((oa > 0 && ob > 0) || (oa < 0 && ob < 0)) continue;
+            const double oi = orient2d_robust(point(a), point(b), pi);
+            const double oj = orient2d_robust(point(a), point(b), pj);
+            if ((oi > 0 && oj > 0) || (oi < 0 && oj < 0)) continue;
+            return false;  // the segments cross or touch
+        }
+        return true;
+    }
+
+    uint32_t triangles() const { return triangles_; }
+
+private:
+    const double* point(uint32_t i) const { return c_.xy + 2 * static_cast<size_t>(i); }
+
+    // Whether positions a and b are joined by an edge of the surface that stays there.
+    bool joined(uint32_t a, uint32_t b) const {
+        return g_.has_edge(ids_[a], ids_[b]) && waived_fin(a, b) == kNoIndex;
+    }
+
+    bool convex(uint32_t i) const {
+        return orient2d_robust(point(c_.prev[i]), point(i), point(c_.next[i])) > 0;
+    }
+
+    void settle_corner(uint32_t i) {
+        if ((c_.flags[i] & kReflex) && convex(i)) c_.flags[i] = 0;
+    }
+
+    void queue(uint32_t t, uint32_t& depth) {
+        if (c_.flags[t] & kQueued) return;
+        c_.flags[t] = kQueued;
+        c_.stack[depth++] = t;
+    }
+
+    // Strictly convex, a diagonal that is no edge of the surface, and no other corner in
+    // the closed triangle. Only non-convex corners need testing (in a simple polygon, a
+    // triangle holding a corner holds a reflex one); those turned convex leave the list.
+    bool is_ear(uint32_t v, uint32_t& reflex_count) {
+        if (c_.flags[v] & kReflex) return false;
+        uint32_t p = c_.prev[v], n = c_.next[v];
+        if (joined(p, n)) return false;
+        bool empty = true;
+        uint32_t kept = 0;
+        for (uint32_t k = 0; k < reflex_count; ++k) {
+            uint32_t r = c_.reflex[k];
+            if (c_.flags[r] != kReflex) continue;
+            c_.reflex[kept++] = r;
+            if (empty && r != p && r != n && in_closed_triangle(point(p), point(v), point(n), point(r)))
+                empty = false;
+        }
+        reflex_count = kept;
+        return empty;
+    }
+
+    // Adds triangle (p, v, n) and links its edges p -> v and v -> n to the triangles beyond.
+    uint32_t add_triangle(uint32_t p, uint32_t v, uint32_t n) {
+        uint32_t t = triangles_++;
+        uint32_t* corner = c_.corners + 3 * static_cast<size_t>(t);
+        corner[0] = p;
+        corner[1] = v;
+        corner[2] = n;
+        link(3 * t, c_.owner[p]);
+        link(3 * t + 1, c_.owner[v]);
+        c_.across[3 * static_cast<size_t>(t) + 2] = kNoIndex;
+        return t;
+    }
+
+    void link(uint32_t edge, uint32_t other) {
+        c_.across[edge] = other;
+        if (other != kNoIndex) c_.across[other] = edge;
+    }
+
+    // Flips the diagonal on edge k of t if the other diagonal lies lower (higher on a top
+    // cap), or on a tie if the vertex beyond lies in t's circumcircle; only where the
+    // quadrilateral is strictly convex and the new diagonal is no edge of the surface.
+    // Returns the other triangle, or kNoIndex if nothing was flipped.
+    uint32_t flip_if_better(uint32_t t, uint32_t k) {
+        uint32_t beyond = c_.across[3 * t + k];
+        if (beyond == kNoIndex) return kNoIndex;
+        uint32_t u = beyond / 3, j = beyond % 3;
+        uint32_t* ct = c_.corners + 3 * static_cast<size_t>(t);
+        uint32_t* cu = c_.corners + 3 * static_cast<size_t>(u);
+        uint32_t a = ct[k], b = ct[(k + 1) % 3], w = ct[(k + 2) % 3], d = cu[(j + 2) % 3];
+        const double heights[4] = {c_.height[a], c_.height[b], c_.height[w], c_.height[d]};
+        // How much lower (higher, on a top cap) the other diagonal lies: flip if clearly
+        // so; on a tie, by the Delaunay criterion. A NaN (a sliver abw) flips nothing.
+        double gain =
+            kLiftedCaps ? depth_below_plane(point(a), point(b), point(w), point(d), heights) : 0;
+        if (!lower_) gain = -gain;
+        if (!(gain > kCapHeightTie ||
+              (gain >= -kCapHeightTie &&
+               incircle_perturbed(point(a), point(b), point(w), point(d), c_.scratch) > 0)))
+            return kNoIndex;
+        if (orient2d_robust(point(a), point(d), point(w)) <= 0 ||
+            orient2d_robust(point(d), point(b), point(w)) <= 0 || joined(w, d))
+            return kNoIndex;
+        uint32_t beyond_bw = c_.across[3 * t + (k + 1) % 3], beyond_wa = c_.across[3 * t + (k + 2) % 3];
+        uint32_t beyond_ad = c_.across[3 * u + (j + 1) % 3], beyond_db = c_.across[3 * u + (j + 2) % 3];
+        // t becomes a -> d -> w (d -> w the new diagonal), u becomes d -> b -> w.
+        ct[0] = a;
+        ct[1] = d;
+        ct[2] = w;
+        cu[0] = d;
+        cu[1] = b;
+        cu[2] = w;
+        link(3 * t, beyond_ad);
+        link(3 * t + 2, beyond_wa);
+        link(3 * u, beyond_db);
+        link(3 * u + 1, beyond_bw);
+        link(3 * t + 1, 3 * u + 2);
+        return u;
+    }
+
+    CapLoop& c_;
+    const uint32_t* ids_;
+    uint32_t length_;
+    const CapGraph& g_;
+    bool lower_;
+    uint32_t triangles_ = 0;
+    const unsigned char* waived_ = nullptr;
+};
+
+struct CapCounts {
+    size_t closed, left_open, triangles, wall_flips;
+};
+
+// Report::detail for the caps, from reconstruct() and cap_ends() alike.
+const char* const kCapsTooLargeDetail =
+    "the triangle array is too small for the caps; triangle_count says how many are needed";
+
+const char* const kLoopLeftOpenDetail =
+    "a boundary loop's projection across the axis is not a simple polygon (or every cap "
+    "found for it would repeat an edge of the surface): it is left open";
+
+// ---- fins flipped out of the way
+//
+// A loop with fins can have no cap at all: each fin's middle corner needs a diagonal to a
+// corner it sees across the loop, and with fins close together those diagonals cross or
+// see nothing (a fin under every other edge: most loops the search leaves open on
+// sparsely sampled ends). Then the wall gives way: the fin (u, v, m)
+// and the wall triangle beyond its chord, (v, u, x), become (u, x, m) and (x, v, m) (m,
+// the fin's middle corner, has no other triangle, so m - x is a new edge and the surface
+// stays a manifold), and the chord u - v is free for the cap. Only fins whose x is on no
+// loop (no new chord) and whose two new triangles face the way the old pair does are
+// offered, and only those whose chord the cap then takes are flipped: a loop that closed
+// before closes as before, and one that stays open leaves the wall as it was.
+
+// The per point key of a loop's fin chords: at the chord's first corner (position i - 1),
+// the fin's position i, for the fins with a flag in `wanted`. `key` is all kNoIndex outside
+// these calls: clear_fin_chords puts it back.
+inline void key_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length,
+                           const unsigned char* fins, unsigned char wanted) {
+    for (uint32_t i = 0; i < length; ++i)
+        if (fins[i] & wanted) key[ids[i == 0 ? length - 1 : i - 1]] = i;
+}
+
+inline void clear_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length) {
+    for (uint32_t i = 0; i < length; ++i) key[ids[i]] = kNoIndex;
+}
+
+// The fin position whose chord is a - b (either way round), or kNoIndex.
+inline uint32_t keyed_fin(const uint32_t* key, const uint32_t* ids, uint32_t length,
+                          uint32_t a, uint32_t b) {
+    for (int side = 0; side < 2; ++side) {
+        const uint32_t i = key[side == 0 ? a : b];
+        if (i != kNoIndex && ids[i + 1 == length ? 0 : i + 1] == (side == 0 ? b : a)) return i;
+    }
+    return kNoIndex;
+}
+
+// Whether (u, x, m) and (x, v, m) face the way (u, v, m) and (v, u, x) do together.
+inline bool fin_flip_keeps_facing(const CloudReader& cloud, const Frame& frame, uint32_t u,
+                                  uint32_t v, uint32_t m, uint32_t x) {
+    const Vec3 pu = frame.offset(cloud.point(u)), pv = frame.offset(cloud.point(v));
+    const Vec3 pm = frame.offset(cloud.point(m)), px = frame.offset(cloud.point(x));
+    const Vec3 fin = cross(pv - pu, pm - pu), beyond = cross(pu - pv, px - pv);
+    const Vec3 first = cross(px - pu, pm - pu), second = cross(pv - px, pm - px);
+    return dot(first, fin) + dot(first, beyond) > 0 && dot(second, fin) + dot(second, beyond) > 0;
+}
+
+// Marks kFinWaived the fins of the loop ids[0 .. length) that may be flipped (above),
+// scanning the wall tri[0 .. 3 wall); returns how many.
+inline uint32_t mark_flippable_fins(const uint32_t* tri, size_t wall, const CloudReader& cloud,
+                                    const Frame& frame, const CapGraph& g, uint32_t* key,
+                                    const uint32_t* ids, uint32_t length, unsigned char* fins) {
+    if (length <= 4) return 0;  // a chord two corners apart either way: no single fin
+    for (uint32_t i = 0; i < length; ++i)
+        fins[i] = g.has_edge(ids[i == 0 ? length - 1 : i - 1], ids[i + 1 == length ? 0 : i + 1])
+                      ? kFinSeen | kFinFlippable : 0;
+    key_fin_chords(key, ids, length, fins, kFinSeen);
+    for (uint32_t i = 0; i < length; ++i) fins[i] = 0;
+    for (size_t t = 0; t < wall; ++t) {
+        const uint32_t* c = tri + 3 * t;
+        for (uint32_t k = 0; k < 3; ++k) {
+            const uint32_t a = c[k], b = c[(k + 1) % 3], o = c[(k + 2) % 3];
+            const uint32_t i = keyed_fin(key, ids, length, a, b);
+            if (i == kNoIndex) continue;
+            if (o == ids[i]) {
+                fins[i] |= kFinSeen;
+            } else if (g.offsets[o + 1] == g.offsets[o] &&  // o is on no loop
+                       fin_flip_keeps_facing(cloud, frame, b, a, ids[i], o)) {
+                fins[i] |= kFinFlippable;  // beyond a -> b: the fin runs b -> a -> ids[i]
+            }
+        }
+    }
+    clear_fin_chords(key, ids, length);
+    uint32_t marked = 0;
+    for (uint32_t i = 0; i < length; ++i) {
+        const bool both = fins[i] == (kFinSeen | kFinFlippable);
+        fins[i] = both ? kFinWaived : 0;
+        marked += both;
+    }
+    return marked;
+}
+
+// Flips the wall's edge under each fin marked kFinUsed; returns how many it flipped. slots:
+// two size_t per position (in the memory of the loop's projection, free once its cap is made).
+inline size_t flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const uint32_t* ids,
+                             uint32_t length, const unsigned char* fins, double* slots) {
+    auto slot = [slots](uint32_t i, uint32_t which) { return slots + 2 * static_cast<size_t>(i) + which; };
+    static_assert(sizeof(size_t) <= sizeof(double), "a slot holds a triangle index");
+    const size_t unset = ~size_t{0};
+    for (uint32_t i = 0; i < length; ++i) {
+        std::memcpy(slot(i, 0), &unset, sizeof unset);
+        std::memcpy(slot(i, 1), &unset, sizeof unset);
+    }
+    key_fin_chords(key, ids, length, fins, kFinUsed);
+    size_t flipped_count = 0;
+    for (size_t t = 0; t < wall; ++t) {
+        const uint32_t* c = tri + 3 * t;
+        for (uint32_t k = 0; k < 3; ++k) {
+            const uint32_t i = keyed_fin(key, ids, length, c[k], c[(k + 1) % 3]);
+            if (i != kNoIndex) std::memcpy(slot(i, c[(k + 2) % 3] == ids[i] ? 0 : 1), &t, sizeof t);
+        }
+    }
+    for (uint32_t i = 0; i < length; ++i) {
+        if (!(fins[i] & kFinUsed)) continue;
+        size_t fin = 0, beyond = 0;
+        std::memcpy(&fin, slot(i, 0), sizeof fin);
+        std::memcpy(&beyond, slot(i, 1), sizeof beyond);
+        if (fin == unset || beyond == unset) continue;  // a soup given to cap_ends() only
+        uint32_t* f = tri + 3 * fin;
+        uint32_t* w = tri + 3 * beyond;
+        uint32_t k = 0;  // w's edge k -> k + 1 is the chord, v -> u
+        while (k < 2 && keyed_fin(key, ids, length, w[k], w[(k + 1) % 3]) != i) ++k;
+        const uint32_t v = w[k], u = w[(k + 1) % 3], x = w[(k + 2) % 3], m = ids[i];
+        const uint32_t flipped[6] = {u, x, m, x, v, m};
+        std::memcpy(f, flipped, 3 * sizeof(uint32_t));
+        std::memcpy(w, flipped + 3, 3 * sizeof(uint32_t));
+        ++flipped_count;
+    }
+    clear_fin_chords(key, ids, length);
+    return flipped_count;
+}
+
+// ---- pockets closed before a cap ----
+//
+// A loop is ragged along the axis: its points dip a little below its highest ones, and
+// where the wall flares out toward the end (its lower points inside the loop, seen along
+// the axis), a cap over the loop dips with them and crosses the wall's top row (a tilted
+// tube widening at its top: 24 to 65 crossing pairs with 60,000 points). So the cap spans
+// the loop's upper hull in the loop's own unrolled picture (the angle around its centroid,
+// and the height; the lower hull for a bottom loop), which lies above the wall, and each
+// pocket between a hull chord and the points dipping under it is first closed by
+// triangles of its own, along the wall. Only for a loop that runs once around its
+// centroid, monotonically; a pocket whose chord or diagonal would repeat an edge of the
+// surface is left for the cap as it is. The pockets and the cap together triangulate the
+// loop, so the caps' triangle count is the same.
+
+// The widest pocket closed, in angle around the loop's centroid: a loop's ragged dips span
+// a few of its points; wider ones (the low side of a slanted end) are the cap's.
+const double kPocketTurn = 3.14159265358979323846 / 8;
+
+// The loop (positions in cap order, the first its highest: see fill_pockets) in its
+// annulus picture, as the layers unroll (see >>unroll): around its centroid across the
+// axis, at a radius exp((h - h_first) / r) for the height h (-h for a bottom loop) and the
+// loop's mean radius r, mirrored so that the loop turns clockwise. False if it does not
+// run once around its centroid monotonically.
+inline bool unroll_loop(const CloudReader& cloud, const Frame& frame, const uint32_t* ids,
+                        uint32_t length, bool lower, double* xy) {
+    double cx = 0, cy = 0, radius = 0;
+    for (uint32_t i = 0; i < length; ++i) {
+        const Local p = frame.local(cloud.point(ids[i]));
+        cx += p.x;
+        cy += p.y;
+    }
+    cx /= length;
+    cy /= length;
+    const double pi = 3.14159265358979323846;
+    double turned = 0, previous = 0;
+    for (uint32_t i = 0; i <= length; ++i) {
+        const Local p = frame.local(cloud.point(ids[i % length]));
+        const double dx = p.x - cx, dy = p.y - cy, angle = std::atan2(dy, dx);
+        double step = i == 0 ? 0 : angle - previous;
+        step = step > pi ? step - 2 * pi : step < -pi ? step + 2 * pi : step;
+        if (i > 0 && !(step * (turned == 0 ? step : turned) > 0)) return false;
+        turned += step;
+        previous = angle;
+        if (i < length) {
+            radius += std::sqrt(dx * dx + dy * dy);
+            xy[2 * i] = dx;
+            xy[2 * i + 1] = lower ? -p.h : p.h;
+        }
+    }
+    if (!(abs_value(abs_value(turned) - 2 * pi) < 1e-9) || !(radius > 0)) return false;
+    radius /= length;
+    const double first = xy[1];
+    for (uint32_t i = 0; i < length; ++i) {
+        const Local p = frame.local(cloud.point(ids[i]));
+        const double dx = p.x - cx, dy = p.y - cy, d = std::sqrt(dx * dx + dy * dy);
+        const double rho = exp_portable((xy[2 * i + 1] - first) / radius);
+        const double u = d > 0 ? dx / d : 1, v = d > 0 ? dy / d : 0;
+        // Clockwise: mirrored where the loop turns counter-clockwise.
+        xy[2 * i] = (turned > 0 ? -u : u) * rho;
+        xy[2 * i + 1] = v * rho;
+    }
+    return true;
+}
+
+// Closes the pocket [from, to] of positions (to may be `length`: the first position again)
+// by ear clipping in the annulus picture, where it turns counter-clockwise; appends its
+// triangles at tri[3 * count] as the cap writes its own (in loop order). False, with count
+// unchanged, where no ear is left whose diagonal is not already an edge of the surface.
+inline bool close_pocket(uint32_t* tri, size_t& count, const CapGraph& g, const uint32_t* ids,
+                         uint32_t length, const double* xy, uint32_t from, uint32_t to,
+                         uint32_t* prev, uint32_t* next) {
+    const uint32_t n = to - from + 1;
+    auto point = [&](uint32_t k) { return xy + 2 * ((from + k) % length); };
+    for (uint32_t k = 0; k < n; ++k) {
+        prev[k] = k == 0 ? n - 1 : k - 1;
+        next[k] = k + 1 == n ? 0 : k + 1;
+    }
+    size_t added = count;
+    uint32_t v = 1, remaining = n, misses = 0;
+    while (remaining > 2) {
+        const uint32_t a = prev[v], b = next[v];
+        bool ear = orient2d_robust(point(a), point(v), point(b)) > 0 &&
+                   (remaining == 3 || !g.has_edge(ids[(from + a) % length], ids[(from + b) % length]));
+        for (uint32_t k = next[b]; ear && k != a; k = next[k])
+            ear = !(orient2d_robust(point(a), point(v), point(k)) >= 0 &&
+                    orient2d_robust(point(v), point(b), point(k)) >= 0 &&
+                    orient2d_robust(point(b), point(a), point(k)) >= 0);
+        if (!ear) {
+            v = b;
+            if (++misses > remaining) return false;
+            continue;
+        }
+        tri[3 * added] = ids[(from + a) % length];
+        tri[3 * added + 1] = ids[(from + v) % length];
+        tri[3 * added + 2] = ids[(from + b) % length];
+        ++added;
+        next[a] = b;
+        prev[b] = a;
+        v = a;
+        --remaining;
+        misses = 0;
+    }
+    count = added;
+    return true;
+}
+
+// Closes the pockets of the loop ids[0 .. length) (see above), rotating ids so that its
+// highest position (its lowest, for a bottom loop) comes first, and keeps in ids, in order,
+// the positions left for the cap; returns their number. The cap loop's arrays serve as
+// scratch.
+inline uint32_t fill_pockets(uint32_t* tri, size_t& count, const CapGraph& g, CapLoop& c,
+                             const CloudReader& cloud, const Frame& frame, uint32_t* ids,
+                             uint32_t length, bool lower) {
+    uint32_t top = 0;
+    for (uint32_t i = 1; i < length; ++i) {
+        const double h = frame.height(cloud.point(ids[i])), best = frame.height(cloud.point(ids[top]));
+        if (lower ? h < best : h > best) top = i;
+    }
+    // Rotated by three reversals, in place.
+    auto reverse = [ids](uint32_t first, uint32_t end) {
+        for (; first + 1 < end; ++first, --end) {
+            const uint32_t t = ids[first];
+            ids[first] = ids[end - 1];
+            ids[end - 1] = t;
+        }
+    };
+    reverse(0, top);
+    reverse(top, length);
+    reverse(0, length);
+    double* xy = c.xy;
+    if (!unroll_loop(cloud, frame, ids, length, lower, xy)) return length;
+    // The convex hull of the clockwise loop from its first position (on the hull, being the
+    // farthest out) round to it again: a Graham scan in the loop's order.
+    // The first position closes the hull again: scanned last, but not stored twice.
+    uint32_t* hull = c.reflex;
+    uint32_t hull_count = 0;
+    for (uint32_t j = 0; j <= length; ++j) {
+        const double* pj = xy + 2 * (j % length);
+        while (hull_count >= 2 &&
+               orient2d_robust(xy + 2 * hull[hull_count - 2], xy + 2 * hull[hull_count - 1], pj) >= 0)
+            --hull_count;  // not a strict right turn: off the hull
+        if (j < length) hull[hull_count++] = j;
+    }
+    if (hull_count < 3) return length;  // the cap needs three corners at least
+    unsigned char* gone = c.flags;
+    std::memset(gone, 0, length);
+    for (uint32_t k = 0; k < hull_count; ++k) {
+        const uint32_t from = hull[k], to = k + 1 < hull_count ? hull[k + 1] : length;
+        const double* pa = xy + 2 * from;
+        const double* pb = xy + 2 * (to % length);
+        const double span = std::atan2(abs_value(pa[0] * pb[1] - pa[1] * pb[0]),
+                                       pa[0] * pb[0] + pa[1] * pb[1]);
+        if (to - from < 2 || !(span < kPocketTurn) || g.has_edge(ids[from], ids[to % length]) ||
+            !close_pocket(tri, count, g, ids, length, xy, from, to, c.prev, c.next))
+            continue;
+        for (uint32_t j = from + 1; j < to; ++j) gone[j] = 1;
+    }
+    uint32_t kept = 0;
+    for (uint32_t i = 0; i < length; ++i)
+        if (!gone[i]) ids[kept++] = ids[i];
+    return kept;
+}
+
+// Caps every boundary loop of the surface tri[0 .. 3 count) over the cloud's points,
+// appending the cap triangles (count grows) and counting into caps (zeroed by the caller);
+// each loop is projected across the frame's axis. Returns ok; out_of_memory; or
+// triangle_capacity with *needed the triangles every cap closing would take, and nothing
+// written.
+inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
+                                 const CloudReader& cloud, size_t point_count,
+                                 const Frame& frame, Arena& arena, CapCounts& caps,
+                                 size_t* needed) {
+    auto project = [&](uint32_t id, double* xy, double* height) {
+        const Local p = frame.local(cloud.point(id));
+        xy[0] = p.x;
+        xy[1] = p.y;
+        *height = p.h;
+    };
+    const size_t wall = count;
+    size_t mark = arena.mark();
+    CapGraph g;
+    if (!allocate_cap_graph(g, point_count, count, arena)) return Status::out_of_memory;
+    size_t boundary = build_cap_graph(tri, count, point_count, g);
+    if (boundary == 0) {
+        arena.rewind(mark);
+        return Status::ok;
+    }
+    CapLoop c;
+    if (!allocate_cap_loop(c, boundary, arena)) return Status::out_of_memory;
+    size_t entries = 0;
+    size_t cap_triangles = trace_boundary_loops(g, point_count, c, &entries);
+    if (cap_triangles > capacity - count) {
+        *needed = count + cap_triangles;
+        return Status::triangle_capacity;
+    }
+    for (size_t start = 0; start < entries;) {
+        size_t end = start + 1;
+        while (end < entries && c.starts[end] == 0) ++end;
+        uint32_t* ids = c.ids + start;
+        // Cap triangle edges are numbered 3 t + k in 32 bits.
+        const bool usable = c.starts[start] == kLoopStart && end - start <= (kNoIndex - 1) / 3;
+        uint32_t length = static_cast<uint32_t>(end - start);
+        start = end;
+        // The loop's projection across the axis, checked to be a simple polygon, and its
+        // turning direction (0: not simple); then the same for the positions its pockets
+        // leave to the cap.
+        double turn = 0;
+        for (bool pockets = kLiftedCaps; usable; pockets = false) {
+            double height = 0;
+            for (uint32_t i = 0; i < length; ++i)
+                project(ids[i], c.xy + 2 * static_cast<size_t>(i), &height);
+            if (!polygon_is_simple(c.xy, length, c.sweep)) break;
+            // The lexicographically lowest corner is convex: it gives the turning direction.
+            uint32_t lowest = 0;
+            for (uint32_t i = 1; i < length; ++i)
+                if (lex_less(c.xy + 2 * static_cast<size_t>(i), c.xy + 2 * static_cast<size_t>(lowest)))
+                    lowest = i;
+            turn = orient2d_robust(c.xy + 2 * static_cast<size_t>(lowest == 0 ? length - 1 : lowest - 1),
+                                   c.xy + 2 * static_cast<size_t>(lowest),
+                                   c.xy + 2 * static_cast<size_t>(lowest + 1 == length ? 0 : lowest + 1));
+            if (!pockets || turn == 0) break;
+            const size_t before = count;
+            length = fill_pockets(tri, count, g, c, cloud, frame, ids, length, turn < 0);
+            caps.triangles += count - before;
+            turn = 0;
+        }
+        if (turn == 0) {
+            ++caps.left_open;
+            continue;
+        }
+        if (turn < 0)
+            for (uint32_t i = 0; i < length; ++i) c.xy[2 * static_cast<size_t>(i)] = -c.xy[2 * static_cast<size_t>(i)];
+        // A loop turning clockwise seen from +axis is capped facing -axis: a bottom cap.
+        CapTriangulation cap(c, ids, length, g, turn < 0);
+        bool clipped = cap.triangulate();
+        // The loop's start markers are read no more: its fins' flags take their place.
+        unsigned char* fins = c.starts + (ids - c.ids);
+        bool waived = false;
+        if (kCapFinFlips && !clipped &&
+            mark_flippable_fins(tri, wall, cloud, frame, g, g.boundary_next, ids, length, fins) > 0) {
+            cap.waive(fins);
+            waived = true;
+            clipped = cap.triangulate();
+        }
+        if (!clipped) {
+            ++caps.left_open;
+            continue;
+        }
+        double xy[2];  // c.xy holds them, mirrored
+        for (uint32_t i = 0; kLiftedCaps && i < length; ++i) project(ids[i], xy, c.height + i);
+        cap.settle_diagonals();
+        bool flips = false;
+        for (size_t k = 0; k < 3 * static_cast<size_t>(cap.triangles()); ++k) {
+            tri[3 * count + k] = ids[c.corners[k]];
+            const uint32_t fin = waived ? cap.waived_fin(c.corners[k], c.corners[k - k % 3 + (k + 1) % 3]) : kNoIndex;
+            if (fin != kNoIndex) {
+                fins[fin] |= kFinUsed;
+                flips = true;
+            }
+        }
+        if (flips)
+            caps.wall_flips += flip_used_fins(tri, wall, g.boundary_next, ids, length, fins, c.xy);
+        count += cap.triangles();
+        caps.triangles += cap.triangles();
+        ++caps.closed;
+    }
+    arena.rewind(mark);
+    return Status::ok;
+}
+
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>webs =================================================================================
+// How much of a finished surface spans gaps (Diagnostics).
+//
+// How much of a finished surface is web (Diagnostics): triangles far longer than the
+// spacing of the points they join, as where one tube wraps limbs and spans the gaps between
+// them. A vertex's local spacing is the median length of its edges, each counted once: the
+// edge that leaves it in each of its triangles (a boundary vertex misses one of its two
+// boundary edges). The median, not the shortest: a CT stack's edges across its slices are
+// far longer than those along a slice, and a vertex at a web's border has a few long edges
+// among its own. A triangle is web when its longest edge exceeds kWebSpacings times the
+// largest spacing of its corners: the largest, so that a triangle between a densely and a
+// sparsely sampled region is measured by the sparse one's. With 6, single columns (tubes,
+// heads, cones, capsules, CT slices, scan grids, noisy tubes, the bundled bust) show no web
+// triangle or a few, under 0.3% of their area, while objects with limbs meshed as one tube
+// show 2 to 12% of theirs. Far more of such a mesh is folded surface whose vertices have
+// only long edges (a fan of slivers from a foot to the body): the measure counts the
+// spans, which is enough to tell. The caps are left out: a cap spans its loop by design.
+//
+// The pass runs once the surface is final, when the layers' scratch is free: 72 bytes a
+// point (with 2 triangles a point), within reconstruct_workspace_size()'s bound. Lengths
+// are measured in the cloud's coordinates times a power of two that brings its extent near
+// 1 (exact), so that no square overflows or underflows.
+
+namespace stratmesh {
+namespace detail {
+
+// The vertices are numbered in the order the triangles first name them, their points
+// copied in that order, and the triangles renumbered in place (then restored): the passes
+// over the triangles then read nearby memory, whatever the cloud's order. The passes over
+// the vertices alone (copying their points, the medians) run as jobs where the caller gave
+// a runner; those over the triangles stay in order, as the areas are summed in it.
+struct WebMemory {
+    Vec3* points;      // a vertex's point (halved where the cloud spans more than a double)
+    size_t* ends;      // a vertex's count of edges, then where its lengths end once sorted
+    float* spacings;   // a vertex's local spacing
+    uint32_t* index;   // a vertex's index in the cloud
+    float* longest;    // a triangle's longest edge
+    // While the vertices are numbered, a point's number (or kNoIndex); then, in the same
+    // memory, the lengths of the edges leaving each vertex, vertex after vertex.
+    uint32_t* id;
+    float* lengths;
+};
+
+inline bool allocate_webs(WebMemory& m, size_t point_count, size_t triangle_count,
+                          Arena& arena) {
+    m.points = arena.alloc<Vec3>(point_count);
+    m.ends = arena.alloc<size_t>(point_count);
+    m.spacings = arena.alloc<float>(point_count);
+    m.index = arena.alloc<uint32_t>(point_count);
+    m.longest = arena.alloc<float>(triangle_count);
+    const size_t lengths = saturating_product(3, triangle_count);
+    void* shared = arena.take(lengths > point_count ? lengths : point_count, sizeof(float));
+    m.id = static_cast<uint32_t*>(shared);
+    m.lengths = static_cast<float*>(shared);
+    return !arena.failed;
+}
+
+// The workspace measure_webs() takes.
+inline size_t webs_workspace_size(size_t point_count, size_t triangle_count) {
+    Arena arena = Arena::measuring();
+    WebMemory m;
+    return allocate_webs(m, point_count, triangle_count, arena) ? arena.required_bytes() : 0;
+}
+
+// Edges in the cloud's coordinates times a power of two that brings the cloud's extent
+// near 1 (exact): no square overflows or underflows. Where the cloud spans more than the
+// largest double, the points are halved first, so that no difference overflows.
+struct WebFrame {
+    double scale;
+    bool halved;
+    Vec3 point(const CloudReader& reader, uint32_t i) const {
+        return halved ? scaled(reader.point(i), 0.5) : reader.point(i);
+    }
+    // ab, bc and ca of the triangle whose corners are numbered c.
+    void edges(const Vec3* points, const uint32_t* c, Vec3 e[3]) const {
+        const double s = halved ? 2 * scale : scale;
+        const Vec3 a = points[c[0]], b = points[c[1]], d = points[c[2]];
+        e[0] = scaled(b - a, s);
+        e[1] = scaled(d - b, s);
+        e[2] = scaled(a - d, s);
+    }
+};
+
+inline WebFrame web_frame(const CloudSums& s) {
+    const Vec3 low = {s.lowest[0], s.lowest[1], s.lowest[2]};
+    const Vec3 high = {s.highest[0], s.highest[1], s.highest[2]};
+    const Vec3 size = high - low, half = scaled(high, 0.5) - scaled(low, 0.5);
+    double extent = half.x > half.y ? half.x : half.y;
+    if (half.z > extent) extent = half.z;
+    return {scale_for_extent(extent), !(is_finite(size.x) && is_finite(size.y) && is_finite(size.z))};
+}
+
+// a, b in order (as min and max, which compile without a branch).
+inline void order(float& a, float& b) {
+    const float low = b < a ? b : a, high = a < b ? b : a;
+    a = low;
+    b = high;
+}
+
+// The lower median of v[0 .. count), count > 0: by a sorting network for a vertex's few
+// edges (no branch to mispredict), by heapsort for a large fan.
+inline float lower_median(float* v, size_t count) {
+    if (count > 8) {
+        heap_sort(v, count);
+        return v[(count - 1) / 2];
+    }
+    float s[8];
+    for (size_t i = 0; i < 8; ++i) s[i] = i < count ? v[i] : FLT_MAX;
+    order(s[0], s[2]), order(s[1], s[3]), order(s[4], s[6]), order(s[5], s[7]);
+    order(s[0], s[4]), order(s[1], s[5]), order(s[2], s[6]), order(s[3], s[7]);
+    order(s[0], s[1]), order(s[2], s[3]), order(s[4], s[5]), order(s[6], s[7]);
+    order(s[2], s[4]), order(s[3], s[5]);
+    order(s[1], s[4]), order(s[3], s[6]);
+    order(s[1], s[2]), order(s[3], s[4]), order(s[5], s[6]);
+    return s[(count - 1) / 2];
+}
+
+// Corners this far ahead are prefetched while the vertices are numbered, and points while
+// they are copied: the triangles name them in no order of the cloud's.
+const size_t kWebAhead = 16;
+
+// Numbers the vertices, renumbers the triangles' corners and counts the edges leaving each
+// vertex, then turns the counts into starts; returns how many vertices there are.
+inline uint32_t number_vertices(uint32_t* tri, size_t count, size_t point_count,
+                                const WebMemory& m) {
+    for (size_t v = 0; v < point_count; ++v) m.id[v] = kNoIndex;
+    uint32_t vertices = 0;
+    for (size_t k = 0; k < 3 * count; ++k) {
+        if (kFastLoops && k + kWebAhead < 3 * count) prefetch(m.id + tri[k + kWebAhead]);
+        uint32_t& id = m.id[tri[k]];
+        if (id == kNoIndex) {
+            id = vertices++;
+            m.index[id] = tri[k];
+            m.ends[id] = 0;
+        }
+        ++m.ends[id];
+        tri[k] = id;
+    }
+    size_t start = 0;
+    for (uint32_t v = 0; v < vertices; ++v) {
+        const size_t edges = m.ends[v];
+        m.ends[v] = start;
+        start += edges;
+    }
+    return vertices;
+}
+
+// The passes over the vertices, by runs of them (see run_pass) or all at once.
+struct WebVertexPass {
+    const CloudReader* reader;
+    const WebFrame* frame;
+    const WebMemory* m;
+    uint32_t vertices;
+    bool medians;  // else the points
+
+    void run(uint32_t k) { over(run_start(vertices, k), run_start(vertices, k + 1)); }
+    void over(size_t begin, size_t end) const {
+        if (!medians) {
+            for (size_t v = begin; v < end; ++v) {
+                if (kFastLoops && v + kWebAhead < end)
+                    prefetch(reader->base + m->index[v + kWebAhead] * reader->stride);
+                m->points[v] = frame->point(*reader, m->index[v]);
+            }
+            return;
+        }
+        for (size_t v = begin; v < end; ++v) {
+            const size_t first = v > 0 ? m->ends[v - 1] : 0;
+            m->spacings[v] = lower_median(m->lengths + first, m->ends[v] - first);
+        }
+    }
+};
+
+inline void run_vertex_pass(const Options& options, WebVertexPass& pass) {
+    if (kParallelLayers && options.run_jobs)
+        run_pass(options, pass);
+    else
+        pass.over(0, pass.vertices);
+}
+
+// The lengths of the edges leaving each vertex, sorted by vertex (a counting sort: each
+// start becomes an end), and each triangle's longest edge. Returns the triangles' area.
+inline double edge_lengths(const WebFrame& f, const uint32_t* tri, size_t count,
+                           const WebMemory& m) {
+    double area = 0;
+    for (size_t t = 0; t < count; ++t) {
+        const uint32_t* c = tri + 3 * t;
+        Vec3 e[3];
+        f.edges(m.points, c, e);
+        const Vec3 n = cross(e[0], e[1]);
+        area += std::sqrt(dot(n, n)) / 2;
+        float longest = 0;
+        for (size_t j = 0; j < 3; ++j) {
+            const float length = static_cast<float>(std::sqrt(dot(e[j], e[j])));
+            m.lengths[m.ends[c[j]]++] = length;
+            longest = length > longest ? length : longest;
+        }
+        m.longest[t] = longest;
+    }
+    return area;
+}
+
+// The web triangles among the renumbered triangles (see Diagnostics), into d, while their
+// corners are numbered back; returns their area.
+inline double find_webs(const WebFrame& f, uint32_t* tri, size_t count, const WebMemory& m,
+                        Diagnostics& d) {
+    double web = 0;
+    Vec3 low = {DBL_MAX, DBL_MAX, DBL_MAX}, high = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+    for (size_t t = 0; t < count; ++t) {
+        uint32_t* c = tri + 3 * t;
+        float spacing = 0;
+        for (size_t j = 0; j < 3; ++j)
+            spacing = m.spacings[c[j]] > spacing ? m.spacings[c[j]] : spacing;
+        if (static_cast<double>(m.longest[t]) > kWebSpacings * static_cast<double>(spacing)) {
+            ++d.web_triangle_count;
+            Vec3 e[3];
+            f.edges(m.points, c, e);
+            const Vec3 n = cross(e[0], e[1]);
+            web += std::sqrt(dot(n, n)) / 2;
+            for (size_t j = 0; j < 3; ++j) {
+                const Vec3 p = m.points[c[j]];
+                low = {p.x < low.x ? p.x : low.x, p.y < low.y ? p.y : low.y,
+                       p.z < low.z ? p.z : low.z};
+                high = {p.x > high.x ? p.x : high.x, p.y > high.y ? p.y : high.y,
+                        p.z > high.z ? p.z : high.z};
+            }
+        }
+        for (size_t j = 0; j < 3; ++j) c[j] = m.index[c[j]];
+    }
+    const double unhalve = f.halved ? 2 : 1;  // the copied points are halved then
+    const double lows[3] = {low.x, low.y, low.z}, highs[3] = {high.x, high.y, high.z};
+    for (int k = 0; d.web_triangle_count > 0 && k < 3; ++k) {
+        d.web_box_min[k] = lows[k] * unhalve;
+        d.web_box_max[k] = highs[k] * unhalve;
+    }
+    return web;
+}
+
+// Measures the webs of triangles[0 .. count) less the last `caps` into rep.diagnostics;
+// the triangles are renumbered meanwhile and come back as they were. False if the
+// workspace is too small (nothing is measured).
+inline bool measure_webs(const Options& options, const CloudReader& reader, size_t point_count,
+                         const CloudSums& sums, uint32_t* triangles, size_t count, size_t caps,
+                         Arena& arena, Report& rep) {
+    const size_t walls = caps < count ? count - caps : 0;
+    const size_t mark = arena.mark();
+    WebMemory m;
+    if (!allocate_webs(m, point_count, walls, arena)) return false;
+    const WebFrame f = web_frame(sums);
+    WebVertexPass pass = {&reader, &f, &m, number_vertices(triangles, walls, point_count, m),
+                          false};
+    run_vertex_pass(options, pass);
+    const double area = edge_lengths(f, triangles, walls, m);
+    pass.medians = true;
+    run_vertex_pass(options, pass);
+    Diagnostics& d = rep.diagnostics;
+    const double web = find_webs(f, triangles, walls, m, d);
+    arena.rewind(mark);
+    if (d.web_triangle_count == 0) return true;
+    d.web_area = web / f.scale / f.scale;
+    d.web_area_fraction = area > 0 ? web / area : 0;
+    return true;
+}
+
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>group ================================================================================
+// A group of layers: triangulated, stitched to the loop below, flipped and sealed.
+
+namespace stratmesh {
+namespace detail {
+
 // Forms the group starting at planned layer `first`, triangulates it, stitches it to the
 // chain's top loop and finishes the chunk. `ahead` (optional) is planned layer `first`
 // triangulated ahead: used when the group is that layer alone. Returns ok (also when
@@ -8265,24 +8722,6 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
     }
 }
 
-// ---- reconstruct -----------------------------------------------------------------------------
-
-// Workspace that lives through the whole call, then the largest scratch of any phase.
-struct ReconstructMemory {
-    double* bounds;        // layer bounds
-    uint32_t* layer_start; // first position in `order` of each layer
-    uint32_t* order;       // valid points grouped by layer
-    SurfaceChain chain;
-};
-
-inline bool plan_reconstruct(ReconstructMemory& m, size_t count, size_t layer_limit,
-                             Arena& arena) {
-    m.bounds = arena.alloc<double>(layer_limit + 1);
-    m.layer_start = arena.alloc<uint32_t>(layer_limit + 2);
-    m.order = arena.alloc<uint32_t>(count);
-    return allocate_chain(m.chain, count, arena);
-}
-
 // The largest scratch any phase takes on top of the plan, for groups of up to `count`
 // points; 0 if that is beyond what size_t can count.
 inline size_t reconstruct_scratch_size(size_t count, bool close) {
@@ -8354,6 +8793,15 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
     if (caps.high_water > most) most = caps.high_water;
     return most;
 }
+
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>parallel layers ======================================================================
+// Layers triangulated ahead as jobs on the caller's runner.
+
+namespace stratmesh {
+namespace detail {
 
 // ---- parallel layers -----------------------------------------------------------------------
 //
@@ -8621,272 +9069,31 @@ inline bool plan_parallel_workspace(size_t, size_t, Arena&, size_t*) { return tr
 
 #endif  // STRATMESH_NO_PARALLEL_LAYERS
 
-inline void notify(const Options& options, Phase phase, double fraction) {
-    if (options.progress) options.progress(options.progress_user, phase, fraction);
-}
+}  // namespace detail
+}  // namespace stratmesh
 
-// The bytes the cloud's coordinates lie in.
-inline ByteRange cloud_bytes(const Cloud& cloud) {
-    const size_t point_bytes = 3 * (cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double));
-    return strided_range(cloud.xyz, cloud.count, cloud.stride_bytes ? cloud.stride_bytes : point_bytes,
-                         point_bytes);
-}
+// >>tube =================================================================================
+// One tube: its layers triangulated, stitched and sealed group by group, then capped.
 
-// True if any two of the caller's buffers share a byte (the report and its layer array
-// included): checked before anything is written. A count beyond the limit is refused as
-// too_many_points instead.
-inline bool reconstruct_buffers_overlap(const Cloud& cloud, void* workspace,
-                                        size_t workspace_bytes, uint32_t* triangles,
-                                        size_t triangle_capacity, size_t* triangle_count,
-                                        const Report* report) {
-    if (cloud.count > kMaxPoints - 1) return false;
-    const ByteRange buffers[] = {
-        cloud_bytes(cloud),
-        byte_range(workspace, workspace_bytes),
-        byte_range(triangles, saturating_product(triangle_capacity, 3 * sizeof(uint32_t))),
-        byte_range(triangle_count, sizeof(size_t)),
-        byte_range(report, sizeof(Report)),
-        byte_range(report ? report->layers.info : nullptr,
-                   report ? saturating_product(report->layers.info_capacity, sizeof(LayerInfo)) : 0),
-        byte_range(kFindParts && report ? report->parts.info : nullptr,
-                   kFindParts && report ? saturating_product(report->parts.info_capacity, sizeof(PartInfo)) : 0)};
-    return any_overlap(buffers, 7);
-}
+namespace stratmesh {
+namespace detail {
 
-inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangles,
-                                          size_t triangle_capacity, size_t* triangle_count,
-                                          void* workspace, Report& rep) {
-    rep.detail = "an argument is invalid: a null pointer with a non-zero count, a stride "
-                 "smaller than one point, an unknown scalar type or a null triangle_count";
-    if (!triangle_count) return Status::invalid_argument;
-    if (cloud.count > kMaxPoints - 1) {
-        rep.detail = "more points than 32-bit triangle indices can address";
-        return Status::too_many_points;
-    }
-    size_t scalar = cloud.scalar == Scalar::float32 ? sizeof(float)
-                  : cloud.scalar == Scalar::float64 ? sizeof(double) : 0;
-    if (scalar == 0) return Status::invalid_argument;
-    if (cloud.stride_bytes != 0 && cloud.stride_bytes < 3 * scalar)
-        return Status::invalid_argument;
-    if (cloud.count > 0 && (!cloud.xyz || !workspace)) return Status::invalid_argument;
-    if (triangle_capacity > 0 && !triangles) return Status::invalid_argument;
-    rep.detail = nullptr;
-    return Status::ok;
-}
+// ---- reconstruct -----------------------------------------------------------------------------
 
-// The drop_outliers step: the bitmap stays in `arena` for the whole call (reader.dropped),
-// the grid's scratch is given back. False if the workspace is too small.
-inline bool find_outliers(CloudReader& reader, size_t count, Arena& arena, Report& rep) {
-    unsigned char* dropped = arena.alloc<unsigned char>(count / 8 + 1);
-    const size_t mark = arena.mark();
-    CellScratch g = allocate_cell_scratch(arena, count);
-    if (arena.failed) return false;
-    std::memset(dropped, 0, count / 8 + 1);
-    rep.points.outlier_count = drop_outliers_of(reader, count, dropped, g);
-    rep.points.rejected_count += rep.points.outlier_count;
-    arena.rewind(mark);
-    return true;
-}
-
-// Reads a cloud that passed check_reconstruct_arguments.
-inline CloudReader reader_of(const Cloud& cloud) {
-    size_t scalar = cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double);
-    return {static_cast<const unsigned char*>(cloud.xyz),
-            cloud.stride_bytes ? cloud.stride_bytes : 3 * scalar, cloud.scalar == Scalar::float32, nullptr};
-}
-
-const char* const kInvalidPointDetail =
-    "a point has a NaN or infinite coordinate (see first_invalid_index; the "
-    "skip_invalid_points flag skips such points instead)";
-
-// Where a cloud of `count` points (`sums` is its sum_cloud) is refused with invalid_point:
-// at its first point with a NaN or infinite coordinate, unless the skip_invalid_points flag
-// is given. `count` if it is not refused.
-inline size_t refused_at(const CloudReader& reader, size_t count, const CloudSums& sums,
-                         const Options& options) {
-    if (sums.valid == count || (options.flags & skip_invalid_points)) return count;
-    size_t first = 0;
-    while (reader.valid(first)) ++first;
-    return first;
-}
-
-// Counts the points with a NaN or infinite coordinate in rep.points.rejected_count, or refuses the
-// cloud (see refused_at).
-inline Status reject_invalid_points(const CloudReader& reader, size_t count,
-                                    const CloudSums& sums, const Options& options, Report& rep) {
-    const size_t first = refused_at(reader, count, sums, options);
-    if (first < count) {
-        rep.points.first_invalid_index = first;
-        rep.points.rejected_count = count;
-        rep.detail = kInvalidPointDetail;
-        return Status::invalid_point;
-    }
-    rep.points.rejected_count += count - sums.valid;
-    return Status::ok;
-}
-
-// The lowest and highest frame height of the valid points.
-inline void height_range(const CloudReader& cloud, size_t count, const Frame& frame, double* lo,
-                         double* hi) {
-    for (size_t i = 0; i < count; ++i) {
-        if (!cloud.valid(i)) continue;
-        const double h = frame.height(cloud.point(i));
-        if (h < *lo) *lo = h;
-        if (h > *hi) *hi = h;
-    }
-}
-
-// height_range without a pass over the cloud, where the axis is a coordinate axis (and
-// the frame not halved): a height is then (p_k - origin_k) * scale plus zeros, exactly
-// that value, and rounding keeps the order, so the lowest and highest coordinates along
-// the axis give the same two heights, bit for bit. False otherwise.
-inline bool height_range_from_extremes(const Frame& frame, double* lo, double* hi) {
-    const double axis[3] = {frame.axis.x, frame.axis.y, frame.axis.z};
-    const double low[3] = {frame.low.x, frame.low.y, frame.low.z};
-    const double high[3] = {frame.high.x, frame.high.y, frame.high.z};
-    const double origin[3] = {frame.origin.x, frame.origin.y, frame.origin.z};
-    for (int k = 0; k < 3; ++k) {
-        if (frame.halved || axis[k] != 1 || axis[(k + 1) % 3] != 0 || axis[(k + 2) % 3] != 0)
-            continue;
-        *lo = (low[k] - origin[k]) * frame.scale;
-        *hi = (high[k] - origin[k]) * frame.scale;
-        return true;
-    }
-    return false;
-}
-
-// Groups the valid points by layer (input order within a layer): a counting sort, with each
-// point's layer kept in `layer` (count entries of scratch) between its two passes. With
-// `staged` (optional, as many entries as valid points), the points in frame coordinates
-// go there in the same order.
-inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& frame,
-                           const LayerPlan& plan, uint32_t* layer, Local* staged,
-                           ReconstructMemory& m) {
-    std::memset(m.layer_start, 0, sizeof(uint32_t) * (plan.count + 2));
-    const double per_height =
-        kFastLoops ? plan.count / (plan.bounds[plan.count] - plan.bounds[0]) : 0;
-    for (size_t i = 0; i < count; ++i) {
-        layer[i] = cloud.valid(i) ? layer_of(plan, frame.height(cloud.point(i)), per_height)
-                                  : kNoIndex;
-        if (layer[i] != kNoIndex) ++m.layer_start[layer[i] + 2];
-    }
-    for (uint32_t k = 0; k < plan.count; ++k) m.layer_start[k + 2] += m.layer_start[k + 1];
-    for (size_t i = 0; i < count; ++i) {
-        if (layer[i] == kNoIndex) continue;
-        const uint32_t position = m.layer_start[layer[i] + 1]++;
-        m.order[position] = static_cast<uint32_t>(i);
-        if (staged) staged[position] = frame.local(cloud.point(i));
-    }
-}
-
-// ---- passes over all points as jobs ----
-//
-// With Options::run_jobs, a pass over all points that gives the same bits in any order
-// (grouping the points by layer) is cut into kPassRuns runs of consecutive points, run as
-// jobs. As for the layers' jobs (see JobRunner), a run the runner skips is done in order
-// afterwards, and a run done again changes nothing.
-const uint32_t kPassRuns = 16;
-
-// The first point of run k of `count` points.
-inline size_t run_start(size_t count, uint32_t k) {
-    return static_cast<size_t>(static_cast<uint64_t>(count) * k / kPassRuns);
-}
-
-template <class Pass> struct PassJobs {
-    Pass* pass;
-    bool done[kPassRuns];
+// Workspace that lives through the whole call, then the largest scratch of any phase.
+struct ReconstructMemory {
+    double* bounds;        // layer bounds
+    uint32_t* layer_start; // first position in `order` of each layer
+    uint32_t* order;       // valid points grouped by layer
+    SurfaceChain chain;
 };
 
-template <class Pass> inline void run_pass_job(void* context, uint32_t index) {
-    PassJobs<Pass>& jobs = *static_cast<PassJobs<Pass>*>(context);
-    if (index >= kPassRuns) return;  // a runner's mistake: no run of ours
-    jobs.pass->run(index);
-    jobs.done[index] = true;
-}
-
-template <class Pass> inline void run_pass(const Options& options, Pass& pass) {
-    PassJobs<Pass> jobs = {&pass, {}};
-    options.run_jobs(options.jobs_user, kPassRuns, run_pass_job<Pass>, &jobs);
-    for (uint32_t k = 0; k < kPassRuns; ++k)
-        if (!jobs.done[k]) pass.run(k);
-}
-
-// group_by_layer's counting sort, run by run: first each point's layer and each run's count
-// per layer, then (once `first` holds each run's first position per layer) the scatter. The
-// positions come out as in group_by_layer.
-struct GroupingPass {
-    const CloudReader* cloud;
-    const Frame* frame;
-    const LayerPlan* plan;
-    double per_height;
-    size_t count;
-    uint32_t* layer;
-    uint32_t* order;
-    uint32_t* counts;    // per run, per layer: its points there
-    uint32_t* first;     // per run, per layer: its first position there
-    uint32_t* next;      // per run, per layer: the scatter's next position
-    bool scatter;
-
-    void run(uint32_t k) {
-        const size_t layers = plan->count, begin = run_start(count, k), end = run_start(count, k + 1);
-        if (!scatter) {
-            uint32_t* c = counts + k * layers;
-            std::memset(c, 0, layers * sizeof(uint32_t));
-            for (size_t i = begin; i < end; ++i) {
-                layer[i] = cloud->valid(i) ? layer_of(*plan, frame->height(cloud->point(i)), per_height)
-                                           : kNoIndex;
-                if (layer[i] != kNoIndex) ++c[layer[i]];
-            }
-            return;
-        }
-        uint32_t* n = next + k * layers;
-        std::memcpy(n, first + k * layers, layers * sizeof(uint32_t));
-        for (size_t i = begin; i < end; ++i)
-            if (layer[i] != kNoIndex) order[n[layer[i]]++] = static_cast<uint32_t>(i);
-    }
-};
-
-// group_by_layer without staging, as jobs; false (nothing done) where its three tables of a
-// count per run and layer would take more than one count per point, or do not fit.
-inline bool group_by_layer_in_jobs(const Options& options, const CloudReader& cloud,
-                                   size_t count, const Frame& frame, const LayerPlan& plan,
-                                   uint32_t* layer, ReconstructMemory& m, Arena& arena) {
-    const size_t table = kPassRuns * static_cast<size_t>(plan.count);
-    if (!kParallelLayers || !options.run_jobs || 3 * table > count) return false;
-    const size_t mark = arena.mark();
-    GroupingPass pass = {&cloud, &frame, &plan, 0, count, layer, m.order,
-                         arena.alloc<uint32_t>(table), arena.alloc<uint32_t>(table),
-                         arena.alloc<uint32_t>(table), false};
-    if (arena.failed) {
-        arena.failed = false;
-        arena.rewind(mark);
-        return false;
-    }
-    pass.per_height = kFastLoops ? plan.count / (plan.bounds[plan.count] - plan.bounds[0]) : 0;
-    run_pass(options, pass);
-    // Layer by layer, run by run: the positions of a counting sort in input order.
-    uint32_t position = 0;
-    for (uint32_t l = 0; l < plan.count; ++l) {
-        m.layer_start[l] = position;
-        for (uint32_t k = 0; k < kPassRuns; ++k) {
-            pass.first[k * plan.count + l] = position;
-            position += pass.counts[k * plan.count + l];
-        }
-    }
-    m.layer_start[plan.count] = position;
-    pass.scatter = true;
-    run_pass(options, pass);
-    arena.rewind(mark);
-    return true;
-}
-
-STRATMESH_SMALL_NOINLINE inline void report_frame(const Frame& frame, Report& rep) {
-    rep.axis[0] = frame.axis.x;
-    rep.axis[1] = frame.axis.y;
-    rep.axis[2] = frame.axis.z;
-    rep.axis_origin[0] = frame.origin.x;
-    rep.axis_origin[1] = frame.origin.y;
-    rep.axis_origin[2] = frame.origin.z;
+inline bool plan_reconstruct(ReconstructMemory& m, size_t count, size_t layer_limit,
+                             Arena& arena) {
+    m.bounds = arena.alloc<double>(layer_limit + 1);
+    m.layer_start = arena.alloc<uint32_t>(layer_limit + 2);
+    m.order = arena.alloc<uint32_t>(count);
+    return allocate_chain(m.chain, count, arena);
 }
 
 inline void describe_layer(const Frame& frame, const Cylinder& cyl, double bottom, double top,
@@ -8906,12 +9113,6 @@ inline void describe_layer(const Frame& frame, const Cylinder& cyl, double botto
     info.fold_count = static_cast<uint32_t>(folds);
     info.closed_ends = cyl.poles;
 }
-
-}  // namespace detail
-
-
-
-namespace detail {
 
 // The workspace bound of mesh_tube() (with read_cloud()) for point_count points.
 inline size_t tube_workspace_size(size_t point_count, const Options& options) {
@@ -9001,47 +9202,6 @@ inline size_t repeats_of_vertices(const CloudReader& reader, size_t count,
     return repeats;
 }
 
-// A cloud as a tube reads it: in place, the points left out (outliers, or the points of
-// other parts) marked in the reader's optional bitmap, and the sums of the points kept.
-struct TubeInput {
-    CloudReader reader;
-    size_t count;
-    CloudSums sums;
-    uint32_t cut_ends;  // ends that are cuts, never closed (Frame::cut_ends), besides open_ends
-};
-
-// Whether this build holds every feature the flags ask for (STRATMESH_SMALL_CODE leaves
-// some out).
-inline bool flags_compiled(const Options& options) {
-    const uint32_t f = options.flags;
-    return (kDropOutliers || !(f & drop_outliers)) && (kSurfaceFlips || !(f & surface_flips)) &&
-           (kClosedEnds || !(f & open_ends));
-}
-
-// Reads a cloud that passed check_reconstruct_arguments: refuses or counts its NaN and
-// infinite points, leaves out its outliers (drop_outliers; the bitmap stays in `arena`)
-// and sums what is kept.
-inline Status read_cloud(const Cloud& cloud, const Options& options, Arena& arena, Report& rep,
-                         TubeInput& in) {
-    in.reader = reader_of(cloud);
-    in.count = cloud.count;
-    // One pass serves the check for invalid points, the frame and the distinct points.
-    in.sums = sum_cloud(in.reader, cloud.count);
-    Status status = reject_invalid_points(in.reader, cloud.count, in.sums, options, rep);
-    if (status != Status::ok) return status;
-    status = validate_layer_options(options);
-    if (status != Status::ok) return status;
-    if (!flags_compiled(options)) {
-        rep.detail = kNotCompiledDetail;
-        return Status::not_compiled;
-    }
-    if (kDropOutliers && (options.flags & drop_outliers)) {
-        if (!find_outliers(in.reader, cloud.count, arena, rep)) return Status::out_of_memory;
-        in.sums = sum_cloud(in.reader, cloud.count);  // without the outliers
-    }
-    return Status::ok;
-}
-
 // Plans the layers of a tube along the frame's axis and groups its points by layer.
 inline Status plan_tube_layers(const TubeInput& in, const Options& options, const Frame& frame,
                                double lo, double hi, Arena& arena, ReconstructMemory& m,
@@ -9076,8 +9236,9 @@ inline Status plan_tube_layers(const TubeInput& in, const Options& options, cons
     if (arena.failed) return Status::out_of_memory;
     if (kStagePoints && !(kParallelLayers && options.run_jobs))
         *staged = static_cast<Local*>(arena.room_at_end(saturating_product(valid, sizeof(Local))));
-    if (!group_by_layer_in_jobs(options, in.reader, in.count, frame, plan, layer, m, arena))
-        group_by_layer(in.reader, in.count, frame, plan, layer, *staged, m);
+    if (!group_by_layer_in_jobs(options, in.reader, in.count, frame, plan, layer, m.layer_start,
+                                m.order, arena))
+        group_by_layer(in.reader, in.count, frame, plan, layer, *staged, m.layer_start, m.order);
     arena.rewind(mark);
     return Status::ok;
 }
@@ -9130,6 +9291,7 @@ inline Status triangulate_tube(const TubeInput& in, const Options& options, cons
 // slivers of no area, so the cloud is refused instead (Status::degenerate; see
 // explain_no_area() for why).
 const double kLeastArea = 0x1p-40;
+
 // The triangles whose areas estimate the surface's: enough to see area where there is some.
 const size_t kAreaSample = 1024;
 
@@ -9228,12 +9390,10 @@ inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& aren
     return Status::ok;
 }
 
-
 }  // namespace detail
-
 }  // namespace stratmesh
 
-// >>stream ==================================================================================
+// >>stream ===============================================================================
 // The same surface, layer by layer, in bounded memory.
 //
 // The stream is reconstruct()'s loop over planned layers, driven by pushes: each push is
@@ -9274,6 +9434,9 @@ struct Stream {
                                   // instructions reach them on 32-bit ARM)
 };
 
+}  // namespace stratmesh
+
+namespace stratmesh {
 namespace detail {
 
 // Points more than this many times the first layer's size away from it are refused: the
@@ -9370,6 +9533,9 @@ inline Status advance(Stream& s, bool complete) {
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 size_t stream_workspace_size(size_t max_points_held, const Options& options) {
     (void)options;
@@ -9585,7 +9751,7 @@ Status stream_close(Stream* stream) {
 
 }  // namespace stratmesh
 
-// >>axis ====================================================================================
+// >>axis =================================================================================
 // The automatic axis.
 //
 // The automatic axis. The method needs the direction along which the cloud's sections are
@@ -9600,23 +9766,25 @@ Status stream_close(Stream* stream) {
 // are every k-th kept point in input order, so the choice is deterministic.
 
 namespace stratmesh {
-
 namespace detail {
 
 // Points meshed per candidate: enough to see an object's limbs and ends, few enough that
 // six candidates cost a small part of a large run.
 const size_t kAxisSample = 512;
+
 // Points the principal directions are measured on: enough for a tube's axis within a
 // fraction of a degree.
 const size_t kAxisShapeSample = 16384;
+
 // The share of the sample surface's normals along the first candidate (the mean squared
 // cosine, weighted by area) below which the surface runs along it: about 0.04 on a tube,
 // 0.16 to 0.5 on heads, bones and hands.
 const double kAlongSurface = 0.1;
+
 // A candidate whose direction is within about 10 degrees of an earlier one is not tried.
 const double kSameAxisCosine = 0.985;
-const uint32_t kMostAxisCandidates = 6;
 
+const uint32_t kMostAxisCandidates = 6;
 
 // The three principal directions of a symmetric 3x3 matrix, largest variance first: power
 // iteration, then again on the matrix without the first direction's share.
@@ -9838,8 +10006,38 @@ inline size_t axis_workspace_size(size_t valid, const Options& options) {
     return arena.failed ? 0 : arena.required_bytes() + tube;
 }
 
-}  // namespace detail
+// The options along the axis to use: Axis::automatic resolved by choose_axis().
+inline Status resolve_axis(const TubeInput& in, const Options& options, Arena& arena,
+                           Options& along, Report& rep) {
+    along = options;
+    if (options.axis != Axis::automatic) return Status::ok;
+    if (!kAxisTrials) {
+        rep.detail = kNotCompiledDetail;
+        return Status::not_compiled;
+    }
+    if (in.sums.distinct < 3) {  // no surface along any axis: mesh_tube says so
+        along.axis = Axis::z;
+        return Status::ok;
+    }
+    Vec3 axis;
+    if (!choose_axis(in, options, arena, axis)) {
+        rep.detail = "the workspace is smaller than reconstruct_workspace_size()";
+        return Status::out_of_memory;
+    }
+    along.axis = Axis::direction;
+    along.direction[0] = axis.x;
+    along.direction[1] = axis.y;
+    along.direction[2] = axis.z;
+    return Status::ok;
+}
 
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>no area ==============================================================================
+// Why a surface through the points would have no area: a line, far points, far clusters.
+
+namespace stratmesh {
 namespace detail {
 
 // Whether the kept points of `in` lie on a line up to rounding (see kLineVariance), judged
@@ -10007,36 +10205,10 @@ inline Status explain_no_area(const TubeInput& in, Status status, Arena& arena, 
     }
 }
 
-// The options along the axis to use: Axis::automatic resolved by choose_axis().
-inline Status resolve_axis(const TubeInput& in, const Options& options, Arena& arena,
-                           Options& along, Report& rep) {
-    along = options;
-    if (options.axis != Axis::automatic) return Status::ok;
-    if (!kAxisTrials) {
-        rep.detail = kNotCompiledDetail;
-        return Status::not_compiled;
-    }
-    if (in.sums.distinct < 3) {  // no surface along any axis: mesh_tube says so
-        along.axis = Axis::z;
-        return Status::ok;
-    }
-    Vec3 axis;
-    if (!choose_axis(in, options, arena, axis)) {
-        rep.detail = "the workspace is smaller than reconstruct_workspace_size()";
-        return Status::out_of_memory;
-    }
-    along.axis = Axis::direction;
-    along.direction[0] = axis.x;
-    along.direction[1] = axis.y;
-    along.direction[2] = axis.z;
-    return Status::ok;
-}
-
 }  // namespace detail
-
 }  // namespace stratmesh
 
-// >>cap ends ================================================================================
+// >>cap ends =============================================================================
 // cap_ends() for a surface the caller holds.
 //
 // cap_ends() is reconstruct()'s last step on a surface the caller holds: the same checks of
@@ -10118,9 +10290,10 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
 }
 
 }  // namespace stratmesh
+
 #endif  // STRATMESH_SMALL_CODE
 
-// >>parting =================================================================================
+// >>parting ==============================================================================
 // find_parting(): where the cloud parts into branches.
 //
 // find_parting(): the cuts lie every half gap along the axis (at most one per point), and
@@ -10137,21 +10310,26 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
 
 #if !defined(STRATMESH_SMALL_CODE)
 namespace stratmesh {
-
 namespace detail {
 
 // The gap, in median nearest-neighbour distances: points of one branch lie closer, the
 // branches of a fork farther apart.
 const double kPartingGap = 4.0;
+
 const uint32_t kStepsPerGap = 2;
+
 // The points the scale (the median distance to the nearest neighbour) is measured on:
 // enough for the median within a few percent.
 const size_t kScaleSample = 2048;
+
 // The blocks of the grid cells met last, by a hash of the cell: a step's points share
 // cells, and each block costs 18 searches to find.
 const uint32_t kBlockCacheSize = 2048;
+
 const uint64_t kNoCell = ~uint64_t{0};  // no key: keys take 63 bits
+
 const uint32_t kNotAdded = ~uint32_t{0};
+
 // The most points a sweep may compare, on average per point: a surface's block of cells
 // holds about 40; a cloud crowded beyond this (many repeats of the same points, a solid
 // volume of points) is not searched, so that no cloud costs time quadratic in its size.
@@ -10536,6 +10714,9 @@ inline Status out_of_workspace(Report& rep) {
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 size_t find_parting_workspace_size(size_t point_count, const Options& options) {
     if (point_count > detail::kMaxPoints - 1) return 0;
@@ -10553,6 +10734,9 @@ size_t find_parting_workspace_size(size_t point_count, const Options& options) {
     return arena.failed ? 0 : arena.required_bytes();
 }
 
+}  // namespace stratmesh
+
+namespace stratmesh {
 namespace detail {
 
 // find_parting() with the fewest points a branch holds given: a sample of the cloud is
@@ -10668,6 +10852,9 @@ inline Status find_parting_with(const Cloud& cloud, const Options& options, void
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
                     size_t workspace_bytes, Parting* parting, uint8_t* branch_of) {
@@ -10676,9 +10863,10 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 }
 
 }  // namespace stratmesh
+
 #endif  // STRATMESH_SMALL_CODE
 
-// >>join branches ===========================================================================
+// >>join branches ========================================================================
 // join_branches(): zips and grafts.
 //
 // join_branches(): the boundary loops of the caller's surface are traced as the caps trace
@@ -10692,17 +10880,19 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 
 #if !defined(STRATMESH_SMALL_CODE)
 namespace stratmesh {
-
 namespace detail {
 
 // The most trunk triangles a graft looks at under one branch's loop (see plan_graft): its
 // arrays are sized for them, not for the whole surface.
 const size_t kGraftMaxTriangles = size_t{1} << 16;
+
 // The small gaps in the trunk's end a graft may close (see plan_graft): at most this many
 // vertices each, within kGapReach times the branch loop's reach of its centre, at most one
 // a graft, so at most kMostFilled triangles in all.
 const uint32_t kGapLoopMost = 32;
+
 const double kGapReach = 1.5;
+
 const size_t kMostFilled = 2 * size_t{kMaxBranches} * (kGapLoopMost - 2);
 
 // A directed edge of a triangle under a branch's loop, and which of them it belongs to.
@@ -11401,6 +11591,9 @@ inline void write_graft(const Graft& graft, const SideView& view, uint32_t* out)
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 size_t join_branches_workspace_size(size_t point_count, size_t triangle_count) {
     if (point_count > detail::kMaxPoints - 1) return 0;
@@ -11563,9 +11756,10 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
 }
 
 }  // namespace stratmesh
+
 #endif  // STRATMESH_SMALL_CODE
 
-// >>parts ===================================================================================
+// >>parts ================================================================================
 // reconstruct()'s default: trunk and branches, meshed and joined.
 //
 // reconstruct()'s default where the cloud parts into branches (PartCounts). One tube wraps
@@ -11585,14 +11779,15 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
 
 #if !defined(STRATMESH_SMALL_CODE)
 namespace stratmesh {
-
 namespace detail {
 
 const size_t kPartingSample = 4096;
+
 // On the sample a branch counts from this share of kSmallestBranch points: fewer than on
 // the whole cloud, so that a branch the whole cloud would count is seen in the sample too
 // (a horn of one point in a hundred); the search in full then decides.
 const uint32_t kSampleBranchShare = 4;
+
 // The trunk's end layer under branches standing on its closed end is merged with the
 // layers next to it until it is this many of their largest radius tall: a closed end
 // projects from a pole one radius in from the end, but at most three quarters of the way
@@ -11642,6 +11837,7 @@ inline TubeInput part_input(const TubeInput& whole, const PartsMemory& m, uint8_
 // away it is a piece of its own (a speck, a patch a hole cut off), and the split is undone.
 // Sought among all points, so at most kMostStrayChecks distance checks in all.
 const double kAdoptionGaps = 2.0;
+
 const uint64_t kMostStrayChecks = uint64_t{1} << 26;
 
 inline void adopt_stray_points(const TubeInput& whole, double gap, uint8_t* labels) {
@@ -11768,7 +11964,9 @@ inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const Opt
 // finds as many branches on each side; `along` then takes its axis. Not where the caller
 // gave cuts, which are positions along the axis. False if the workspace is too small.
 const double kSquareCutLeast = 0.99996;  // cos 0.5 degree
+
 const double kSquareCutMost = 0.866;     // cos 30 degrees
+
 const int kSquareCutRounds = 4;
 
 inline bool square_cut_to_trunk(const Cloud& cloud, const TubeInput& whole, const PartsMemory& m,
@@ -12082,19 +12280,39 @@ inline size_t parts_workspace_size(size_t count, const Options& options) {
 }
 
 }  // namespace detail
-
 }  // namespace stratmesh
+
 #endif  // STRATMESH_SMALL_CODE
 
-// >>reconstruct entry ======================================================================
+// >>reconstruct ==========================================================================
 // reconstruct() in its steps: validate, axis, parts or one tube.
-//
-// reconstruct() in its steps: check the arguments, read the cloud, choose the axis, then
-// one tube or the parts (where the build has them and the one_tube flag is not given).
 
 namespace stratmesh {
-
 namespace detail {
+
+// Reads a cloud that passed check_reconstruct_arguments: refuses or counts its NaN and
+// infinite points, leaves out its outliers (drop_outliers; the bitmap stays in `arena`)
+// and sums what is kept.
+inline Status read_cloud(const Cloud& cloud, const Options& options, Arena& arena, Report& rep,
+                         TubeInput& in) {
+    in.reader = reader_of(cloud);
+    in.count = cloud.count;
+    // One pass serves the check for invalid points, the frame and the distinct points.
+    in.sums = sum_cloud(in.reader, cloud.count);
+    Status status = reject_invalid_points(in.reader, cloud.count, in.sums, options, rep);
+    if (status != Status::ok) return status;
+    status = validate_layer_options(options);
+    if (status != Status::ok) return status;
+    if (!flags_compiled(options)) {
+        rep.detail = kNotCompiledDetail;
+        return Status::not_compiled;
+    }
+    if (kDropOutliers && (options.flags & drop_outliers)) {
+        if (!find_outliers(in.reader, cloud.count, arena, rep)) return Status::out_of_memory;
+        in.sums = sum_cloud(in.reader, cloud.count);  // without the outliers
+    }
+    return Status::ok;
+}
 
 // Whether reconstruct() looks for branches with these options.
 inline bool searches_parts(const Options& options) {
@@ -12162,6 +12380,9 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 size_t reconstruct_max_triangles(size_t point_count, const Options& options) {
     // A manifold surface through V vertices, open or closed, has at most 2V triangles; the

@@ -1,4 +1,4 @@
-// >>arena ===================================================================================
+// >>arena ================================================================================
 // The bump allocator over the caller's workspace.
 //
 // A bump allocator over the caller's buffer. A "measuring" arena (null base) only adds up

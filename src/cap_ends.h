@@ -1,4 +1,4 @@
-// >>cap ends ================================================================================
+// >>cap ends =============================================================================
 // cap_ends() for a surface the caller holds.
 //
 // cap_ends() is reconstruct()'s last step on a surface the caller holds: the same checks of
@@ -80,4 +80,5 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
 }
 
 }  // namespace stratmesh
+
 #endif  // STRATMESH_SMALL_CODE

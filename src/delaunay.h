@@ -1,4 +1,4 @@
-// >>delaunay ================================================================================
+// >>delaunay =============================================================================
 // The incremental 2D Delaunay triangulation (delaunay_2d).
 //
 // This work is based on:
@@ -21,6 +21,7 @@ namespace detail {
 static const uint32_t kGhost = kNoIndex;
 
 inline uint32_t next_edge(uint32_t e) { return e % 3 == 2 ? e - 2 : e + 1; }
+
 inline uint32_t prev_edge(uint32_t e) { return e % 3 == 0 ? e + 2 : e - 1; }
 
 struct Triangulation {
@@ -345,6 +346,9 @@ inline bool plan_delaunay_2d(Delaunay2dMemory& m, size_t count, Arena& arena,
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 size_t delaunay_2d_workspace_size(size_t point_count) {
     if (point_count > detail::kMaxPoints) return 0;
@@ -359,6 +363,9 @@ size_t delaunay_2d_max_triangles(size_t point_count) {
     return point_count >= 3 ? 2 * point_count - 5 : 0;
 }
 
+}  // namespace stratmesh
+
+namespace stratmesh {
 namespace detail {
 
 // True if any two of the caller's buffers share a byte: checked before anything is
@@ -379,6 +386,9 @@ inline bool delaunay_buffers_overlap(const double* xy, size_t point_count, size_
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
                    void* workspace, size_t workspace_bytes,
@@ -454,7 +464,4 @@ Status delaunay_2d(const double* xy, size_t point_count, size_t stride_bytes,
     return Status::ok;
 }
 
-namespace detail {
-
-}  // namespace detail
 }  // namespace stratmesh

@@ -1,4 +1,4 @@
-// >>join branches ===========================================================================
+// >>join branches ========================================================================
 // join_branches(): zips and grafts.
 //
 // join_branches(): the boundary loops of the caller's surface are traced as the caps trace
@@ -12,17 +12,19 @@
 
 #if !defined(STRATMESH_SMALL_CODE)
 namespace stratmesh {
-
 namespace detail {
 
 // The most trunk triangles a graft looks at under one branch's loop (see plan_graft): its
 // arrays are sized for them, not for the whole surface.
 const size_t kGraftMaxTriangles = size_t{1} << 16;
+
 // The small gaps in the trunk's end a graft may close (see plan_graft): at most this many
 // vertices each, within kGapReach times the branch loop's reach of its centre, at most one
 // a graft, so at most kMostFilled triangles in all.
 const uint32_t kGapLoopMost = 32;
+
 const double kGapReach = 1.5;
+
 const size_t kMostFilled = 2 * size_t{kMaxBranches} * (kGapLoopMost - 2);
 
 // A directed edge of a triangle under a branch's loop, and which of them it belongs to.
@@ -721,6 +723,9 @@ inline void write_graft(const Graft& graft, const SideView& view, uint32_t* out)
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 size_t join_branches_workspace_size(size_t point_count, size_t triangle_count) {
     if (point_count > detail::kMaxPoints - 1) return 0;
@@ -883,4 +888,5 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
 }
 
 }  // namespace stratmesh
+
 #endif  // STRATMESH_SMALL_CODE

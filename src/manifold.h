@@ -1,4 +1,4 @@
-// >>manifold ================================================================================
+// >>manifold =============================================================================
 // The safety net that keeps the surface a manifold.
 //
 // The paper's step 5, as a safety net: by construction the layers and bands already form a

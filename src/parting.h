@@ -1,4 +1,4 @@
-// >>parting =================================================================================
+// >>parting ==============================================================================
 // find_parting(): where the cloud parts into branches.
 //
 // find_parting(): the cuts lie every half gap along the axis (at most one per point), and
@@ -15,21 +15,26 @@
 
 #if !defined(STRATMESH_SMALL_CODE)
 namespace stratmesh {
-
 namespace detail {
 
 // The gap, in median nearest-neighbour distances: points of one branch lie closer, the
 // branches of a fork farther apart.
 const double kPartingGap = 4.0;
+
 const uint32_t kStepsPerGap = 2;
+
 // The points the scale (the median distance to the nearest neighbour) is measured on:
 // enough for the median within a few percent.
 const size_t kScaleSample = 2048;
+
 // The blocks of the grid cells met last, by a hash of the cell: a step's points share
 // cells, and each block costs 18 searches to find.
 const uint32_t kBlockCacheSize = 2048;
+
 const uint64_t kNoCell = ~uint64_t{0};  // no key: keys take 63 bits
+
 const uint32_t kNotAdded = ~uint32_t{0};
+
 // The most points a sweep may compare, on average per point: a surface's block of cells
 // holds about 40; a cloud crowded beyond this (many repeats of the same points, a solid
 // volume of points) is not searched, so that no cloud costs time quadratic in its size.
@@ -414,6 +419,9 @@ inline Status out_of_workspace(Report& rep) {
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 size_t find_parting_workspace_size(size_t point_count, const Options& options) {
     if (point_count > detail::kMaxPoints - 1) return 0;
@@ -431,6 +439,9 @@ size_t find_parting_workspace_size(size_t point_count, const Options& options) {
     return arena.failed ? 0 : arena.required_bytes();
 }
 
+}  // namespace stratmesh
+
+namespace stratmesh {
 namespace detail {
 
 // find_parting() with the fewest points a branch holds given: a sample of the cloud is
@@ -546,6 +557,9 @@ inline Status find_parting_with(const Cloud& cloud, const Options& options, void
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
                     size_t workspace_bytes, Parting* parting, uint8_t* branch_of) {
@@ -554,4 +568,5 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 }
 
 }  // namespace stratmesh
+
 #endif  // STRATMESH_SMALL_CODE

@@ -1,4 +1,4 @@
-// >>parts ===================================================================================
+// >>parts ================================================================================
 // reconstruct()'s default: trunk and branches, meshed and joined.
 //
 // reconstruct()'s default where the cloud parts into branches (PartCounts). One tube wraps
@@ -18,14 +18,15 @@
 
 #if !defined(STRATMESH_SMALL_CODE)
 namespace stratmesh {
-
 namespace detail {
 
 const size_t kPartingSample = 4096;
+
 // On the sample a branch counts from this share of kSmallestBranch points: fewer than on
 // the whole cloud, so that a branch the whole cloud would count is seen in the sample too
 // (a horn of one point in a hundred); the search in full then decides.
 const uint32_t kSampleBranchShare = 4;
+
 // The trunk's end layer under branches standing on its closed end is merged with the
 // layers next to it until it is this many of their largest radius tall: a closed end
 // projects from a pole one radius in from the end, but at most three quarters of the way
@@ -75,6 +76,7 @@ inline TubeInput part_input(const TubeInput& whole, const PartsMemory& m, uint8_
 // away it is a piece of its own (a speck, a patch a hole cut off), and the split is undone.
 // Sought among all points, so at most kMostStrayChecks distance checks in all.
 const double kAdoptionGaps = 2.0;
+
 const uint64_t kMostStrayChecks = uint64_t{1} << 26;
 
 inline void adopt_stray_points(const TubeInput& whole, double gap, uint8_t* labels) {
@@ -201,7 +203,9 @@ inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const Opt
 // finds as many branches on each side; `along` then takes its axis. Not where the caller
 // gave cuts, which are positions along the axis. False if the workspace is too small.
 const double kSquareCutLeast = 0.99996;  // cos 0.5 degree
+
 const double kSquareCutMost = 0.866;     // cos 30 degrees
+
 const int kSquareCutRounds = 4;
 
 inline bool square_cut_to_trunk(const Cloud& cloud, const TubeInput& whole, const PartsMemory& m,
@@ -515,6 +519,6 @@ inline size_t parts_workspace_size(size_t count, const Options& options) {
 }
 
 }  // namespace detail
-
 }  // namespace stratmesh
+
 #endif  // STRATMESH_SMALL_CODE

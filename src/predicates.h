@@ -1,4 +1,4 @@
-// >>predicates ==============================================================================
+// >>predicates ===========================================================================
 // orient2d and incircle: filter, integer and expansion stages.
 //
 // This work is based on:
@@ -17,8 +17,11 @@ namespace stratmesh {
 namespace detail {
 
 constexpr double kEps = DBL_EPSILON / 2;
+
 constexpr double kSplitter = 134217729.0; // 2^27 + 1: splits a double into two 26-bit halves
+
 constexpr double kOrientBoundA = (3.0 + 16.0 * kEps) * kEps;
+
 constexpr double kIncircleBoundA = (10.0 + 96.0 * kEps) * kEps;
 
 // a + b = x + y exactly, with x = fl(a + b).
@@ -681,6 +684,9 @@ STRATMESH_SMALL_NOINLINE inline int incircle_perturbed(const double* a, const do
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 double orient2d(const double a[2], const double b[2], const double c[2]) {
     return detail::orient2d_robust(a, b, c);
@@ -691,7 +697,4 @@ double incircle(const double a[2], const double b[2], const double c[2], const d
     return detail::incircle_robust(a, b, c, d, scratch);
 }
 
-namespace detail {
-
-}  // namespace detail
 }  // namespace stratmesh

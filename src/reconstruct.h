@@ -1,12 +1,32 @@
-// >>reconstruct entry ======================================================================
+// >>reconstruct ==========================================================================
 // reconstruct() in its steps: validate, axis, parts or one tube.
-//
-// reconstruct() in its steps: check the arguments, read the cloud, choose the axis, then
-// one tube or the parts (where the build has them and the one_tube flag is not given).
 
 namespace stratmesh {
-
 namespace detail {
+
+// Reads a cloud that passed check_reconstruct_arguments: refuses or counts its NaN and
+// infinite points, leaves out its outliers (drop_outliers; the bitmap stays in `arena`)
+// and sums what is kept.
+inline Status read_cloud(const Cloud& cloud, const Options& options, Arena& arena, Report& rep,
+                         TubeInput& in) {
+    in.reader = reader_of(cloud);
+    in.count = cloud.count;
+    // One pass serves the check for invalid points, the frame and the distinct points.
+    in.sums = sum_cloud(in.reader, cloud.count);
+    Status status = reject_invalid_points(in.reader, cloud.count, in.sums, options, rep);
+    if (status != Status::ok) return status;
+    status = validate_layer_options(options);
+    if (status != Status::ok) return status;
+    if (!flags_compiled(options)) {
+        rep.detail = kNotCompiledDetail;
+        return Status::not_compiled;
+    }
+    if (kDropOutliers && (options.flags & drop_outliers)) {
+        if (!find_outliers(in.reader, cloud.count, arena, rep)) return Status::out_of_memory;
+        in.sums = sum_cloud(in.reader, cloud.count);  // without the outliers
+    }
+    return Status::ok;
+}
 
 // Whether reconstruct() looks for branches with these options.
 inline bool searches_parts(const Options& options) {
@@ -74,6 +94,9 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 size_t reconstruct_max_triangles(size_t point_count, const Options& options) {
     // A manifold surface through V vertices, open or closed, has at most 2V triangles; the

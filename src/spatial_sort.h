@@ -1,4 +1,4 @@
-// >>spatial sort ============================================================================
+// >>spatial sort =========================================================================
 // The insertion order of the Delaunay triangulation.
 //
 // This work is based on:

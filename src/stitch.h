@@ -1,4 +1,4 @@
-// >>stitch ==================================================================================
+// >>stitch ===============================================================================
 // The band between two layers' loops.
 //
 // Two neighbouring layers meet at a cut: the top loop A of the lower layer and the bottom

@@ -1,4 +1,4 @@
-// >>stream ==================================================================================
+// >>stream ===============================================================================
 // The same surface, layer by layer, in bounded memory.
 //
 // The stream is reconstruct()'s loop over planned layers, driven by pushes: each push is
@@ -39,6 +39,9 @@ struct Stream {
                                   // instructions reach them on 32-bit ARM)
 };
 
+}  // namespace stratmesh
+
+namespace stratmesh {
 namespace detail {
 
 // Points more than this many times the first layer's size away from it are refused: the
@@ -135,6 +138,9 @@ inline Status advance(Stream& s, bool complete) {
 }
 
 }  // namespace detail
+}  // namespace stratmesh
+
+namespace stratmesh {
 
 size_t stream_workspace_size(size_t max_points_held, const Options& options) {
     (void)options;

@@ -1,4 +1,4 @@
-// >>unroll ==================================================================================
+// >>unroll ===============================================================================
 // A layer onto its annulus (cylinder and closed ends).
 //
 // Each layer is projected on a cylinder around its own centre, unrolled to (u, v) =

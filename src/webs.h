@@ -1,4 +1,4 @@
-// >>webs ====================================================================================
+// >>webs =================================================================================
 // How much of a finished surface spans gaps (Diagnostics).
 //
 // How much of a finished surface is web (Diagnostics): triangles far longer than the
@@ -23,10 +23,6 @@
 
 namespace stratmesh {
 namespace detail {
-
-// From the passes over all points as jobs (>>reconstruct).
-inline size_t run_start(size_t count, uint32_t k);
-template <class Pass> inline void run_pass(const Options& options, Pass& pass);
 
 // The vertices are numbered in the order the triangles first name them, their points
 // copied in that order, and the triangles renumbered in place (then restored): the passes

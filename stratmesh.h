@@ -1382,8 +1382,8 @@ stratmesh_status stratmesh_stream_close(stratmesh_stream* stream);
 //   >>layer plan          cuts along the axis: explicit, equal, by height or automatic;
 //                         points grouped by layer
 //   >>unroll              a layer onto its annulus (cylinder and closed ends)
-//   >>layer               one layer loaded on its annulus: its loops and their peeling,
-//                         closed ends, the centre search
+//   >>layer               one layer on its annulus: its loops and their peeling, closed
+//                         ends, the centre search
 //   >>stitch              the band between two layers' loops
 //   >>manifold            the safety net that keeps the surface a manifold
 //   >>chain               the surface as a chain of chunks: a group of layers with its
@@ -3700,10 +3700,9 @@ const char* const kNotCompiledDetail =
 // >>frame ================================================================================
 // The frame the layers are cut in: its axis, origin and scale.
 //
-// The cloud is read in place (float or double, any stride) and expressed in a frame whose
-// third axis is the stacking axis and whose origin is the centroid, so that clouds far
-// from the origin (georeferenced scans) keep their millimetres. Layers are height ranges
-// along the axis; the points are grouped by layer, in input order within a layer.
+// The cloud is expressed in a frame whose third axis is the stacking axis and whose origin
+// is the centroid, so that clouds far from the origin (georeferenced scans) keep their
+// millimetres; a power of two brings its extent near 1.
 
 namespace stratmesh {
 namespace detail {
@@ -3968,6 +3967,9 @@ template <class Pass> inline void run_pass(const Options& options, Pass& pass) {
 
 // >>layer plan ===========================================================================
 // Cuts along the axis: explicit, equal, by height or automatic; points grouped by layer.
+//
+// Layers are height ranges along the axis; the points are grouped by layer, in input order
+// within a layer.
 
 namespace stratmesh {
 namespace detail {
@@ -4754,7 +4756,7 @@ struct TriangleSink {
 }  // namespace stratmesh
 
 // >>layer ================================================================================
-// One layer loaded on its annulus: its loops and their peeling, closed ends, the centre search.
+// One layer on its annulus: its loops and their peeling, closed ends, the centre search.
 
 namespace stratmesh {
 namespace detail {
@@ -6010,12 +6012,6 @@ inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count,
 
 // >>chain ================================================================================
 // The surface as a chain of chunks: a group of layers with its band, sealed to the one below.
-//
-// Validate, choose the frame and the layers, group the points by layer, then for each
-// layer: fit its cylinder, triangulate it on its annulus, stitch it to the layer below.
-// A layer that cannot be triangulated around its axis (too few points, or a gap in its
-// angular coverage) is merged with the next one; trailing points that never form such a
-// layer stay unused and are reported. Last, the manifold safety net.
 
 namespace stratmesh {
 namespace detail {
@@ -9074,6 +9070,12 @@ inline bool plan_parallel_workspace(size_t, size_t, Arena&, size_t*) { return tr
 
 // >>tube =================================================================================
 // One tube: its layers triangulated, stitched and sealed group by group, then capped.
+//
+// Choose the frame and the layers, group the points by layer, then for each layer: fit its
+// cylinder, triangulate it on its annulus, stitch it to the layer below. A layer that
+// cannot be triangulated around its axis (too few points, or a gap in its angular
+// coverage) is merged with the next one; trailing points that never form such a layer stay
+// unused and are reported. The manifold safety net runs on each chunk as it is sealed.
 
 namespace stratmesh {
 namespace detail {

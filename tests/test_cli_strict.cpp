@@ -137,7 +137,9 @@ TEST_CASE("an atomic file appears only when committed, keeping the old one until
         std::fflush(file.file());
         CHECK(load(path) == "old");
         CHECK(dir.entries() == 2);
-        REQUIRE(file.commit(0, error));
+        REQUIRE(file.complete(0, error));
+        CHECK(load(path) == "old"); // complete, not yet committed
+        REQUIRE(commit_files({&file}, error));
     }
     CHECK(load(path) == "new");
     CHECK(dir.entries() == 1);
@@ -161,7 +163,8 @@ TEST_CASE("starting the writeback early is only a hint: the file still appears w
             expected.size() - half);
     file.start_writeback();
     CHECK(load(path) == "old");
-    REQUIRE_MESSAGE(file.commit(0, error), error);
+    REQUIRE_MESSAGE(file.complete(0, error), error);
+    REQUIRE_MESSAGE(commit_files({&file}, error), error);
     CHECK(load(path) == expected);
     CHECK(dir.entries() == 1);
 #ifndef _WIN32
@@ -171,7 +174,7 @@ TEST_CASE("starting the writeback early is only a hint: the file still appears w
         REQUIRE(full.open("/dev/full", error));
         std::fputs("anything", full.file());
         full.start_writeback();
-        CHECK_FALSE(full.commit(0, error));
+        CHECK_FALSE(full.complete(0, error));
         CHECK(contains(error, "/dev/full: cannot write"));
     }
 #endif
@@ -186,8 +189,9 @@ TEST_CASE("a failed write leaves the old file and no temporary") {
         std::string error;
         REQUIRE(file.open(path, error));
         std::fputs("partial", file.file());
-        CHECK_FALSE(file.commit(ENOSPC, error));
+        CHECK_FALSE(file.complete(ENOSPC, error));
         CHECK(error == path + ": cannot write: " + std::strerror(ENOSPC));
+        CHECK_FALSE(commit_files({&file}, error));
     }
     SUBCASE("abandoned (an error elsewhere)") {
         AtomicFile file;
@@ -199,6 +203,46 @@ TEST_CASE("a failed write leaves the old file and no temporary") {
     CHECK(dir.entries() == 1);
 }
 
+TEST_CASE("outputs are committed all or none") {
+    ScratchDir dir;
+    save(dir.file("m.ply"), "old mesh");
+    AtomicFile mesh, report;
+    std::string error;
+    REQUIRE(mesh.open(dir.file("m.ply"), error));
+    REQUIRE(report.open(dir.file("r.json"), error));
+    std::fputs("new mesh", mesh.file());
+    std::fputs("new report", report.file());
+    REQUIRE(mesh.complete(0, error));
+    SUBCASE("one failed") {
+        CHECK_FALSE(report.complete(ENOSPC, error));
+        CHECK_FALSE(commit_files({&mesh, &report}, error));
+        CHECK(contains(error, "no output is replaced"));
+        CHECK(load(dir.file("m.ply")) == "old mesh");
+        CHECK(dir.entries() == 1);
+    }
+    SUBCASE("one still being written") {
+        CHECK_FALSE(commit_files({&mesh, &report}, error));
+        CHECK(contains(error, "r.json: not written whole"));
+        CHECK(load(dir.file("m.ply")) == "old mesh");
+        CHECK(dir.entries() == 1);
+    }
+    SUBCASE("one discarded (a refused run writes only its report)") {
+        mesh.discard();
+        REQUIRE(report.complete(0, error));
+        REQUIRE(commit_files({&mesh, &report}, error));
+        CHECK(load(dir.file("m.ply")) == "old mesh");
+        CHECK(load(dir.file("r.json")) == "new report");
+        CHECK(dir.entries() == 2);
+    }
+    SUBCASE("both complete") {
+        REQUIRE(report.complete(0, error));
+        REQUIRE(commit_files({&mesh, &report}, error));
+        CHECK(load(dir.file("m.ply")) == "new mesh");
+        CHECK(load(dir.file("r.json")) == "new report");
+        CHECK(dir.entries() == 2);
+    }
+}
+
 TEST_CASE("a symlinked destination is replaced at its target, and a device is written directly") {
     ScratchDir dir;
     save(dir.file("real.ply"), "old");
@@ -207,7 +251,8 @@ TEST_CASE("a symlinked destination is replaced at its target, and a device is wr
     std::string error;
     REQUIRE(file.open(dir.file("link.ply"), error));
     std::fputs("new", file.file());
-    REQUIRE(file.commit(0, error));
+    REQUIRE(file.complete(0, error));
+    REQUIRE(commit_files({&file}, error));
     CHECK(fs::is_symlink(dir.file("link.ply")));
     CHECK(load(dir.file("real.ply")) == "new");
     CHECK(dir.entries() == 2);
@@ -215,8 +260,9 @@ TEST_CASE("a symlinked destination is replaced at its target, and a device is wr
     if (fs::exists("/dev/full")) {
         AtomicFile full;
         REQUIRE(full.open("/dev/full", error));
+        CHECK(full.direct());
         std::fputs("anything", full.file());
-        CHECK_FALSE(full.commit(0, error));
+        CHECK_FALSE(full.complete(0, error));
         CHECK(contains(error, "/dev/full: cannot write"));
         CHECK(fs::is_character_file("/dev/full"));
     }

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #ifndef _WIN32
+#include <signal.h>
 #include <unistd.h>
 #endif
 #ifdef __linux__
@@ -54,6 +55,24 @@ extern "C" void remove_temporaries_and_die(int signal_number) {
     std::signal(signal_number, SIG_DFL);
     std::raise(signal_number);
 }
+
+// Holds off the signals that end the tool while it lives, so that what it guards runs
+// whole; a signal that came meanwhile is delivered when it ends.
+class SignalsHeld {
+public:
+#ifndef _WIN32
+    SignalsHeld() {
+        sigset_t ending;
+        sigemptyset(&ending);
+        for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&ending, signal_number);
+        sigprocmask(SIG_BLOCK, &ending, &before_);
+    }
+    ~SignalsHeld() { sigprocmask(SIG_SETMASK, &before_, nullptr); }
+
+private:
+    sigset_t before_;
+#endif
+};
 
 // ---- names -------------------------------------------------------------------------------
 
@@ -173,7 +192,7 @@ bool AtomicFile::open(const std::string& path, std::string& error) {
     return false;
 }
 
-bool AtomicFile::commit(int failure, std::string& error) {
+bool AtomicFile::complete(int failure, std::string& error) {
     if (!file_) {
         error = path_ + ": cannot write: the file is not open";
         return false;
@@ -190,23 +209,59 @@ bool AtomicFile::commit(int failure, std::string& error) {
         std::error_code e;
         const fs::file_status old = fs::status(target_, e);
         if (fs::is_regular_file(old)) fs::permissions(temporary_, old.permissions(), e);
-        e.clear();
-        fs::rename(temporary_, target_, e);
-        if (e) failure = e.value();
-        if (!e) {
-            temporary_.clear();
-            forget_temporary(slot_);
+    }
+    completed_ = failure == 0;
+    if (completed_) return true;
+    error = write_error(failure);
+    discard();
+    failed_ = true;
+    return false;
+}
+
+std::string AtomicFile::write_error(int failure) const {
+    return path_ + ": cannot write: " + std::strerror(failure);
+}
+
+bool AtomicFile::rename_into_place(std::string& error) {
+    std::error_code e;
+    fs::rename(temporary_, target_, e);
+    if (e) {
+        error = write_error(e.value());
+        return false;
+    }
+    temporary_.clear();
+    forget_temporary(slot_);
+    return true;
+}
+
+bool commit_files(std::initializer_list<AtomicFile*> files, std::string& error) {
+    bool ok = true;
+    for (const AtomicFile* file : files) {
+        if (ok && (file->failed_ || file->file_)) {
+            error = file->path_ + ": not written whole: no output is replaced";
+            ok = false;
         }
     }
-    if (failure == 0) return true;
-    error = path_ + ": cannot write: " + std::strerror(failure);
-    discard();
-    return false;
+    std::string replaced; // the destinations renamed onto so far
+    {
+        // Only renames are left: an interrupt between two would replace some destinations
+        // and not the others.
+        const SignalsHeld held;
+        for (AtomicFile* file : files) {
+            if (!ok || !file->completed_ || file->direct()) continue;
+            ok = file->rename_into_place(error);
+            if (ok) replaced += (replaced.empty() ? "" : ", ") + file->path_;
+            else if (!replaced.empty()) error += " (" + replaced + " already replaced)";
+        }
+    }
+    for (AtomicFile* file : files) file->discard();
+    return ok;
 }
 
 void AtomicFile::discard() {
     if (file_ && !standard_output_) std::fclose(file_);
     file_ = nullptr;
+    completed_ = failed_ = false;
     if (!temporary_.empty()) std::remove(temporary_.c_str());
     temporary_.clear();
     forget_temporary(slot_);
@@ -214,7 +269,7 @@ void AtomicFile::discard() {
 
 void AtomicFile::start_writeback() {
 #ifdef __linux__
-    // What stdio still buffers goes out later (its errors are commit()'s to report). The
+    // What stdio still buffers goes out later (its errors are complete()'s to report). The
     // whole file's range: pages already written or on their way to the disk are skipped.
     if (file_ && !temporary_.empty()) sync_file_range(fileno(file_), 0, 0, SYNC_FILE_RANGE_WRITE);
 #endif

@@ -4,6 +4,7 @@
 #include "frame_check.h"
 #include "mesh_ends.h"
 #include "mesh_io.h"
+#include "safe_output.h"
 
 #include <algorithm>
 #include <chrono>
@@ -68,8 +69,9 @@ private:
 
 class StreamRunner {
 public:
-    StreamRunner(const CommandLine& line, stratmesh::Options options, RunRecord& record)
-        : line_(line), options_(options), record_(record), tops_(line),
+    StreamRunner(const CommandLine& line, stratmesh::Options options, RunRecord& record,
+                 AtomicFile& mesh)
+        : line_(line), options_(options), record_(record), mesh_(mesh), tops_(line),
           layers_(kLayerCapacity) {
         // The stream refuses close_ends: --cap runs cap_ends() once it is closed.
         options_.flags &= ~static_cast<uint32_t>(stratmesh::close_ends);
@@ -89,7 +91,7 @@ public:
         if (record_.stream_points > most) record_.stream_points = most;
         record_.input_format = cloud_format_name(info.format);
         record_.input_encoding = info.encoding;
-        if (!writer_.open(line_.output, line_.output_format, line_.ascii, error))
+        if (!writer_.open(mesh_, line_.output_format, line_.ascii, error))
             return StreamOutcome::file_error;
         StreamOutcome outcome = read_and_push(*reader, error);
         if (outcome == StreamOutcome::done) outcome = close(error);
@@ -214,7 +216,7 @@ private:
         record_.reconstruct_seconds = stream_seconds_;
         if (record_.status != stratmesh::Status::ok) return StreamOutcome::refused;
         start = Clock::now();
-        bool written = writer_.finish(true, error);
+        bool written = writer_.finish(error);
         write_seconds_ += seconds_since(start);
         record_.write_seconds = write_seconds_;
         record_.output_written = written;
@@ -272,6 +274,7 @@ private:
     const CommandLine& line_;
     stratmesh::Options options_;
     RunRecord& record_;
+    AtomicFile& mesh_;
     LayerTops tops_;
     double axis_[3];
     MeshStreamWriter writer_;
@@ -294,10 +297,10 @@ private:
 } // namespace
 
 StreamOutcome run_stream(const CommandLine& line, stratmesh::Options options, RunRecord& record,
-                         std::string& error) {
+                         AtomicFile& mesh, std::string& error) {
     record.stream = true;
     record.stream_points = line.stream_points;
-    return StreamRunner(line, options, record).run(error);
+    return StreamRunner(line, options, record, mesh).run(error);
 }
 
 } // namespace stratmesh_cli

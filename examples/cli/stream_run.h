@@ -21,10 +21,10 @@ enum class StreamOutcome {
 };
 
 // Runs the stream with `options` (axis, flags; the origin, unless given, is the first
-// valid point read)
-// and the layers of `line` (--cuts or --layer-height). Fills `record`.
+// valid point read) and the layers of `line` (--cuts or --layer-height), writing the mesh
+// into `mesh` (opened; completed when done, for commit_files() to publish). Fills `record`.
 StreamOutcome run_stream(const CommandLine& line, stratmesh::Options options, RunRecord& record,
-                         std::string& error);
+                         AtomicFile& mesh, std::string& error);
 
 } // namespace stratmesh_cli
 

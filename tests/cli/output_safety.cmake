@@ -2,7 +2,8 @@
 #
 #   TOOL      the stratmesh tool
 #   INPUTS    the directory make-inputs filled
-#   TINY      a 4-point PLY (its mesh about 300 bytes, its report over 2 KB)
+#   TINY      a 4-point PLY (its mesh about 300 bytes, its picture over 1 KB, its report
+#             over 2 KB)
 #   WORK_DIR  emptied and used as the working directory
 #
 # 1. Each pair of the input, -o and --report naming one file (the same path, or a symlink
@@ -12,6 +13,10 @@
 #    /dev/full (a device, written directly and left a device), and a file size limit
 #    (ulimit -f, which binds root too) on the mesh, on the report and on --stream's
 #    output. The controls: the same runs without the failure write the files.
+# 3. The outputs are published all or none: a report or a picture that fails (on /dev/full,
+#    a device, written directly; or beyond a file size limit) leaves the mesh file as it
+#    was, or absent, with and without --stream; a run refused midway writes nothing to
+#    standard output, even with --stream's OBJ, whose lines come as the layers do.
 file(REMOVE_RECURSE "${WORK_DIR}")
 file(MAKE_DIRECTORY "${WORK_DIR}")
 file(COPY "${INPUTS}/sorted.ply" DESTINATION "${WORK_DIR}")
@@ -43,10 +48,12 @@ function(snapshot out)
   set(${out} "${state}" PARENT_SCOPE)
 endfunction()
 
-# run(EXIT regex args...): the tool in WORK_DIR must exit with EXIT and print `regex`.
+# run(EXIT regex args...): the tool in WORK_DIR must exit with EXIT and print `regex`; its
+# standard output goes to `last_stdout`.
 function(run expected_exit regex)
   execute_process(COMMAND ${ARGN} WORKING_DIRECTORY "${WORK_DIR}"
     RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  set(last_stdout "${out}" PARENT_SCOPE)
   message(STATUS "${ARGN}\n-- exit ${code}: ${err}")
   if(NOT "${code}" STREQUAL "${expected_exit}")
     fail("exit ${code}, expected ${expected_exit}: ${ARGN}\n${err}")
@@ -103,7 +110,6 @@ run(3 "old.ply: cannot write: File too large"
 # The tiny mesh fits in 1 block, its report does not.
 set(limited_1 sh -c "ulimit -f 1 && exec \"$@\"" limited "${TOOL}")
 run(3 "old.json: cannot write: File too large" ${limited_1} ${tiny} -o tiny.ply -q --report old.json)
-file(REMOVE "${WORK_DIR}/tiny.ply")
 snapshot(after)
 if(NOT before STREQUAL after)
   fail("a failed write changed the files or left a temporary:\n${before}\n${after}")
@@ -117,4 +123,28 @@ endif()
 file(GLOB left "${WORK_DIR}/.*stratmesh*")
 if(left)
   fail("temporaries left behind: ${left}")
+endif()
+
+# 3. All or none.
+snapshot(before)
+if(EXISTS /dev/full)
+  run(3 "^stratmesh: /dev/full: cannot write: No space left on device\n$"
+    "${TOOL}" sorted.ply -o old.ply --report /dev/full -q)
+  run(3 "/dev/full: cannot write" "${TOOL}" sorted.ply -o new.ply --report /dev/full)
+  run(3 "/dev/full: cannot write"
+    "${TOOL}" sorted.ply -o new.ply --preview new.svg --report /dev/full -q)
+  run(3 "/dev/full: cannot write" "${TOOL}" sorted.ply -o old.ply --preview /dev/full -q)
+  run(3 "/dev/full: cannot write"
+    "${TOOL}" sorted.ply -o old.ply --report /dev/full -q --stream --axis z --cuts 50)
+endif()
+run(3 "new.svg: cannot write: File too large"
+  ${limited_1} ${tiny} -o new.ply --preview new.svg --report new.json -q)
+run(1 "invalid_point"
+  "${TOOL}" ${INPUTS}/sorted_nan.xyz -o - --format obj --stream --axis z --cuts 25,50,75)
+if(NOT last_stdout STREQUAL "")
+  fail("a refused run wrote to standard output")
+endif()
+snapshot(after)
+if(NOT before STREQUAL after)
+  fail("a failed output let another be written, or left a temporary:\n${before}\n${after}")
 endif()

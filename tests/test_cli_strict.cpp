@@ -22,6 +22,11 @@
 #include <string>
 #include <vector>
 
+#ifndef _WIN32
+#include <fcntl.h>
+#include <unistd.h>
+#endif
+
 using namespace stratmesh_cli;
 namespace fs = std::filesystem;
 
@@ -116,13 +121,60 @@ TEST_CASE("the command line's files are the input, -o, --report and --preview") 
     CHECK(files[1].option == "-o");
     CHECK(files[2].path == "r.json");
     CHECK(files[3].option == "--preview");
-    // The standard streams and options not given name no file.
+    // The standard streams are named too, the input's as the input; options not given
+    // name nothing.
     CommandLine streams;
     const char* dashes[] = {"stratmesh", "-", "-o", "-", "--format", "off"};
     REQUIRE(parse_command_line(6, dashes, streams, error) == CommandAction::run);
     CHECK(streams.output_format == MeshFormat::off);
-    CHECK(named_files(streams).empty());
+    files = named_files(streams);
+    REQUIRE(files.size() == 2);
+    CHECK((files[0].path == "-" && files[0].input));
+    CHECK((files[1].path == "-" && !files[1].input));
 }
+
+TEST_CASE("at most one output goes to standard output") {
+    const char* cases[][8] = {
+        {"stratmesh", "in.ply", "-o", "-", "--format", "obj", "--report", "-"},
+        {"stratmesh", "in.ply", "-o", "-", "--format", "obj", "--preview", "-"},
+        {"stratmesh", "in.ply", "-o", "m.ply", "--report", "-", "--preview", "-"}};
+    for (const auto& argv : cases) {
+        CommandLine line;
+        std::string error;
+        CHECK(parse_command_line(8, argv, line, error) == CommandAction::usage_error);
+        CHECK(contains(error, "at most one of -o, --report and --preview may be -"));
+    }
+}
+
+#ifndef _WIN32
+TEST_CASE("standard input is compared as the file it is") {
+    ScratchDir dir;
+    const std::string scan = dir.file("scan.ply");
+    save(scan, "points");
+    fs::create_symlink("scan.ply", dir.file("link.ply"));
+    // Standard input, for the length of the test, is scan.ply.
+    const int saved = dup(STDIN_FILENO);
+    const int opened = open(scan.c_str(), O_RDONLY);
+    REQUIRE(saved >= 0);
+    REQUIRE(opened >= 0);
+    REQUIRE(dup2(opened, STDIN_FILENO) == STDIN_FILENO);
+    close(opened);
+    std::string error;
+    const NamedFile input = {"the input", "-", true};
+    const bool over_it = check_distinct_files({input, {"-o", scan}}, error);
+    const std::string over_it_error = error;
+    const bool through_link =
+        check_distinct_files({input, {"--report", dir.file("link.ply")}}, error);
+    const bool elsewhere = check_distinct_files({input, {"-o", dir.file("m.ply")}}, error);
+    dup2(saved, STDIN_FILENO);
+    close(saved);
+    CHECK_FALSE(over_it);
+    CHECK(contains(over_it_error,
+                   "-o '" + scan + "' is the same file as the input (standard input)"));
+    CHECK_FALSE(through_link);
+    CHECK(elsewhere);
+}
+#endif
 
 TEST_CASE("an atomic file appears only when committed, keeping the old one until then") {
     ScratchDir dir;

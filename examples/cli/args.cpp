@@ -322,6 +322,14 @@ std::string stream_conflict(const CommandLine& line) {
     return "";
 }
 
+// How many of -o, --report and --preview go to standard output.
+int standard_outputs(const CommandLine& line) {
+    int count = 0;
+    for (const std::string* path : {&line.output, &line.report, &line.preview})
+        if (*path == kStandardStream) ++count;
+    return count;
+}
+
 // The machine's hardware threads, at least 1.
 uint32_t default_threads() {
     unsigned count = std::thread::hardware_concurrency();
@@ -428,6 +436,9 @@ private:
                         extra_input_ + "')" + hint);
         }
         if (line_.output.empty()) return fail("no output file (use -o OUTPUT)");
+        if (standard_outputs(line_) > 1)
+            return fail("at most one of -o, --report and --preview may be - (standard "
+                        "output): one stream cannot hold two files; give the others paths");
         if (line_.output_format == MeshFormat::unknown && line_.output == "-")
             return fail("-o - writes to standard output: give its format with --format "
                         "ply|obj|off|stl");
@@ -464,13 +475,13 @@ CommandAction parse_command_line(int argc, const char* const* argv, CommandLine&
 }
 
 std::vector<NamedFile> named_files(const CommandLine& line) {
-    // Options not given name nothing, and "-" (the standard streams) is no file that
-    // another name can clobber.
     std::vector<NamedFile> files;
-    const NamedFile all[] = {{"the input", line.input}, {"-o", line.output},
-                             {"--report", line.report}, {"--preview", line.preview}};
+    const NamedFile all[] = {{"the input", line.input, true},
+                             {"-o", line.output},
+                             {"--report", line.report},
+                             {"--preview", line.preview}};
     for (const NamedFile& file : all)
-        if (!file.path.empty() && file.path != kStandardStream) files.push_back(file);
+        if (!file.path.empty()) files.push_back(file);
     return files;
 }
 

@@ -9,6 +9,7 @@
 
 #ifndef _WIN32
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #endif
 #ifdef __linux__
@@ -122,22 +123,46 @@ std::FILE* create_beside(const std::string& target, const char* mode, std::strin
     return nullptr;
 }
 
-// Whether two paths name the same file, or would once created.
-bool same_file(const std::string& a, const std::string& b) {
-    std::error_code ea, eb;
-    const bool a_exists = fs::exists(a, ea), b_exists = fs::exists(b, eb);
-    if (a_exists && b_exists) {
-        std::error_code e;
-        return fs::equivalent(a, b, e) && !e;
-    }
-    if (a_exists || b_exists) return false;
-    const fs::path pa(a), pb(b);
+#ifndef _WIN32
+// The file behind a name, through symlinks; for "-", the standard stream it stands for.
+// False if there is none.
+bool identify(const NamedFile& file, struct stat& status) {
+    if (file.path != kStandardStream) return stat(file.path.c_str(), &status) == 0;
+    return fstat(file.input ? STDIN_FILENO : STDOUT_FILENO, &status) == 0;
+}
+#endif
+
+// Whether two of the tool's names stand for one file, or would once created.
+bool same_file(const NamedFile& a, const NamedFile& b) {
+#ifndef _WIN32
+    struct stat sa, sb;
+    const bool a_exists = identify(a, sa), b_exists = identify(b, sb);
+    // A character device (a terminal, /dev/null) holds no data: the input may come from
+    // the one an output goes to.
+    if (a_exists && b_exists)
+        return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino &&
+               !(a.input != b.input && S_ISCHR(sa.st_mode));
+#else
+    std::error_code ea, eb, e;
+    const bool a_exists = a.path != kStandardStream && fs::exists(a.path, ea);
+    const bool b_exists = b.path != kStandardStream && fs::exists(b.path, eb);
+    if (a_exists && b_exists) return fs::equivalent(a.path, b.path, e) && !e;
+#endif
+    if (a_exists || b_exists || a.path == kStandardStream || b.path == kStandardStream)
+        return false;
+    const fs::path pa(a.path), pb(b.path);
     if (pa.filename() != pb.filename()) return false;
     fs::path da = pa.parent_path(), db = pb.parent_path();
     if (da.empty()) da = ".";
     if (db.empty()) db = ".";
-    std::error_code e;
-    return fs::equivalent(da, db, e) && !e;
+    std::error_code same;
+    return fs::equivalent(da, db, same) && !same;
+}
+
+// "-o 'm.ply'", "the input (standard input)".
+std::string describe(const NamedFile& file) {
+    if (file.path != kStandardStream) return file.option + " '" + file.path + "'";
+    return file.option + (file.input ? " (standard input)" : " (standard output)");
 }
 
 } // namespace
@@ -145,12 +170,10 @@ bool same_file(const std::string& a, const std::string& b) {
 bool check_distinct_files(const std::vector<NamedFile>& files, std::string& error) {
     for (size_t j = 1; j < files.size(); ++j) {
         for (size_t i = 0; i < j; ++i) {
-            if (files[i].path.empty() || files[j].path.empty() ||
-                !same_file(files[i].path, files[j].path))
+            if (files[i].path.empty() || files[j].path.empty() || !same_file(files[i], files[j]))
                 continue;
-            error = files[j].option + " '" + files[j].path + "' is the same file as " +
-                    files[i].option + " '" + files[i].path + "': give " + files[j].option +
-                    " another path";
+            error = describe(files[j]) + " is the same file as " + describe(files[i]) +
+                    ": give " + files[j].option + " another path";
             return false;
         }
     }

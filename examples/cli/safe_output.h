@@ -16,15 +16,18 @@ namespace stratmesh_cli {
 inline const char kStandardStream[] = "-";
 
 // A file the tool reads or writes, with how the command line names it ("the input", "-o",
-// "--report").
+// "--report"). "-" is standard input for the input, standard output for an output.
 struct NamedFile {
     std::string option;
     std::string path;
+    bool input = false;
 };
 
 // False, with a message naming both options, if two of `files` are the same file: the same
-// device and inode (through symlinks and hard links) for files that exist, the same
-// directory and name for files that do not exist yet.
+// device and inode (through symlinks and hard links; for "-", those of the standard stream
+// it stands for, so that `- -o in.xyz < in.xyz` is caught) for files that exist, the same
+// directory and name for files that do not exist yet. The input may share a character
+// device (a terminal, /dev/null) with an output: a device holds no data to destroy.
 bool check_distinct_files(const std::vector<NamedFile>& files, std::string& error);
 
 // A file written whole or not at all. open() creates a temporary in the destination's

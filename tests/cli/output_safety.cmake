@@ -6,9 +6,11 @@
 #             over 2 KB)
 #   WORK_DIR  emptied and used as the working directory
 #
-# 1. Each pair of the input, -o and --report naming one file (the same path, or a symlink
-#    to it) is refused with exit 2 and a message naming both options, and every file in the
-#    directory keeps its bytes.
+# 1. Each pair of the input, -o, --report and --preview naming one file (the same path, a
+#    symlink to it, or standard input redirected from it) is refused with exit 2 and a
+#    message naming both options, and every file in the directory keeps its bytes; so are
+#    two outputs on standard output (-, or - and /dev/stdout). The input may share a
+#    character device with an output: /dev/null as both is read as an empty input.
 # 2. A write that fails leaves the old output and no temporary: -o through a symlink to
 #    /dev/full (a device, written directly and left a device), and a file size limit
 #    (ulimit -f, which binds root too) on the mesh, on the report and on --stream's
@@ -49,10 +51,14 @@ function(snapshot out)
 endfunction()
 
 # run(EXIT regex args...): the tool in WORK_DIR must exit with EXIT and print `regex`; its
-# standard output goes to `last_stdout`.
+# standard output goes to `last_stdout`, its standard input is `stdin_file` if set.
 function(run expected_exit regex)
+  set(streams OUTPUT_VARIABLE out)
+  if(DEFINED stdin_file)
+    list(APPEND streams INPUT_FILE "${stdin_file}")
+  endif()
   execute_process(COMMAND ${ARGN} WORKING_DIRECTORY "${WORK_DIR}"
-    RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    RESULT_VARIABLE code ERROR_VARIABLE err ${streams})
   set(last_stdout "${out}" PARENT_SCOPE)
   message(STATUS "${ARGN}\n-- exit ${code}: ${err}")
   if(NOT "${code}" STREQUAL "${expected_exit}")
@@ -72,11 +78,22 @@ set(clashes
   "sorted.ply -o m.ply --report link.ply|--report 'link.ply' is the same file as the input"
   "sorted.ply -o m.ply --report m.ply|--report 'm.ply' is the same file as -o 'm.ply'"
   "sorted.ply -o old.ply --report old_link.ply|--report 'old_link.ply' is the same file as -o"
-  "sorted.ply -o m.ply --report ./m.ply --stream --axis z --cuts 50|--report './m.ply' is the same file as -o")
+  "sorted.ply -o m.ply --report ./m.ply --stream --axis z --cuts 50|--report './m.ply' is the same file as -o"
+  "sorted.ply -o m.ply --preview sorted.ply|--preview 'sorted.ply' is the same file as the input"
+  "<sorted.ply - -o sorted.ply|-o 'sorted.ply' is the same file as the input \\(standard input\\)"
+  "<sorted.ply - -o m.ply --report sorted.ply|--report 'sorted.ply' .* the input \\(standard input\\)"
+  "<sorted.ply - -o m.ply --preview link.ply|--preview 'link.ply' .* the input \\(standard input\\)"
+  "<sorted.ply - -o sorted.ply --stream --axis z --cuts 50|-o 'sorted.ply' .* \\(standard input\\)"
+  "sorted.ply -o - --format ply --report /dev/stdout|--report '/dev/stdout' .* -o \\(standard output\\)")
 foreach(clash IN LISTS clashes)
   string(REPLACE "|" ";" fields "${clash}")
   list(GET fields 0 args)
   list(GET fields 1 regex)
+  unset(stdin_file)
+  if(args MATCHES "^<([^ ]+) (.*)$")
+    set(stdin_file "${WORK_DIR}/${CMAKE_MATCH_1}")
+    set(args "${CMAKE_MATCH_2}")
+  endif()
   separate_arguments(args UNIX_COMMAND "${args}")
   snapshot(before)
   run(2 "${regex}.*: give .* another path" "${TOOL}" ${args})
@@ -85,6 +102,20 @@ foreach(clash IN LISTS clashes)
     fail("the files changed:\n${before}\n${after}")
   endif()
 endforeach()
+unset(stdin_file)
+# Two outputs on standard output; the control: one, and /dev/null both read and written.
+foreach(args IN ITEMS "-o - --format obj --report -" "-o - --format obj --preview -"
+    "-o m.ply --report - --preview -")
+  separate_arguments(args UNIX_COMMAND "${args}")
+  run(2 "at most one of -o, --report and --preview may be -" "${TOOL}" sorted.ply ${args})
+endforeach()
+run(0 "" "${TOOL}" sorted.ply -o - --format obj -q)
+if(NOT last_stdout MATCHES "^# [^\n]*\nv ")
+  fail("-o - wrote no OBJ to standard output")
+endif()
+set(stdin_file /dev/null)
+run(3 "standard input: the file is empty" "${TOOL}" - -o /dev/null --format ply)
+unset(stdin_file)
 
 # 2. Failed writes.
 snapshot(before)

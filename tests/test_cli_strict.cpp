@@ -321,6 +321,32 @@ TEST_CASE("a symlinked destination is replaced at its target, and a device is wr
 #endif
 }
 
+TEST_CASE("a temporary fits wherever its destination does: a long name gets a short one") {
+    ScratchDir dir;
+    for (size_t length : {size_t{200}, size_t{239}, size_t{250}, size_t{255}}) {
+        CAPTURE(length);
+        const std::string path = dir.file(std::string(length - 4, 'n') + ".ply");
+        AtomicFile file;
+        std::string error;
+        const bool opened = file.open(path, error);
+        CHECK_MESSAGE(opened, error);
+        if (!opened) continue;
+        std::string temporary;
+        for (const auto& entry : fs::directory_iterator(dir.path))
+            temporary = entry.path().filename().string();
+        CHECK(temporary.rfind(length + 18 <= 255 ? ".nnn" : ".stratmesh-", 0) == 0);
+        std::FILE* scratch = scratch_file_beside(path, error);
+        CHECK_MESSAGE(scratch, error);
+        if (scratch) std::fclose(scratch);
+        std::fputs("mesh", file.file());
+        REQUIRE_MESSAGE(file.complete(0, error), error);
+        REQUIRE_MESSAGE(commit_files({&file}, error), error);
+        CHECK(load(path) == "mesh");
+        fs::remove(path);
+        CHECK(dir.entries() == 0);
+    }
+}
+
 TEST_CASE("a destination that cannot be created says so") {
     ScratchDir dir;
     AtomicFile file;

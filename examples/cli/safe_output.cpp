@@ -77,6 +77,9 @@ private:
 
 // ---- names -------------------------------------------------------------------------------
 
+// The temporaries' name where the target's own is too long to be part of it.
+const char kShortPrefix[] = ".stratmesh-";
+
 // Six letters that differ between calls and between processes; a clash only costs a retry
 // (the temporary is created exclusively).
 std::string unique_suffix() {
@@ -98,22 +101,28 @@ std::string unique_suffix() {
     return suffix;
 }
 
-// Creates a new file, exclusively, named after `target` in its directory: a hidden name
-// (".NAME.stratmesh-XXXXXX") that no reader takes for the finished file. The name goes into
-// `temporary` and into the signal handler's table (`slot`) before the file exists.
+// Creates a new file, exclusively, in the directory of `target`: a hidden name that no
+// reader takes for the finished file, ".NAME.stratmesh-XXXXXX" after the target's NAME, or
+// ".stratmesh-XXXXXX" where that is too long for the file system (NAME is then longer than
+// it), so that a temporary fits wherever the target does. The name goes into `temporary`
+// and into the signal handler's table (`slot`) before the file exists.
 std::FILE* create_beside(const std::string& target, const char* mode, std::string& temporary,
                          int& slot) {
     const fs::path where(target);
     fs::path directory = where.parent_path();
     if (directory.empty()) directory = ".";
-    const std::string name = where.filename().string();
+    std::string prefix = "." + where.filename().string() + ".stratmesh-";
     for (int attempt = 0; attempt < 100; ++attempt) {
-        temporary = (directory / ("." + name + ".stratmesh-" + unique_suffix())).string();
+        temporary = (directory / (prefix + unique_suffix())).string();
         slot = remember_temporary(temporary);
         std::FILE* file = std::fopen(temporary.c_str(), mode);
         if (file) return file;
         const int failure = errno;
         forget_temporary(slot);
+        if (failure == ENAMETOOLONG && prefix != kShortPrefix) {
+            prefix = kShortPrefix;
+            continue;
+        }
         if (failure != EEXIST) {
             errno = failure;
             return nullptr;

@@ -31,9 +31,10 @@ struct NamedFile {
 bool check_distinct_files(const std::vector<NamedFile>& files, std::string& error);
 
 // A file written whole or not at all. open() creates a temporary in the destination's
-// directory (the directory of a symlink's target), ".NAME.stratmesh-XXXXXX"; complete()
-// flushes it to the disk and closes it; commit_files() renames it onto the destination,
-// keeping the permissions of a file it replaces. A destination that exists and is no regular file (a device such as
+// directory (the directory of a symlink's target), ".NAME.stratmesh-XXXXXX", or
+// ".stratmesh-XXXXXX" where NAME is too long for that; complete() flushes it to the disk and
+// closes it; commit_files() renames it onto the destination, keeping the permissions of a
+// file it replaces. A destination that exists and is no regular file (a device such as
 // /dev/null, a pipe) is written directly: renaming onto it would replace the device, and so
 // is "-", which stands for standard output (left open). Destroyed uncommitted, it removes
 // its temporary.

@@ -19,6 +19,8 @@
 #    a device, written directly; or beyond a file size limit) leaves the mesh file as it
 #    was, or absent, with and without --stream; a run refused midway writes nothing to
 #    standard output, even with --stream's OBJ, whose lines come as the layers do.
+# 4. Names as long as a file name may be (250 and 255 bytes) are written, and replaced, with
+#    and without --stream: the temporaries beside them take a shorter name.
 file(REMOVE_RECURSE "${WORK_DIR}")
 file(MAKE_DIRECTORY "${WORK_DIR}")
 file(COPY "${INPUTS}/sorted.ply" DESTINATION "${WORK_DIR}")
@@ -178,4 +180,22 @@ endif()
 snapshot(after)
 if(NOT before STREQUAL after)
   fail("a failed output let another be written, or left a temporary:\n${before}\n${after}")
+endif()
+
+# 4. Long names.
+string(REPEAT "n" 246 long)
+string(REPEAT "s" 251 longest)
+foreach(pass IN ITEMS create replace)
+  run(0 "" "${TOOL}" sorted.ply -o ${long}.ply --report ${long}.json --preview ${long}.svg -q)
+  run(0 "" "${TOOL}" sorted.ply -o ${longest}.ply -q --stream --axis z --cuts 50)
+endforeach()
+foreach(name IN ITEMS ${long}.ply ${long}.json ${long}.svg ${longest}.ply)
+  file(SIZE "${WORK_DIR}/${name}" bytes)
+  if(bytes LESS 1000)
+    fail("${name} holds ${bytes} bytes")
+  endif()
+endforeach()
+file(GLOB left "${WORK_DIR}/.*stratmesh*")
+if(left)
+  fail("temporaries left behind: ${left}")
 endif()

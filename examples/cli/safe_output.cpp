@@ -251,6 +251,9 @@ bool AtomicFile::complete(int failure, std::string& error) {
 }
 
 std::string AtomicFile::write_error(int failure) const {
+    if (standard_output_ && failure == EPIPE)
+        return "standard output closed early (broken pipe): its reader stopped before the "
+               "end, and what it read is incomplete";
     return path_ + ": cannot write: " + std::strerror(failure);
 }
 
@@ -336,6 +339,7 @@ void install_output_signal_handlers() {
 #ifndef _WIN32
     std::signal(SIGHUP, remove_temporaries_and_die);
     std::signal(SIGXFSZ, SIG_IGN);
+    std::signal(SIGPIPE, SIG_IGN);
 #endif
 }
 

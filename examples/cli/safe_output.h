@@ -58,7 +58,8 @@ public:
     // that already failed (0 if none). False with write_error()'s message (the temporary
     // removed) if anything failed.
     bool complete(int failure, std::string& error);
-    // "PATH: cannot write: ...".
+    // "PATH: cannot write: ...", or for standard output whose reader has gone (EPIPE),
+    // "standard output closed early (broken pipe): ...".
     std::string write_error(int failure) const;
     // Removes the temporary (nothing if committed or never opened): the destination stays
     // as it was.
@@ -102,7 +103,9 @@ std::FILE* scratch_file_beside(const std::string& path, std::string& error);
 
 // For the tool's main(): SIGINT, SIGTERM and SIGHUP remove the open temporaries before the
 // tool dies of the signal; SIGXFSZ is ignored, so a write beyond a file size limit
-// (ulimit -f) fails as a write error (EFBIG) instead of killing the tool mid-file.
+// (ulimit -f) fails as a write error (EFBIG) instead of killing the tool mid-file, and so
+// is SIGPIPE, so that a reader that closes the pipe early (| head) makes the write fail
+// (EPIPE), which the tool reports, instead of killing it without a word.
 void install_output_signal_handlers();
 
 } // namespace stratmesh_cli

@@ -21,6 +21,8 @@
 #    standard output, even with --stream's OBJ, whose lines come as the layers do.
 # 4. Names as long as a file name may be (250 and 255 bytes) are written, and replaced, with
 #    and without --stream: the temporaries beside them take a shorter name.
+# 5. A reader that closes standard output early (| head -c 10): the tool says so and exits
+#    with 3, not killed by SIGPIPE, and replaces no file, with and without --stream.
 file(REMOVE_RECURSE "${WORK_DIR}")
 file(MAKE_DIRECTORY "${WORK_DIR}")
 file(COPY "${INPUTS}/sorted.ply" DESTINATION "${WORK_DIR}")
@@ -198,4 +200,31 @@ endforeach()
 file(GLOB left "${WORK_DIR}/.*stratmesh*")
 if(left)
   fail("temporaries left behind: ${left}")
+endif()
+
+# 5. Standard output closed early.
+find_program(HEAD head)
+if(HEAD)
+  snapshot(before)
+  foreach(args IN ITEMS "-o new.ply --report new.json --preview -"
+      "-o - --format obj --report new.json"
+      "-o - --format obj --report new.json --stream --axis z --cuts 50")
+    separate_arguments(args UNIX_COMMAND "${args}")
+    execute_process(COMMAND "${TOOL}" sorted.ply ${args} -q COMMAND "${HEAD}" -c 10
+      WORKING_DIRECTORY "${WORK_DIR}" RESULTS_VARIABLE codes OUTPUT_VARIABLE out
+      ERROR_VARIABLE err)
+    message(STATUS "${args} | head -c 10\n-- exit ${codes}: ${err}")
+    if(NOT codes STREQUAL "3;0" OR NOT err MATCHES
+        "^stratmesh: standard output closed early \\(broken pipe\\): [^\n]*\n$")
+      fail("| head -c 10: exit ${codes}, expected 3 and the message: ${args}\n${err}")
+    endif()
+    string(LENGTH "${out}" length)
+    if(NOT length EQUAL 10)
+      fail("head read ${length} bytes")
+    endif()
+  endforeach()
+  snapshot(after)
+  if(NOT before STREQUAL after)
+    fail("a run cut short replaced a file or left a temporary:\n${before}\n${after}")
+  endif()
 endif()

@@ -301,23 +301,26 @@ void name_far_point(const std::vector<double>& xyz) {
                  farthest, far, *decile);
 }
 
-void explain_refusal(const CommandLine& line, const RunRecord& record) {
-    std::fprintf(stderr, "stratmesh: cannot reconstruct %s: %s\n", display_name(line.input).c_str(),
+// `advice`, if any, is the tool's own account of the refusal (the stream's memory, which
+// its options size), said in place of the library's.
+void explain_refusal(const CommandLine& line, const RunRecord& record, const std::string& advice) {
+    const std::string name = display_name(line.input);
+    if (!advice.empty()) {
+        std::fprintf(stderr, "stratmesh: cannot reconstruct %s: out_of_memory: %s\n", name.c_str(),
+                     advice.c_str());
+        return;
+    }
+    std::fprintf(stderr, "stratmesh: cannot reconstruct %s: %s\n", name.c_str(),
                  stratmesh::status_string(record.status));
+    // Where the tool gives its own advice (--skip-invalid), the library's, in the library's
+    // terms, is left out.
     if (record.status == stratmesh::Status::invalid_point)
         std::fprintf(stderr,
                      "stratmesh: point %zu (counting from 0) has a NaN or infinite coordinate; "
                      "--skip-invalid skips such points\n",
                      record.report.points.first_invalid_index);
-    // Where the tool gives its own advice (--skip-invalid, the stream's budget, which are
-    // its options), the library's, in the library's terms, is left out.
-    const bool budget = record.stream && record.status == stratmesh::Status::out_of_memory;
-    if (record.report.detail && !budget && record.status != stratmesh::Status::invalid_point)
+    else if (record.report.detail)
         std::fprintf(stderr, "stratmesh: %s\n", record.report.detail);
-    if (budget)
-        std::fprintf(stderr,
-                     "stratmesh: --stream-points %llu is too few for these layers: raise it\n",
-                     static_cast<unsigned long long>(record.stream_points));
 }
 
 // The valid points' range along the axis used, the cuts given outside it, and with layers
@@ -443,12 +446,12 @@ int finish_run(const CommandLine& line, RunRecord& record, Outputs& outputs) {
     return line.strict && !warnings.empty() ? kExitWarned : kExitOk;
 }
 
-// Explains the refusal and writes the report alone.
+// Explains the refusal (with the tool's `advice`, if any) and writes the report alone.
 int refuse(const CommandLine& line, RunRecord& record, const std::vector<double>& xyz,
-           Outputs& outputs) {
+           const std::string& advice, Outputs& outputs) {
     const std::string faces = faces_warning(record);
     if (!faces.empty()) print_warnings(stderr, {faces});
-    explain_refusal(line, record);
+    explain_refusal(line, record, advice);
     if (record.status == stratmesh::Status::not_columnar ||
         record.status == stratmesh::Status::degenerate)
         name_far_point(xyz);
@@ -467,7 +470,7 @@ int run_streamed(const CommandLine& line, RunRecord& record, Outputs& outputs) {
         run_stream(line, make_options(line, silent, jobs), record, outputs.mesh, error);
     switch (outcome) {
     case StreamOutcome::done: return finish_run(line, record, outputs);
-    case StreamOutcome::refused: return refuse(line, record, {}, outputs);
+    case StreamOutcome::refused: return refuse(line, record, {}, error, outputs);
     case StreamOutcome::file_error: break;
     case StreamOutcome::usage:
         std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
@@ -498,7 +501,7 @@ int run(const CommandLine& line) {
     if (line.origin_given && !origin_in_reach(line, xyz)) return kExitUsage;
     if (line.find_branches && !find_branches(xyz, line, record)) return kExitRefused;
     if (!reconstruct_points(xyz, line, result, record)) return kExitRefused;
-    if (record.status != stratmesh::Status::ok) return refuse(line, record, xyz, outputs);
+    if (record.status != stratmesh::Status::ok) return refuse(line, record, xyz, "", outputs);
     measure_along_axis(xyz, record);
     record.ends = find_surface_ends(xyz.data(), result.triangles.get(), result.triangle_count,
                                     record.report.axis, record.layers);

@@ -14,7 +14,8 @@ namespace stratmesh_cli {
 
 enum class StreamOutcome {
     done,       // the mesh is written
-    refused,    // the library refused the input: record.status says why
+    refused,    // the library refused the input: record.status says why, and where the
+                // stream ran out of memory, `error` what to do about it
     file_error, // reading or writing failed: `error` says what and where
     unsorted,   // a point lies below the one before it along the axis: `error` says which
     usage       // the command line asks for what the cloud cannot give: `error` says what

@@ -5,6 +5,7 @@
 #   TINY      a 4-point PLY (its mesh about 300 bytes, its picture over 1 KB, its report
 #             over 2 KB)
 #   WORK_DIR  emptied and used as the working directory
+#   SANITIZED ON in a sanitizer build, whose shadow memory no address-space limit allows
 #
 # 1. Each pair of the input, -o, --report and --preview naming one file (the same path, a
 #    symlink to it, or standard input redirected from it) is refused with exit 2 and a
@@ -23,6 +24,8 @@
 #    and without --stream: the temporaries beside them take a shorter name.
 # 5. A reader that closes standard output early (| head -c 10): the tool says so and exits
 #    with 3, not killed by SIGPIPE, and replaces no file, with and without --stream.
+# 6. Under an address-space limit (ulimit -v) too small for --stream's default workspace,
+#    the tool says to lower --stream-points, to a number that then works under that limit.
 file(REMOVE_RECURSE "${WORK_DIR}")
 file(MAKE_DIRECTORY "${WORK_DIR}")
 file(COPY "${INPUTS}/sorted.ply" DESTINATION "${WORK_DIR}")
@@ -55,7 +58,8 @@ function(snapshot out)
 endfunction()
 
 # run(EXIT regex args...): the tool in WORK_DIR must exit with EXIT and print `regex`; its
-# standard output goes to `last_stdout`, its standard input is `stdin_file` if set.
+# standard output and error go to `last_stdout` and `last_stderr`, its standard input is
+# `stdin_file` if set.
 function(run expected_exit regex)
   set(streams OUTPUT_VARIABLE out)
   if(DEFINED stdin_file)
@@ -64,6 +68,7 @@ function(run expected_exit regex)
   execute_process(COMMAND ${ARGN} WORKING_DIRECTORY "${WORK_DIR}"
     RESULT_VARIABLE code ERROR_VARIABLE err ${streams})
   set(last_stdout "${out}" PARENT_SCOPE)
+  set(last_stderr "${err}" PARENT_SCOPE)
   message(STATUS "${ARGN}\n-- exit ${code}: ${err}")
   if(NOT "${code}" STREQUAL "${expected_exit}")
     fail("exit ${code}, expected ${expected_exit}: ${ARGN}\n${err}")
@@ -227,4 +232,17 @@ if(HEAD)
   if(NOT before STREQUAL after)
     fail("a run cut short replaced a file or left a temporary:\n${before}\n${after}")
   endif()
+endif()
+
+# 6. The stream under a memory limit: 400 MB, where the default 3000000 points need about
+#    540 MB (standard input, whose points are not counted beforehand).
+if(NOT SANITIZED)
+  set(stdin_file "${INPUTS}/sorted.xyz")
+  set(capped sh -c "ulimit -v 400000 && exec \"$@\"" capped "${TOOL}")
+  run(1 "cannot be allocated: lower --stream-points to [0-9]+ or fewer"
+    ${capped} - -o streamed.ply --stream --axis z --cuts 50)
+  string(REGEX MATCH "lower --stream-points to ([0-9]+)" advice "${last_stderr}")
+  run(0 "" ${capped} - -o streamed.ply --stream --axis z --cuts 50 -q
+    --stream-points ${CMAKE_MATCH_1})
+  unset(stdin_file)
 endif()

@@ -23,7 +23,7 @@ namespace stratmesh_cli {
 class BlockWriter {
 public:
     // `output`, if given, is the AtomicFile that `file` belongs to: its writeback to the
-    // disk is started as the blocks go out, so that commit() waits for little.
+    // disk is started as the blocks go out, so that complete() waits for little.
     explicit BlockWriter(std::FILE* file, AtomicFile* output = nullptr)
         : file_(file), output_(output), buffer_(new char[kBlockBytes]) {}
 

@@ -281,7 +281,7 @@ bool commit_files(std::initializer_list<AtomicFile*> files, std::string& error) 
     {
         // Only renames are left: an interrupt between two would replace some destinations
         // and not the others.
-        const SignalsHeld held;
+        SignalsHeld held;
         for (AtomicFile* file : files) {
             if (!ok || !file->completed_ || file->direct()) continue;
             ok = file->rename_into_place(error);

@@ -27,6 +27,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <new>
 #include <string>
 #include <utility>
 #include <vector>
@@ -511,6 +512,17 @@ int run(const CommandLine& line) {
     return finish_run(line, record, outputs);
 }
 
+// What to do when the memory ran out outside the workspaces the tool sizes and checks.
+const char* memory_advice(const CommandLine& line) {
+    if (!line.stream)
+        return "--stream reads and meshes a cloud sorted along its axis in bounded memory";
+    if (line.cap)
+        return "--cap keeps every point and triangle until the end: without it the stream "
+               "holds only its layers";
+    return "thinner layers (closer --cuts, a smaller --layer-height) or a lower "
+           "--stream-points leave more room";
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -527,5 +539,12 @@ int main(int argc, char** argv) {
         return kExitUsage;
     case CommandAction::run: break;
     }
-    return run(line);
+    try {
+        return run(line);
+    } catch (const std::bad_alloc&) {
+        // Unwound: the outputs' temporaries are gone, every destination is as it was.
+        std::fprintf(stderr, "stratmesh: out of memory, no file replaced: %s\n",
+                     memory_advice(line));
+        return kExitRefused;
+    }
 }

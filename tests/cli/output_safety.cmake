@@ -5,6 +5,7 @@
 #   TINY      a 4-point PLY (its mesh about 300 bytes, its picture over 1 KB, its report
 #             over 2 KB)
 #   WORK_DIR  emptied and used as the working directory
+#   SAMPLE    the bundled scan (30,000 points)
 #   SANITIZED ON in a sanitizer build, whose shadow memory no address-space limit allows
 #
 # 1. Each pair of the input, -o, --report and --preview naming one file (the same path, a
@@ -26,6 +27,10 @@
 #    with 3, not killed by SIGPIPE, and replaces no file, with and without --stream.
 # 6. Under an address-space limit (ulimit -v) too small for --stream's default workspace,
 #    the tool says to lower --stream-points, to a number that then works under that limit.
+# 7. Whatever the address-space limit, from too little to load the tool to enough for the
+#    run, on four threads: the tool ends with a message and an exit status, never aborted
+#    (an exception it does not catch, a thread it cannot start), and leaves a whole report
+#    and mesh or none, and no temporary.
 file(REMOVE_RECURSE "${WORK_DIR}")
 file(MAKE_DIRECTORY "${WORK_DIR}")
 file(COPY "${INPUTS}/sorted.ply" DESTINATION "${WORK_DIR}")
@@ -245,4 +250,27 @@ if(NOT SANITIZED)
   run(0 "" ${capped} - -o streamed.ply --stream --axis z --cuts 50 -q
     --stream-points ${CMAKE_MATCH_1})
   unset(stdin_file)
+endif()
+
+# 7. Memory limits.
+if(NOT SANITIZED)
+  foreach(limit RANGE 4000 30000 2000)
+    execute_process(COMMAND sh -c "ulimit -v ${limit} && exec \"$@\"" limited "${TOOL}"
+        "${SAMPLE}" -o new.ply --report new.json -q --threads 4
+      WORKING_DIRECTORY "${WORK_DIR}" RESULT_VARIABLE code ERROR_VARIABLE err OUTPUT_QUIET)
+    message(STATUS "ulimit -v ${limit}: exit ${code}: ${err}")
+    if(NOT code MATCHES "^(0|1|3|127)$" OR err MATCHES "terminate called")
+      fail("ulimit -v ${limit}: exit ${code}\n${err}")
+    endif()
+    file(GLOB written "${WORK_DIR}/new.*" "${WORK_DIR}/.*stratmesh*")
+    if(code EQUAL 0)
+      list(LENGTH written count)
+      if(NOT count EQUAL 2)
+        fail("ulimit -v ${limit}: exit 0 but the files are ${written}")
+      endif()
+      file(REMOVE ${written})
+    elseif(written)
+      fail("ulimit -v ${limit}: exit ${code} but these are left: ${written}")
+    endif()
+  endforeach()
 endif()

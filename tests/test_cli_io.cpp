@@ -10,6 +10,7 @@
 #include "mesh_ends.h"
 #include "mesh_io.h"
 #include "report_json.h"
+#include "safe_output.h"
 #include "text_scan.h"
 
 #include "cli/mini_json.h"
@@ -948,8 +949,11 @@ WrittenMesh small_mesh(bool float_exact) {
 mini_mesh::Mesh write_and_read(const WrittenMesh& m, const std::string& path, bool ascii) {
     MeshView view = {m.xyz.data(), m.xyz.size() / 3, m.tris.data(), m.tris.size() / 3};
     std::string error;
-    REQUIRE_MESSAGE(write_mesh_file(path, mesh_format_from_extension(path), view, ascii, error),
+    AtomicFile file;
+    REQUIRE_MESSAGE(file.open(path, error), error);
+    REQUIRE_MESSAGE(write_mesh_file(file, mesh_format_from_extension(path), view, ascii, error),
                     error);
+    REQUIRE_MESSAGE(commit_files({&file}, error), error);
     mini_mesh::Mesh back;
     REQUIRE(mini_mesh::read(path, back));
     return back;
@@ -985,15 +989,18 @@ TEST_CASE("the stream writer, fed piece by piece, writes what write_mesh_file wr
             CAPTURE(out.second);
             mini_mesh::Mesh whole = write_and_read(m, dir.file("whole_" + name), out.second);
             std::string path = dir.file("pieces_" + name), error;
+            AtomicFile file;
+            REQUIRE_MESSAGE(file.open(path, error), error);
             MeshStreamWriter writer;
-            REQUIRE_MESSAGE(writer.open(path, mesh_format_from_extension(path), out.second, error),
+            REQUIRE_MESSAGE(writer.open(file, mesh_format_from_extension(path), out.second, error),
                             error);
             // Vertices 0-2, the triangle over them, the other vertices, the rest.
             writer.add_vertices(m.xyz.data(), 3);
             writer.add_triangles(m.tris.data(), 1);
             writer.add_vertices(m.xyz.data() + 9, m.xyz.size() / 3 - 3);
             writer.add_triangles(m.tris.data() + 3, m.tris.size() / 3 - 1);
-            REQUIRE_MESSAGE(writer.finish(true, error), error);
+            REQUIRE_MESSAGE(writer.finish(error), error);
+            REQUIRE_MESSAGE(commit_files({&file}, error), error);
             mini_mesh::Mesh pieces;
             REQUIRE(mini_mesh::read(path, pieces));
             CHECK(pieces.xyz == whole.xyz);
@@ -1006,21 +1013,20 @@ TEST_CASE("the stream writer, fed piece by piece, writes what write_mesh_file wr
     }
 }
 
-TEST_CASE("the stream writer leaves nothing behind when abandoned or unwritable") {
+TEST_CASE("the stream writer leaves nothing behind when abandoned") {
     TempDir dir;
     std::string error;
     {
+        AtomicFile file;
+        REQUIRE(file.open(dir.file("m.ply"), error));
         MeshStreamWriter writer;
-        REQUIRE(writer.open(dir.file("m.ply"), MeshFormat::ply, false, error));
+        REQUIRE(writer.open(file, MeshFormat::ply, false, error));
         // Only the output's temporary is there: the scratch bodies are unnamed.
         CHECK_FALSE(std::filesystem::exists(dir.file("m.ply")));
         CHECK(std::distance(std::filesystem::directory_iterator(dir.path),
                             std::filesystem::directory_iterator()) == 1);
     }
     CHECK(std::filesystem::is_empty(dir.path));
-    MeshStreamWriter writer;
-    CHECK_FALSE(writer.open(dir.file("no/such/dir/m.ply"), MeshFormat::ply, false, error));
-    CHECK(contains(error, "no/such/dir/m.ply: cannot create"));
 }
 
 TEST_CASE("binary PLY uses float when every coordinate is a float, double otherwise") {
@@ -1105,15 +1111,18 @@ TEST_CASE("large meshes: every format reads back bit for bit, the stream writer'
             CHECK(same_bits(xyz, m.xyz));
             if (name == "m.obj") continue; // the stream interleaves OBJ's lines
             const std::string pieces = dir.file("pieces_" + name);
+            AtomicFile file;
+            REQUIRE_MESSAGE(file.open(pieces, error), error);
             MeshStreamWriter writer;
-            REQUIRE_MESSAGE(writer.open(pieces, mesh_format_from_extension(pieces), out.second,
+            REQUIRE_MESSAGE(writer.open(file, mesh_format_from_extension(pieces), out.second,
                                         error),
                             error);
             const size_t half = m.xyz.size() / 6;
             writer.add_vertices(m.xyz.data(), half);
             writer.add_vertices(m.xyz.data() + 3 * half, m.xyz.size() / 3 - half);
             writer.add_triangles(m.tris.data(), m.tris.size() / 3);
-            REQUIRE_MESSAGE(writer.finish(true, error), error);
+            REQUIRE_MESSAGE(writer.finish(error), error);
+            REQUIRE_MESSAGE(commit_files({&file}, error), error);
             std::string whole_bytes, piece_bytes;
             REQUIRE(mini_mesh::load(path, whole_bytes));
             REQUIRE(mini_mesh::load(pieces, piece_bytes));
@@ -1157,19 +1166,21 @@ TEST_CASE("the tool reads back what it writes, exactly") {
     }
 }
 
-TEST_CASE("writer errors: bad indices, unwritable path") {
+TEST_CASE("writer errors: bad indices leave nothing behind") {
     TempDir dir;
     WrittenMesh m = small_mesh(false);
     m.tris[4] = 6;
     MeshView view = {m.xyz.data(), 6, m.tris.data(), 4};
     std::string error;
-    CHECK_FALSE(write_mesh_file(dir.file("bad.ply"), MeshFormat::ply, view, false, error));
-    CHECK(contains(error, "refers to vertex 6"));
+    {
+        AtomicFile file;
+        REQUIRE(file.open(dir.file("bad.ply"), error));
+        CHECK_FALSE(write_mesh_file(file, MeshFormat::ply, view, false, error));
+        CHECK(contains(error, "refers to vertex 6"));
+        CHECK_FALSE(commit_files({&file}, error));
+    }
     CHECK_FALSE(std::filesystem::exists(dir.file("bad.ply")));
-    view.triangle_count = 1;
-    std::string nowhere = dir.file("no/such/dir/m.obj");
-    CHECK_FALSE(write_mesh_file(nowhere, MeshFormat::obj, view, false, error));
-    CHECK(contains(error, nowhere + ": cannot create"));
+    CHECK(std::filesystem::is_empty(dir.path));
 }
 
 // ==== JSON report =========================================================================

@@ -22,6 +22,11 @@
 #include <string>
 #include <vector>
 
+#ifndef _WIN32
+#include <fcntl.h>
+#include <unistd.h>
+#endif
+
 using namespace stratmesh_cli;
 namespace fs = std::filesystem;
 
@@ -116,13 +121,60 @@ TEST_CASE("the command line's files are the input, -o, --report and --preview") 
     CHECK(files[1].option == "-o");
     CHECK(files[2].path == "r.json");
     CHECK(files[3].option == "--preview");
-    // The standard streams and options not given name no file.
+    // The standard streams are named too, the input's as the input; options not given
+    // name nothing.
     CommandLine streams;
     const char* dashes[] = {"stratmesh", "-", "-o", "-", "--format", "off"};
     REQUIRE(parse_command_line(6, dashes, streams, error) == CommandAction::run);
     CHECK(streams.output_format == MeshFormat::off);
-    CHECK(named_files(streams).empty());
+    files = named_files(streams);
+    REQUIRE(files.size() == 2);
+    CHECK((files[0].path == "-" && files[0].input));
+    CHECK((files[1].path == "-" && !files[1].input));
 }
+
+TEST_CASE("at most one output goes to standard output") {
+    const char* cases[][8] = {
+        {"stratmesh", "in.ply", "-o", "-", "--format", "obj", "--report", "-"},
+        {"stratmesh", "in.ply", "-o", "-", "--format", "obj", "--preview", "-"},
+        {"stratmesh", "in.ply", "-o", "m.ply", "--report", "-", "--preview", "-"}};
+    for (const auto& argv : cases) {
+        CommandLine line;
+        std::string error;
+        CHECK(parse_command_line(8, argv, line, error) == CommandAction::usage_error);
+        CHECK(contains(error, "at most one of -o, --report and --preview may be -"));
+    }
+}
+
+#ifndef _WIN32
+TEST_CASE("standard input is compared as the file it is") {
+    ScratchDir dir;
+    const std::string scan = dir.file("scan.ply");
+    save(scan, "points");
+    fs::create_symlink("scan.ply", dir.file("link.ply"));
+    // Standard input, for the length of the test, is scan.ply.
+    const int saved = dup(STDIN_FILENO);
+    const int opened = open(scan.c_str(), O_RDONLY);
+    REQUIRE(saved >= 0);
+    REQUIRE(opened >= 0);
+    REQUIRE(dup2(opened, STDIN_FILENO) == STDIN_FILENO);
+    close(opened);
+    std::string error;
+    const NamedFile input = {"the input", "-", true};
+    const bool over_it = check_distinct_files({input, {"-o", scan}}, error);
+    const std::string over_it_error = error;
+    const bool through_link =
+        check_distinct_files({input, {"--report", dir.file("link.ply")}}, error);
+    const bool elsewhere = check_distinct_files({input, {"-o", dir.file("m.ply")}}, error);
+    dup2(saved, STDIN_FILENO);
+    close(saved);
+    CHECK_FALSE(over_it);
+    CHECK(contains(over_it_error,
+                   "-o '" + scan + "' is the same file as the input (standard input)"));
+    CHECK_FALSE(through_link);
+    CHECK(elsewhere);
+}
+#endif
 
 TEST_CASE("an atomic file appears only when committed, keeping the old one until then") {
     ScratchDir dir;
@@ -137,7 +189,9 @@ TEST_CASE("an atomic file appears only when committed, keeping the old one until
         std::fflush(file.file());
         CHECK(load(path) == "old");
         CHECK(dir.entries() == 2);
-        REQUIRE(file.commit(0, error));
+        REQUIRE(file.complete(0, error));
+        CHECK(load(path) == "old"); // complete, not yet committed
+        REQUIRE(commit_files({&file}, error));
     }
     CHECK(load(path) == "new");
     CHECK(dir.entries() == 1);
@@ -161,7 +215,8 @@ TEST_CASE("starting the writeback early is only a hint: the file still appears w
             expected.size() - half);
     file.start_writeback();
     CHECK(load(path) == "old");
-    REQUIRE_MESSAGE(file.commit(0, error), error);
+    REQUIRE_MESSAGE(file.complete(0, error), error);
+    REQUIRE_MESSAGE(commit_files({&file}, error), error);
     CHECK(load(path) == expected);
     CHECK(dir.entries() == 1);
 #ifndef _WIN32
@@ -171,7 +226,7 @@ TEST_CASE("starting the writeback early is only a hint: the file still appears w
         REQUIRE(full.open("/dev/full", error));
         std::fputs("anything", full.file());
         full.start_writeback();
-        CHECK_FALSE(full.commit(0, error));
+        CHECK_FALSE(full.complete(0, error));
         CHECK(contains(error, "/dev/full: cannot write"));
     }
 #endif
@@ -186,8 +241,9 @@ TEST_CASE("a failed write leaves the old file and no temporary") {
         std::string error;
         REQUIRE(file.open(path, error));
         std::fputs("partial", file.file());
-        CHECK_FALSE(file.commit(ENOSPC, error));
+        CHECK_FALSE(file.complete(ENOSPC, error));
         CHECK(error == path + ": cannot write: " + std::strerror(ENOSPC));
+        CHECK_FALSE(commit_files({&file}, error));
     }
     SUBCASE("abandoned (an error elsewhere)") {
         AtomicFile file;
@@ -199,6 +255,46 @@ TEST_CASE("a failed write leaves the old file and no temporary") {
     CHECK(dir.entries() == 1);
 }
 
+TEST_CASE("outputs are committed all or none") {
+    ScratchDir dir;
+    save(dir.file("m.ply"), "old mesh");
+    AtomicFile mesh, report;
+    std::string error;
+    REQUIRE(mesh.open(dir.file("m.ply"), error));
+    REQUIRE(report.open(dir.file("r.json"), error));
+    std::fputs("new mesh", mesh.file());
+    std::fputs("new report", report.file());
+    REQUIRE(mesh.complete(0, error));
+    SUBCASE("one failed") {
+        CHECK_FALSE(report.complete(ENOSPC, error));
+        CHECK_FALSE(commit_files({&mesh, &report}, error));
+        CHECK(contains(error, "no output is replaced"));
+        CHECK(load(dir.file("m.ply")) == "old mesh");
+        CHECK(dir.entries() == 1);
+    }
+    SUBCASE("one still being written") {
+        CHECK_FALSE(commit_files({&mesh, &report}, error));
+        CHECK(contains(error, "r.json: not written whole"));
+        CHECK(load(dir.file("m.ply")) == "old mesh");
+        CHECK(dir.entries() == 1);
+    }
+    SUBCASE("one discarded (a refused run writes only its report)") {
+        mesh.discard();
+        REQUIRE(report.complete(0, error));
+        REQUIRE(commit_files({&mesh, &report}, error));
+        CHECK(load(dir.file("m.ply")) == "old mesh");
+        CHECK(load(dir.file("r.json")) == "new report");
+        CHECK(dir.entries() == 2);
+    }
+    SUBCASE("both complete") {
+        REQUIRE(report.complete(0, error));
+        REQUIRE(commit_files({&mesh, &report}, error));
+        CHECK(load(dir.file("m.ply")) == "new mesh");
+        CHECK(load(dir.file("r.json")) == "new report");
+        CHECK(dir.entries() == 2);
+    }
+}
+
 TEST_CASE("a symlinked destination is replaced at its target, and a device is written directly") {
     ScratchDir dir;
     save(dir.file("real.ply"), "old");
@@ -207,7 +303,8 @@ TEST_CASE("a symlinked destination is replaced at its target, and a device is wr
     std::string error;
     REQUIRE(file.open(dir.file("link.ply"), error));
     std::fputs("new", file.file());
-    REQUIRE(file.commit(0, error));
+    REQUIRE(file.complete(0, error));
+    REQUIRE(commit_files({&file}, error));
     CHECK(fs::is_symlink(dir.file("link.ply")));
     CHECK(load(dir.file("real.ply")) == "new");
     CHECK(dir.entries() == 2);
@@ -215,12 +312,39 @@ TEST_CASE("a symlinked destination is replaced at its target, and a device is wr
     if (fs::exists("/dev/full")) {
         AtomicFile full;
         REQUIRE(full.open("/dev/full", error));
+        CHECK(full.direct());
         std::fputs("anything", full.file());
-        CHECK_FALSE(full.commit(0, error));
+        CHECK_FALSE(full.complete(0, error));
         CHECK(contains(error, "/dev/full: cannot write"));
         CHECK(fs::is_character_file("/dev/full"));
     }
 #endif
+}
+
+TEST_CASE("a temporary fits wherever its destination does: a long name gets a short one") {
+    ScratchDir dir;
+    for (size_t length : {size_t{200}, size_t{239}, size_t{250}, size_t{255}}) {
+        CAPTURE(length);
+        const std::string path = dir.file(std::string(length - 4, 'n') + ".ply");
+        AtomicFile file;
+        std::string error;
+        const bool opened = file.open(path, error);
+        CHECK_MESSAGE(opened, error);
+        if (!opened) continue;
+        std::string temporary;
+        for (const auto& entry : fs::directory_iterator(dir.path))
+            temporary = entry.path().filename().string();
+        CHECK(temporary.rfind(length + 18 <= 255 ? ".nnn" : ".stratmesh-", 0) == 0);
+        std::FILE* scratch = scratch_file_beside(path, error);
+        CHECK_MESSAGE(scratch, error);
+        if (scratch) std::fclose(scratch);
+        std::fputs("mesh", file.file());
+        REQUIRE_MESSAGE(file.complete(0, error), error);
+        REQUIRE_MESSAGE(commit_files({&file}, error), error);
+        CHECK(load(path) == "mesh");
+        fs::remove(path);
+        CHECK(dir.entries() == 0);
+    }
 }
 
 TEST_CASE("a destination that cannot be created says so") {

@@ -53,6 +53,7 @@ const char kUsage[] =
     "                        (at most one of --cuts, --layers, --layer-height; without\n"
     "                        them the layers are chosen automatically)\n"
     "  --report FILE.json    write counts, timings, memory and per-layer details as JSON\n"
+    "                        (- for standard output, as for --preview)\n"
     "  --preview FILE.svg    draw the mesh from the front and the side (orthographic,\n"
     "                        shaded, the layers in alternating tints, the boundary edges\n"
     "                        in red): a polygon per triangle and view, about 200 bytes\n"
@@ -105,7 +106,9 @@ const char kUsage[] =
     "                        --stream would\n"
     "  --stream-points N     the most points the stream may hold at once (default\n"
     "                        3000000, about 190 bytes each; never more than the input\n"
-    "                        file can hold); about three layers' worth\n"
+    "                        file can hold); about three layers' worth. Where a layer\n"
+    "                        does not fit, or the memory does not hold them, the tool\n"
+    "                        says how many to give instead\n"
     "  -q, --quiet           no progress and no summary on stderr (warnings and errors\n"
     "                        still are)\n"
     "  --verbose             the summary also gives the branches and parts, the threads,\n"
@@ -138,10 +141,18 @@ const char kUsage[] =
     "wrapped in one tube or left apart, points left out, caps left open, input faces\n"
     "ignored, cuts outside the cloud.\n"
     "\n"
+    "Files: no output may be the input or another output, by any name (a symlink, a hard\n"
+    "link, standard input or output redirected from or to it), and at most one of -o,\n"
+    "--report and --preview may be - (standard output); that is refused before anything is\n"
+    "read. The outputs are written to temporaries beside them and renamed into place\n"
+    "together once every one is complete: any failure leaves every file as it was. Standard\n"
+    "output, devices and pipes are written directly, before any file is renamed; what one\n"
+    "received stays if a later output fails.\n"
+    "\n"
     "Exit status: 0 success; 1 the reconstruction refused the input; 2 usage error;\n"
-    "3 file error (cannot open, read, parse or write); 4 with --stream, a point lies below\n"
-    "the one before it along the axis (sort the input along the axis first); 5 with\n"
-    "--strict, the mesh was written but with warnings.\n";
+    "3 file error (cannot open, read, parse or write; standard output closed early); 4 with\n"
+    "--stream, a point lies below the one before it along the axis (sort the input along\n"
+    "the axis first); 5 with --strict, the mesh was written but with warnings.\n";
 
 bool parse_finite(std::string_view text, double& value) {
     return parse_number(text, value) && std::isfinite(value);
@@ -322,6 +333,14 @@ std::string stream_conflict(const CommandLine& line) {
     return "";
 }
 
+// How many of -o, --report and --preview go to standard output.
+int standard_outputs(const CommandLine& line) {
+    int count = 0;
+    for (const std::string* path : {&line.output, &line.report, &line.preview})
+        if (*path == kStandardStream) ++count;
+    return count;
+}
+
 // The machine's hardware threads, at least 1.
 uint32_t default_threads() {
     unsigned count = std::thread::hardware_concurrency();
@@ -428,6 +447,9 @@ private:
                         extra_input_ + "')" + hint);
         }
         if (line_.output.empty()) return fail("no output file (use -o OUTPUT)");
+        if (standard_outputs(line_) > 1)
+            return fail("at most one of -o, --report and --preview may be - (standard "
+                        "output): one stream cannot hold two files; give the others paths");
         if (line_.output_format == MeshFormat::unknown && line_.output == "-")
             return fail("-o - writes to standard output: give its format with --format "
                         "ply|obj|off|stl");
@@ -464,13 +486,13 @@ CommandAction parse_command_line(int argc, const char* const* argv, CommandLine&
 }
 
 std::vector<NamedFile> named_files(const CommandLine& line) {
-    // Options not given name nothing, and "-" (the standard streams) is no file that
-    // another name can clobber.
     std::vector<NamedFile> files;
-    const NamedFile all[] = {{"the input", line.input}, {"-o", line.output},
-                             {"--report", line.report}, {"--preview", line.preview}};
+    const NamedFile all[] = {{"the input", line.input, true},
+                             {"-o", line.output},
+                             {"--report", line.report},
+                             {"--preview", line.preview}};
     for (const NamedFile& file : all)
-        if (!file.path.empty() && file.path != kStandardStream) files.push_back(file);
+        if (!file.path.empty()) files.push_back(file);
     return files;
 }
 

@@ -55,7 +55,7 @@ enum class CommandAction { run, help, version, usage_error };
 CommandAction parse_command_line(int argc, const char* const* argv, CommandLine& line,
                                  std::string& error);
 
-// The files the command line names (not "-", the standard streams), the input first, each
+// The files the command line names ("-" for the standard streams), the input first, each
 // with how the command line names it: what check_distinct_files (safe_output.h) compares.
 std::vector<NamedFile> named_files(const CommandLine& line);
 

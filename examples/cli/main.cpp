@@ -27,6 +27,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <new>
 #include <string>
 #include <utility>
 #include <vector>
@@ -301,23 +302,26 @@ void name_far_point(const std::vector<double>& xyz) {
                  farthest, far, *decile);
 }
 
-void explain_refusal(const CommandLine& line, const RunRecord& record) {
-    std::fprintf(stderr, "stratmesh: cannot reconstruct %s: %s\n", display_name(line.input).c_str(),
+// `advice`, if any, is the tool's own account of the refusal (the stream's memory, which
+// its options size), said in place of the library's.
+void explain_refusal(const CommandLine& line, const RunRecord& record, const std::string& advice) {
+    const std::string name = display_name(line.input);
+    if (!advice.empty()) {
+        std::fprintf(stderr, "stratmesh: cannot reconstruct %s: out_of_memory: %s\n", name.c_str(),
+                     advice.c_str());
+        return;
+    }
+    std::fprintf(stderr, "stratmesh: cannot reconstruct %s: %s\n", name.c_str(),
                  stratmesh::status_string(record.status));
+    // Where the tool gives its own advice (--skip-invalid), the library's, in the library's
+    // terms, is left out.
     if (record.status == stratmesh::Status::invalid_point)
         std::fprintf(stderr,
                      "stratmesh: point %zu (counting from 0) has a NaN or infinite coordinate; "
                      "--skip-invalid skips such points\n",
                      record.report.points.first_invalid_index);
-    // Where the tool gives its own advice (--skip-invalid, the stream's budget, which are
-    // its options), the library's, in the library's terms, is left out.
-    const bool budget = record.stream && record.status == stratmesh::Status::out_of_memory;
-    if (record.report.detail && !budget && record.status != stratmesh::Status::invalid_point)
+    else if (record.report.detail)
         std::fprintf(stderr, "stratmesh: %s\n", record.report.detail);
-    if (budget)
-        std::fprintf(stderr,
-                     "stratmesh: --stream-points %llu is too few for these layers: raise it\n",
-                     static_cast<unsigned long long>(record.stream_points));
 }
 
 // The valid points' range along the axis used, the cuts given outside it, and with layers
@@ -369,35 +373,61 @@ void measure_along_axis(const std::vector<double>& xyz, RunRecord& record) {
     }
 }
 
-// With --preview: the picture of the mesh, written whole or not at all.
+// The files a run writes: opened before the input is read, so that a destination that
+// cannot be created fails before any work, each completed as it is written, and published
+// together at the end (commit_files, safe_output.h), or not at all.
+struct Outputs {
+    AtomicFile mesh, preview, report;
+
+    bool open(const CommandLine& line) {
+        const std::pair<AtomicFile*, const std::string*> named[] = {
+            {&mesh, &line.output}, {&preview, &line.preview}, {&report, &line.report}};
+        for (const auto& [file, path] : named) {
+            std::string error;
+            if (path->empty() || file->open(*path, error)) continue;
+            std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
+            return false;
+        }
+        return true;
+    }
+
+    // Publishes the outputs written; false with the message printed.
+    bool commit() {
+        std::string error;
+        if (commit_files({&mesh, &preview, &report}, error)) return true;
+        std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
+        return false;
+    }
+};
+
+// With --preview: the picture of the mesh.
 bool write_preview(const CommandLine& line, const std::vector<double>& xyz,
-                   const Reconstruction& result, const RunRecord& record) {
+                   const Reconstruction& result, const RunRecord& record, AtomicFile& file) {
     if (line.preview.empty()) return true;
     const MeshView mesh = {xyz.data(), xyz.size() / 3, result.triangles.get(),
                            result.triangle_count};
     std::string error;
-    if (write_preview_svg(line.preview, mesh, record.report.axis, record.layers, error))
-        return true;
+    if (write_preview_svg(file, mesh, record.report.axis, record.layers, error)) return true;
     std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
     return false;
 }
 
-bool write_report(const CommandLine& line, const RunRecord& record) {
+bool write_report(const CommandLine& line, const RunRecord& record, AtomicFile& file) {
     if (line.report.empty()) return true;
     std::string error;
-    if (write_text_file(line.report, run_record_json(record), error)) return true;
+    if (write_text_file(file, run_record_json(record), error)) return true;
     std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
     return false;
 }
 
 bool write_output(const CommandLine& line, const std::vector<double>& xyz,
                   const PointAttributes& attributes, const Reconstruction& result,
-                  RunRecord& record) {
+                  RunRecord& record, AtomicFile& file) {
     Clock::time_point start = Clock::now();
     MeshView mesh = {xyz.data(), xyz.size() / 3, result.triangles.get(), result.triangle_count,
                      &attributes};
     std::string error;
-    if (!write_mesh_file(line.output, line.output_format, mesh, line.ascii, error)) {
+    if (!write_mesh_file(file, line.output_format, mesh, line.ascii, error)) {
         std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
         return false;
     }
@@ -406,37 +436,42 @@ bool write_output(const CommandLine& line, const std::vector<double>& xyz,
     return true;
 }
 
-// Prints the summary (not with --quiet) and the warnings (always), and writes the report
-// of a run whose mesh is written.
-int finish_run(const CommandLine& line, RunRecord& record) {
+// Writes the report of a run whose mesh is written, publishes the outputs, then prints the
+// summary (not with --quiet) and the warnings (always).
+int finish_run(const CommandLine& line, RunRecord& record, Outputs& outputs) {
     record.peak_rss_bytes = peak_resident_bytes();
+    if (!write_report(line, record, outputs.report) || !outputs.commit()) return kExitFile;
     const std::vector<std::string> warnings = run_warnings(record);
     if (!line.quiet) print_summary(stderr, record, warnings.size(), line.verbose);
     print_warnings(stderr, warnings);
-    if (!write_report(line, record)) return kExitFile;
     return line.strict && !warnings.empty() ? kExitWarned : kExitOk;
 }
 
-int refuse(const CommandLine& line, RunRecord& record, const std::vector<double>& xyz) {
+// Explains the refusal (with the tool's `advice`, if any) and writes the report alone.
+int refuse(const CommandLine& line, RunRecord& record, const std::vector<double>& xyz,
+           const std::string& advice, Outputs& outputs) {
     const std::string faces = faces_warning(record);
     if (!faces.empty()) print_warnings(stderr, {faces});
-    explain_refusal(line, record);
+    explain_refusal(line, record, advice);
     if (record.status == stratmesh::Status::not_columnar ||
         record.status == stratmesh::Status::degenerate)
         name_far_point(xyz);
     record.peak_rss_bytes = peak_resident_bytes();
-    write_report(line, record);
+    outputs.mesh.discard();
+    outputs.preview.discard();
+    if (write_report(line, record, outputs.report)) outputs.commit();
     return kExitRefused;
 }
 
-int run_streamed(const CommandLine& line, RunRecord& record) {
+int run_streamed(const CommandLine& line, RunRecord& record, Outputs& outputs) {
     ProgressMonitor silent(false, stderr);
     ThreadJobs jobs;
     std::string error;
-    StreamOutcome outcome = run_stream(line, make_options(line, silent, jobs), record, error);
+    StreamOutcome outcome =
+        run_stream(line, make_options(line, silent, jobs), record, outputs.mesh, error);
     switch (outcome) {
-    case StreamOutcome::done: return finish_run(line, record);
-    case StreamOutcome::refused: return refuse(line, record, {});
+    case StreamOutcome::done: return finish_run(line, record, outputs);
+    case StreamOutcome::refused: return refuse(line, record, {}, error, outputs);
     case StreamOutcome::file_error: break;
     case StreamOutcome::usage:
         std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
@@ -455,9 +490,11 @@ int run(const CommandLine& line) {
         std::fprintf(stderr, "stratmesh: %s\n", clash.c_str());
         return kExitUsage;
     }
+    Outputs outputs;
+    if (!outputs.open(line)) return kExitFile;
     RunRecord record;
     record_command_line(line, record);
-    if (line.stream) return run_streamed(line, record);
+    if (line.stream) return run_streamed(line, record, outputs);
     std::vector<double> xyz;
     PointAttributes attributes;
     Reconstruction result;
@@ -465,13 +502,25 @@ int run(const CommandLine& line) {
     if (line.origin_given && !origin_in_reach(line, xyz)) return kExitUsage;
     if (line.find_branches && !find_branches(xyz, line, record)) return kExitRefused;
     if (!reconstruct_points(xyz, line, result, record)) return kExitRefused;
-    if (record.status != stratmesh::Status::ok) return refuse(line, record, xyz);
+    if (record.status != stratmesh::Status::ok) return refuse(line, record, xyz, "", outputs);
     measure_along_axis(xyz, record);
     record.ends = find_surface_ends(xyz.data(), result.triangles.get(), result.triangle_count,
                                     record.report.axis, record.layers);
-    if (!write_output(line, xyz, attributes, result, record)) return kExitFile;
-    if (!write_preview(line, xyz, result, record)) return kExitFile;
-    return finish_run(line, record);
+    if (!write_output(line, xyz, attributes, result, record, outputs.mesh) ||
+        !write_preview(line, xyz, result, record, outputs.preview))
+        return kExitFile;
+    return finish_run(line, record, outputs);
+}
+
+// What to do when the memory ran out outside the workspaces the tool sizes and checks.
+const char* memory_advice(const CommandLine& line) {
+    if (!line.stream)
+        return "--stream reads and meshes a cloud sorted along its axis in bounded memory";
+    if (line.cap)
+        return "--cap keeps every point and triangle until the end: without it the stream "
+               "holds only its layers";
+    return "thinner layers (closer --cuts, a smaller --layer-height) or a lower "
+           "--stream-points leave more room";
 }
 
 } // namespace
@@ -490,5 +539,12 @@ int main(int argc, char** argv) {
         return kExitUsage;
     case CommandAction::run: break;
     }
-    return run(line);
+    try {
+        return run(line);
+    } catch (const std::bad_alloc&) {
+        // Unwound: the outputs' temporaries are gone, every destination is as it was.
+        std::fprintf(stderr, "stratmesh: out of memory, no file replaced: %s\n",
+                     memory_advice(line));
+        return kExitRefused;
+    }
 }

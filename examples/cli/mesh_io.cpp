@@ -23,7 +23,7 @@ namespace stratmesh_cli {
 class BlockWriter {
 public:
     // `output`, if given, is the AtomicFile that `file` belongs to: its writeback to the
-    // disk is started as the blocks go out, so that commit() waits for little.
+    // disk is started as the blocks go out, so that complete() waits for little.
     explicit BlockWriter(std::FILE* file, AtomicFile* output = nullptr)
         : file_(file), output_(output), buffer_(new char[kBlockBytes]) {}
 
@@ -546,56 +546,59 @@ bool all_coordinates_are_floats(const double* xyz, size_t count) {
     return true;
 }
 
-bool write_mesh_file(const std::string& path, MeshFormat format, const MeshView& mesh, bool ascii,
+bool write_mesh_file(AtomicFile& file, MeshFormat format, const MeshView& mesh, bool ascii,
                      std::string& error) {
     if (format == MeshFormat::unknown) {
-        error = path + ": unknown mesh format (use .ply, .obj, .off or .stl)";
+        error = file.path() + ": unknown mesh format (use .ply, .obj, .off or .stl)";
         return false;
     }
     if (!check_mesh(mesh, format, error)) {
-        error = path + ": " + error;
+        error = file.path() + ": " + error;
         return false;
     }
-    AtomicFile file;
-    if (!file.open(path, error)) return false;
     BlockWriter writer(file.file(), &file);
     write_body(writer, format, mesh, ascii);
-    return file.commit(writer.drain(), error);
+    return file.complete(writer.drain(), error);
 }
 
 MeshStreamWriter::MeshStreamWriter() = default;
 
-// A writer still open here is abandoned: its temporaries are removed, the destination left
-// as it was.
+// A writer not finished here is abandoned: its scratch bodies go, and the output's
+// temporary with its AtomicFile.
 MeshStreamWriter::~MeshStreamWriter() {
     std::string ignored;
-    if (out_) finish(false, ignored);
+    close_bodies(ignored);
 }
 
-bool MeshStreamWriter::open(const std::string& path, MeshFormat format, bool ascii,
+bool MeshStreamWriter::open(AtomicFile& file, MeshFormat format, bool ascii,
                             std::string& error) {
-    path_ = path;
+    file_ = &file;
     format_ = format;
     ascii_ = ascii && format == MeshFormat::ply;
-    file_ = std::make_unique<AtomicFile>();
-    if (!file_->open(path, error)) return false;
-    out_ = std::make_unique<BlockWriter>(file_->file(), file_.get());
-    if (format == MeshFormat::obj) {
+    out_ = std::make_unique<BlockWriter>(file.file(), &file);
+    // OBJ goes straight into a temporary; into a direct output (standard output, a pipe)
+    // it waits in a scratch body like the others, so that a run that fails midway writes
+    // nothing there.
+    if (format == MeshFormat::obj && !file.direct()) {
         out_->append(obj_header());
         return true;
     }
-    std::FILE* vertices = scratch_file_beside(path, error);
-    std::FILE* faces = vertices ? scratch_file_beside(path, error) : nullptr;
+    std::FILE* vertices = scratch_file_beside(file.path(), error);
+    std::FILE* faces = vertices && format != MeshFormat::obj
+                           ? scratch_file_beside(file.path(), error)
+                           : nullptr;
     if (vertices) vertices_ = std::make_unique<BlockWriter>(vertices);
     if (faces) faces_ = std::make_unique<BlockWriter>(faces);
-    if (faces) return true;
-    std::string ignored;
-    finish(false, ignored);
-    return false;
+    return faces_ || (vertices_ && format == MeshFormat::obj);
+}
+
+BlockWriter& MeshStreamWriter::body(bool vertices) {
+    if (format_ == MeshFormat::obj) return vertices_ ? *vertices_ : *out_;
+    return vertices ? *vertices_ : *faces_;
 }
 
 void MeshStreamWriter::add_vertices(const double* xyz, size_t count) {
-    BlockWriter& w = format_ == MeshFormat::obj ? *out_ : *vertices_;
+    BlockWriter& w = body(true);
     all_floats_ = all_floats_ && all_coordinates_are_floats(xyz, count);
     if (format_ == MeshFormat::ply && !ascii_)
         put_binary_vertices(w, xyz, count, false);
@@ -605,7 +608,7 @@ void MeshStreamWriter::add_vertices(const double* xyz, size_t count) {
 }
 
 void MeshStreamWriter::add_triangles(const uint32_t* triangles, size_t count) {
-    BlockWriter& w = format_ == MeshFormat::obj ? *out_ : *faces_;
+    BlockWriter& w = body(false);
     if (format_ == MeshFormat::ply && !ascii_)
         put_binary_faces(w, triangles, count);
     else
@@ -634,26 +637,33 @@ bool MeshStreamWriter::copy_body(BlockWriter& from, bool doubles_to_floats) {
     return !from.failed() && !std::ferror(from.file());
 }
 
-bool MeshStreamWriter::finish(bool keep, std::string& error) {
-    bool single = format_ == MeshFormat::ply && !ascii_ && all_floats_;
-    if (keep && format_ != MeshFormat::obj) {
-        out_->append(format_ == MeshFormat::ply
-                         ? ply_header(vertex_count_, triangle_count_, ascii_, single)
-                         : off_header(vertex_count_, triangle_count_));
-    }
-    std::string failure;
-    bool ok = keep && (format_ == MeshFormat::obj ||
-                       (copy_body(*vertices_, single) && copy_body(*faces_, false)));
-    if (keep && !ok) failure = "a temporary file cannot be read back";
+bool MeshStreamWriter::close_bodies(std::string& failure) {
+    bool ok = true;
     for (std::unique_ptr<BlockWriter>* w : {&vertices_, &faces_}) {
         if (*w && !(*w)->close(failure)) ok = false;
         w->reset();
     }
-    const int written = out_ ? out_->drain() : 0;
+    return ok;
+}
+
+bool MeshStreamWriter::finish(std::string& error) {
+    const bool single = format_ == MeshFormat::ply && !ascii_ && all_floats_;
+    if (format_ == MeshFormat::ply)
+        out_->append(ply_header(vertex_count_, triangle_count_, ascii_, single));
+    else if (format_ == MeshFormat::off)
+        out_->append(off_header(vertex_count_, triangle_count_));
+    else if (vertices_)
+        out_->append(obj_header());
+    std::string failure;
+    bool ok = !vertices_ || copy_body(*vertices_, single);
+    ok = ok && (!faces_ || copy_body(*faces_, false));
+    if (!ok) failure = "a temporary file cannot be read back";
+    ok = close_bodies(failure) && ok;
+    const int written = out_->drain();
     out_.reset();
-    if (ok) return file_->commit(written, error);
-    if (file_) file_->discard();
-    if (keep) error = path_ + ": cannot write: " + failure;
+    if (ok) return file_->complete(written, error);
+    error = file_->path() + ": cannot write: " + failure;
+    file_->discard();
     return false;
 }
 

@@ -62,42 +62,46 @@ size_t carried_attributes(const PointAttributes* attributes, MeshFormat format);
 // True if every coordinate converts to float and back unchanged (NaN and infinities too).
 bool all_coordinates_are_floats(const double* xyz, size_t count);
 
-// Writes the mesh; `ascii` selects text PLY and text STL (OBJ and OFF are always text).
-// Written whole or not at all (AtomicFile, safe_output.h): on failure a file already at
-// `path` is left as it was and `error` names the file and the cause.
-bool write_mesh_file(const std::string& path, MeshFormat format, const MeshView& mesh, bool ascii,
-                     std::string& error);
-
 class AtomicFile;
 class BlockWriter;
+
+// Writes the mesh into `file` (opened, safe_output.h) and completes it; `ascii` selects text
+// PLY and text STL (OBJ and OFF are always text). False with a message naming the file if
+// the mesh is unfit or a write failed: the caller's commit_files() then leaves the
+// destination as it was.
+bool write_mesh_file(AtomicFile& file, MeshFormat format, const MeshView& mesh, bool ascii,
+                     std::string& error);
 
 // Writes a mesh whose vertices and triangles arrive piece by piece (--stream), in bounded
 // memory, with the same vertex rule and the same bytes as write_mesh_file() given the
 // whole mesh (OBJ excepted: its vertex and face lines interleave as they arrive). OBJ goes
-// straight to the output's temporary; PLY and OFF, whose headers count what follows,
-// collect the vertex and face bodies in two unnamed scratch files beside the output and
-// copy them after the header at finish(). The output is renamed into place only then.
-// STL, which repeats the corners' coordinates in every triangle, is not supported.
+// straight to the output's temporary; PLY and OFF, whose headers count what follows, and
+// OBJ bound for a direct output, collect their bodies in unnamed scratch files beside the
+// output and copy them after the header at finish(), so that nothing reaches the output
+// before the mesh is complete. STL, which repeats the corners' coordinates in every
+// triangle, is not supported.
 class MeshStreamWriter {
 public:
     MeshStreamWriter();
     ~MeshStreamWriter();
 
-    // Creates the output; false with a message naming the file.
-    bool open(const std::string& path, MeshFormat format, bool ascii, std::string& error);
+    // Starts the mesh in `file`, which must stay open while the writer lives; false with a
+    // message naming the file.
+    bool open(AtomicFile& file, MeshFormat format, bool ascii, std::string& error);
     void add_vertices(const double* xyz, size_t count);
     // Triangles must only use vertices already added.
     void add_triangles(const uint32_t* triangles, size_t count);
-    // Completes the file; on failure removes it and says why. `keep` false just removes it.
-    bool finish(bool keep, std::string& error);
+    // Completes the file (AtomicFile::complete); on failure discards it and says why.
+    bool finish(std::string& error);
 
 private:
+    BlockWriter& body(bool vertices);
     bool copy_body(BlockWriter& from, bool doubles_to_floats);
+    bool close_bodies(std::string& failure);
 
-    std::string path_;
+    AtomicFile* file_ = nullptr;
     MeshFormat format_ = MeshFormat::unknown;
     bool ascii_ = false;
-    std::unique_ptr<AtomicFile> file_;
     std::unique_ptr<BlockWriter> out_, vertices_, faces_;
     size_t vertex_count_ = 0, triangle_count_ = 0;
     bool all_floats_ = true;

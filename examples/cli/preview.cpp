@@ -236,11 +236,9 @@ private:
 
 } // namespace
 
-bool write_preview_svg(const std::string& path, const MeshView& mesh, const double axis[3],
+bool write_preview_svg(AtomicFile& file, const MeshView& mesh, const double axis[3],
                        const std::vector<stratmesh::LayerInfo>& layers, std::string& error) {
-    AtomicFile file;
-    if (!file.open(path, error)) return false;
-    return file.commit(Painter(mesh, axis, layers, file.file()).draw(), error);
+    return file.complete(Painter(mesh, axis, layers, file.file()).draw(), error);
 }
 
 } // namespace stratmesh_cli

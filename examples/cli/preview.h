@@ -15,9 +15,9 @@ namespace stratmesh_cli {
 // painted far to near, shaded by its angle to the light (both faces lit, so that the inside
 // shows through an open end) and tinted by its layer, alternately blue and orange
 // (`layers` bottom up; one tint if empty); the boundary edges drawn over them in red.
-// Written to `path` whole or not at all (AtomicFile, safe_output.h); false with a message
+// Written into `file` (opened, safe_output.h), which it completes; false with a message
 // naming the file on failure.
-bool write_preview_svg(const std::string& path, const MeshView& mesh, const double axis[3],
+bool write_preview_svg(AtomicFile& file, const MeshView& mesh, const double axis[3],
                        const std::vector<stratmesh::LayerInfo>& layers, std::string& error);
 
 } // namespace stratmesh_cli

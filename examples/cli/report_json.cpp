@@ -557,11 +557,9 @@ std::string run_record_json(const RunRecord& record) {
     return j.text();
 }
 
-bool write_text_file(const std::string& path, const std::string& text, std::string& error) {
-    AtomicFile file;
-    if (!file.open(path, error)) return false;
+bool write_text_file(AtomicFile& file, const std::string& text, std::string& error) {
     const bool written = std::fwrite(text.data(), 1, text.size(), file.file()) == text.size();
-    return file.commit(written ? 0 : (errno != 0 ? errno : EIO), error);
+    return file.complete(written ? 0 : (errno != 0 ? errno : EIO), error);
 }
 
 } // namespace stratmesh_cli

@@ -113,8 +113,11 @@ std::string run_record_json(const RunRecord& record);
 // U+FFFD, so the result is always valid JSON.
 std::string json_string(std::string_view text);
 
-// Writes `text` to `path`; false with a message naming the file on failure.
-bool write_text_file(const std::string& path, const std::string& text, std::string& error);
+class AtomicFile;
+
+// Writes `text` into `file` (opened, safe_output.h) and completes it; false with a message
+// naming the file on failure.
+bool write_text_file(AtomicFile& file, const std::string& text, std::string& error);
 
 } // namespace stratmesh_cli
 

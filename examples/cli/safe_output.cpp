@@ -8,6 +8,8 @@
 #include <filesystem>
 
 #ifndef _WIN32
+#include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #endif
 #ifdef __linux__
@@ -55,7 +57,28 @@ extern "C" void remove_temporaries_and_die(int signal_number) {
     std::raise(signal_number);
 }
 
+// Holds off the signals that end the tool while it lives, so that what it guards runs
+// whole; a signal that came meanwhile is delivered when it ends.
+class SignalsHeld {
+public:
+#ifndef _WIN32
+    SignalsHeld() {
+        sigset_t ending;
+        sigemptyset(&ending);
+        for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&ending, signal_number);
+        sigprocmask(SIG_BLOCK, &ending, &before_);
+    }
+    ~SignalsHeld() { sigprocmask(SIG_SETMASK, &before_, nullptr); }
+
+private:
+    sigset_t before_;
+#endif
+};
+
 // ---- names -------------------------------------------------------------------------------
+
+// The temporaries' name where the target's own is too long to be part of it.
+const char kShortPrefix[] = ".stratmesh-";
 
 // Six letters that differ between calls and between processes; a clash only costs a retry
 // (the temporary is created exclusively).
@@ -78,22 +101,28 @@ std::string unique_suffix() {
     return suffix;
 }
 
-// Creates a new file, exclusively, named after `target` in its directory: a hidden name
-// (".NAME.stratmesh-XXXXXX") that no reader takes for the finished file. The name goes into
-// `temporary` and into the signal handler's table (`slot`) before the file exists.
+// Creates a new file, exclusively, in the directory of `target`: a hidden name that no
+// reader takes for the finished file, ".NAME.stratmesh-XXXXXX" after the target's NAME, or
+// ".stratmesh-XXXXXX" where that is too long for the file system (NAME is then longer than
+// it), so that a temporary fits wherever the target does. The name goes into `temporary`
+// and into the signal handler's table (`slot`) before the file exists.
 std::FILE* create_beside(const std::string& target, const char* mode, std::string& temporary,
                          int& slot) {
     const fs::path where(target);
     fs::path directory = where.parent_path();
     if (directory.empty()) directory = ".";
-    const std::string name = where.filename().string();
+    std::string prefix = "." + where.filename().string() + ".stratmesh-";
     for (int attempt = 0; attempt < 100; ++attempt) {
-        temporary = (directory / ("." + name + ".stratmesh-" + unique_suffix())).string();
+        temporary = (directory / (prefix + unique_suffix())).string();
         slot = remember_temporary(temporary);
         std::FILE* file = std::fopen(temporary.c_str(), mode);
         if (file) return file;
         const int failure = errno;
         forget_temporary(slot);
+        if (failure == ENAMETOOLONG && prefix != kShortPrefix) {
+            prefix = kShortPrefix;
+            continue;
+        }
         if (failure != EEXIST) {
             errno = failure;
             return nullptr;
@@ -103,22 +132,46 @@ std::FILE* create_beside(const std::string& target, const char* mode, std::strin
     return nullptr;
 }
 
-// Whether two paths name the same file, or would once created.
-bool same_file(const std::string& a, const std::string& b) {
-    std::error_code ea, eb;
-    const bool a_exists = fs::exists(a, ea), b_exists = fs::exists(b, eb);
-    if (a_exists && b_exists) {
-        std::error_code e;
-        return fs::equivalent(a, b, e) && !e;
-    }
-    if (a_exists || b_exists) return false;
-    const fs::path pa(a), pb(b);
+#ifndef _WIN32
+// The file behind a name, through symlinks; for "-", the standard stream it stands for.
+// False if there is none.
+bool identify(const NamedFile& file, struct stat& status) {
+    if (file.path != kStandardStream) return stat(file.path.c_str(), &status) == 0;
+    return fstat(file.input ? STDIN_FILENO : STDOUT_FILENO, &status) == 0;
+}
+#endif
+
+// Whether two of the tool's names stand for one file, or would once created.
+bool same_file(const NamedFile& a, const NamedFile& b) {
+#ifndef _WIN32
+    struct stat sa, sb;
+    const bool a_exists = identify(a, sa), b_exists = identify(b, sb);
+    // A character device (a terminal, /dev/null) holds no data: the input may come from
+    // the one an output goes to.
+    if (a_exists && b_exists)
+        return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino &&
+               !(a.input != b.input && S_ISCHR(sa.st_mode));
+#else
+    std::error_code ea, eb, e;
+    const bool a_exists = a.path != kStandardStream && fs::exists(a.path, ea);
+    const bool b_exists = b.path != kStandardStream && fs::exists(b.path, eb);
+    if (a_exists && b_exists) return fs::equivalent(a.path, b.path, e) && !e;
+#endif
+    if (a_exists || b_exists || a.path == kStandardStream || b.path == kStandardStream)
+        return false;
+    const fs::path pa(a.path), pb(b.path);
     if (pa.filename() != pb.filename()) return false;
     fs::path da = pa.parent_path(), db = pb.parent_path();
     if (da.empty()) da = ".";
     if (db.empty()) db = ".";
-    std::error_code e;
-    return fs::equivalent(da, db, e) && !e;
+    std::error_code same;
+    return fs::equivalent(da, db, same) && !same;
+}
+
+// "-o 'm.ply'", "the input (standard input)".
+std::string describe(const NamedFile& file) {
+    if (file.path != kStandardStream) return file.option + " '" + file.path + "'";
+    return file.option + (file.input ? " (standard input)" : " (standard output)");
 }
 
 } // namespace
@@ -126,12 +179,10 @@ bool same_file(const std::string& a, const std::string& b) {
 bool check_distinct_files(const std::vector<NamedFile>& files, std::string& error) {
     for (size_t j = 1; j < files.size(); ++j) {
         for (size_t i = 0; i < j; ++i) {
-            if (files[i].path.empty() || files[j].path.empty() ||
-                !same_file(files[i].path, files[j].path))
+            if (files[i].path.empty() || files[j].path.empty() || !same_file(files[i], files[j]))
                 continue;
-            error = files[j].option + " '" + files[j].path + "' is the same file as " +
-                    files[i].option + " '" + files[i].path + "': give " + files[j].option +
-                    " another path";
+            error = describe(files[j]) + " is the same file as " + describe(files[i]) +
+                    ": give " + files[j].option + " another path";
             return false;
         }
     }
@@ -173,7 +224,7 @@ bool AtomicFile::open(const std::string& path, std::string& error) {
     return false;
 }
 
-bool AtomicFile::commit(int failure, std::string& error) {
+bool AtomicFile::complete(int failure, std::string& error) {
     if (!file_) {
         error = path_ + ": cannot write: the file is not open";
         return false;
@@ -190,23 +241,62 @@ bool AtomicFile::commit(int failure, std::string& error) {
         std::error_code e;
         const fs::file_status old = fs::status(target_, e);
         if (fs::is_regular_file(old)) fs::permissions(temporary_, old.permissions(), e);
-        e.clear();
-        fs::rename(temporary_, target_, e);
-        if (e) failure = e.value();
-        if (!e) {
-            temporary_.clear();
-            forget_temporary(slot_);
+    }
+    completed_ = failure == 0;
+    if (completed_) return true;
+    error = write_error(failure);
+    discard();
+    failed_ = true;
+    return false;
+}
+
+std::string AtomicFile::write_error(int failure) const {
+    if (standard_output_ && failure == EPIPE)
+        return "standard output closed early (broken pipe): its reader stopped before the "
+               "end, and what it read is incomplete";
+    return path_ + ": cannot write: " + std::strerror(failure);
+}
+
+bool AtomicFile::rename_into_place(std::string& error) {
+    std::error_code e;
+    fs::rename(temporary_, target_, e);
+    if (e) {
+        error = write_error(e.value());
+        return false;
+    }
+    temporary_.clear();
+    forget_temporary(slot_);
+    return true;
+}
+
+bool commit_files(std::initializer_list<AtomicFile*> files, std::string& error) {
+    bool ok = true;
+    for (const AtomicFile* file : files) {
+        if (ok && (file->failed_ || file->file_)) {
+            error = file->path_ + ": not written whole: no output is replaced";
+            ok = false;
         }
     }
-    if (failure == 0) return true;
-    error = path_ + ": cannot write: " + std::strerror(failure);
-    discard();
-    return false;
+    std::string replaced; // the destinations renamed onto so far
+    {
+        // Only renames are left: an interrupt between two would replace some destinations
+        // and not the others.
+        SignalsHeld held;
+        for (AtomicFile* file : files) {
+            if (!ok || !file->completed_ || file->direct()) continue;
+            ok = file->rename_into_place(error);
+            if (ok) replaced += (replaced.empty() ? "" : ", ") + file->path_;
+            else if (!replaced.empty()) error += " (" + replaced + " already replaced)";
+        }
+    }
+    for (AtomicFile* file : files) file->discard();
+    return ok;
 }
 
 void AtomicFile::discard() {
     if (file_ && !standard_output_) std::fclose(file_);
     file_ = nullptr;
+    completed_ = failed_ = false;
     if (!temporary_.empty()) std::remove(temporary_.c_str());
     temporary_.clear();
     forget_temporary(slot_);
@@ -214,7 +304,7 @@ void AtomicFile::discard() {
 
 void AtomicFile::start_writeback() {
 #ifdef __linux__
-    // What stdio still buffers goes out later (its errors are commit()'s to report). The
+    // What stdio still buffers goes out later (its errors are complete()'s to report). The
     // whole file's range: pages already written or on their way to the disk are skipped.
     if (file_ && !temporary_.empty()) sync_file_range(fileno(file_), 0, 0, SYNC_FILE_RANGE_WRITE);
 #endif
@@ -249,6 +339,7 @@ void install_output_signal_handlers() {
 #ifndef _WIN32
     std::signal(SIGHUP, remove_temporaries_and_die);
     std::signal(SIGXFSZ, SIG_IGN);
+    std::signal(SIGPIPE, SIG_IGN);
 #endif
 }
 

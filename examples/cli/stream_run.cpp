@@ -4,6 +4,7 @@
 #include "frame_check.h"
 #include "mesh_ends.h"
 #include "mesh_io.h"
+#include "safe_output.h"
 
 #include <algorithm>
 #include <chrono>
@@ -37,6 +38,16 @@ void unit_axis(const stratmesh::Options& options, double axis[3]) {
     for (size_t k = 0; k < 3; ++k) axis[k] /= length;
 }
 
+// Whether `bytes` can be allocated now. The byte written (volatile) keeps the compiler from
+// taking the allocation for unused and leaving it out.
+bool can_allocate(size_t bytes) {
+    if (bytes == 0) return false;
+    std::unique_ptr<unsigned char[]> block(new (std::nothrow) unsigned char[bytes]);
+    if (!block) return false;
+    *static_cast<volatile unsigned char*>(block.get()) = 0;
+    return true;
+}
+
 // Where the layers end: after the first point, the top of the layer a height falls in.
 class LayerTops {
 public:
@@ -68,8 +79,9 @@ private:
 
 class StreamRunner {
 public:
-    StreamRunner(const CommandLine& line, stratmesh::Options options, RunRecord& record)
-        : line_(line), options_(options), record_(record), tops_(line),
+    StreamRunner(const CommandLine& line, stratmesh::Options options, RunRecord& record,
+                 AtomicFile& mesh)
+        : line_(line), options_(options), record_(record), mesh_(mesh), tops_(line),
           layers_(kLayerCapacity) {
         // The stream refuses close_ends: --cap runs cap_ends() once it is closed.
         options_.flags &= ~static_cast<uint32_t>(stratmesh::close_ends);
@@ -89,11 +101,14 @@ public:
         if (record_.stream_points > most) record_.stream_points = most;
         record_.input_format = cloud_format_name(info.format);
         record_.input_encoding = info.encoding;
-        if (!writer_.open(line_.output, line_.output_format, line_.ascii, error))
+        if (!writer_.open(mesh_, line_.output_format, line_.ascii, error))
             return StreamOutcome::file_error;
         StreamOutcome outcome = read_and_push(*reader, error);
         if (outcome == StreamOutcome::done) outcome = close(error);
-        if (outcome == StreamOutcome::refused) count_refused_push();
+        if (outcome == StreamOutcome::refused) {
+            count_refused_push();
+            error = advice_;
+        }
         record_.take_report(report_, layers_);
         // With --cap every triangle is kept: the ends can be read off them.
         if (outcome == StreamOutcome::done && line_.cap)
@@ -144,6 +159,7 @@ private:
         record_.reconstructed = true;
         if (!workspace_ || record_.workspace_bytes == 0) {
             record_.status = stratmesh::Status::out_of_memory;
+            advice_ = workspace_advice();
             return false;
         }
         record_.status = stratmesh::stream_open(options_, workspace_.get(), record_.workspace_bytes,
@@ -195,6 +211,7 @@ private:
         pushed_ += cloud.count;
         record_.status = stratmesh::stream_push(stream_, cloud, top);
         stream_seconds_ += seconds_since(pushed);
+        if (record_.status == stratmesh::Status::out_of_memory) advice_ = layer_advice();
         ++record_.stream_pushes;
         record_.batch_cuts.push_back(top);
         layer_.clear();
@@ -214,7 +231,7 @@ private:
         record_.reconstruct_seconds = stream_seconds_;
         if (record_.status != stratmesh::Status::ok) return StreamOutcome::refused;
         start = Clock::now();
-        bool written = writer_.finish(true, error);
+        bool written = writer_.finish(error);
         write_seconds_ += seconds_since(start);
         record_.write_seconds = write_seconds_;
         record_.output_written = written;
@@ -229,7 +246,13 @@ private:
         const size_t n = all_points_.size() / 3, surface = kept_.size() / 3;
         const size_t bytes = stratmesh::cap_ends_workspace_size(n, surface);
         std::unique_ptr<unsigned char[]> work(new (std::nothrow) unsigned char[bytes]);
-        if (!work || bytes == 0) return stratmesh::Status::out_of_memory;
+        if (!work || bytes == 0) {
+            advice_ = "--cap needs " + std::to_string(bytes) + " bytes more to cap the " +
+                      std::to_string(n) +
+                      " points kept, which cannot be allocated: run without --cap (the stream "
+                      "then holds only its layers)";
+            return stratmesh::Status::out_of_memory;
+        }
         kept_.resize(3 * stratmesh::reconstruct_max_triangles(n, options_));
         size_t count = surface;
         const stratmesh::Cloud cloud = {all_points_.data(), n, 0, stratmesh::Scalar::float64};
@@ -247,6 +270,38 @@ private:
         report_.caps.wall_flip_count = caps.caps.wall_flip_count;
         report_.triangle_count = count;
         return status;
+    }
+
+    // The workspace for --stream-points cannot be allocated: how many points' workspace
+    // can, halving until one is (the library needs room for 16).
+    std::string workspace_advice() const {
+        uint64_t fits = std::min<uint64_t>(record_.stream_points, SIZE_MAX) / 2;
+        while (fits >= 16 &&
+               !can_allocate(stratmesh::stream_workspace_size(static_cast<size_t>(fits), options_)))
+            fits /= 2;
+        const std::string bytes = record_.workspace_bytes > 0
+                                      ? std::to_string(record_.workspace_bytes) + " bytes"
+                                      : "more bytes than the machine addresses";
+        const std::string message = "the stream's workspace for --stream-points " +
+                                    std::to_string(record_.stream_points) + " (" + bytes +
+                                    ") cannot be allocated";
+        if (fits < 16) return message + ", nor the one for 16 points: free some memory";
+        return message + ": lower --stream-points to " + std::to_string(fits) +
+               " or fewer (that many points' workspace can be)";
+    }
+
+    // A layer did not fit beside the points the stream holds: it needs at most the most
+    // held so far and the layer's valid points.
+    std::string layer_advice() const {
+        size_t valid = 0;
+        for (size_t i = 0; i + 2 < layer_.size(); i += 3)
+            valid += std::isfinite(layer_[i]) && std::isfinite(layer_[i + 1]) &&
+                     std::isfinite(layer_[i + 2]);
+        const uint64_t enough = std::max<uint64_t>(report_.points.held_count + valid,
+                                                   record_.stream_points + 1);
+        return "--stream-points " + std::to_string(record_.stream_points) +
+               " is too few for these layers (one of " + std::to_string(valid) +
+               " points did not fit): raise it to at least " + std::to_string(enough);
     }
 
     std::string backwards_message(double height) const {
@@ -272,6 +327,7 @@ private:
     const CommandLine& line_;
     stratmesh::Options options_;
     RunRecord& record_;
+    AtomicFile& mesh_;
     LayerTops tops_;
     double axis_[3];
     MeshStreamWriter writer_;
@@ -289,15 +345,16 @@ private:
     double stream_seconds_ = 0, write_seconds_ = 0;
     CloudBox box_;             // with --origin: the points pushed so far
     std::string origin_error_; // why --origin is out of reach
+    std::string advice_;       // out_of_memory: what to do about the stream's memory
 };
 
 } // namespace
 
 StreamOutcome run_stream(const CommandLine& line, stratmesh::Options options, RunRecord& record,
-                         std::string& error) {
+                         AtomicFile& mesh, std::string& error) {
     record.stream = true;
     record.stream_points = line.stream_points;
-    return StreamRunner(line, options, record).run(error);
+    return StreamRunner(line, options, record, mesh).run(error);
 }
 
 } // namespace stratmesh_cli

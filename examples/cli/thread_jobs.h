@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -27,7 +28,16 @@ struct ThreadJobs {
         };
         uint32_t helpers = (self.threads < count ? self.threads : count);
         std::vector<std::thread> started;
-        for (uint32_t t = 1; t < helpers; ++t) started.emplace_back(work);
+        started.reserve(helpers);
+        for (uint32_t t = 1; t < helpers; ++t) {
+            // A thread the system cannot start (out of memory or of threads) leaves its
+            // share to the others; the caller's thread alone does them all.
+            try {
+                started.emplace_back(work);
+            } catch (const std::system_error&) {
+                break;
+            }
+        }
         work();
         for (std::thread& thread : started) thread.join();
     }

@@ -124,6 +124,13 @@ bool contains(const std::string& text, const std::string& part) {
 
 const char* kXyz = "property float x\nproperty float y\nproperty float z\n";
 
+// The file is refused with a message holding every part.
+void check_fails(const std::string& bytes, const std::vector<std::string>& parts) {
+    ReadResult r = read_text(bytes);
+    CHECK_FALSE(r.ok);
+    for (const std::string& part : parts) CHECK_MESSAGE(contains(r.error, part), r.error);
+}
+
 // ---- PLY files built by the tests --------------------------------------------------------
 
 // Binary PLY with a face element before the vertices and an edge element after, and
@@ -572,16 +579,6 @@ TEST_CASE("OBJ: v lines only, with vn, vt, f, groups and comments ignored") {
 
 // ==== cloud readers: malformed input ======================================================
 
-namespace {
-
-void check_fails(const std::string& bytes, const std::vector<std::string>& parts) {
-    ReadResult r = read_text(bytes);
-    CHECK_FALSE(r.ok);
-    for (const std::string& part : parts) CHECK_MESSAGE(contains(r.error, part), r.error);
-}
-
-} // namespace
-
 TEST_CASE("truncated binary PLY") {
     std::string whole = busy_binary_ply(test_points(10), false);
     check_fails(whole.substr(0, whole.size() - 20), {"byte", "vertex"});
@@ -662,6 +659,17 @@ TEST_CASE("garbage in text files names the line") {
     check_fails("OFF\n2 0 0\n1 2 3\n1 2\n", {"line 4", "expected at least 3"});
     check_fails("v 1 2 3\nv 1 2\n", {"line 2", "expected at least 3"});
     check_fails(std::string("1 2 3\n\x01\x02\xff 5 6\n", 14), {"line 2", "\\x01\\x02\\xff"});
+}
+
+TEST_CASE("OFF: a face naming a vertex beyond the file's is refused with the line") {
+    const std::string head = "OFF\n# a comment\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n";
+    ReadResult r = read_text(head + "3 1 2 3 0.5 0.5 0.5\n");
+    REQUIRE_MESSAGE(r.ok, r.error);
+    CHECK(r.info.faces_ignored == 2);
+    check_fails(head + "3 1 2 4\n",
+                {"line 9: face 1 names vertex 4, but the file has 4 vertices (numbered from 0)"});
+    check_fails(head + "3 5000 1 2\n", {"line 9: face 1 names vertex 5000"});
+    check_fails("OFF\n0 1 0\n3 0 0 0\n", {"line 3: face 0 names vertex 0, but the file has 0 vertices"});
 }
 
 TEST_CASE("empty and pointless files") {

@@ -92,9 +92,10 @@ bool read_off_vertices(LineCursor& lines, uint64_t count, std::vector<double>& x
     return true;
 }
 
-// The face lines after an OFF file's vertices: each a vertex count k and k whole numbers
-// (colours may follow); nothing but blank and comment lines after the last.
-bool read_off_faces(LineCursor& lines, uint64_t count, std::string& error) {
+// The face lines after an OFF file's vertices: each a vertex count k and k whole numbers,
+// indices of the `vertices` (colours may follow); nothing but blank and comment lines
+// after the last.
+bool read_off_faces(LineCursor& lines, uint64_t count, uint64_t vertices, std::string& error) {
     std::string_view content, field;
     for (uint64_t f = 0; f < count; ++f) {
         if (!next_content_line(lines, content)) {
@@ -103,14 +104,23 @@ bool read_off_faces(LineCursor& lines, uint64_t count, std::string& error) {
             return false;
         }
         uint64_t corners = 0, index = 0;
+        bool in_range = true;
         next_field(content, field, false);
         CountParse parsed = parse_count(field, corners);
-        for (uint64_t k = 0; parsed == CountParse::ok && k < corners; ++k)
+        for (uint64_t k = 0; parsed == CountParse::ok && in_range && k < corners; ++k) {
             parsed = next_field(content, field, false) ? parse_count(field, index)
                                                        : CountParse::not_a_number;
+            in_range = index < vertices;
+        }
         if (parsed != CountParse::ok) {
             error = at_line(lines.line_number()) + "face " + std::to_string(f) +
                     " is not a corner count followed by that many vertex indices";
+            return false;
+        }
+        if (!in_range) {
+            error = at_line(lines.line_number()) + "face " + std::to_string(f) + " names vertex " +
+                    std::to_string(index) + ", but the file has " + std::to_string(vertices) +
+                    " vertices (numbered from 0)";
             return false;
         }
     }
@@ -291,7 +301,7 @@ bool read_off(std::string_view data, std::vector<double>& xyz, std::string& erro
     faces = 0;
     return read_off_header(lines, vertex_count, faces, error) &&
            read_off_vertices(lines, vertex_count, xyz, error) &&
-           read_off_faces(lines, faces, error);
+           read_off_faces(lines, faces, vertex_count, error);
 }
 
 bool read_obj(std::string_view data, std::vector<double>& xyz, std::string& error,

@@ -661,6 +661,18 @@ TEST_CASE("garbage in text files names the line") {
     check_fails(std::string("1 2 3\n\x01\x02\xff 5 6\n", 14), {"line 2", "\\x01\\x02\\xff"});
 }
 
+TEST_CASE("PLY: only version 1.0 of the format is read") {
+    for (const std::string version : {"2.0", "1.1", "1", "1.00", "0.9"}) {
+        CAPTURE(version);
+        check_fails("ply\nformat ascii " + version + "\nelement vertex 1\n" + kXyz +
+                        "end_header\n1 2 3\n",
+                    {"line 2: PLY version '" + version + "' is not read (only 1.0)"});
+        check_fails("ply\nformat binary_little_endian " + version +
+                        "\nelement vertex 0\n" + kXyz + "end_header\n",
+                    {"line 2: PLY version"});
+    }
+}
+
 TEST_CASE("OFF: a face naming a vertex beyond the file's is refused with the line") {
     const std::string head = "OFF\n# a comment\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n";
     ReadResult r = read_text(head + "3 1 2 3 0.5 0.5 0.5\n");

@@ -161,6 +161,10 @@ bool parse_format_line(const Words& words, PlyHeader& header, std::string& error
         error = "expected 'format <encoding> 1.0'";
         return false;
     }
+    if (words.word[2] != "1.0") {
+        error = "PLY version " + quote(words.word[2]) + " is not read (only 1.0)";
+        return false;
+    }
     std::string_view name = words.word[1];
     if (name == "ascii") header.encoding = PlyEncoding::ascii;
     if (name == "binary_little_endian") header.encoding = PlyEncoding::little_endian;

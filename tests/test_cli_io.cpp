@@ -684,6 +684,45 @@ TEST_CASE("OFF: a face naming a vertex beyond the file's is refused with the lin
     check_fails("OFF\n0 1 0\n3 0 0 0\n", {"line 3: face 0 names vertex 0, but the file has 0 vertices"});
 }
 
+TEST_CASE("CR-only line ends are refused, saying so, and CRLF and LF are read") {
+    const std::string cr_message = "a carriage return (CR) without a line feed: lines ended by CR "
+                                   "alone, as classic Mac OS wrote them, are not read";
+    auto with_ends = [](std::string text, const std::string& end) {
+        std::string out;
+        for (char c : text) out += c == '\n' ? end : std::string(1, c);
+        return out;
+    };
+    const std::string files[] = {
+        "ply\nformat ascii 1.0\nelement vertex 3\n" + std::string(kXyz) +
+            "end_header\n1 2 3\n4 5 6\n7 8 9\n",
+        "# points\n1 2 3\n4 5 6\n7 8 9\n", "x;y;z\n1;2;3\n4;5;6\n7;8;9\n",
+        "OFF\n3 0 0\n1 2 3\n4 5 6\n7 8 9\n", "# obj\nv 1 2 3\nv 4 5 6\nv 7 8 9\n"};
+    for (const std::string& file : files) {
+        CAPTURE(file);
+        for (const char* end : {"\n", "\r\n"}) {
+            ReadResult r = read_text(with_ends(file, end));
+            REQUIRE_MESSAGE(r.ok, r.error);
+            CHECK(r.xyz == std::vector<double>{1, 2, 3, 4, 5, 6, 7, 8, 9});
+        }
+        check_fails(with_ends(file, "\r"), {"line 1: " + cr_message});
+    }
+    // A binary PLY header with CR-only line ends.
+    check_fails("ply\rformat binary_little_endian 1.0\relement vertex 0\rend_header\r",
+                {"line 1: " + cr_message});
+    // A lone CR anywhere, even in a comment, where it would hide the points after it.
+    check_fails("1 2 3\n# note\r4 5 6\n7 8 9\n", {"line 2: " + cr_message});
+    check_fails("1 2 3\n4 5 6\r\r\n7 8 9\n", {"line 2: " + cr_message});
+    check_fails("ply\nformat ascii 1.0\nelement vertex 2\n" + std::string(kXyz) +
+                    "end_header\n1 2 3\n4 5\r6\n",
+                {"line 9: " + cr_message});
+    check_fails("ply\nformat ascii 1.0\nelement vertex 0\ncomment a\rb\nend_header\n",
+                {"line 4: " + cr_message});
+    // A CR as the very last byte ends the last line (CRLF cut short).
+    ReadResult r = read_text("1 2 3\n4 5 6\n7 8 9\r");
+    REQUIRE_MESSAGE(r.ok, r.error);
+    CHECK(r.xyz.size() == 9);
+}
+
 TEST_CASE("empty and pointless files") {
     check_fails("", {"empty"});
     check_fails("# nothing here\n\n", {"no points"});
@@ -763,6 +802,7 @@ TEST_CASE("the content decides the format") {
     auto detect = [](const std::string& s) { return detect_cloud_format(s.data(), s.size()); };
     CHECK(detect("ply\nformat ascii 1.0\n") == CloudFormat::ply);
     CHECK(detect("ply\r\nformat ascii 1.0\r\n") == CloudFormat::ply);
+    CHECK(detect("ply\rformat ascii 1.0\r") == CloudFormat::ply);
     CHECK(detect("OFF\n3 1 0\n") == CloudFormat::off);
     CHECK(detect("# c\nSTCNOFF\n") == CloudFormat::off);
     CHECK(detect("# obj\nmtllib x.mtl\no a\nv 1 2 3\n") == CloudFormat::obj);
@@ -923,6 +963,14 @@ TEST_CASE("point by point reading: what it cannot read, and errors that name the
     TempDir dir;
     std::vector<double> xyz = test_points(10);
     std::string whole = fixed_binary_ply(xyz, false), ascii = ascii_ply(xyz, "\n");
+    // A lone carriage return on line 50001, well past the reader's first window.
+    std::string late_carriage_return, late_carriage_return_ply =
+        "ply\nformat ascii 1.0\nelement vertex 60000\n" + std::string(kXyz) + "end_header\n";
+    for (int i = 0; i < 60000; ++i) {
+        const std::string line = std::to_string(i) + (i == 50000 ? " 1.25\r2\n" : " 1.25 2\n");
+        late_carriage_return += line;
+        late_carriage_return_ply += line;
+    }
     const struct {
         const char* name;
         std::string bytes;
@@ -936,7 +984,12 @@ TEST_CASE("point by point reading: what it cannot read, and errors that name the
         {"bad.xyz", "1 2 3\n4 5 6\n7 eight 9\n", "line 3: 'eight' is not a number"},
         {"ascii_short.ply", ascii.substr(0, ascii.size() - 30),
          "the line ends before property 'z' of element 'vertex' record 9 of 10"},
-        {"empty.xyz", "", "the file is empty"}};
+        {"empty.xyz", "", "the file is empty"},
+        {"cr_only.xyz", "1 2 3\r4 5 6\r", "line 1: a carriage return (CR) without a line feed"},
+        {"cr_only.ply", "ply\rformat ascii 1.0\r", "line 1: a carriage return (CR) without a line feed"},
+        {"late_cr.xyz", late_carriage_return, "line 50001: a carriage return (CR) without a line feed"},
+        {"late_cr.ply", late_carriage_return_ply,
+         "line 50008: a carriage return (CR) without a line feed"}};
     for (const auto& c : cases) {
         std::string name = c.name;
         CAPTURE(name);

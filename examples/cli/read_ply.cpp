@@ -272,11 +272,14 @@ bool parse_header(std::string_view data, PlyHeader& header, std::string& error) 
     const size_t start = data.size() - skip_byte_order_mark(data).size();
     LineCursor lines(data.substr(start));
     std::string_view line;
-    if (!lines.next(line) || line != "ply") {
+    const bool first = lines.next(line);
+    if (first && !check_line_ends(line, 1, error)) return false;
+    if (!first || line != "ply") {
         error = "line 1: not a PLY file (the first line is not 'ply')";
         return false;
     }
     while (lines.next(line)) {
+        if (!check_line_ends(line, lines.line_number(), error)) return false;
         Words words = split_words(line);
         if (words.count == 0) continue;
         if (words.word[0] == "end_header") {
@@ -656,7 +659,7 @@ bool read_binary_body(std::string_view data, const PlyHeader& header, const Vert
 // ---- ascii body --------------------------------------------------------------------------
 // A record is one line holding exactly its properties' values (a list: its length, then
 // that many items). The readers take any line source: BodyLines over the whole file, or
-// FileLines over a window of it (--stream).
+// WindowLines over a window of it (--stream).
 
 // The lines of an ascii body held in memory, numbered as in the file.
 class BodyLines {
@@ -806,6 +809,7 @@ bool check_ascii_end(Lines& in, const PlyHeader& header, std::string& error) {
 
 bool read_ascii_body(std::string_view data, const PlyHeader& header, const VertexLayout& layout,
                      std::vector<double>& xyz, PointAttributes* attributes, std::string& error) {
+    if (!check_line_ends(data.substr(header.data_offset), header.data_line, error)) return false;
     BodyLines in(data.substr(header.data_offset), header.data_line);
     for (size_t e = 0; e < header.elements.size(); ++e) {
         const PlyElement& element = header.elements[e];
@@ -853,29 +857,6 @@ uint64_t face_count(const PlyHeader& header) {
 
 // ---- streaming (--stream) ----------------------------------------------------------------
 
-// Lines of a file read through a FileWindow: a LineCursor over each run of whole lines.
-class FileLines {
-public:
-    explicit FileLines(FileWindow& file) : file_(file), cursor_(std::string_view()) {}
-
-    bool next(std::string_view& line) {
-        std::string_view block;
-        while (!cursor_.next(line)) {
-            if (!file_.next_lines(block)) return false;
-            cursor_ = LineCursor(block);
-        }
-        return true;
-    }
-    size_t line_number() const {
-        return cursor_.line_number() == 0 ? file_.lines_first_line()
-                                          : file_.lines_first_line() + cursor_.line_number() - 1;
-    }
-
-private:
-    FileWindow& file_;
-    LineCursor cursor_;
-};
-
 // The vertex element's points, one record at a time; at their end, the rest of the body
 // checked against the header.
 class PlyPoints : public PointReader {
@@ -890,7 +871,8 @@ public:
             const PlyElement& element = header_.elements[e];
             if (header_.encoding == PlyEncoding::ascii) {
                 std::vector<int> none(element.properties.size(), -1);
-                if (!read_ascii_element(lines_, element, none, nullptr, error)) return false;
+                if (!lines_read(read_ascii_element(lines_, element, none, nullptr, error), error))
+                    return false;
                 continue;
             }
             uint64_t size = fixed_record_size(element);
@@ -919,15 +901,22 @@ public:
                       ? read_ascii_record(lines_, vertex, layout_.coordinate_of, xyz, record_,
                                           error)
                       : next_binary(vertex, xyz, error);
-        std::string failure = file_->failure();
-        if (!failure.empty()) error = failure;
         ++record_;
-        return ok && failure.empty();
+        return lines_read(ok, error);
     }
 
     uint64_t faces_ignored() const override { return face_count(header_); }
 
 private:
+    // `ok`, unless reading the file failed or its lines have a lone carriage return: then
+    // false with that failure as the error (a reader seeing no more lines says otherwise).
+    bool lines_read(bool ok, std::string& error) const {
+        std::string failure = lines_.failure();
+        if (failure.empty()) return ok;
+        error = failure;
+        return false;
+    }
+
     bool discard_records(const PlyElement& element, uint64_t size, std::string& error) {
         if (element.count <= UINT64_MAX / (size ? size : 1) && file_->discard(element.count * size))
             return true;
@@ -976,7 +965,8 @@ private:
             const PlyElement& element = header_.elements[e];
             if (header_.encoding == PlyEncoding::ascii) {
                 std::vector<int> none(element.properties.size(), -1);
-                if (!read_ascii_element(lines_, element, none, nullptr, error)) return false;
+                if (!lines_read(read_ascii_element(lines_, element, none, nullptr, error), error))
+                    return false;
                 continue;
             }
             const uint64_t size = fixed_record_size(element);
@@ -987,7 +977,8 @@ private:
             for (uint64_t r = 0; r < element.count; ++r)
                 if (!discard_binary_record(element, r, error)) return false;
         }
-        if (header_.encoding == PlyEncoding::ascii) return check_ascii_end(lines_, header_, error);
+        if (header_.encoding == PlyEncoding::ascii)
+            return lines_read(check_ascii_end(lines_, header_, error), error);
         const uint64_t end = file_->offset();
         uint64_t rest = 0;
         bool clean = true;
@@ -1022,7 +1013,7 @@ private:
     std::unique_ptr<FileWindow> file_;
     PlyHeader header_;
     VertexLayout layout_;
-    FileLines lines_;
+    WindowLines lines_;
     uint64_t record_ = 0;
     bool checked_rest_ = false;
 };

@@ -233,12 +233,12 @@ public:
         std::string_view line;
         point_.clear();
         while (point_.empty()) {
-            if (!next_line(line)) {
-                error = file_->failure();
+            if (!lines_.next(line)) {
+                error = lines_.failure();
                 if (error.empty() && !obj_) columns_.finish(error);
                 return false;
             }
-            size_t number = file_->lines_first_line() + lines_.line_number() - 1;
+            const size_t number = lines_.line_number();
             bool ok = obj_ ? take_obj_line(line, number, point_, faces_, error)
                            : columns_.take(line, number, point_, error);
             if (!ok) return false;
@@ -250,18 +250,9 @@ public:
     uint64_t faces_ignored() const override { return faces_; }
 
 private:
-    bool next_line(std::string_view& line) {
-        std::string_view block;
-        while (!lines_.next(line)) {
-            if (!file_->next_lines(block)) return false;
-            lines_ = LineCursor(block);
-        }
-        return true;
-    }
-
     std::unique_ptr<FileWindow> file_;
     bool obj_;
-    LineCursor lines_{std::string_view()};
+    WindowLines lines_{*file_};
     ColumnRows columns_;
     std::vector<double> point_;
     uint64_t faces_ = 0;
@@ -285,6 +276,7 @@ bool read_xyz(std::string_view data, std::vector<double>& xyz, std::string& erro
     std::string_view line;
     ColumnRows rows;
     xyz.clear();
+    if (!check_line_ends(data, 1, error)) return false;
     while (lines.next(line))
         if (!rows.take(line, lines.line_number(), xyz, error)) return false;
     if (!rows.finish(error)) return false;
@@ -299,7 +291,7 @@ bool read_off(std::string_view data, std::vector<double>& xyz, std::string& erro
     uint64_t vertex_count = 0;
     xyz.clear();
     faces = 0;
-    return read_off_header(lines, vertex_count, faces, error) &&
+    return check_line_ends(data, 1, error) && read_off_header(lines, vertex_count, faces, error) &&
            read_off_vertices(lines, vertex_count, xyz, error) &&
            read_off_faces(lines, faces, vertex_count, error);
 }
@@ -310,6 +302,7 @@ bool read_obj(std::string_view data, std::vector<double>& xyz, std::string& erro
     std::string_view line;
     xyz.clear();
     faces = 0;
+    if (!check_line_ends(data, 1, error)) return false;
     while (lines.next(line))
         if (!take_obj_line(line, lines.line_number(), xyz, faces, error)) return false;
     if (!xyz.empty()) return true;

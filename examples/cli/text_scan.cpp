@@ -1,5 +1,6 @@
 #include "text_scan.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
@@ -38,6 +39,19 @@ bool LineCursor::next(std::string_view& line) {
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     pos_ = end == std::string_view::npos ? text_.size() : end + 1;
     ++line_number_;
+    return true;
+}
+
+bool check_line_ends(std::string_view text, size_t first_line, std::string& error) {
+    for (size_t at = text.find('\r'); at != std::string_view::npos; at = text.find('\r', at + 1)) {
+        if (at + 1 == text.size() || text[at + 1] == '\n') continue;
+        const auto before = text.substr(0, at);
+        const size_t line = first_line + static_cast<size_t>(std::count(before.begin(), before.end(), '\n'));
+        error = "line " + std::to_string(line) +
+                ": a carriage return (CR) without a line feed: lines ended by CR alone, as "
+                "classic Mac OS wrote them, are not read; convert the line ends to LF or CRLF";
+        return false;
+    }
     return true;
 }
 

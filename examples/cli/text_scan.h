@@ -11,7 +11,8 @@
 
 namespace stratmesh_cli {
 
-// Walks a buffer line by line. Lines end at '\n'; a '\r' before it is dropped.
+// Walks a buffer line by line. Lines end at '\n'; a '\r' before it is dropped, and so is
+// one as the buffer's last byte (a CRLF line end cut short by the end of the file).
 class LineCursor {
 public:
     explicit LineCursor(std::string_view text) : text_(text) {}
@@ -28,6 +29,12 @@ private:
     size_t pos_ = 0;
     size_t line_number_ = 0;
 };
+
+// False, with a message naming the line, if `text` holds a carriage return that ends no
+// CRLF pair: lines ended by CR alone (as classic Mac OS wrote them) are refused, never
+// read as one long line. `first_line` is the number of the text's first line. A '\r' as
+// the text's last byte passes: `text` is whole lines, or the end of the file.
+bool check_line_ends(std::string_view text, size_t first_line, std::string& error);
 
 // Cuts `line` at the first comment marker: '#' always, "//" when `slashes` is set.
 std::string_view strip_comment(std::string_view line, bool slashes);

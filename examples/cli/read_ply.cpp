@@ -66,9 +66,10 @@ const char* type_name(PlyType type) {
     return "?";
 }
 
-// Whether a value read from text is one the type can hold: integers whole and within
-// their range; floats within float's range (NaN and infinities too, for the library to
-// judge); doubles anything (a literal beyond their range is already refused).
+// Whether a value read from text is one the type can hold: integers (whole, as
+// scan_integer reads them) within their range; floats within float's range (NaN and
+// infinities too, for the library to judge); doubles anything (a literal beyond their
+// range is already refused).
 bool type_holds(PlyType type, double v) {
     double lowest = 0, highest = 0;
     switch (type) {
@@ -81,7 +82,7 @@ bool type_holds(PlyType type, double v) {
     case PlyType::float32: return !std::isfinite(v) || std::fabs(v) <= static_cast<double>(FLT_MAX);
     case PlyType::float64: return true;
     }
-    return v >= lowest && v <= highest && std::floor(v) == v;
+    return v >= lowest && v <= highest;
 }
 
 struct PlyProperty {
@@ -678,25 +679,45 @@ std::string property_place(const PlyElement& element, const PlyProperty& propert
     return "property " + quote(property.name) + " of " + record_place(element, record);
 }
 
+// `token` as a value of the integer type `type`; why it is none, if it is none.
+std::string integer_problem(std::string_view token, PlyType type, double& value) {
+    bool negative = false;
+    uint64_t magnitude = 0;
+    const IntegerParse parsed = scan_integer(token, negative, magnitude);
+    if (parsed == IntegerParse::not_an_integer) {
+        char point = '.';
+        const NumberParse as_number = scan_number(token, point, value);
+        if (as_number != NumberParse::ok) return number_problem(token, as_number, '.');
+        return quote(token) + " is not an integer (digits with an optional sign), as " +
+               type_name(type) + " requires";
+    }
+    value = negative ? -static_cast<double>(magnitude) : static_cast<double>(magnitude);
+    if (parsed == IntegerParse::ok && type_holds(type, value)) return std::string();
+    return quote(token) + " is out of the range of " + type_name(type);
+}
+
 // The next value of a record's line, checked against `type`.
 bool next_ascii_value(std::string_view& rest, size_t line, const PlyElement& element,
                       const PlyProperty& property, PlyType type, uint64_t record,
                       double& value, std::string& error) {
     std::string_view token;
     NumberParse parsed = NumberParse::ok;
-    if (!next_number(rest, token, value, parsed, false)) {
+    char point = '.';
+    const bool more = is_integral(type) ? next_field(rest, token, false)
+                                        : next_number(rest, token, value, parsed, point);
+    if (!more) {
         error = at_line(line) + "the line ends before " + property_place(element, property, record);
         return false;
     }
-    if (parsed == NumberParse::ok && type_holds(type, value)) return true;
-    std::string problem = parsed == NumberParse::not_a_number   ? " is not a number"
-                          : parsed == NumberParse::out_of_range ? " is beyond the range of a double"
-                          : is_integral(type) && std::floor(value) != value
-                              ? std::string(" is not a whole number, as ") + type_name(type) +
-                                    " requires"
-                              : std::string(" is out of the range of ") + type_name(type);
-    error = at_line(line) + quote(token) + problem + " (" +
-            property_place(element, property, record) + ")";
+    std::string problem;
+    if (is_integral(type))
+        problem = integer_problem(token, type, value);
+    else if (parsed != NumberParse::ok)
+        problem = number_problem(token, parsed, '.');
+    else if (!type_holds(type, value))
+        problem = quote(token) + " is out of the range of " + type_name(type);
+    if (problem.empty()) return true;
+    error = at_line(line) + problem + " (" + property_place(element, property, record) + ")";
     return false;
 }
 

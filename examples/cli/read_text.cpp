@@ -14,56 +14,128 @@ std::string at_line(size_t line) { return "line " + std::to_string(line) + ": ";
 
 bool is_letter(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); }
 
+// The fields of a line that one `separator` parts, blanks around each dropped; any of them
+// may be empty, the last too ("1;2;" has three fields).
+class SeparatedFields {
+public:
+    SeparatedFields(std::string_view line, char separator) : rest_(line), separator_(separator) {}
+
+    bool next(std::string_view& field) {
+        if (done_) return false;
+        const size_t at = rest_.find(separator_);
+        done_ = at == std::string_view::npos;
+        field = trim_blanks(rest_.substr(0, at));
+        rest_.remove_prefix(done_ ? rest_.size() : at + 1);
+        return true;
+    }
+
+private:
+    std::string_view rest_;
+    char separator_;
+    bool done_ = false;
+};
+
 // The fields of one line, all expected to be numbers.
 struct NumberRow {
     size_t fields = 0; // fields seen
     double first[3] = {0, 0, 0};
+    size_t empty = 0;     // the first empty field, counting from 1; 0 if none
     std::string_view bad; // the first field that is not a number, if any
     NumberParse bad_as = NumberParse::ok; // and why
-    bool all_start_with_letters = true;
 };
 
-NumberRow scan_numbers(std::string_view content, bool commas) {
+// The numbers of a line whose fields `separator` parts: ' ' for runs of blanks, else ','
+// or ';'. `mark` is the file's decimal mark (kEitherMark until a number has one).
+NumberRow scan_numbers(std::string_view content, char separator, char& mark) {
     NumberRow row;
+    SeparatedFields separated(content, separator);
     std::string_view field;
     double value = 0;
     NumberParse parsed = NumberParse::ok;
-    while (next_number(content, field, value, parsed, commas)) {
-        bool numeric = parsed == NumberParse::ok;
-        if (!numeric && row.bad.empty()) {
+    for (;;) {
+        const bool more = separator == ' ' ? next_number(content, field, value, parsed, mark)
+                                           : separated.next(field);
+        if (!more) break;
+        ++row.fields;
+        if (field.empty()) {
+            if (row.empty == 0) row.empty = row.fields;
+            continue;
+        }
+        if (separator != ' ') parsed = scan_number(field, mark, value);
+        if (parsed != NumberParse::ok && row.bad.empty()) {
             row.bad = field;
             row.bad_as = parsed;
         }
-        if (numeric && row.fields < 3) row.first[row.fields] = value;
-        row.all_start_with_letters = row.all_start_with_letters && !numeric && is_letter(field[0]);
-        ++row.fields;
+        if (parsed == NumberParse::ok && row.fields <= 3) row.first[row.fields - 1] = value;
     }
     return row;
 }
 
-// A point row: every field a number, at least three of them. False with a message if not.
-bool take_point(const NumberRow& row, size_t line, std::vector<double>& xyz, std::string& error) {
-    if (!row.bad.empty()) {
-        error = at_line(line) + quote(row.bad) +
-                (row.bad_as == NumberParse::out_of_range ? " is beyond the range of a double"
-                                                         : " is not a number");
-        return false;
-    }
-    if (row.fields < 3) {
-        error = at_line(line) + "expected at least 3 numbers (x y z), found " +
-                std::to_string(row.fields);
+// What keeps a row from being a point (every field a number, at least three of them), as a
+// clause of a message; empty if nothing does.
+std::string point_problem(const NumberRow& row, char mark, size_t mark_line) {
+    if (row.empty > 0) return "field " + std::to_string(row.empty) + " is empty";
+    if (!row.bad.empty()) return number_problem(row.bad, row.bad_as, mark, mark_line);
+    if (row.fields < 3)
+        return "found " + std::to_string(row.fields) +
+               (row.fields == 1 ? " number" : " numbers") + " where a point needs at least 3 (x y z)";
+    return std::string();
+}
+
+// A point row of an OFF or OBJ file, blanks parting numbers with a decimal point, appended
+// to `xyz`; false with a message if the row is no point.
+bool take_point(std::string_view content, size_t line, std::vector<double>& xyz,
+                std::string& error) {
+    char point = '.';
+    const NumberRow row = scan_numbers(content, ' ', point);
+    const std::string problem = point_problem(row, point, 0);
+    if (!problem.empty()) {
+        error = at_line(line) + problem;
         return false;
     }
     xyz.insert(xyz.end(), row.first, row.first + 3);
     return true;
 }
 
+// A line of column names: no field a number, each beginning with a letter ("X Y Z",
+// "x;y;z").
+bool is_column_names(std::string_view content) {
+    std::string_view field;
+    while (next_field(content, field, true)) {
+        char mark = kEitherMark;
+        double value = 0;
+        if (!is_letter(field[0]) || scan_number(field, mark, value) == NumberParse::ok)
+            return false;
+    }
+    return true;
+}
+
+// The separator of a column file, from its first point line: ';' if the line has one;
+// ',' where commas part the line (it has fewer than three blank-parted fields, or a comma
+// beside a blank or at an end); else blanks, a comma then being a decimal comma.
+char column_separator(std::string_view content) {
+    if (content.find(';') != std::string_view::npos) return ';';
+    if (content.find(',') == std::string_view::npos) return ' ';
+    std::string_view field;
+    size_t fields = 0;
+    bool comma_at_edge = false;
+    while (next_field(content, field, false)) {
+        ++fields;
+        comma_at_edge = comma_at_edge || field.front() == ',' || field.back() == ',';
+    }
+    return fields < 3 || comma_at_edge ? ',' : ' ';
+}
+
+const char* separator_name(char separator) {
+    return separator == ',' ? "','" : separator == ';' ? "';'" : "blanks";
+}
+
 // A PTS count line: a single whole number.
 bool is_count_line(std::string_view content, uint64_t& count) {
     std::string_view field, rest = content;
-    if (!next_field(rest, field, true)) return false;
+    if (!next_field(rest, field, false)) return false;
     std::string_view extra;
-    return !next_field(rest, extra, true) && parse_count(field, count) == CountParse::ok;
+    return !next_field(rest, extra, false) && parse_count(field, count) == CountParse::ok;
 }
 
 // Advances to the next line with something other than blanks and '#' comments.
@@ -86,8 +158,7 @@ bool read_off_vertices(LineCursor& lines, uint64_t count, std::vector<double>& x
                     " of the " + std::to_string(count) + " vertices the header announces";
             return false;
         }
-        if (!take_point(scan_numbers(content, false), lines.line_number(), xyz, error))
-            return false;
+        if (!take_point(content, lines.line_number(), xyz, error)) return false;
     }
     return true;
 }
@@ -172,18 +243,20 @@ bool read_off_header(LineCursor& lines, uint64_t& vertex_count, uint64_t& face_c
 // comment lines and a first line of column names. A file whose first line with a number
 // is a single whole number is PTS: each such count line announces the points up to the
 // next one (scans joined one after another), and each must count them exactly.
+// The first point line decides how the file's lines split: at which separator
+// (column_separator) and into how many fields, the same on every point line. The first
+// number with a decimal mark decides the mark of the others.
 class ColumnRows {
 public:
     // Appends the line's point, if it has one; false with a message on a bad line.
     bool take(std::string_view line, size_t line_number, std::vector<double>& xyz,
               std::string& error) {
-        std::string_view content = strip_comment(line, true);
-        NumberRow row = scan_numbers(content, true);
-        if (row.fields == 0) return true;
-        bool column_names = first_content_ && row.all_start_with_letters;
+        std::string_view content = strip_comment(line, true), probe = content, field;
+        if (!next_field(probe, field, false)) return true;
+        const bool first_content = first_content_;
         first_content_ = false;
-        if (column_names) return true;
-        bool first = first_number_;
+        if (first_content && is_column_names(content)) return true;
+        const bool first = first_number_;
         first_number_ = false;
         uint64_t count = 0;
         if ((first || counted_) && is_count_line(content, count)) {
@@ -194,8 +267,11 @@ public:
             points_ = 0;
             return true;
         }
-        ++points_;
-        return take_point(row, line_number, xyz, error);
+        if (separator_ == 0) {
+            separator_ = column_separator(content);
+            if (separator_ == ',') mark_ = '.';
+        }
+        return take_point_line(content, line_number, xyz, error);
     }
 
     // At the end of the file: false with a message if a count line was wrong.
@@ -207,11 +283,43 @@ public:
     }
 
 private:
+    bool take_point_line(std::string_view content, size_t line, std::vector<double>& xyz,
+                         std::string& error) {
+        const char mark_before = mark_;
+        const NumberRow row = scan_numbers(content, separator_, mark_);
+        if (mark_before == kEitherMark && mark_ != kEitherMark) mark_line_ = line;
+        std::string problem;
+        if (row.empty == 0 && fields_ > 0 && row.fields != fields_)
+            problem = "splits into " + std::to_string(row.fields) +
+                      (row.fields == 1 ? " field at " : " fields at ") +
+                      separator_name(separator_) + ", where line " + std::to_string(fields_line_) +
+                      " splits into " + std::to_string(fields_);
+        else
+            problem = point_problem(row, mark_, mark_line_);
+        if (!problem.empty()) {
+            error = at_line(line) + (fields_ == 0 ? "read as XYZ text (x y z columns), but " : "") +
+                    problem;
+            return false;
+        }
+        if (fields_ == 0) {
+            fields_ = row.fields;
+            fields_line_ = line;
+        }
+        ++points_;
+        xyz.insert(xyz.end(), row.first, row.first + 3);
+        return true;
+    }
+
     bool first_content_ = true;
     bool first_number_ = true;
     bool counted_ = false; // PTS: count lines start the blocks
     uint64_t count_ = 0, points_ = 0;
     size_t count_line_ = 0;
+    char separator_ = 0;          // ' ' (blanks), ',' or ';'; 0 until the first point line
+    char mark_ = kEitherMark;     // the decimal mark
+    size_t mark_line_ = 0;        // the line whose number decided it (0: the separator did)
+    size_t fields_ = 0;           // on every point line; 0 until the first
+    size_t fields_line_ = 0;      // the first point line
 };
 
 // Appends the point of an OBJ "v" line and counts "f" lines; other lines are ignored.
@@ -221,7 +329,7 @@ bool take_obj_line(std::string_view line, size_t line_number, std::vector<double
     if (!next_field(rest, keyword, false)) return true;
     if (keyword == "f") ++faces;
     if (keyword != "v") return true;
-    return take_point(scan_numbers(rest, false), line_number, xyz, error);
+    return take_point(rest, line_number, xyz, error);
 }
 
 // The points of a column or OBJ file read line by line through a window (--stream).
@@ -281,7 +389,7 @@ bool read_xyz(std::string_view data, std::vector<double>& xyz, std::string& erro
         if (!rows.take(line, lines.line_number(), xyz, error)) return false;
     if (!rows.finish(error)) return false;
     if (!xyz.empty()) return true;
-    error = "no points found (no line with 3 numbers)";
+    error = "no points found: read as XYZ text (x y z columns), no line holds a point";
     return false;
 }
 

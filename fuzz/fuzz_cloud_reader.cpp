@@ -4,16 +4,19 @@
 // Checked: no crash or sanitizer report; on success the coordinates come in threes and the
 // point count is consistent with the input size (every point needs at least 3 bytes:
 // three one-byte binary properties or three one-digit numbers), and a PLY file gives
-// exactly the vertex count its header declares; on failure the message names the line or
-// the byte where the file went wrong (but for an empty file or a text file without a single
-// point); detect_cloud_format agrees with what the automatic read reports; a second read
-// gives the same result. Allocations proportional to a lying header are caught by
+// exactly the vertex count its header declares; no text read succeeds over a carriage
+// return that ends no CRLF pair (CR-only line ends are refused, never read as one line); on
+// failure the message names the line or the byte where the file went wrong (but for an
+// empty file or a text file without a single point); detect_cloud_format agrees with what
+// the automatic read reports; a second read gives the same result. Allocations proportional to a lying header are caught by
 // libFuzzer's -malloc_limit_mb / -rss_limit_mb (see .ci/fuzz.sh).
 //
 // The custom mutator knows the formats: it rewrites PLY element counts, property types
 // and names, duplicates header lines, adds and removes tokens and lines of the body, turns
-// numbers into extreme values, adds a byte-order mark, and switches line ends; otherwise it
-// leaves the bytes to libFuzzer's own mutations.
+// numbers into extreme values and NaN spellings, writes a line as European software does
+// (semicolons, decimal commas) or with a thousands separator or an empty field, adds a
+// byte-order mark, and switches line ends (LF, CRLF, CR alone); otherwise it leaves the
+// bytes to libFuzzer's own mutations.
 #include "fuzz_common.h"
 
 #include "cloud_io.h"
@@ -72,6 +75,13 @@ bool declared_vertices(std::string_view text, uint64_t& count) {
         if (end == std::string_view::npos) break;
         at = end + 1;
     }
+    return false;
+}
+
+// A carriage return that is neither followed by a line feed nor the last byte.
+bool has_lone_carriage_return(std::string_view text) {
+    for (size_t at = text.find('\r'); at != std::string_view::npos; at = text.find('\r', at + 1))
+        if (at + 1 < text.size() && text[at + 1] != '\n') return true;
     return false;
 }
 
@@ -143,7 +153,9 @@ std::string join_lines(const std::vector<std::string>& lines) {
 const char* const kExtremes[] = {"1e400",   "-1e400", "1e-400", "nan",        "inf",  "-0",
                                  "366",     "-1",     "0.66",   "4294967296", "256",  "65536",
                                  "2147483648", "3.5e38", "0x10", "1e308",     "",     "+",
-                                 "18446744073709551616"};
+                                 "18446744073709551616", "1.#INF", "-1.#IND", "1.#QNAN00",
+                                 "nan(ind)", "-Infinity", "NaNQ", "1.#J", "1e2", "2,176.92",
+                                 "1,5", "1.234,5", "#", "1#", "+inf"};
 const char* const kTypes[] = {"char",  "uchar", "short", "ushort", "int",   "uint",  "float",
                               "double", "int8", "uint32", "float64", "list", "float128"};
 const char* const kCounts[] = {"0", "1", "2", "3", "10", "4000000000", "18446744073709551615",
@@ -162,7 +174,7 @@ bool mutate_structure(std::string& text, Random& random) {
     const bool ply = end_header < lines.size();
     std::string& line = lines[random.below(lines.size())];
     std::vector<std::pair<size_t, size_t>> tokens = tokens_of(line);
-    switch (random.below(11)) {
+    switch (random.below(13)) {
     case 0: { // an element's count
         if (!ply) return false;
         std::string& header_line = lines[random.below(end_header)];
@@ -223,20 +235,33 @@ bool mutate_structure(std::string& text, Random& random) {
         lines.insert(lines.begin() + static_cast<std::ptrdiff_t>(random.below(lines.size() + 1)),
                      std::string(random.below(3), ' '));
         break;
-    case 9: // a byte-order mark, on or off
+    case 9: { // a line written as European software does: semicolons, decimal commas
+        std::string european;
+        for (char c : line) european += c == '.' ? ',' : c == ' ' ? ';' : c;
+        line = european;
+        break;
+    }
+    case 10: { // an empty field, or a comma inside a number (a thousands separator)
+        if (tokens.empty()) return false;
+        const auto& t = tokens[random.below(tokens.size())];
+        line.insert(t.first + random.below(t.second + 1), random.below(2) ? ",," : ",");
+        break;
+    }
+    case 11: // a byte-order mark, on or off
         if (text.rfind("\xEF\xBB\xBF", 0) == 0) {
             text.erase(0, 3);
         } else {
             text.insert(0, "\xEF\xBB\xBF");
         }
         return true;
-    default: { // line ends switched
+    default: { // line ends switched: LF to CRLF, CRLF to CR alone, CR alone to LF
         std::string switched;
-        const bool to_crlf = text.find("\r\n") == std::string::npos;
+        const bool crlf = text.find("\r\n") != std::string::npos;
+        const bool cr = !crlf && text.find('\r') != std::string::npos;
         for (size_t i = 0; i < text.size(); ++i) {
-            if (to_crlf && text[i] == '\n') switched += '\r';
-            if (!to_crlf && text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n') continue;
-            switched += text[i];
+            if (!crlf && !cr && text[i] == '\n') switched += '\r';
+            if (crlf && text[i] == '\n' && i > 0 && text[i - 1] == '\r') continue;
+            switched += cr && text[i] == '\r' ? '\n' : text[i];
         }
         text = switched;
         return true;
@@ -294,6 +319,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             if (info.format == CloudFormat::ply)
                 STRATMESH_FUZZ_CHECK(has_count && xyz.size() / 3 == declared,
                                      "a PLY file read with other than its header's vertex count");
+            if (info.format != CloudFormat::ply || info.encoding == "ascii")
+                STRATMESH_FUZZ_CHECK(!has_lone_carriage_return(std::string_view(p, size)),
+                                     "a text file with CR-only line ends read");
         } else {
             STRATMESH_FUZZ_CHECK(!error.empty(), "failure without a message");
             if (!names_a_place(error) && !is_whole_file_message(error))

@@ -16,6 +16,7 @@
 #include "cli/mini_json.h"
 #include "cli/mini_mesh.h"
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cstdint>
@@ -124,6 +125,13 @@ bool contains(const std::string& text, const std::string& part) {
 }
 
 const char* kXyz = "property float x\nproperty float y\nproperty float z\n";
+
+// The file is refused with a message holding every part.
+void check_fails(const std::string& bytes, const std::vector<std::string>& parts) {
+    ReadResult r = read_text(bytes);
+    CHECK_FALSE(r.ok);
+    for (const std::string& part : parts) CHECK_MESSAGE(contains(r.error, part), r.error);
+}
 
 // ---- PLY files built by the tests --------------------------------------------------------
 
@@ -452,22 +460,112 @@ TEST_CASE("PLY with zero vertices is an empty cloud, not an error") {
     CHECK(r.xyz.empty());
 }
 
-TEST_CASE("XYZ columns: spaces, tabs, commas, comments, blank lines, extra columns") {
-    std::vector<double> xyz = test_points(20);
-    std::string text = "# scanner export\nX,Y,Z,R,G,B\n\n";
-    for (size_t i = 0; i < 20; ++i) {
-        const char* separators[] = {" ", "\t", ",", ", "};
-        std::string sep = separators[i % 4];
-        text += exact_text(xyz[3 * i]) + sep + exact_text(xyz[3 * i + 1]) + sep +
-                exact_text(xyz[3 * i + 2]);
-        text += i % 2 ? sep + "255" + sep + "0" + sep + "12" : "";
+namespace {
+
+// The points as columns parted by `separator`, with a decimal comma if `comma`, extra
+// columns if `extra`, after a comment and a line of column names; comments, blank lines and
+// CRLF line ends here and there.
+std::string columns_text(const std::vector<double>& xyz, const std::string& separator,
+                         bool comma, bool extra) {
+    auto number = [&](double v) {
+        std::string text = exact_text(v);
+        if (comma) std::replace(text.begin(), text.end(), '.', ',');
+        return text;
+    };
+    std::string text = "# scanner export\nX" + separator + "Y" + separator + "Z" +
+                       (extra ? separator + "R" + separator + "G" + separator + "B" : "") +
+                       "\n\n";
+    for (size_t i = 0; i < xyz.size() / 3; ++i) {
+        text += number(xyz[3 * i]) + separator + number(xyz[3 * i + 1]) + separator +
+                number(xyz[3 * i + 2]);
+        text += extra ? separator + "255" + separator + "0" + separator + "12" : "";
         text += i % 3 == 0 ? "  // a comment\r\n" : "\n";
-        if (i == 7) text += "   \n// a line comment\n";
+        if (i == 7) text += "   \n// a line comment\n# another\n";
     }
-    ReadResult r = read_text(text);
+    return text;
+}
+
+} // namespace
+
+TEST_CASE("XYZ columns: each file parted by blanks, commas or semicolons, a point or a comma as its decimal mark") {
+    const std::vector<double> xyz = test_points(20);
+    const struct {
+        const char* separator;
+        bool comma;
+    } dialects[] = {{" ", false},  {"  ", false}, {"\t", false}, {" \t", false}, {",", false},
+                    {", ", false}, {" , ", false}, {";", false}, {"; ", false},  {";", true},
+                    {" ; ", true}, {" ", true},    {"\t", true}};
+    for (const auto& dialect : dialects) {
+        for (bool extra : {false, true}) {
+            CAPTURE(dialect.separator);
+            CAPTURE(dialect.comma);
+            CAPTURE(extra);
+            ReadResult r = read_text(columns_text(xyz, dialect.separator, dialect.comma, extra));
+            REQUIRE_MESSAGE(r.ok, r.error);
+            CHECK(r.info.format == CloudFormat::xyz);
+            CHECK(r.xyz == xyz);
+        }
+    }
+}
+
+TEST_CASE("a semicolon-separated file with decimal commas, as European software writes it") {
+    ReadResult r = read_text("x;y;z\n0,0675;0,8916;2,1769\n-1,5;2;1e3\n,5;-,25;3,\n");
     REQUIRE_MESSAGE(r.ok, r.error);
-    CHECK(r.info.format == CloudFormat::xyz);
-    CHECK(r.xyz == xyz);
+    CHECK(r.xyz == std::vector<double>{0.0675, 0.8916, 2.1769, -1.5, 2, 1000, 0.5, -0.25, 3});
+}
+
+TEST_CASE("a column file whose lines split differently, or with an empty field, is refused with the line") {
+    const std::pair<const char*, std::vector<std::string>> cases[] = {
+        {"1;2;3\n4,5,6\n", {"line 2: splits into 1 field at ';', where line 1 splits into 3"}},
+        {"1;2;3\n4;5\n", {"line 2: splits into 2 fields at ';', where line 1 splits into 3"}},
+        {"1,2,3\n4;5;6\n", {"line 2: splits into 1 field at ',', where line 1 splits into 3"}},
+        {"1 2 3\n4,5,6\n", {"line 2: splits into 1 field at blanks, where line 1 splits into 3"}},
+        {"1 2 3 4\n5 6 7\n", {"line 2: splits into 3 fields at blanks, where line 1 splits into 4"}},
+        {"x,y,z\n1,2,3\n4,5,6,7\n", {"line 3: splits into 4 fields at ','"}},
+        {"a,b,c\n1,,2,3\n", {"line 2: read as XYZ text (x y z columns), but field 2 is empty"}},
+        {"1,2,3\n4,,5,6\n", {"line 2: field 2 is empty"}},
+        {"1;2;3\n4;5;6;\n", {"line 2: field 4 is empty"}},
+        {";1;2;3\n", {"line 1:", "field 1 is empty"}},
+        {"1;2; ;3\n", {"line 1:", "field 3 is empty"}},
+        {"1, 2,\t,3\n", {"line 1:", "field 3 is empty"}}};
+    for (const auto& c : cases) {
+        const std::string file = c.first;
+        CAPTURE(file);
+        ReadResult r = read_text(file);
+        CHECK_FALSE(r.ok);
+        for (const std::string& part : c.second) CHECK_MESSAGE(contains(r.error, part), r.error);
+    }
+}
+
+TEST_CASE("thousands separators and a second decimal mark are refused with the line") {
+    const std::pair<const char*, std::vector<std::string>> cases[] = {
+        {"67.55 891.56 2,176.92\n", {"line 1:", "'2,176.92' has a thousands separator (',')"}},
+        {"1 2 3\n67.55 891.56 2,176.92\n", {"line 2: '2,176.92' has a thousands separator (',')"}},
+        {"1.5 2 3\n2,176 1 1\n", {"line 2: '2,176' has a thousands separator (',')"}},
+        {"1,234,567 2 3\n", {"line 1:", "'1,234,567' has a thousands separator (',')"}},
+        {"1.234,5;2;3\n", {"line 1:", "'1.234,5' has a thousands separator ('.')"}},
+        {"1,5;2;3\n1.234;2;3\n", {"line 2: '1.234' has a thousands separator ('.')"}},
+        {"-1,234.5e3 2 3\n", {"line 1:", "'-1,234.5e3' has a thousands separator (',')"}},
+        {"1.5 2 3\n1,5 2 3\n",
+         {"line 2: '1,5' has a decimal comma, where the file's decimal mark is a point (as line 1 writes it)"}},
+        {"1;2,5;3\n1;2;3.5\n",
+         {"line 2: '3.5' has a decimal point, where the file's decimal mark is a comma (as line 1 writes it)"}},
+        {"1,5 2 3\n1.5 2 3\n", {"line 2: '1.5' has a decimal point"}},
+        {"1.2.3 4 5\n", {"line 1:", "'1.2.3' is not a number"}},
+        {"1,2,3\n4,5.5.5,6\n", {"line 2: '5.5.5' is not a number"}}};
+    for (const auto& c : cases) {
+        const std::string file = c.first;
+        CAPTURE(file);
+        ReadResult r = read_text(file);
+        CHECK_FALSE(r.ok);
+        for (const std::string& part : c.second) CHECK_MESSAGE(contains(r.error, part), r.error);
+    }
+    // In PLY, OFF and OBJ the decimal mark is a point.
+    check_fails("ply\nformat ascii 1.0\nelement vertex 1\n" + std::string(kXyz) +
+                    "end_header\n1,5 2 3\n",
+                {"line 8: '1,5' has a decimal comma, where the file's decimal mark is a point"});
+    check_fails("OFF\n1 0 0\n1 2 2,176.5\n", {"line 3: '2,176.5' has a thousands separator"});
+    check_fails("v 1 2 3\nv 1,5 2 3\n", {"line 2: '1,5' has a decimal comma"});
 }
 
 TEST_CASE("fields part at blanks, and at commas and semicolons when asked, no other byte") {
@@ -491,32 +589,37 @@ TEST_CASE("fields part at blanks, and at commas and semicolons when asked, no ot
 }
 
 TEST_CASE("numbers read in one pass are the fields and numbers of the two-step scan") {
-    const char* pieces[] = {"1",    "-2.5e3", "+4",  ".5",   "-.5",    "1e400", "-1e-400", "nan",
-                            "-inf", "inf",    "1e",  "1.5x", "0x10",   "abc",   "5+3",     "+",
-                            "-",    "1,2",    "3;4", "1e5",  "7.25E-2", "00012", "1..2",   "\xff"};
-    const char* separators[] = {" ", "\t", ",", ";", "  ", ", ", "\r", ""};
+    const char* pieces[] = {"1",    "-2.5e3", "+4",    ".5",    "-.5",     "1e400",  "-1e-400",
+                            "nan",  "-inf",   "inf",   "1e",    "1.5x",    "0x10",   "abc",
+                            "5+3",  "+",      "-",     "1,2",   "3;4",     "1e5",    "7.25E-2",
+                            "00012", "1..2",  "\xff",  "1,5",   "2,176.92", "1.#INF", "-1.#IND00",
+                            "+nan", "1.",     ",5",    "1.#J",  "nan(ind)", "1 ,2"};
+    const size_t kPieces = sizeof pieces / sizeof pieces[0];
+    const char* separators[] = {" ", "\t", "  ", " \t", "\r", "\v", "\f", ""};
     std::mt19937 random(99);
     for (int round = 0; round < 5000; ++round) {
         std::string line;
         const int count = static_cast<int>(random() % 6);
         for (int k = 0; k < count; ++k) {
             line += separators[random() % 8];
-            line += pieces[random() % 24];
+            line += pieces[random() % kPieces];
         }
         line += separators[random() % 8];
         CAPTURE(line);
-        for (bool commas : {false, true}) {
+        for (char start_mark : {kEitherMark, '.', ','}) {
             std::string_view two = line, one = line, field_two, field_one;
+            char mark_two = start_mark, mark_one = start_mark;
             for (;;) {
                 double value_two = -7, value_one = -7;
                 NumberParse parsed_one = NumberParse::ok;
-                const bool more_two = next_field(two, field_two, commas);
-                const bool more_one = next_number(one, field_one, value_one, parsed_one, commas);
+                const bool more_two = next_field(two, field_two, false);
+                const bool more_one = next_number(one, field_one, value_one, parsed_one, mark_one);
                 REQUIRE(more_two == more_one);
                 if (!more_two) break;
-                const NumberParse parsed_two = scan_number(field_two, value_two);
+                const NumberParse parsed_two = scan_number(field_two, mark_two, value_two);
                 CHECK(field_one == field_two);
                 CHECK(parsed_one == parsed_two);
+                CHECK(mark_one == mark_two);
                 if (parsed_two == NumberParse::ok)
                     CHECK(std::memcmp(&value_one, &value_two, sizeof(double)) == 0);
                 CHECK(one.data() == two.data());
@@ -525,8 +628,72 @@ TEST_CASE("numbers read in one pass are the fields and numbers of the two-step s
     }
 }
 
+TEST_CASE("every NaN and infinity spelling in use is read as not finite, by every reader") {
+    const double inf = std::numeric_limits<double>::infinity();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const std::pair<const char*, double> spellings[] = {
+        {"nan", nan},          {"NaN", nan},          {"NAN", nan},         {"-nan", nan},
+        {"+nan", nan},         {"nan(ind)", nan},     {"-nan(ind)", nan},   {"nan(snan)", nan},
+        {"NaNQ", nan},         {"NaNS", nan},         {"-NaNQ", nan},       {"1.#IND", nan},
+        {"-1.#IND", nan},      {"1.#QNAN", nan},      {"-1.#QNAN", nan},    {"1.#SNAN", nan},
+        {"1.#IND00", nan},     {"-1.#IND000000", nan}, {"1.#QNAN0", nan},   {"1.#ind", nan},
+        {"1,#IND", nan},       {"-1.#IND00e+000", nan}, {"inf", inf},       {"INF", inf},
+        {"Inf", inf},          {"+inf", inf},         {"-inf", -inf},       {"infinity", inf},
+        {"Infinity", inf},     {"-Infinity", -inf},   {"+INFINITY", inf},   {"1.#INF", inf},
+        {"-1.#INF", -inf},     {"1.#INF00", inf},     {"-1.#INF000000", -inf},
+        {"1.#INF00e+000", inf}, {"1,#INF", inf}};
+    for (const auto& spelling : spellings) {
+        const std::string token = spelling.first;
+        CAPTURE(token);
+        const std::string files[] = {
+            "1 2 3\n0.5 0.5 " + token + "\n",
+            "1;2;3\n0,5;0,5;" + token + "\n",
+            "1,2,3\n0.5,0.5," + token + "\n",
+            "ply\nformat ascii 1.0\nelement vertex 2\n" + std::string(kXyz) +
+                "end_header\n1 2 3\n0.5 0.5 " + token + "\n",
+            "OFF\n2 0 0\n1 2 3\n0.5 0.5 " + token + "\n",
+            "v 1 2 3\nv 0.5 0.5 " + token + "\n"};
+        for (const std::string& file : files) {
+            CAPTURE(file);
+            // A comma-separated file cannot hold MSVC's spellings with a decimal comma.
+            if (file[1] == ',' && token.find(',') != std::string::npos) continue;
+            ReadResult r = read_text(file);
+            REQUIRE_MESSAGE(r.ok, r.error);
+            REQUIRE(r.xyz.size() == 6);
+            CHECK(r.xyz[3] == 0.5);
+            CHECK(r.xyz[4] == 0.5);
+            if (std::isnan(spelling.second))
+                CHECK(std::isnan(r.xyz[5]));
+            else
+                CHECK(r.xyz[5] == spelling.second);
+        }
+    }
+}
+
+TEST_CASE("a '#' inside a field is no comment: spellings cut short are not numbers") {
+    for (const char* token : {"1.#J", "-1.#J", "1.$", "1.#IO", "1.#R", "1.#INFx", "1.#INF0x",
+                              "1#", "3#c", "1.#IND00e", "2.#INF", "1.#NAN", "nanx",
+                              "++1", "+-1", "NA", "1.#INFe+0x"}) {
+        const std::string quoted = "'" + std::string(token) + "' is not a number";
+        CAPTURE(quoted);
+        check_fails("1 2 3\n0.5 0.5 " + std::string(token) + "\n", {"line 2: " + quoted});
+        check_fails("ply\nformat ascii 1.0\nelement vertex 1\n" + std::string(kXyz) +
+                        "end_header\n0.5 0.5 " + token + "\n",
+                    {"line 8: " + quoted});
+        check_fails("OFF\n1 0 0\n0.5 0.5 " + std::string(token) + "\n", {"line 3: " + quoted});
+        check_fails("v 1 2 3\nv 0.5 0.5 " + std::string(token) + "\n", {"line 2: " + quoted});
+    }
+    // A comment starts a field: at the line's start or after a blank.
+    ReadResult r = read_text("#c\n1 2 3 #c\n4 5 6\t// c\n  # c\n7 8 9//c\n");
+    CHECK_FALSE(r.ok);
+    CHECK_MESSAGE(contains(r.error, "line 5: '9//c' is not a number"), r.error);
+    r = read_text("#c\n1 2 3 #c\n4 5 6\t// c\n  # c\n7 8 9 //c\n");
+    REQUIRE_MESSAGE(r.ok, r.error);
+    CHECK(r.xyz == std::vector<double>{1, 2, 3, 4, 5, 6, 7, 8, 9});
+}
+
 TEST_CASE("PTS with a count line, and a leading plus sign") {
-    ReadResult r = read_text("3\n1 2 3 -50 255 255 255\n+4 5e0 6 10 1 2 3\n.5 -0 7\n");
+    ReadResult r = read_text("3\n1 2 3 -50 255 255 255\n+4 5e0 6 10 1 2 3\n.5 -0 7 0 0 0 0\n");
     REQUIRE_MESSAGE(r.ok, r.error);
     CHECK(r.xyz == std::vector<double>{1, 2, 3, 4, 5, 6, 0.5, 0, 7});
 }
@@ -572,16 +739,6 @@ TEST_CASE("OBJ: v lines only, with vn, vt, f, groups and comments ignored") {
 }
 
 // ==== cloud readers: malformed input ======================================================
-
-namespace {
-
-void check_fails(const std::string& bytes, const std::vector<std::string>& parts) {
-    ReadResult r = read_text(bytes);
-    CHECK_FALSE(r.ok);
-    for (const std::string& part : parts) CHECK_MESSAGE(contains(r.error, part), r.error);
-}
-
-} // namespace
 
 TEST_CASE("truncated binary PLY") {
     std::string whole = busy_binary_ply(test_points(10), false);
@@ -655,14 +812,134 @@ TEST_CASE("a file that is only a header") {
 
 TEST_CASE("garbage in text files names the line") {
     check_fails("1 2 3\n4 5 6\n7 x 9\n", {"line 3", "'x' is not a number"});
-    check_fails("1 2 3\n4 5\n", {"line 2", "expected at least 3 numbers"});
-    check_fails("1 2 3\n4 5 6 7 8 9 oops\n", {"line 2", "'oops'"});
+    check_fails("1 2\n", {"line 1: read as XYZ text (x y z columns), but found 2 numbers where "
+                           "a point needs at least 3 (x y z)"});
+    check_fails("1 2 3\n4 5\n", {"line 2: splits into 2 fields at blanks, where line 1 splits into 3"});
+    check_fails("1 2 3 4 5 6 7\n4 5 6 7 8 9 oops\n", {"line 2: 'oops' is not a number"});
     check_fails("ply\nformat ascii 1.0\nelement vertex 2\n" + std::string(kXyz) +
                     "end_header\n1 2 3\n4 five 6\n",
                 {"line 9", "'five' is not a number"});
-    check_fails("OFF\n2 0 0\n1 2 3\n1 2\n", {"line 4", "expected at least 3"});
-    check_fails("v 1 2 3\nv 1 2\n", {"line 2", "expected at least 3"});
+    check_fails("OFF\n2 0 0\n1 2 3\n1 2\n", {"line 4: found 2 numbers where a point needs at least 3"});
+    check_fails("v 1 2 3\nv 1 2\n", {"line 2: found 2 numbers where a point needs at least 3"});
     check_fails(std::string("1 2 3\n\x01\x02\xff 5 6\n", 14), {"line 2", "\\x01\\x02\\xff"});
+}
+
+TEST_CASE("a text file that is no cloud says how it was read and what was expected") {
+    check_fails("stratmesh 0.1.0 report\n",
+                {"line 1: read as XYZ text (x y z columns), but 'stratmesh' is not a number"});
+    check_fails("Hello\nworld\n",
+                {"line 2: read as XYZ text (x y z columns), but 'world' is not a number"});
+    check_fails("title\n", {"no points found: read as XYZ text (x y z columns), no line holds a point"});
+    // Once a point is read, a bad line is a bad point line.
+    check_fails("1 2 3\nstratmesh 2 3\n", {"line 2: 'stratmesh' is not a number"});
+}
+
+TEST_CASE("PLY: only version 1.0 of the format is read") {
+    for (const std::string version : {"2.0", "1.1", "1", "1.00", "0.9"}) {
+        CAPTURE(version);
+        check_fails("ply\nformat ascii " + version + "\nelement vertex 1\n" + kXyz +
+                        "end_header\n1 2 3\n",
+                    {"line 2: PLY version '" + version + "' is not read (only 1.0)"});
+        check_fails("ply\nformat binary_little_endian " + version +
+                        "\nelement vertex 0\n" + kXyz + "end_header\n",
+                    {"line 2: PLY version"});
+    }
+}
+
+TEST_CASE("PLY: an integer property takes an integer, written as one") {
+    auto ply = [](const std::string& value) {
+        return "ply\nformat ascii 1.0\nelement vertex 1\n" + std::string(kXyz) +
+               "property int label\nproperty uchar red\nelement face 1\n"
+               "property list uchar int vertex_indices\nend_header\n1 2 3 " +
+               value + " 7\n3 0 0 0\n";
+    };
+    for (const auto& good : {std::pair<const char*, double>{"100", 100}, {"+100", 100},
+                             {"-5", -5}, {"0", 0}, {"-0", 0}, {"-2147483648", -2147483648.0},
+                             {"0002147483647", 2147483647.0}}) {
+        const std::string value = good.first;
+        CAPTURE(value);
+        ReadResult r;
+        r.info.keep_attributes = true;
+        const std::string bytes = ply(good.first);
+        r.ok = read_cloud_from_memory(bytes.data(), bytes.size(), CloudFormat::automatic, r.xyz,
+                                      r.error, &r.info);
+        REQUIRE_MESSAGE(r.ok, r.error);
+        CHECK(r.xyz == std::vector<double>{1, 2, 3});
+        REQUIRE(r.info.attributes.find("label") == 0);
+        CHECK(r.info.attributes.value(0, 0) == good.second);
+    }
+    const std::pair<const char*, const char*> bad[] = {
+        {"1e2", "'1e2' is not an integer (digits with an optional sign), as int requires"},
+        {"100.0", "'100.0' is not an integer (digits with an optional sign), as int requires"},
+        {"0.66", "'0.66' is not an integer"},
+        {"nan", "'nan' is not an integer"},
+        {"-1.#IND", "'-1.#IND' is not an integer"},
+        {"2147483648", "'2147483648' is out of the range of int"},
+        {"99999999999999999999999", "'99999999999999999999999' is out of the range of int"},
+        {"1,000", "'1,000' has a thousands separator (',')"},
+        {"x", "'x' is not a number"}};
+    for (const auto& c : bad) {
+        const std::string value = c.first;
+        CAPTURE(value);
+        check_fails(ply(value), {"line 12: " + std::string(c.second),
+                                 "(property 'label' of element 'vertex' record 0 of 1)"});
+    }
+    // A list's length too.
+    const std::string list = "ply\nformat ascii 1.0\nelement vertex 1\n" + std::string(kXyz) +
+                             "element face 1\nproperty list uchar int vertex_indices\n"
+                             "end_header\n1 2 3\n";
+    check_fails(list + "3e0 0 0 0\n", {"line 11: '3e0' is not an integer", "property 'vertex_indices'"});
+    check_fails(list + "3 0 1e0 0\n", {"line 11: '1e0' is not an integer"});
+}
+
+TEST_CASE("OFF: a face naming a vertex beyond the file's is refused with the line") {
+    const std::string head = "OFF\n# a comment\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n";
+    ReadResult r = read_text(head + "3 1 2 3 0.5 0.5 0.5\n");
+    REQUIRE_MESSAGE(r.ok, r.error);
+    CHECK(r.info.faces_ignored == 2);
+    check_fails(head + "3 1 2 4\n",
+                {"line 9: face 1 names vertex 4, but the file has 4 vertices (numbered from 0)"});
+    check_fails(head + "3 5000 1 2\n", {"line 9: face 1 names vertex 5000"});
+    check_fails("OFF\n0 1 0\n3 0 0 0\n", {"line 3: face 0 names vertex 0, but the file has 0 vertices"});
+}
+
+TEST_CASE("CR-only line ends are refused, saying so, and CRLF and LF are read") {
+    const std::string cr_message = "a carriage return (CR) without a line feed: lines ended by CR "
+                                   "alone, as classic Mac OS wrote them, are not read";
+    auto with_ends = [](std::string text, const std::string& end) {
+        std::string out;
+        for (char c : text) out += c == '\n' ? end : std::string(1, c);
+        return out;
+    };
+    const std::string files[] = {
+        "ply\nformat ascii 1.0\nelement vertex 3\n" + std::string(kXyz) +
+            "end_header\n1 2 3\n4 5 6\n7 8 9\n",
+        "# points\n1 2 3\n4 5 6\n7 8 9\n", "x;y;z\n1;2;3\n4;5;6\n7;8;9\n",
+        "OFF\n3 0 0\n1 2 3\n4 5 6\n7 8 9\n", "# obj\nv 1 2 3\nv 4 5 6\nv 7 8 9\n"};
+    for (const std::string& file : files) {
+        CAPTURE(file);
+        for (const char* end : {"\n", "\r\n"}) {
+            ReadResult r = read_text(with_ends(file, end));
+            REQUIRE_MESSAGE(r.ok, r.error);
+            CHECK(r.xyz == std::vector<double>{1, 2, 3, 4, 5, 6, 7, 8, 9});
+        }
+        check_fails(with_ends(file, "\r"), {"line 1: " + cr_message});
+    }
+    // A binary PLY header with CR-only line ends.
+    check_fails("ply\rformat binary_little_endian 1.0\relement vertex 0\rend_header\r",
+                {"line 1: " + cr_message});
+    // A lone CR anywhere, even in a comment, where it would hide the points after it.
+    check_fails("1 2 3\n# note\r4 5 6\n7 8 9\n", {"line 2: " + cr_message});
+    check_fails("1 2 3\n4 5 6\r\r\n7 8 9\n", {"line 2: " + cr_message});
+    check_fails("ply\nformat ascii 1.0\nelement vertex 2\n" + std::string(kXyz) +
+                    "end_header\n1 2 3\n4 5\r6\n",
+                {"line 9: " + cr_message});
+    check_fails("ply\nformat ascii 1.0\nelement vertex 0\ncomment a\rb\nend_header\n",
+                {"line 4: " + cr_message});
+    // A CR as the very last byte ends the last line (CRLF cut short).
+    ReadResult r = read_text("1 2 3\n4 5 6\n7 8 9\r");
+    REQUIRE_MESSAGE(r.ok, r.error);
+    CHECK(r.xyz.size() == 9);
 }
 
 TEST_CASE("empty and pointless files") {
@@ -673,6 +950,9 @@ TEST_CASE("empty and pointless files") {
     check_fails("OFF BINARY\n", {"binary OFF"});
     check_fails("4OFF\n1 0 0\n1 2 3 4\n", {"'4OFF' files are not supported"});
     check_fails("OFF\n", {"vertex count is missing"});
+    ReadResult mark_only = read_text(std::string(kByteOrderMark), CloudFormat::ply);
+    CHECK_FALSE(mark_only.ok);
+    CHECK(contains(mark_only.error, "line 1: not a PLY file"));
     ReadResult forced = read_text("1 2 3\n", CloudFormat::obj);
     CHECK_FALSE(forced.ok);
     CHECK(contains(forced.error, "no 'v' line"));
@@ -744,6 +1024,7 @@ TEST_CASE("the content decides the format") {
     auto detect = [](const std::string& s) { return detect_cloud_format(s.data(), s.size()); };
     CHECK(detect("ply\nformat ascii 1.0\n") == CloudFormat::ply);
     CHECK(detect("ply\r\nformat ascii 1.0\r\n") == CloudFormat::ply);
+    CHECK(detect("ply\rformat ascii 1.0\r") == CloudFormat::ply);
     CHECK(detect("OFF\n3 1 0\n") == CloudFormat::off);
     CHECK(detect("# c\nSTCNOFF\n") == CloudFormat::off);
     CHECK(detect("# obj\nmtllib x.mtl\no a\nv 1 2 3\n") == CloudFormat::obj);
@@ -858,6 +1139,8 @@ TEST_CASE("point by point reading gives the points of the whole-file readers") {
         {"little.ply", fixed_binary_ply(xyz, false)}, {"big.ply", fixed_binary_ply(xyz, true)},
         {"lf.ply", ascii_ply(xyz, "\n")},             {"crlf.ply", ascii_ply(xyz, "\r\n")},
         {"spaces.xyz", xyz_text(xyz, " ")},           {"commas.csv", xyz_text(xyz, ",")},
+        {"european.csv", columns_text(xyz, ";", true, true)},
+        {"decimal_comma.txt", columns_text(xyz, "\t", true, false)},
         {"cloud.obj", obj}};
     for (const auto& file : files) {
         CAPTURE(file.first);
@@ -885,7 +1168,7 @@ TEST_CASE("point by point reading: the most points a text file can hold bounds t
     TempDir dir;
     // The shortest lines a point can take, with and without a line end on the last one.
     const std::pair<const char*, std::string> files[] = {
-        {"short.xyz", "1 2 3\n4 5 6\n7 8 9\n"}, {"no_end.xyz", "1 2 3\n4 5 6\n7,8,9"},
+        {"short.xyz", "1 2 3\n4 5 6\n7 8 9\n"}, {"no_end.xyz", "1 2 3\n4 5 6\n7 8 9"},
         {"short.obj", "v 1 2 3\nv 4 5 6\nv 7 8 9"}};
     for (const auto& file : files) {
         CAPTURE(file.first);
@@ -904,6 +1187,14 @@ TEST_CASE("point by point reading: what it cannot read, and errors that name the
     TempDir dir;
     std::vector<double> xyz = test_points(10);
     std::string whole = fixed_binary_ply(xyz, false), ascii = ascii_ply(xyz, "\n");
+    // A lone carriage return on line 50001, well past the reader's first window.
+    std::string late_carriage_return, late_carriage_return_ply =
+        "ply\nformat ascii 1.0\nelement vertex 60000\n" + std::string(kXyz) + "end_header\n";
+    for (int i = 0; i < 60000; ++i) {
+        const std::string line = std::to_string(i) + (i == 50000 ? " 1.25\r2\n" : " 1.25 2\n");
+        late_carriage_return += line;
+        late_carriage_return_ply += line;
+    }
     const struct {
         const char* name;
         std::string bytes;
@@ -917,7 +1208,15 @@ TEST_CASE("point by point reading: what it cannot read, and errors that name the
         {"bad.xyz", "1 2 3\n4 5 6\n7 eight 9\n", "line 3: 'eight' is not a number"},
         {"ascii_short.ply", ascii.substr(0, ascii.size() - 30),
          "the line ends before property 'z' of element 'vertex' record 9 of 10"},
-        {"empty.xyz", "", "the file is empty"}};
+        {"empty.xyz", "", "the file is empty"},
+        {"cr_only.xyz", "1 2 3\r4 5 6\r", "line 1: a carriage return (CR) without a line feed"},
+        {"cr_only.ply", "ply\rformat ascii 1.0\r", "line 1: a carriage return (CR) without a line feed"},
+        {"late_cr.xyz", late_carriage_return, "line 50001: a carriage return (CR) without a line feed"},
+        {"late_cr.ply", late_carriage_return_ply,
+         "line 50008: a carriage return (CR) without a line feed"},
+        {"split.csv", "1;2;3\n4;5;6\n7,8,9\n", "line 3: splits into 1 field at ';', where line 1 splits into 3"},
+        {"thousands.xyz", "1 2 3\n67.55 891.56 2,176.92\n",
+         "line 2: '2,176.92' has a thousands separator (',')"}};
     for (const auto& c : cases) {
         std::string name = c.name;
         CAPTURE(name);

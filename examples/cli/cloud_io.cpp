@@ -123,7 +123,8 @@ CloudFormat cloud_format_from_extension(const std::string& path) {
 
 CloudFormat detect_cloud_format(const char* data, size_t size) {
     std::string_view text = skip_byte_order_mark(std::string_view(data, data ? size : 0));
-    if (starts_with(text, "ply\n") || starts_with(text, "ply\r\n")) return CloudFormat::ply;
+    // "ply\r" alone too: the PLY reader refuses CR-only line ends with a message that says so.
+    if (starts_with(text, "ply\n") || starts_with(text, "ply\r")) return CloudFormat::ply;
     return detect_text_format(text);
 }
 
@@ -224,7 +225,9 @@ std::unique_ptr<PointReader> open_point_reader(const std::string& path, CloudInf
             info.point_limit = bytes / (info.format == CloudFormat::obj ? 8 : 6) + 1;
         if (start.substr(0, kByteOrderMark.size()) == kByteOrderMark)
             file->skip(kByteOrderMark.size());
-        reader = open_text_points(std::move(file), info.format == CloudFormat::obj);
+        // Refused here, before the window would grow to hold a file of CR-only lines whole.
+        if (check_line_ends(start, 1, error))
+            reader = open_text_points(std::move(file), info.format == CloudFormat::obj);
     }
     if (!reader) error = display_name(path) + ": " + error;
     return reader;

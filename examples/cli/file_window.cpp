@@ -56,6 +56,16 @@ bool FileWindow::next_lines(std::string_view& lines) {
     return true;
 }
 
+bool WindowLines::next(std::string_view& line) {
+    std::string_view block;
+    while (!cursor_.next(line)) {
+        if (!failure_.empty() || !file_.next_lines(block)) return false;
+        if (!check_line_ends(block, file_.lines_first_line(), failure_)) return false;
+        cursor_ = LineCursor(block);
+    }
+    return true;
+}
+
 std::string FileWindow::failure() const {
     return failure_ != 0 ? "cannot read: " + std::string(std::strerror(failure_)) : "";
 }

@@ -3,6 +3,8 @@
 #ifndef STRATMESH_CLI_FILE_WINDOW_H
 #define STRATMESH_CLI_FILE_WINDOW_H
 
+#include "text_scan.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -50,6 +52,30 @@ private:
     uint64_t consumed_ = 0; // bytes before buffer_[0]
     size_t next_line_ = 1, lines_first_line_ = 1;
     int failure_ = 0;
+};
+
+// The lines of a file read through a FileWindow, numbered as in the file: a LineCursor over
+// each run of whole lines. A run with a carriage return that ends no CRLF pair
+// (check_line_ends) ends them, and failure() says so.
+class WindowLines {
+public:
+    explicit WindowLines(FileWindow& file) : file_(file), cursor_(std::string_view()) {}
+
+    // The next line, without its terminator; false at the end of the file or on a failure.
+    bool next(std::string_view& line);
+    // The number of the line last returned (or, before any, of the first line to come).
+    size_t line_number() const {
+        return cursor_.line_number() == 0 ? file_.lines_first_line()
+                                          : file_.lines_first_line() + cursor_.line_number() - 1;
+    }
+    // Why next() returned false before the end of the file: a read error or a lone carriage
+    // return (empty otherwise).
+    std::string failure() const { return failure_.empty() ? file_.failure() : failure_; }
+
+private:
+    FileWindow& file_;
+    LineCursor cursor_;
+    std::string failure_;
 };
 
 } // namespace stratmesh_cli

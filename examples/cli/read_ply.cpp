@@ -66,9 +66,10 @@ const char* type_name(PlyType type) {
     return "?";
 }
 
-// Whether a value read from text is one the type can hold: integers whole and within
-// their range; floats within float's range (NaN and infinities too, for the library to
-// judge); doubles anything (a literal beyond their range is already refused).
+// Whether a value read from text is one the type can hold: integers (whole, as
+// scan_integer reads them) within their range; floats within float's range (NaN and
+// infinities too, for the library to judge); doubles anything (a literal beyond their
+// range is already refused).
 bool type_holds(PlyType type, double v) {
     double lowest = 0, highest = 0;
     switch (type) {
@@ -81,7 +82,7 @@ bool type_holds(PlyType type, double v) {
     case PlyType::float32: return !std::isfinite(v) || std::fabs(v) <= static_cast<double>(FLT_MAX);
     case PlyType::float64: return true;
     }
-    return v >= lowest && v <= highest && std::floor(v) == v;
+    return v >= lowest && v <= highest;
 }
 
 struct PlyProperty {
@@ -159,6 +160,10 @@ bool parse_format_line(const Words& words, PlyHeader& header, std::string& error
     }
     if (words.count != 3) {
         error = "expected 'format <encoding> 1.0'";
+        return false;
+    }
+    if (words.word[2] != "1.0") {
+        error = "PLY version " + quote(words.word[2]) + " is not read (only 1.0)";
         return false;
     }
     std::string_view name = words.word[1];
@@ -268,11 +273,14 @@ bool parse_header(std::string_view data, PlyHeader& header, std::string& error) 
     const size_t start = data.size() - skip_byte_order_mark(data).size();
     LineCursor lines(data.substr(start));
     std::string_view line;
-    if (!lines.next(line) || line != "ply") {
+    const bool first = lines.next(line);
+    if (first && !check_line_ends(line, 1, error)) return false;
+    if (!first || line != "ply") {
         error = "line 1: not a PLY file (the first line is not 'ply')";
         return false;
     }
     while (lines.next(line)) {
+        if (!check_line_ends(line, lines.line_number(), error)) return false;
         Words words = split_words(line);
         if (words.count == 0) continue;
         if (words.word[0] == "end_header") {
@@ -652,7 +660,7 @@ bool read_binary_body(std::string_view data, const PlyHeader& header, const Vert
 // ---- ascii body --------------------------------------------------------------------------
 // A record is one line holding exactly its properties' values (a list: its length, then
 // that many items). The readers take any line source: BodyLines over the whole file, or
-// FileLines over a window of it (--stream).
+// WindowLines over a window of it (--stream).
 
 // The lines of an ascii body held in memory, numbered as in the file.
 class BodyLines {
@@ -671,25 +679,45 @@ std::string property_place(const PlyElement& element, const PlyProperty& propert
     return "property " + quote(property.name) + " of " + record_place(element, record);
 }
 
+// `token` as a value of the integer type `type`; why it is none, if it is none.
+std::string integer_problem(std::string_view token, PlyType type, double& value) {
+    bool negative = false;
+    uint64_t magnitude = 0;
+    const IntegerParse parsed = scan_integer(token, negative, magnitude);
+    if (parsed == IntegerParse::not_an_integer) {
+        char point = '.';
+        const NumberParse as_number = scan_number(token, point, value);
+        if (as_number != NumberParse::ok) return number_problem(token, as_number, '.');
+        return quote(token) + " is not an integer (digits with an optional sign), as " +
+               type_name(type) + " requires";
+    }
+    value = negative ? -static_cast<double>(magnitude) : static_cast<double>(magnitude);
+    if (parsed == IntegerParse::ok && type_holds(type, value)) return std::string();
+    return quote(token) + " is out of the range of " + type_name(type);
+}
+
 // The next value of a record's line, checked against `type`.
 bool next_ascii_value(std::string_view& rest, size_t line, const PlyElement& element,
                       const PlyProperty& property, PlyType type, uint64_t record,
                       double& value, std::string& error) {
     std::string_view token;
     NumberParse parsed = NumberParse::ok;
-    if (!next_number(rest, token, value, parsed, false)) {
+    char point = '.';
+    const bool more = is_integral(type) ? next_field(rest, token, false)
+                                        : next_number(rest, token, value, parsed, point);
+    if (!more) {
         error = at_line(line) + "the line ends before " + property_place(element, property, record);
         return false;
     }
-    if (parsed == NumberParse::ok && type_holds(type, value)) return true;
-    std::string problem = parsed == NumberParse::not_a_number   ? " is not a number"
-                          : parsed == NumberParse::out_of_range ? " is beyond the range of a double"
-                          : is_integral(type) && std::floor(value) != value
-                              ? std::string(" is not a whole number, as ") + type_name(type) +
-                                    " requires"
-                              : std::string(" is out of the range of ") + type_name(type);
-    error = at_line(line) + quote(token) + problem + " (" +
-            property_place(element, property, record) + ")";
+    std::string problem;
+    if (is_integral(type))
+        problem = integer_problem(token, type, value);
+    else if (parsed != NumberParse::ok)
+        problem = number_problem(token, parsed, '.');
+    else if (!type_holds(type, value))
+        problem = quote(token) + " is out of the range of " + type_name(type);
+    if (problem.empty()) return true;
+    error = at_line(line) + problem + " (" + property_place(element, property, record) + ")";
     return false;
 }
 
@@ -802,6 +830,7 @@ bool check_ascii_end(Lines& in, const PlyHeader& header, std::string& error) {
 
 bool read_ascii_body(std::string_view data, const PlyHeader& header, const VertexLayout& layout,
                      std::vector<double>& xyz, PointAttributes* attributes, std::string& error) {
+    if (!check_line_ends(data.substr(header.data_offset), header.data_line, error)) return false;
     BodyLines in(data.substr(header.data_offset), header.data_line);
     for (size_t e = 0; e < header.elements.size(); ++e) {
         const PlyElement& element = header.elements[e];
@@ -849,29 +878,6 @@ uint64_t face_count(const PlyHeader& header) {
 
 // ---- streaming (--stream) ----------------------------------------------------------------
 
-// Lines of a file read through a FileWindow: a LineCursor over each run of whole lines.
-class FileLines {
-public:
-    explicit FileLines(FileWindow& file) : file_(file), cursor_(std::string_view()) {}
-
-    bool next(std::string_view& line) {
-        std::string_view block;
-        while (!cursor_.next(line)) {
-            if (!file_.next_lines(block)) return false;
-            cursor_ = LineCursor(block);
-        }
-        return true;
-    }
-    size_t line_number() const {
-        return cursor_.line_number() == 0 ? file_.lines_first_line()
-                                          : file_.lines_first_line() + cursor_.line_number() - 1;
-    }
-
-private:
-    FileWindow& file_;
-    LineCursor cursor_;
-};
-
 // The vertex element's points, one record at a time; at their end, the rest of the body
 // checked against the header.
 class PlyPoints : public PointReader {
@@ -886,7 +892,8 @@ public:
             const PlyElement& element = header_.elements[e];
             if (header_.encoding == PlyEncoding::ascii) {
                 std::vector<int> none(element.properties.size(), -1);
-                if (!read_ascii_element(lines_, element, none, nullptr, error)) return false;
+                if (!lines_read(read_ascii_element(lines_, element, none, nullptr, error), error))
+                    return false;
                 continue;
             }
             uint64_t size = fixed_record_size(element);
@@ -915,15 +922,22 @@ public:
                       ? read_ascii_record(lines_, vertex, layout_.coordinate_of, xyz, record_,
                                           error)
                       : next_binary(vertex, xyz, error);
-        std::string failure = file_->failure();
-        if (!failure.empty()) error = failure;
         ++record_;
-        return ok && failure.empty();
+        return lines_read(ok, error);
     }
 
     uint64_t faces_ignored() const override { return face_count(header_); }
 
 private:
+    // `ok`, unless reading the file failed or its lines have a lone carriage return: then
+    // false with that failure as the error (a reader seeing no more lines says otherwise).
+    bool lines_read(bool ok, std::string& error) const {
+        std::string failure = lines_.failure();
+        if (failure.empty()) return ok;
+        error = failure;
+        return false;
+    }
+
     bool discard_records(const PlyElement& element, uint64_t size, std::string& error) {
         if (element.count <= UINT64_MAX / (size ? size : 1) && file_->discard(element.count * size))
             return true;
@@ -972,7 +986,8 @@ private:
             const PlyElement& element = header_.elements[e];
             if (header_.encoding == PlyEncoding::ascii) {
                 std::vector<int> none(element.properties.size(), -1);
-                if (!read_ascii_element(lines_, element, none, nullptr, error)) return false;
+                if (!lines_read(read_ascii_element(lines_, element, none, nullptr, error), error))
+                    return false;
                 continue;
             }
             const uint64_t size = fixed_record_size(element);
@@ -983,7 +998,8 @@ private:
             for (uint64_t r = 0; r < element.count; ++r)
                 if (!discard_binary_record(element, r, error)) return false;
         }
-        if (header_.encoding == PlyEncoding::ascii) return check_ascii_end(lines_, header_, error);
+        if (header_.encoding == PlyEncoding::ascii)
+            return lines_read(check_ascii_end(lines_, header_, error), error);
         const uint64_t end = file_->offset();
         uint64_t rest = 0;
         bool clean = true;
@@ -1018,7 +1034,7 @@ private:
     std::unique_ptr<FileWindow> file_;
     PlyHeader header_;
     VertexLayout layout_;
-    FileLines lines_;
+    WindowLines lines_;
     uint64_t record_ = 0;
     bool checked_rest_ = false;
 };

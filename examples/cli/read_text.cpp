@@ -14,56 +14,128 @@ std::string at_line(size_t line) { return "line " + std::to_string(line) + ": ";
 
 bool is_letter(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); }
 
+// The fields of a line that one `separator` parts, blanks around each dropped; any of them
+// may be empty, the last too ("1;2;" has three fields).
+class SeparatedFields {
+public:
+    SeparatedFields(std::string_view line, char separator) : rest_(line), separator_(separator) {}
+
+    bool next(std::string_view& field) {
+        if (done_) return false;
+        const size_t at = rest_.find(separator_);
+        done_ = at == std::string_view::npos;
+        field = trim_blanks(rest_.substr(0, at));
+        rest_.remove_prefix(done_ ? rest_.size() : at + 1);
+        return true;
+    }
+
+private:
+    std::string_view rest_;
+    char separator_;
+    bool done_ = false;
+};
+
 // The fields of one line, all expected to be numbers.
 struct NumberRow {
     size_t fields = 0; // fields seen
     double first[3] = {0, 0, 0};
+    size_t empty = 0;     // the first empty field, counting from 1; 0 if none
     std::string_view bad; // the first field that is not a number, if any
     NumberParse bad_as = NumberParse::ok; // and why
-    bool all_start_with_letters = true;
 };
 
-NumberRow scan_numbers(std::string_view content, bool commas) {
+// The numbers of a line whose fields `separator` parts: ' ' for runs of blanks, else ','
+// or ';'. `mark` is the file's decimal mark (kEitherMark until a number has one).
+NumberRow scan_numbers(std::string_view content, char separator, char& mark) {
     NumberRow row;
+    SeparatedFields separated(content, separator);
     std::string_view field;
     double value = 0;
     NumberParse parsed = NumberParse::ok;
-    while (next_number(content, field, value, parsed, commas)) {
-        bool numeric = parsed == NumberParse::ok;
-        if (!numeric && row.bad.empty()) {
+    for (;;) {
+        const bool more = separator == ' ' ? next_number(content, field, value, parsed, mark)
+                                           : separated.next(field);
+        if (!more) break;
+        ++row.fields;
+        if (field.empty()) {
+            if (row.empty == 0) row.empty = row.fields;
+            continue;
+        }
+        if (separator != ' ') parsed = scan_number(field, mark, value);
+        if (parsed != NumberParse::ok && row.bad.empty()) {
             row.bad = field;
             row.bad_as = parsed;
         }
-        if (numeric && row.fields < 3) row.first[row.fields] = value;
-        row.all_start_with_letters = row.all_start_with_letters && !numeric && is_letter(field[0]);
-        ++row.fields;
+        if (parsed == NumberParse::ok && row.fields <= 3) row.first[row.fields - 1] = value;
     }
     return row;
 }
 
-// A point row: every field a number, at least three of them. False with a message if not.
-bool take_point(const NumberRow& row, size_t line, std::vector<double>& xyz, std::string& error) {
-    if (!row.bad.empty()) {
-        error = at_line(line) + quote(row.bad) +
-                (row.bad_as == NumberParse::out_of_range ? " is beyond the range of a double"
-                                                         : " is not a number");
-        return false;
-    }
-    if (row.fields < 3) {
-        error = at_line(line) + "expected at least 3 numbers (x y z), found " +
-                std::to_string(row.fields);
+// What keeps a row from being a point (every field a number, at least three of them), as a
+// clause of a message; empty if nothing does.
+std::string point_problem(const NumberRow& row, char mark, size_t mark_line) {
+    if (row.empty > 0) return "field " + std::to_string(row.empty) + " is empty";
+    if (!row.bad.empty()) return number_problem(row.bad, row.bad_as, mark, mark_line);
+    if (row.fields < 3)
+        return "found " + std::to_string(row.fields) +
+               (row.fields == 1 ? " number" : " numbers") + " where a point needs at least 3 (x y z)";
+    return std::string();
+}
+
+// A point row of an OFF or OBJ file, blanks parting numbers with a decimal point, appended
+// to `xyz`; false with a message if the row is no point.
+bool take_point(std::string_view content, size_t line, std::vector<double>& xyz,
+                std::string& error) {
+    char point = '.';
+    const NumberRow row = scan_numbers(content, ' ', point);
+    const std::string problem = point_problem(row, point, 0);
+    if (!problem.empty()) {
+        error = at_line(line) + problem;
         return false;
     }
     xyz.insert(xyz.end(), row.first, row.first + 3);
     return true;
 }
 
+// A line of column names: no field a number, each beginning with a letter ("X Y Z",
+// "x;y;z").
+bool is_column_names(std::string_view content) {
+    std::string_view field;
+    while (next_field(content, field, true)) {
+        char mark = kEitherMark;
+        double value = 0;
+        if (!is_letter(field[0]) || scan_number(field, mark, value) == NumberParse::ok)
+            return false;
+    }
+    return true;
+}
+
+// The separator of a column file, from its first point line: ';' if the line has one;
+// ',' where commas part the line (it has fewer than three blank-parted fields, or a comma
+// beside a blank or at an end); else blanks, a comma then being a decimal comma.
+char column_separator(std::string_view content) {
+    if (content.find(';') != std::string_view::npos) return ';';
+    if (content.find(',') == std::string_view::npos) return ' ';
+    std::string_view field;
+    size_t fields = 0;
+    bool comma_at_edge = false;
+    while (next_field(content, field, false)) {
+        ++fields;
+        comma_at_edge = comma_at_edge || field.front() == ',' || field.back() == ',';
+    }
+    return fields < 3 || comma_at_edge ? ',' : ' ';
+}
+
+const char* separator_name(char separator) {
+    return separator == ',' ? "','" : separator == ';' ? "';'" : "blanks";
+}
+
 // A PTS count line: a single whole number.
 bool is_count_line(std::string_view content, uint64_t& count) {
     std::string_view field, rest = content;
-    if (!next_field(rest, field, true)) return false;
+    if (!next_field(rest, field, false)) return false;
     std::string_view extra;
-    return !next_field(rest, extra, true) && parse_count(field, count) == CountParse::ok;
+    return !next_field(rest, extra, false) && parse_count(field, count) == CountParse::ok;
 }
 
 // Advances to the next line with something other than blanks and '#' comments.
@@ -86,15 +158,15 @@ bool read_off_vertices(LineCursor& lines, uint64_t count, std::vector<double>& x
                     " of the " + std::to_string(count) + " vertices the header announces";
             return false;
         }
-        if (!take_point(scan_numbers(content, false), lines.line_number(), xyz, error))
-            return false;
+        if (!take_point(content, lines.line_number(), xyz, error)) return false;
     }
     return true;
 }
 
-// The face lines after an OFF file's vertices: each a vertex count k and k whole numbers
-// (colours may follow); nothing but blank and comment lines after the last.
-bool read_off_faces(LineCursor& lines, uint64_t count, std::string& error) {
+// The face lines after an OFF file's vertices: each a vertex count k and k whole numbers,
+// indices of the `vertices` (colours may follow); nothing but blank and comment lines
+// after the last.
+bool read_off_faces(LineCursor& lines, uint64_t count, uint64_t vertices, std::string& error) {
     std::string_view content, field;
     for (uint64_t f = 0; f < count; ++f) {
         if (!next_content_line(lines, content)) {
@@ -103,14 +175,23 @@ bool read_off_faces(LineCursor& lines, uint64_t count, std::string& error) {
             return false;
         }
         uint64_t corners = 0, index = 0;
+        bool in_range = true;
         next_field(content, field, false);
         CountParse parsed = parse_count(field, corners);
-        for (uint64_t k = 0; parsed == CountParse::ok && k < corners; ++k)
+        for (uint64_t k = 0; parsed == CountParse::ok && in_range && k < corners; ++k) {
             parsed = next_field(content, field, false) ? parse_count(field, index)
                                                        : CountParse::not_a_number;
+            in_range = index < vertices;
+        }
         if (parsed != CountParse::ok) {
             error = at_line(lines.line_number()) + "face " + std::to_string(f) +
                     " is not a corner count followed by that many vertex indices";
+            return false;
+        }
+        if (!in_range) {
+            error = at_line(lines.line_number()) + "face " + std::to_string(f) + " names vertex " +
+                    std::to_string(index) + ", but the file has " + std::to_string(vertices) +
+                    " vertices (numbered from 0)";
             return false;
         }
     }
@@ -162,18 +243,20 @@ bool read_off_header(LineCursor& lines, uint64_t& vertex_count, uint64_t& face_c
 // comment lines and a first line of column names. A file whose first line with a number
 // is a single whole number is PTS: each such count line announces the points up to the
 // next one (scans joined one after another), and each must count them exactly.
+// The first point line decides how the file's lines split: at which separator
+// (column_separator) and into how many fields, the same on every point line. The first
+// number with a decimal mark decides the mark of the others.
 class ColumnRows {
 public:
     // Appends the line's point, if it has one; false with a message on a bad line.
     bool take(std::string_view line, size_t line_number, std::vector<double>& xyz,
               std::string& error) {
-        std::string_view content = strip_comment(line, true);
-        NumberRow row = scan_numbers(content, true);
-        if (row.fields == 0) return true;
-        bool column_names = first_content_ && row.all_start_with_letters;
+        std::string_view content = strip_comment(line, true), probe = content, field;
+        if (!next_field(probe, field, false)) return true;
+        const bool first_content = first_content_;
         first_content_ = false;
-        if (column_names) return true;
-        bool first = first_number_;
+        if (first_content && is_column_names(content)) return true;
+        const bool first = first_number_;
         first_number_ = false;
         uint64_t count = 0;
         if ((first || counted_) && is_count_line(content, count)) {
@@ -184,8 +267,11 @@ public:
             points_ = 0;
             return true;
         }
-        ++points_;
-        return take_point(row, line_number, xyz, error);
+        if (separator_ == 0) {
+            separator_ = column_separator(content);
+            if (separator_ == ',') mark_ = '.';
+        }
+        return take_point_line(content, line_number, xyz, error);
     }
 
     // At the end of the file: false with a message if a count line was wrong.
@@ -197,11 +283,43 @@ public:
     }
 
 private:
+    bool take_point_line(std::string_view content, size_t line, std::vector<double>& xyz,
+                         std::string& error) {
+        const char mark_before = mark_;
+        const NumberRow row = scan_numbers(content, separator_, mark_);
+        if (mark_before == kEitherMark && mark_ != kEitherMark) mark_line_ = line;
+        std::string problem;
+        if (row.empty == 0 && fields_ > 0 && row.fields != fields_)
+            problem = "splits into " + std::to_string(row.fields) +
+                      (row.fields == 1 ? " field at " : " fields at ") +
+                      separator_name(separator_) + ", where line " + std::to_string(fields_line_) +
+                      " splits into " + std::to_string(fields_);
+        else
+            problem = point_problem(row, mark_, mark_line_);
+        if (!problem.empty()) {
+            error = at_line(line) + (fields_ == 0 ? "read as XYZ text (x y z columns), but " : "") +
+                    problem;
+            return false;
+        }
+        if (fields_ == 0) {
+            fields_ = row.fields;
+            fields_line_ = line;
+        }
+        ++points_;
+        xyz.insert(xyz.end(), row.first, row.first + 3);
+        return true;
+    }
+
     bool first_content_ = true;
     bool first_number_ = true;
     bool counted_ = false; // PTS: count lines start the blocks
     uint64_t count_ = 0, points_ = 0;
     size_t count_line_ = 0;
+    char separator_ = 0;          // ' ' (blanks), ',' or ';'; 0 until the first point line
+    char mark_ = kEitherMark;     // the decimal mark
+    size_t mark_line_ = 0;        // the line whose number decided it (0: the separator did)
+    size_t fields_ = 0;           // on every point line; 0 until the first
+    size_t fields_line_ = 0;      // the first point line
 };
 
 // Appends the point of an OBJ "v" line and counts "f" lines; other lines are ignored.
@@ -211,7 +329,7 @@ bool take_obj_line(std::string_view line, size_t line_number, std::vector<double
     if (!next_field(rest, keyword, false)) return true;
     if (keyword == "f") ++faces;
     if (keyword != "v") return true;
-    return take_point(scan_numbers(rest, false), line_number, xyz, error);
+    return take_point(rest, line_number, xyz, error);
 }
 
 // The points of a column or OBJ file read line by line through a window (--stream).
@@ -223,12 +341,12 @@ public:
         std::string_view line;
         point_.clear();
         while (point_.empty()) {
-            if (!next_line(line)) {
-                error = file_->failure();
+            if (!lines_.next(line)) {
+                error = lines_.failure();
                 if (error.empty() && !obj_) columns_.finish(error);
                 return false;
             }
-            size_t number = file_->lines_first_line() + lines_.line_number() - 1;
+            const size_t number = lines_.line_number();
             bool ok = obj_ ? take_obj_line(line, number, point_, faces_, error)
                            : columns_.take(line, number, point_, error);
             if (!ok) return false;
@@ -240,18 +358,9 @@ public:
     uint64_t faces_ignored() const override { return faces_; }
 
 private:
-    bool next_line(std::string_view& line) {
-        std::string_view block;
-        while (!lines_.next(line)) {
-            if (!file_->next_lines(block)) return false;
-            lines_ = LineCursor(block);
-        }
-        return true;
-    }
-
     std::unique_ptr<FileWindow> file_;
     bool obj_;
-    LineCursor lines_{std::string_view()};
+    WindowLines lines_{*file_};
     ColumnRows columns_;
     std::vector<double> point_;
     uint64_t faces_ = 0;
@@ -275,11 +384,12 @@ bool read_xyz(std::string_view data, std::vector<double>& xyz, std::string& erro
     std::string_view line;
     ColumnRows rows;
     xyz.clear();
+    if (!check_line_ends(data, 1, error)) return false;
     while (lines.next(line))
         if (!rows.take(line, lines.line_number(), xyz, error)) return false;
     if (!rows.finish(error)) return false;
     if (!xyz.empty()) return true;
-    error = "no points found (no line with 3 numbers)";
+    error = "no points found: read as XYZ text (x y z columns), no line holds a point";
     return false;
 }
 
@@ -289,9 +399,9 @@ bool read_off(std::string_view data, std::vector<double>& xyz, std::string& erro
     uint64_t vertex_count = 0;
     xyz.clear();
     faces = 0;
-    return read_off_header(lines, vertex_count, faces, error) &&
+    return check_line_ends(data, 1, error) && read_off_header(lines, vertex_count, faces, error) &&
            read_off_vertices(lines, vertex_count, xyz, error) &&
-           read_off_faces(lines, faces, error);
+           read_off_faces(lines, faces, vertex_count, error);
 }
 
 bool read_obj(std::string_view data, std::vector<double>& xyz, std::string& error,
@@ -300,6 +410,7 @@ bool read_obj(std::string_view data, std::vector<double>& xyz, std::string& erro
     std::string_view line;
     xyz.clear();
     faces = 0;
+    if (!check_line_ends(data, 1, error)) return false;
     while (lines.next(line))
         if (!take_obj_line(line, lines.line_number(), xyz, faces, error)) return false;
     if (!xyz.empty()) return true;

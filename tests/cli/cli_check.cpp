@@ -26,6 +26,7 @@
 #include "mini_mesh.h"
 #include "../support/shapes.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -36,6 +37,7 @@
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -261,6 +263,101 @@ std::string sorted_with_nan_at(std::vector<double> sorted, size_t index) {
     return as_xyz(sorted, 0);
 }
 
+// ---- text as people write it: the text readers' cases -------------------------------------
+// The cylinder as columns: `head` first, then a line per point, its numbers parted by
+// `separator` and written with a decimal comma if `comma`. Line `odd_line` (counting from 1,
+// 0 for none) is `odd` instead; every line ends with `end`.
+struct Columns {
+    Columns(std::string head_line, std::string parting, bool decimal_comma = false,
+            size_t replaced_line = 0, std::string replacement = "", std::string line_end = "\n")
+        : head(std::move(head_line)), separator(std::move(parting)), comma(decimal_comma),
+          odd_line(replaced_line), odd(std::move(replacement)), end(std::move(line_end)) {}
+    std::string head, separator;
+    bool comma;
+    size_t odd_line;
+    std::string odd, end;
+};
+
+std::string as_columns(const std::vector<double>& xyz, const Columns& c) {
+    auto number = [&](double v) {
+        std::string text = number_text(v);
+        if (c.comma) std::replace(text.begin(), text.end(), '.', ',');
+        return text;
+    };
+    std::string text;
+    size_t line = 0;
+    auto add = [&](const std::string& content) {
+        ++line;
+        text += (line == c.odd_line ? c.odd : content) + c.end;
+    };
+    if (!c.head.empty()) add(c.head);
+    for (size_t i = 0; i < xyz.size() / 3; ++i)
+        add(number(xyz[3 * i]) + c.separator + number(xyz[3 * i + 1]) + c.separator +
+            number(xyz[3 * i + 2]));
+    return text;
+}
+
+// The cylinder with a point of NaN or infinite coordinates every 500 points, each in
+// another spelling in use (MSVC's among them).
+std::string with_nan_spellings(const std::vector<double>& xyz) {
+    const char* spellings[] = {"-1.#IND 0.5 0.5", "0.5 0.5 1.#INF", "1.#QNAN 1.#SNAN -1.#INF00",
+                               "nan(ind) -nan(ind) 0", "NaN -Infinity 1", "0.5 0.5 NaNQ"};
+    std::string text;
+    for (size_t i = 0; i < xyz.size() / 3; ++i) {
+        if (i % 500 == 250) text += std::string(spellings[i / 500 % 6]) + "\n";
+        text += number_text(xyz[3 * i]) + " " + number_text(xyz[3 * i + 1]) + " " +
+                number_text(xyz[3 * i + 2]) + "\n";
+    }
+    return text;
+}
+
+// An ascii PLY of the cylinder's first 10 points with a label; `format` is its format
+// line, `label` the first point's label.
+std::string small_ply(const std::vector<double>& xyz, const std::string& format,
+                      const std::string& label, const std::string& end) {
+    std::string text = "ply" + end + format + end + "element vertex 10" + end +
+                       "property double x" + end + "property double y" + end +
+                       "property double z" + end + "property int label" + end + "end_header" + end;
+    for (size_t i = 0; i < 10; ++i)
+        text += number_text(xyz[3 * i]) + " " + number_text(xyz[3 * i + 1]) + " " +
+                number_text(xyz[3 * i + 2]) + " " + (i == 0 ? label : "7") + end;
+    return text;
+}
+
+// An OFF mesh of the cylinder's first 1500 points, its faces fans; the last face names
+// vertex `last`.
+std::string off_mesh(const std::vector<double>& xyz, size_t last) {
+    std::string text = "OFF\n1500 3 0\n";
+    for (size_t i = 0; i < 1500; ++i)
+        text += number_text(xyz[3 * i]) + " " + number_text(xyz[3 * i + 1]) + " " +
+                number_text(xyz[3 * i + 2]) + "\n";
+    return text + "3 0 1 2\n3 0 2 3\n3 0 3 " + std::to_string(last) + "\n";
+}
+
+bool make_reader_inputs(const std::string& dir, const std::vector<double>& cylinder) {
+    const std::string thousands = "67.55 891.56 2,176.92";
+    return write_file(dir + "/european.csv", as_columns(cylinder, {"X;Y;Z", ";", true})) &&
+           write_file(dir + "/decimal_comma.txt", as_columns(cylinder, {"", "\t", true})) &&
+           write_file(dir + "/comma_separated.csv", as_columns(cylinder, {"x, y, z", ", "})) &&
+           write_file(dir + "/thousands.xyz", as_columns(cylinder, {"", " ", false, 7, thousands})) &&
+           write_file(dir + "/empty_field.csv",
+                      as_columns(cylinder, {"x,y,z", ",", false, 12, "1.5,,2.5,3.5"})) &&
+           write_file(dir + "/split_differently.csv",
+                      as_columns(cylinder, {"x;y;z", ";", true, 30, "1,5,2,5,3,5"})) &&
+           write_file(dir + "/mixed_marks.csv",
+                      as_columns(cylinder, {"x;y;z", ";", true, 40, "1.5;2;3"})) &&
+           write_file(dir + "/not_a_cloud.txt", "stratmesh 0.1.0 report\npoints: 3000\n") &&
+           write_file(dir + "/cr_only.xyz", as_columns(cylinder, {"# CR only", " ", false, 0, "", "\r"})) &&
+           write_file(dir + "/cr_only.ply", small_ply(cylinder, "format ascii 1.0", "7", "\r")) &&
+           write_file(dir + "/ply_version_2.ply", small_ply(cylinder, "format ascii 2.0", "7", "\n")) &&
+           write_file(dir + "/ply_int_exponent.ply",
+                      small_ply(cylinder, "format ascii 1.0", "1e2", "\n")) &&
+           write_file(dir + "/off_face_beyond.off", off_mesh(cylinder, 5000)) &&
+           write_file(dir + "/nan_spellings.xyz", with_nan_spellings(cylinder)) &&
+           write_file(dir + "/nan_cut_short.xyz",
+                      as_columns(cylinder, {"", " ", false, 20, "0.5 0.5 -1.#J"}));
+}
+
 int make_inputs(const std::string& dir) {
     std::error_code ignored;
     std::filesystem::create_directories(dir, ignored);
@@ -296,7 +393,8 @@ int make_inputs(const std::string& dir) {
               write_file(dir + "/huge_integer.xyz", xyz_with_huge_integer()) &&
               write_file(dir + "/sorted_nan.xyz", sorted_with_nan_at(sorted, 1500)) &&
               write_file(dir + "/line.xyz", as_xyz(line_points(2000), 0, "on a line up to rounding")) &&
-              write_file(dir + "/far_speck.xyz", as_xyz(with_far_point(cylinder), 0, "a point at 1e30"));
+              write_file(dir + "/far_speck.xyz", as_xyz(with_far_point(cylinder), 0, "a point at 1e30")) &&
+              make_reader_inputs(dir, cylinder);
     if (!ok) std::fprintf(stderr, "cannot write the inputs into %s\n", dir.c_str());
     return ok ? 0 : 1;
 }

@@ -5,7 +5,6 @@
 
 #include "args.h"
 #include "cloud_io.h"
-#include "frame_check.h"
 #include "safe_output.h"
 
 #include <cerrno>
@@ -373,52 +372,6 @@ TEST_CASE("a scratch file beside the destination leaves no name behind") {
 #endif
     std::fclose(scratch);
     CHECK(dir.entries() == 0);
-}
-
-// ==== the frame the command line asks for =================================================
-
-TEST_CASE("a direction of any finite non-zero length normalises without overflow") {
-    const double cases[][3] = {{1e308, 0, 0},          {1e-320, 0, 0},     {1e308, 1e308, 1e308},
-                               {-4.9e-324, 4.9e-324, 0}, {3, -4, 0},       {1e308, 1e-320, -1}};
-    for (const auto& c : cases) {
-        double v[3] = {c[0], c[1], c[2]};
-        REQUIRE(normalise_direction(v));
-        const double length = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        CHECK(length == doctest::Approx(1).epsilon(1e-15));
-        // A component far below the largest may vanish; the others keep their signs.
-        for (size_t k = 0; k < 3; ++k)
-            if (v[k] != 0) CHECK((v[k] > 0) == (c[k] > 0));
-    }
-    double v[3] = {3, -4, 0};
-    REQUIRE(normalise_direction(v));
-    CHECK(v[0] == doctest::Approx(0.6));
-    CHECK(v[1] == doctest::Approx(-0.8));
-    double zero[3] = {0, 0, -0.0};
-    CHECK_FALSE(normalise_direction(zero));
-    double inf[3] = {HUGE_VAL, 0, 0};
-    CHECK_FALSE(normalise_direction(inf));
-}
-
-TEST_CASE("an origin too far from the cloud is refused, naming --origin") {
-    const double cloud[] = {0, 0, 0, 100, 0, 0, 0, 50, 10};
-    CloudBox box;
-    std::string error;
-    const double none[3] = {1e300, 0, 0};
-    CHECK(box.origin_in_reach(none, error)); // nothing seen yet
-    box.add(cloud, 3);
-    const double near[3] = {50, 25, -1e9};
-    CHECK(box.origin_in_reach(near, error));
-    const double edge[3] = {100 + 100 * kOriginReach, 0, 0};
-    CHECK(box.origin_in_reach(edge, error));
-    const double beyond[3] = {100 + 101 * kOriginReach, 0, 0};
-    CHECK_FALSE(box.origin_in_reach(beyond, error));
-    CHECK(contains(error, "--origin"));
-    const double far[3] = {-1e300, 0, 0};
-    CHECK_FALSE(box.origin_in_reach(far, error));
-    CHECK(contains(error, "lies 1e+300 from the cloud, which spans 100"));
-    const double skipped[] = {std::nan(""), 1e300, 0};
-    box.add(skipped, 1); // not finite: not part of the box
-    CHECK_FALSE(box.origin_in_reach(far, error));
 }
 
 // ==== round trip through every format and encoding ========================================

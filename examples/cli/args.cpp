@@ -1,6 +1,5 @@
 #include "args.h"
 
-#include "frame_check.h"
 #include "mesh_io.h"
 #include "text_scan.h"
 
@@ -196,8 +195,8 @@ bool parse_axis(std::string_view text, CommandLine& line, std::string& error) {
         error = "--axis: expected x, y, z or a direction X,Y,Z, not '" + std::string(text) + "'";
         return false;
     }
-    // Normalised here, so any finite non-zero length works (1e308,0,0 and 1e-320,0,0).
-    if (!normalise_direction(v.data())) {
+    // Passed as given: the library takes any finite non-zero length (1e308,0,0 and 1e-320,0,0).
+    if (v[0] == 0 && v[1] == 0 && v[2] == 0) {
         error = "--axis: the direction must not be zero";
         return false;
     }

@@ -6,7 +6,6 @@
 // unchanged. See mesh_io.h.
 #include "args.h"
 #include "cloud_io.h"
-#include "frame_check.h"
 #include "mesh_ends.h"
 #include "mesh_io.h"
 #include "peak_memory.h"
@@ -161,16 +160,6 @@ bool read_input(const CommandLine& line, std::vector<double>& xyz, PointAttribut
     return true;
 }
 
-// False, with the message printed, if --origin is too far from the cloud for any frame.
-bool origin_in_reach(const CommandLine& line, const std::vector<double>& xyz) {
-    CloudBox box;
-    box.add(xyz.data(), xyz.size() / 3);
-    std::string error;
-    if (box.origin_in_reach(line.origin, error)) return true;
-    std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
-    return false;
-}
-
 // What reconstruct() produced: triangles indexing the input points.
 struct Reconstruction {
     std::unique_ptr<uint32_t, FreeDeleter> triangles;
@@ -267,41 +256,6 @@ bool find_branches(const std::vector<double>& xyz, const CommandLine& line, RunR
     return true;
 }
 
-// A point this many times farther from the middle of the cloud than nine points in ten
-// sets the cloud's extent on its own.
-const double kFarPointRatio = 1e6;
-
-// Where a cloud was refused for its shape: the point that lies farthest from the middle of
-// the cloud (the median of each coordinate), named when it lies kFarPointRatio times
-// farther than nine points in ten.
-void name_far_point(const std::vector<double>& xyz) {
-    const size_t n = xyz.size() / 3;
-    if (n < 10) return;
-    double middle[3];
-    std::vector<double> values(n);
-    for (size_t k = 0; k < 3; ++k) {
-        for (size_t i = 0; i < n; ++i) values[i] = xyz[3 * i + k];
-        std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(n / 2),
-                         values.end());
-        middle[k] = values[n / 2];
-    }
-    size_t farthest = 0;
-    for (size_t i = 0; i < n; ++i) {
-        double d = 0;
-        for (size_t k = 0; k < 3; ++k) d += (xyz[3 * i + k] - middle[k]) * (xyz[3 * i + k] - middle[k]);
-        values[i] = std::isfinite(d) ? std::sqrt(d) : 0;
-        if (values[i] > values[farthest]) farthest = i;
-    }
-    const double far = values[farthest];
-    const auto decile = values.begin() + static_cast<std::ptrdiff_t>(9 * n / 10);
-    std::nth_element(values.begin(), decile, values.end());
-    if (!(far > kFarPointRatio * *decile)) return;
-    std::fprintf(stderr,
-                 "stratmesh: point %zu (counting from 0) lies %g from the middle of the cloud, "
-                 "where 9 points in 10 lie within %g: --drop-outliers leaves such points out\n",
-                 farthest, far, *decile);
-}
-
 // `advice`, if any, is the tool's own account of the refusal (the stream's memory, which
 // its options size), said in place of the library's.
 void explain_refusal(const CommandLine& line, const RunRecord& record, const std::string& advice) {
@@ -309,6 +263,13 @@ void explain_refusal(const CommandLine& line, const RunRecord& record, const std
     if (!advice.empty()) {
         std::fprintf(stderr, "stratmesh: cannot reconstruct %s: out_of_memory: %s\n", name.c_str(),
                      advice.c_str());
+        return;
+    }
+    if (record.status == stratmesh::Status::invalid_origin) {
+        std::fprintf(stderr, "stratmesh: --origin %.6g,%.6g,%.6g: %s\n", line.origin[0],
+                     line.origin[1], line.origin[2],
+                     in_tool_words(record.report.detail ? record.report.detail
+                                                        : stratmesh::status_string(record.status)).c_str());
         return;
     }
     std::fprintf(stderr, "stratmesh: cannot reconstruct %s: %s\n", name.c_str(),
@@ -321,7 +282,7 @@ void explain_refusal(const CommandLine& line, const RunRecord& record, const std
                      "--skip-invalid skips such points\n",
                      record.report.points.first_invalid_index);
     else if (record.report.detail)
-        std::fprintf(stderr, "stratmesh: %s\n", record.report.detail);
+        std::fprintf(stderr, "stratmesh: %s\n", in_tool_words(record.report.detail).c_str());
 }
 
 // The valid points' range along the axis used, the cuts given outside it, and with layers
@@ -448,19 +409,17 @@ int finish_run(const CommandLine& line, RunRecord& record, Outputs& outputs) {
 }
 
 // Explains the refusal (with the tool's `advice`, if any) and writes the report alone.
-int refuse(const CommandLine& line, RunRecord& record, const std::vector<double>& xyz,
+int refuse(const CommandLine& line, RunRecord& record,
            const std::string& advice, Outputs& outputs) {
     const std::string faces = faces_warning(record);
     if (!faces.empty()) print_warnings(stderr, {faces});
     explain_refusal(line, record, advice);
-    if (record.status == stratmesh::Status::not_columnar ||
-        record.status == stratmesh::Status::degenerate)
-        name_far_point(xyz);
     record.peak_rss_bytes = peak_resident_bytes();
     outputs.mesh.discard();
     outputs.preview.discard();
     if (write_report(line, record, outputs.report)) outputs.commit();
-    return kExitRefused;
+    // An origin the frame cannot use is the command line's fault, not the cloud's.
+    return record.status == stratmesh::Status::invalid_origin ? kExitUsage : kExitRefused;
 }
 
 int run_streamed(const CommandLine& line, RunRecord& record, Outputs& outputs) {
@@ -471,7 +430,7 @@ int run_streamed(const CommandLine& line, RunRecord& record, Outputs& outputs) {
         run_stream(line, make_options(line, silent, jobs), record, outputs.mesh, error);
     switch (outcome) {
     case StreamOutcome::done: return finish_run(line, record, outputs);
-    case StreamOutcome::refused: return refuse(line, record, {}, error, outputs);
+    case StreamOutcome::refused: return refuse(line, record, error, outputs);
     case StreamOutcome::file_error: break;
     case StreamOutcome::usage:
         std::fprintf(stderr, "stratmesh: %s\n", error.c_str());
@@ -499,10 +458,9 @@ int run(const CommandLine& line) {
     PointAttributes attributes;
     Reconstruction result;
     if (!read_input(line, xyz, attributes, record)) return kExitFile;
-    if (line.origin_given && !origin_in_reach(line, xyz)) return kExitUsage;
     if (line.find_branches && !find_branches(xyz, line, record)) return kExitRefused;
     if (!reconstruct_points(xyz, line, result, record)) return kExitRefused;
-    if (record.status != stratmesh::Status::ok) return refuse(line, record, xyz, "", outputs);
+    if (record.status != stratmesh::Status::ok) return refuse(line, record, "", outputs);
     measure_along_axis(xyz, record);
     record.ends = find_surface_ends(xyz.data(), result.triangles.get(), result.triangle_count,
                                     record.report.axis, record.layers);

@@ -1,7 +1,6 @@
 #include "stream_run.h"
 
 #include "cloud_io.h"
-#include "frame_check.h"
 #include "mesh_ends.h"
 #include "mesh_io.h"
 #include "safe_output.h"
@@ -133,7 +132,7 @@ private:
                     error = backwards_message(height);
                     return StreamOutcome::unsorted;
                 }
-                if (height >= top_ && !push(top_)) return stopped(error);
+                if (height >= top_ && !push(top_)) return StreamOutcome::refused;
                 if (height >= top_ || !std::isfinite(highest_)) top_ = tops_.top_above(height);
                 highest_ = height;
             }
@@ -187,21 +186,9 @@ private:
         report_.points.in_count = pushed_;
     }
 
-    // Why push() returned false: the library refused, or the --origin given is out of reach.
-    StreamOutcome stopped(std::string& error) const {
-        if (origin_error_.empty()) return StreamOutcome::refused;
-        error = origin_error_;
-        return StreamOutcome::usage;
-    }
-
-    // Writes the layer's vertices (before any triangle can use them) and pushes it. An
-    // --origin given is checked against the points read so far first (frame_check.h).
+    // Writes the layer's vertices (before any triangle can use them) and pushes it.
     bool push(double top) {
         if (layer_.empty()) return true;
-        if (line_.origin_given) {
-            box_.add(layer_.data(), layer_.size() / 3);
-            if (!box_.origin_in_reach(options_.origin, origin_error_)) return false;
-        }
         Clock::time_point start = Clock::now();
         writer_.add_vertices(layer_.data(), layer_.size() / 3);
         if (line_.cap) all_points_.insert(all_points_.end(), layer_.begin(), layer_.end());
@@ -221,7 +208,7 @@ private:
     StreamOutcome close(std::string& error) {
         // The last push's top only bounds its points.
         double last_top = std::isfinite(highest_) ? highest_ : 0;
-        if (points_read_ > 0 && !push(last_top)) return stopped(error);
+        if (points_read_ > 0 && !push(last_top)) return StreamOutcome::refused;
         if (!record_.batch_cuts.empty()) record_.batch_cuts.pop_back();
         Clock::time_point start = Clock::now();
         record_.status =
@@ -343,8 +330,6 @@ private:
     size_t points_read_ = 0;
     size_t pushed_ = 0; // points handed to stream_push, refused ones too
     double stream_seconds_ = 0, write_seconds_ = 0;
-    CloudBox box_;             // with --origin: the points pushed so far
-    std::string origin_error_; // why --origin is out of reach
     std::string advice_;       // out_of_memory: what to do about the stream's memory
 };
 

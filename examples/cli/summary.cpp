@@ -2,10 +2,38 @@
 
 #include "safe_output.h"
 
+#include <cctype>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 namespace stratmesh_cli {
+
+std::string in_tool_words(const char* library_sentence) {
+    static const struct {
+        const char* library;
+        const char* tool;
+    } kWords[] = {{"drop_outliers", "--drop-outliers"}, {"skip_invalid_points", "--skip-invalid"},
+                  {"close_ends", "--cap"},              {"open_ends", "--open-ends"},
+                  {"surface_flips", "--surface-flips"}, {"one_tube", "--one-tube"},
+                  {"keep_parts", "--split-branches"}};
+    std::string text = library_sentence ? library_sentence : "";
+    for (const auto& w : kWords) {
+        const std::string from = w.library;
+        for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at)) {
+            const bool word_start = at == 0 || !(std::isalnum(static_cast<unsigned char>(text[at - 1])) || text[at - 1] == '_');
+            const size_t end = at + from.size();
+            const bool word_end = end == text.size() || !(std::isalnum(static_cast<unsigned char>(text[end])) || text[end] == '_');
+            if (word_start && word_end) {
+                text.replace(at, from.size(), w.tool);
+                at += std::strlen(w.tool);
+            } else {
+                at = end;
+            }
+        }
+    }
+    return text;
+}
 
 namespace {
 
@@ -251,7 +279,7 @@ std::string left_out_warning(const RunRecord& r) {
     add(p.unused_count, "unused");
     std::string text = plural(p.rejected_count + p.unused_count, "point", "points") +
                        " left out of the mesh (in the output, used by no triangle): " + parts;
-    if (p.unused_count && r.report.detail) text += std::string("; ") + r.report.detail;
+    if (p.unused_count && r.report.detail) text += "; " + in_tool_words(r.report.detail);
     return text;
 }
 
@@ -322,7 +350,7 @@ void print_split(std::FILE* out, const RunRecord& r) {
     if (r.split_undone)
         std::fprintf(out, "             not kept%s%s: meshed as one tube instead (--split-branches "
                           "keeps the parts)\n",
-                     r.report.detail ? ", " : "", r.report.detail ? r.report.detail : "");
+                     r.report.detail ? ", " : "", in_tool_words(r.report.detail).c_str());
 }
 
 void print_costs(std::FILE* out, const RunRecord& r) {

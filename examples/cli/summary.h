@@ -28,6 +28,10 @@ std::vector<std::string> run_warnings(const RunRecord& record);
 // The input faces left out of the cloud, or an empty string.
 std::string faces_warning(const RunRecord& record);
 
+// A sentence of the library's (Report::detail) in the tool's words: the library's option
+// names become the command line's (drop_outliers: --drop-outliers).
+std::string in_tool_words(const char* library_sentence);
+
 // Each warning on a line of its own, "stratmesh: warning: ...".
 void print_warnings(std::FILE* out, const std::vector<std::string>& warnings);
 

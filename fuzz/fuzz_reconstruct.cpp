@@ -7,14 +7,15 @@
 // and the triangle array ends where its allocation ends, so any overrun trips
 // AddressSanitizer. Options: every axis (direction with zero/NaN components too), cuts
 // with NaN, unsorted and repeated values, layer_count, layer_height, skip_invalid_points,
-// close_ends (caps), a layer array to fill.
+// close_ends (caps), layer and part arrays to fill.
 //
 // Checked after each run: the status is a documented one; the report's counts add up on
 // every status; on ok, every index < n, no repeated index in a triangle, at most
 // reconstruct_max_triangles triangles, the mesh an oriented edge- and vertex-manifold
 // (tests/support/mesh_check.h), vertices only distinct valid points and points_used equal
 // to the vertices used; a second run on a differently-filled workspace, with the layers
-// triangulated ahead by jobs (Options::run_jobs, run in reverse order), gives the same bits.
+// triangulated ahead by jobs (Options::run_jobs, run in reverse order), gives the same bits
+// (triangles, report, layers, parts).
 // On an eighth of the inputs (by a hash of their bytes; all of them with
 // STRATMESH_FUZZ_STRICT) the second run and find_parting() run too, in a workspace of exactly
 // find_parting_workspace_size(): a documented status, and on ok branches that a side of
@@ -45,18 +46,22 @@ struct Run {
     stratmesh::Report report;
     std::vector<uint32_t> triangles;
     std::vector<stratmesh::LayerInfo> layers;
+    std::vector<stratmesh::PartInfo> parts;
 };
 
 Run run(const stratmesh::Cloud& cloud, const stratmesh::Options& options, size_t capacity,
-        size_t layer_capacity, unsigned char fill) {
+        size_t info_capacity, unsigned char fill) {
     Run r;
     const size_t work_bytes = stratmesh::reconstruct_workspace_size(cloud.count, options);
     std::vector<unsigned char> work(work_bytes, fill);
     r.triangles.assign(3 * capacity, 0xDEADBEEFu);
-    r.layers.resize(layer_capacity);
+    r.layers.resize(info_capacity);
+    r.parts.resize(info_capacity);
     std::memset(static_cast<void*>(&r.report), fill, sizeof r.report);
-    r.report.layers.info = layer_capacity ? r.layers.data() : nullptr;
-    r.report.layers.info_capacity = layer_capacity;
+    r.report.layers.info = info_capacity ? r.layers.data() : nullptr;
+    r.report.layers.info_capacity = info_capacity;
+    r.report.parts.info = info_capacity ? r.parts.data() : nullptr;
+    r.report.parts.info_capacity = info_capacity;
     r.count = 12345;
     r.status = stratmesh::reconstruct(cloud, options, work.empty() ? nullptr : work.data(),
                                       work_bytes, capacity ? r.triangles.data() : nullptr,
@@ -184,7 +189,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const size_t max_tris = stratmesh::reconstruct_max_triangles(n, options);
     const bool small_capacity = (ocfg & 0x40) != 0;
     const size_t capacity = small_capacity ? std::min<size_t>(max_tris, in.below(64)) : max_tris;
-    const size_t layer_capacity = in.below(8);
+    const size_t info_capacity = in.below(8);
     // Read last, so that the corpus's older inputs keep their meaning.
     const uint8_t last = in.u8();
     if (last & 1) options.flags |= stratmesh::drop_outliers;
@@ -193,7 +198,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const bool dropping = (options.flags & stratmesh::drop_outliers) != 0;
 
     if (thorough) check_parting(cloud, options);
-    Run first = run(cloud, options, capacity, layer_capacity, 0xA5);
+    Run first = run(cloud, options, capacity, info_capacity, 0xA5);
     const stratmesh::Report& rep = first.report;
     if (std::getenv("STRATMESH_FUZZ_VERBOSE"))
         std::fprintf(stderr, "n %zu, %s, %zu triangles, %zu layers, used %zu dup %zu rej %zu unused %zu\n", n,
@@ -321,7 +326,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (!thorough) return 0;
     stratmesh::Options with_jobs = options;
     with_jobs.run_jobs = run_jobs_in_reverse;
-    Run second = run(cloud, with_jobs, capacity, layer_capacity, 0x5A);
+    Run second = run(cloud, with_jobs, capacity, info_capacity, 0x5A);
     STRATMESH_FUZZ_CHECK(second.status == first.status, "second run: different status");
     STRATMESH_FUZZ_CHECK(second.count == first.count, "second run: different count");
     STRATMESH_FUZZ_CHECK(second.triangles == first.triangles, "second run: different triangles");
@@ -334,7 +339,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (size_t k = 0; k < 3; ++k)
         STRATMESH_FUZZ_CHECK(same_double(r2.axis[k], rep.axis[k]) && same_double(r2.axis_origin[k], rep.axis_origin[k]),
                              "second run: different axis");
-    size_t filled = std::min(rep.layers.used_count, layer_capacity);
+    size_t filled = std::min(rep.layers.used_count, info_capacity);
     for (size_t k = 0; k < filled; ++k) {
         const stratmesh::LayerInfo& a = first.layers[k];
         const stratmesh::LayerInfo& b = second.layers[k];
@@ -343,6 +348,21 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                     a.triangle_count == b.triangle_count && a.fold_count == b.fold_count;
         for (size_t j = 0; j < 3; ++j) same = same && same_double(a.centre[j], b.centre[j]);
         STRATMESH_FUZZ_CHECK(same, "second run: different layers");
+    }
+    const stratmesh::PartCounts &p1 = rep.parts, &p2 = r2.parts;
+    STRATMESH_FUZZ_CHECK(p1.outcome == p2.outcome && p1.part_count == p2.part_count &&
+                             p1.joined_side_count == p2.joined_side_count && p1.apart_side_count == p2.apart_side_count &&
+                             p1.grafted_branch_count == p2.grafted_branch_count &&
+                             p1.junction_triangle_count == p2.junction_triangle_count &&
+                             p1.removed_triangle_count == p2.removed_triangle_count,
+                         "second run: different parts");
+    for (size_t k = 0; k < std::min(p1.part_count, info_capacity); ++k) {
+        const stratmesh::PartInfo& a = first.parts[k];
+        const stratmesh::PartInfo& b = second.parts[k];
+        STRATMESH_FUZZ_CHECK(a.label == b.label && a.status == b.status && a.point_count == b.point_count &&
+                                 a.layer_count == b.layer_count && a.triangle_count == b.triangle_count &&
+                                 a.fold_count == b.fold_count && a.merged_end_layer_count == b.merged_end_layer_count,
+                             "second run: different part details");
     }
     return 0;
 }

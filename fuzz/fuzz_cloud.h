@@ -29,6 +29,16 @@ struct FuzzCloud {
         return {n ? buffer.data() : nullptr, n, stride,
                 f32 ? stratmesh::Scalar::float32 : stratmesh::Scalar::float64};
     }
+
+    // The first `count` points (at most n), in a buffer of their exact size.
+    FuzzCloud first(size_t count) const {
+        FuzzCloud c = *this;
+        c.n = count < n ? count : n;
+        c.xyz.assign(xyz.begin(), xyz.begin() + static_cast<std::ptrdiff_t>(3 * c.n));
+        const size_t bytes = c.n ? (c.n - 1) * step + 3 * (f32 ? 4 : 8) : 0;
+        c.buffer = std::vector<unsigned char>(buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(bytes));
+        return c;
+    }
 };
 
 inline FuzzCloud read_cloud(Bytes& in, uint32_t max_points) {

@@ -42,6 +42,7 @@ public:
     Bytes(const uint8_t* data, size_t size) : data_(data), size_(size) {}
 
     size_t remaining() const { return size_ - pos_; }
+    size_t position() const { return pos_; }
 
     uint8_t u8() { return pos_ < size_ ? data_[pos_++] : 0; }
     // (Each read is its own statement: the order in which operands or function arguments
@@ -98,6 +99,12 @@ public:
     }
     // An integer in [0, n); 0 for n = 0.
     size_t below(size_t n) { return n ? static_cast<size_t>(next() % n) : 0; }
+    // An integer in [lo, hi].
+    int64_t between(int64_t lo, int64_t hi) {
+        return lo + static_cast<int64_t>(below(static_cast<size_t>(hi - lo) + 1));
+    }
+    // A double in [0, 1).
+    double uniform() { return static_cast<double>(next() >> 11) * 0x1p-53; }
 
 private:
     uint64_t state_;

@@ -7,7 +7,8 @@
 // triangle array ends where its allocation ends, so any overrun trips AddressSanitizer.
 // Options: every axis (direction with zero/NaN components too), cuts with NaN, unsorted and
 // repeated values, layer_count, layer_height, skip_invalid_points, close_ends (caps),
-// drop_outliers, surface_flips, open_ends, layer and part arrays to fill.
+// drop_outliers, surface_flips, open_ends, layer and part arrays to fill. Under libFuzzer a
+// structure-aware mutator (fuzz_cloud_mutator.h) makes the clouds that sensors make.
 //
 // How much of the pipeline runs, by a hash of the input's bytes (a given input always runs
 // the same way; libFuzzer's mutations of it spread over all three):
@@ -33,6 +34,7 @@
 // adding up to at most n), each point labelled (the branches above exactly as large as
 // reported, those below at most: the side above keeps the points of both).
 #include "fuzz_cloud.h"
+#include "fuzz_cloud_mutator.h"
 #include "fuzz_common.h"
 #include "known_bugs.h"
 
@@ -48,10 +50,8 @@
 
 namespace {
 
-// The most points a cloud holds (a fork of two branches of kSmallestBranch points and its
-// trunk fits), and the most that the quick runs mesh (see above).
-const uint32_t kMaxPoints = 256;
-const size_t kQuickPoints = 48;
+const uint32_t kMaxPoints = stratmesh_fuzz::kReconstructMaxPoints;
+const size_t kQuickPoints = stratmesh_fuzz::kReconstructQuickPoints;
 // One input in kWholeShare runs the whole pipeline, one in kAxisShare of the others the
 // automatic axis (see above).
 const uint64_t kWholeShare = 64;
@@ -416,3 +416,29 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (thorough) check_second_run(first, cloud, setup, capacity);
     return 0;
 }
+
+// ---- the mutator (libFuzzer only: the replay driver runs the corpus as it is) -------------
+#if !defined(STRATMESH_FUZZ_REPLAY)
+
+extern "C" size_t LLVMFuzzerMutate(uint8_t* data, size_t size, size_t max_size);
+
+// Half the time the cloud's structure (fuzz_cloud_mutator.h), otherwise libFuzzer's own
+// changes to the bytes, which also reach the options after the cloud.
+extern "C" size_t LLVMFuzzerCustomMutator(uint8_t* data, size_t size, size_t max_size, unsigned int seed) {
+    stratmesh_fuzz::Random random(seed);
+    if (random.below(2) == 0) {
+        const size_t written = stratmesh_fuzz::mutate_cloud(data, size, max_size, kMaxPoints, kQuickPoints, random);
+        if (written) return written;
+    }
+    return LLVMFuzzerMutate(data, size, max_size);
+}
+
+extern "C" size_t LLVMFuzzerCustomCrossOver(const uint8_t* data1, size_t size1, const uint8_t* data2,
+                                            size_t size2, uint8_t* out, size_t max_out_size,
+                                            unsigned int seed) {
+    stratmesh_fuzz::Random random(seed);
+    return stratmesh_fuzz::cross_clouds(data1, size1, data2, size2, out, max_out_size, kMaxPoints,
+                                        kQuickPoints, random);
+}
+
+#endif

@@ -35,7 +35,7 @@ namespace stratmesh_fuzz {
 // fork: two branches of kSmallestBranch points and a trunk), of which most runs mesh only the
 // first kReconstructQuickPoints (fuzz_reconstruct.cpp says why).
 const uint32_t kReconstructMaxPoints = 256;
-const size_t kReconstructQuickPoints = 48;
+const size_t kReconstructQuickPoints = 32;
 
 // An input as the mutator sees it: its cloud and the bytes after it.
 struct SplitInput {

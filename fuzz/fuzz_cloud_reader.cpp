@@ -111,20 +111,7 @@ extern "C" size_t LLVMFuzzerMutate(uint8_t* data, size_t size, size_t max_size);
 
 namespace {
 
-class Random {
-public:
-    explicit Random(unsigned seed) : state_(seed * 0x9E3779B97F4A7C15ull + 1) {}
-    uint64_t next() {
-        state_ ^= state_ << 13;
-        state_ ^= state_ >> 7;
-        state_ ^= state_ << 17;
-        return state_;
-    }
-    size_t below(size_t n) { return n ? static_cast<size_t>(next() % n) : 0; }
-
-private:
-    uint64_t state_;
-};
+using stratmesh_fuzz::Random;
 
 std::vector<std::string> split_lines(const std::string& text) {
     std::vector<std::string> lines;

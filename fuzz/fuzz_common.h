@@ -1,5 +1,6 @@
 // Shared helpers for the stratmesh fuzz harnesses: a byte reader that never runs out
-// (missing bytes read as zero) and a loud failure for a broken invariant.
+// (missing bytes read as zero), a loud failure for a broken invariant, and the random
+// numbers of the structure-aware mutators.
 //
 // The harnesses are built two ways: with clang's libFuzzer (fuzz/CMakeLists.txt) and, with
 // any compiler, against fuzz/replay/replay_main.cpp, which runs each file of a corpus
@@ -41,6 +42,7 @@ public:
     Bytes(const uint8_t* data, size_t size) : data_(data), size_(size) {}
 
     size_t remaining() const { return size_ - pos_; }
+    size_t position() const { return pos_; }
 
     uint8_t u8() { return pos_ < size_ ? data_[pos_++] : 0; }
     // (Each read is its own statement: the order in which operands or function arguments
@@ -83,6 +85,29 @@ private:
     const uint8_t* data_;
     size_t size_;
     size_t pos_ = 0;
+};
+
+// The custom mutators' random numbers (xorshift), from libFuzzer's seed for the call.
+class Random {
+public:
+    explicit Random(unsigned seed) : state_(seed * 0x9E3779B97F4A7C15ull + 1) {}
+    uint64_t next() {
+        state_ ^= state_ << 13;
+        state_ ^= state_ >> 7;
+        state_ ^= state_ << 17;
+        return state_;
+    }
+    // An integer in [0, n); 0 for n = 0.
+    size_t below(size_t n) { return n ? static_cast<size_t>(next() % n) : 0; }
+    // An integer in [lo, hi].
+    int64_t between(int64_t lo, int64_t hi) {
+        return lo + static_cast<int64_t>(below(static_cast<size_t>(hi - lo) + 1));
+    }
+    // A double in [0, 1).
+    double uniform() { return static_cast<double>(next() >> 11) * 0x1p-53; }
+
+private:
+    uint64_t state_;
 };
 
 }  // namespace stratmesh_fuzz

@@ -27,10 +27,24 @@
 //    spreads above 320 bits (orient2d's filter in fuzz_predicates.cpp: above 800).
 //    Reproducer: bug-B-incircle-wrong-sign-span-618-bits (fuzz_predicates); the 434-bit one
 //    passes since the rescaling limits changed, but is equally outside the contract.
+// J: reconstruct() takes time quadratic in the points where Options::layer_height plans
+//    about a layer a point and the thin layers do not surround the axis or are mostly
+//    repeats: 16 points repeated to 2,040 along y with layer_height 1 and one_tube took
+//    7.3 s in a Release build (0.2 s at 255 points, 5 ms with automatic layers); a cloud of
+//    255 points that surrounds no axis, with layer_height 1/16, 0.9 s (41 ms with automatic
+//    layers). Under the sanitizers such runs of 255 points took 10 to 15 s, which CI's fuzz
+//    stage counts as failures. The filter: fuzz_reconstruct runs an input whose
+//    layer_height would plan more layers than an eighth of its points as a quick run (at
+//    most kReconstructQuickPoints points) instead of the whole pipeline. Reproducer:
+//    bug-J-thin-layers-of-repeats-quadratic-time (fuzz_reconstruct), slow only with
+//    STRATMESH_FUZZ_STRICT=1 (no invariant fails, so no expected-to-fail test).
 #ifndef STRATMESH_FUZZ_KNOWN_BUGS_H
 #define STRATMESH_FUZZ_KNOWN_BUGS_H
 
+#include "stratmesh.h"
+
 #include <cmath>
+#include <cstddef>
 #include <cstdlib>
 
 namespace stratmesh_fuzz {
@@ -79,6 +93,26 @@ inline int orient2d_spread(const double* a, const double* b, const double* c) {
 
 inline bool bug_b_incircle(const double* a, const double* b, const double* c, const double* d) {
     return incircle_spread(a, b, c, d) > 320;  // the contract's bound (stratmesh.h)
+}
+
+// Whether layer_height lays out the layers of the n points xyz[0, 3n) and would plan more
+// than n / 8 of them (the diagonal of the finite coordinates' box over the height: at least
+// the cloud's extent along any axis).
+inline bool bug_j_thin_layers(const double* xyz, size_t n, const stratmesh::Options& options) {
+    if (options.cut_count || options.layer_count || !(options.layer_height > 0)) return false;
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (size_t i = 0; i < n; ++i) {
+        const double* p = xyz + 3 * i;
+        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) continue;
+        for (size_t k = 0; k < 3; ++k) {
+            lo[k] = std::fmin(lo[k], p[k]);
+            hi[k] = std::fmax(hi[k], p[k]);
+        }
+    }
+    double diagonal = 0;
+    for (size_t k = 0; k < 3; ++k)
+        if (lo[k] <= hi[k]) diagonal = std::hypot(diagonal, hi[k] - lo[k]);
+    return diagonal / options.layer_height > static_cast<double>(n) / 8;
 }
 
 }  // namespace stratmesh_fuzz

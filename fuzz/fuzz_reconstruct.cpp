@@ -221,6 +221,7 @@ void check_status(const Run& first, const Setup& s, const stratmesh_fuzz::FuzzCl
     case Status::flat_cloud:
     case Status::not_columnar:
     case Status::degenerate:
+    case Status::separate_clusters:
     case Status::triangle_capacity:
         break;
     default:

@@ -1377,8 +1377,8 @@ stratmesh_status stratmesh_stream_close(stratmesh_stream* stream);
 //   >>cloud               reading the cloud: invalid points refused or counted, outliers
 //                         left out, sums
 //   >>frame               the frame the layers are cut in: its axis, origin and scale
-//   >>jobs                the caller's callbacks: progress, and passes split into jobs for
-//                         the runner
+//   >>jobs                the caller's callbacks: progress, and batches of jobs for the
+//                         runner
 //   >>layer plan          cuts along the axis: explicit, equal, by height or automatic;
 //                         points grouped by layer
 //   >>unroll              a layer onto its annulus (cylinder and closed ends)
@@ -3921,7 +3921,7 @@ STRATMESH_SMALL_NOINLINE inline void report_frame(const Frame& frame, Report& re
 }  // namespace stratmesh
 
 // >>jobs =================================================================================
-// The caller's callbacks: progress, and passes split into jobs for the runner.
+// The caller's callbacks: progress, and batches of jobs for the runner.
 
 namespace stratmesh {
 namespace detail {
@@ -3930,36 +3930,57 @@ inline void notify(const Options& options, Phase phase, double fraction) {
     if (options.progress) options.progress(options.progress_user, phase, fraction);
 }
 
+// ---- jobs on the caller's runner ----
+//
+// Every batch of jobs reaches Options::run_jobs through run_jobs below, which holds the
+// runner to its contract (see JobRunner): an index outside the batch is ignored, a job run
+// again does nothing, and a job the runner skipped is done afterwards as the batch says.
+
+// Whether work is cut into jobs: a runner given, in a build that has them.
+inline bool has_runner(const Options& options) {
+    return kParallelLayers && options.run_jobs != nullptr;
+}
+
+template <class Job> struct JobBatch {
+    const Job* job;
+    uint32_t count;
+    bool done[kMaxJobs];
+};
+
+template <class Job> inline void run_batch_job(void* context, uint32_t index) {
+    JobBatch<Job>& batch = *static_cast<JobBatch<Job>*>(context);
+    if (index >= batch.count || batch.done[index]) return;  // no job of ours, or done already
+    (*batch.job)(index);
+    batch.done[index] = true;
+}
+
+// Runs job(k) for k in [0, count), count <= kMaxJobs, on the caller's runner where there is
+// one. With `redo_skipped`, each job the runner skipped, or every job without a runner, is
+// then run here in order; else it is left undone (the layers not done ahead are
+// triangulated by their groups).
+template <class Job>
+inline void run_jobs(const Options& options, uint32_t count, bool redo_skipped, const Job& job) {
+    JobBatch<Job> batch = {&job, count, {}};
+    if (has_runner(options)) options.run_jobs(options.jobs_user, count, run_batch_job<Job>, &batch);
+    for (uint32_t k = 0; redo_skipped && k < count; ++k)
+        if (!batch.done[k]) job(k);
+}
+
 // ---- passes over all points as jobs ----
 //
-// With Options::run_jobs, a pass over all points that gives the same bits in any order
-// (grouping the points by layer) is cut into kPassRuns runs of consecutive points, run as
-// jobs. As for the layers' jobs (see JobRunner), a run the runner skips is done in order
-// afterwards, and a run done again changes nothing.
+// With a runner, a pass over all points that gives the same bits in any order (grouping
+// the points by layer) is cut into kPassRuns runs of consecutive points, run as jobs.
 const uint32_t kPassRuns = 16;
+static_assert(kPassRuns <= kMaxJobs, "a pass's runs are one batch of jobs");
 
 // The first point of run k of `count` points.
 inline size_t run_start(size_t count, uint32_t k) {
     return static_cast<size_t>(static_cast<uint64_t>(count) * k / kPassRuns);
 }
 
-template <class Pass> struct PassJobs {
-    Pass* pass;
-    bool done[kPassRuns];
-};
-
-template <class Pass> inline void run_pass_job(void* context, uint32_t index) {
-    PassJobs<Pass>& jobs = *static_cast<PassJobs<Pass>*>(context);
-    if (index >= kPassRuns) return;  // a runner's mistake: no run of ours
-    jobs.pass->run(index);
-    jobs.done[index] = true;
-}
-
+// Runs pass.run(k) for every run k: as jobs with a runner, else in order.
 template <class Pass> inline void run_pass(const Options& options, Pass& pass) {
-    PassJobs<Pass> jobs = {&pass, {}};
-    options.run_jobs(options.jobs_user, kPassRuns, run_pass_job<Pass>, &jobs);
-    for (uint32_t k = 0; k < kPassRuns; ++k)
-        if (!jobs.done[k]) pass.run(k);
+    run_jobs(options, kPassRuns, true, [&pass](uint32_t k) { pass.run(k); });
 }
 
 }  // namespace detail
@@ -4369,7 +4390,7 @@ inline bool group_by_layer_in_jobs(const Options& options, const CloudReader& cl
                                    uint32_t* layer, uint32_t* layer_start, uint32_t* order,
                                    Arena& arena) {
     const size_t table = kPassRuns * static_cast<size_t>(plan.count);
-    if (!kParallelLayers || !options.run_jobs || 3 * table > count) return false;
+    if (!has_runner(options) || 3 * table > count) return false;
     const size_t mark = arena.mark();
     GroupingPass pass = {&cloud, &frame, &plan, 0, count, layer, order,
                          arena.alloc<uint32_t>(table), arena.alloc<uint32_t>(table),
@@ -8370,7 +8391,7 @@ inline uint32_t number_vertices(uint32_t* tri, size_t count, size_t point_count,
     return vertices;
 }
 
-// The passes over the vertices, by runs of them (see run_pass) or all at once.
+// The passes over the vertices, by runs of them (see run_pass).
 struct WebVertexPass {
     const CloudReader* reader;
     const WebFrame* frame;
@@ -8378,8 +8399,8 @@ struct WebVertexPass {
     uint32_t vertices;
     bool medians;  // else the points
 
-    void run(uint32_t k) { over(run_start(vertices, k), run_start(vertices, k + 1)); }
-    void over(size_t begin, size_t end) const {
+    void run(uint32_t k) const {
+        const size_t begin = run_start(vertices, k), end = run_start(vertices, k + 1);
         if (!medians) {
             for (size_t v = begin; v < end; ++v) {
                 if (kFastLoops && v + kWebAhead < end)
@@ -8394,13 +8415,6 @@ struct WebVertexPass {
         }
     }
 };
-
-inline void run_vertex_pass(const Options& options, WebVertexPass& pass) {
-    if (kParallelLayers && options.run_jobs)
-        run_pass(options, pass);
-    else
-        pass.over(0, pass.vertices);
-}
 
 // The lengths of the edges leaving each vertex, sorted by vertex (a counting sort: each
 // start becomes an end), and each triangle's longest edge. Returns the triangles' area.
@@ -8473,10 +8487,10 @@ inline bool measure_webs(const Options& options, const CloudReader& reader, size
     const WebFrame f = web_frame(sums);
     WebVertexPass pass = {&reader, &f, &m, number_vertices(triangles, walls, point_count, m),
                           false};
-    run_vertex_pass(options, pass);
+    run_pass(options, pass);
     const double area = edge_lengths(f, triangles, walls, m);
     pass.medians = true;
-    run_vertex_pass(options, pass);
+    run_pass(options, pass);
     Diagnostics& d = rep.diagnostics;
     const double web = find_webs(f, triangles, walls, m, d);
     arena.rewind(mark);
@@ -8895,12 +8909,12 @@ inline void keep_border(LayerAhead& a, const uint32_t* ids, size_t n, Arena& are
     for (size_t k = 0; k < 3 * a.triangle_count; ++k) a.triangles[k] = ids[a.triangles[k]];
 }
 
-inline void run_layer_job(void* context, uint32_t index) {
-    const ParallelLayers& p = *static_cast<const ParallelLayers*>(context);
-    if (index >= p.job_count) return;  // a runner's mistake: no job of ours
+// Job `job`: triangulates the layers of slots first_slot[job] .. first_slot[job + 1] - 1 in
+// the job's own scratch.
+inline void triangulate_job(const ParallelLayers& p, uint32_t job) {
     const LayerQueue& q = *p.queue;
-    Arena arena = Arena::over(p.scratch[index], p.scratch_bytes[index]);
-    for (uint32_t slot = p.first_slot[index]; slot < p.first_slot[index + 1]; ++slot) {
+    Arena arena = Arena::over(p.scratch[job], p.scratch_bytes[job]);
+    for (uint32_t slot = p.first_slot[job]; slot < p.first_slot[job + 1]; ++slot) {
         LayerAhead& a = p.ahead[slot];
         const uint32_t k = p.layer_of_slot[slot];
         const size_t n = q.start[k + 1] - q.start[k];
@@ -8931,33 +8945,17 @@ inline void run_layer_job(void* context, uint32_t index) {
     }
 }
 
-// Plans the jobs over the queue, carves their results and scratch from the arena and runs
-// them. Returns with p.ready false (and the arena as it was) when there is nothing to gain or
-// no room: the groups are then triangulated in order. The results stay in the arena; the
-// jobs' scratch is released.
-inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& arena) {
-    p.ready = false;
+// Gives each layer that may stand alone a slot: its part of the results carved from the
+// arena (false if they do not fit). `points` are the slots' points in all.
+inline bool assign_slots(ParallelLayers& p, uint32_t slots, size_t points, Arena& arena) {
     const LayerQueue& q = *p.queue;
-    uint32_t slots = 0;
-    size_t points = 0;
-    for (uint32_t k = 0; k < q.planned; ++k)
-        if (may_stand_alone(q, k)) {
-            ++slots;
-            points += q.start[k + 1] - q.start[k];
-        }
-    if (slots < 2) return;
-    const size_t mark = arena.mark();
-    auto give_up = [&]() {
-        arena.failed = false;
-        arena.rewind(mark);
-    };
     uint32_t* triangles = nullptr;
     uint32_t* loops = nullptr;
     unsigned char* loop_flags = nullptr;
     uint32_t* borders = nullptr;
     if (!allocate_ahead(p, slots, points, q.planned, arena, &triangles, &loops, &loop_flags,
                         &borders))
-        return give_up();
+        return false;
     p.slots = slots;
     uint32_t slot = 0;
     size_t at = 0, border_at = 0;
@@ -8979,15 +8977,19 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
         p.layer_of_slot[slot] = k;
         p.slot_of_layer[k] = slot++;
     }
-    const size_t results = arena.mark();
-    // Jobs: runs of slots with about equal point counts. A slot goes to the share of the
-    // points its middle falls in, so equal layers get a job each (a threshold on a running
-    // count would put a layer slightly under the mean together with the next).
-    const uint32_t most = slots < kMaxJobs ? slots : kMaxJobs;
+    return true;
+}
+
+// Cuts the slots into jobs: runs of slots with about equal point counts. A slot goes to the
+// share of the points its middle falls in, so equal layers get a job each (a threshold on
+// a running count would put a layer slightly under the mean together with the next).
+inline void divide_jobs(ParallelLayers& p, size_t points) {
+    const LayerQueue& q = *p.queue;
+    const uint32_t most = p.slots < kMaxJobs ? p.slots : kMaxJobs;
     uint32_t job = 0;
     uint64_t share_of_job = 0, before = 0;
     p.first_slot[0] = 0;
-    for (uint32_t s = 0; s < slots; ++s) {
+    for (uint32_t s = 0; s < p.slots; ++s) {
         const uint32_t k = p.layer_of_slot[s];
         const uint64_t n = q.start[k + 1] - q.start[k];
         const uint64_t share = (before + n / 2) * most / points;
@@ -8998,7 +9000,12 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
         before += n;
     }
     p.job_count = job + 1;
-    p.first_slot[p.job_count] = slots;
+    p.first_slot[p.job_count] = p.slots;
+}
+
+// Each job's scratch: that of its largest layer. False if they do not fit.
+inline bool allocate_job_scratch(ParallelLayers& p, Arena& arena) {
+    const LayerQueue& q = *p.queue;
     for (uint32_t j = 0; j < p.job_count; ++j) {
         size_t largest = 0;
         for (uint32_t s = p.first_slot[j]; s < p.first_slot[j + 1]; ++s) {
@@ -9009,8 +9016,35 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
         p.scratch_bytes[j] = reconstruct_scratch_size(largest, false) + Arena::kAlign;
         p.scratch[j] = arena.alloc<unsigned char>(p.scratch_bytes[j]);
     }
-    if (arena.failed) return give_up();
-    options.run_jobs(options.jobs_user, p.job_count, run_layer_job, &p);
+    return !arena.failed;
+}
+
+// Plans the jobs over the queue, carves their results and scratch from the arena and runs
+// them. Returns with p.ready false (and the arena as it was) when there is nothing to gain or
+// no room: the groups are then triangulated in order. The results stay in the arena; the
+// jobs' scratch is released.
+inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& arena) {
+    p.ready = false;
+    const LayerQueue& q = *p.queue;
+    uint32_t slots = 0;
+    size_t points = 0;
+    for (uint32_t k = 0; k < q.planned; ++k)
+        if (may_stand_alone(q, k)) {
+            ++slots;
+            points += q.start[k + 1] - q.start[k];
+        }
+    if (slots < 2) return;
+    const size_t mark = arena.mark();
+    auto give_up = [&]() {
+        arena.failed = false;
+        arena.rewind(mark);
+    };
+    if (!assign_slots(p, slots, points, arena)) return give_up();
+    const size_t results = arena.mark();
+    divide_jobs(p, points);
+    if (!allocate_job_scratch(p, arena)) return give_up();
+    // A job the runner skips leaves its layers to their groups.
+    run_jobs(options, p.job_count, false, [&p](uint32_t job) { triangulate_job(p, job); });
     arena.rewind(results);
     p.ready = true;
 }
@@ -9020,7 +9054,7 @@ inline size_t start_parallel_layers(const Options& options, const CloudReader& r
                                     const Frame& frame, const LayerQueue& queue, Arena& arena,
                                     ParallelLayers& parallel) {
     parallel.ready = false;
-    if (!options.run_jobs) return 0;
+    if (!has_runner(options)) return 0;
     parallel.reader = &reader;
     parallel.frame = &frame;
     parallel.queue = &queue;
@@ -9138,7 +9172,7 @@ inline size_t tube_workspace_size(size_t point_count, const Options& options) {
                                                       (options.flags & close_ends) != 0);
     // With a runner, the layers done ahead (at most one per kMinLayerPoints points, plus the
     // last) stay while the groups are formed.
-    if (options.run_jobs &&
+    if (has_runner(options) &&
         !plan_parallel_workspace(point_count, layer_limit, arena, &scratch))
         return 0;
     if (arena.failed || scratch == 0 || scratch > SIZE_MAX - arena.required_bytes()) return 0;
@@ -9236,7 +9270,7 @@ inline Status plan_tube_layers(const TubeInput& in, const Options& options, cons
     const size_t mark = arena.mark();
     uint32_t* layer = arena.alloc<uint32_t>(in.count);
     if (arena.failed) return Status::out_of_memory;
-    if (kStagePoints && !(kParallelLayers && options.run_jobs))
+    if (kStagePoints && !has_runner(options))
         *staged = static_cast<Local*>(arena.room_at_end(saturating_product(valid, sizeof(Local))));
     if (!group_by_layer_in_jobs(options, in.reader, in.count, frame, plan, layer, m.layer_start,
                                 m.order, arena))

@@ -402,7 +402,7 @@ inline bool group_by_layer_in_jobs(const Options& options, const CloudReader& cl
                                    uint32_t* layer, uint32_t* layer_start, uint32_t* order,
                                    Arena& arena) {
     const size_t table = kPassRuns * static_cast<size_t>(plan.count);
-    if (!kParallelLayers || !options.run_jobs || 3 * table > count) return false;
+    if (!has_runner(options) || 3 * table > count) return false;
     const size_t mark = arena.mark();
     GroupingPass pass = {&cloud, &frame, &plan, 0, count, layer, order,
                          arena.alloc<uint32_t>(table), arena.alloc<uint32_t>(table),

@@ -68,7 +68,7 @@ inline size_t tube_workspace_size(size_t point_count, const Options& options) {
                                                       (options.flags & close_ends) != 0);
     // With a runner, the layers done ahead (at most one per kMinLayerPoints points, plus the
     // last) stay while the groups are formed.
-    if (options.run_jobs &&
+    if (has_runner(options) &&
         !plan_parallel_workspace(point_count, layer_limit, arena, &scratch))
         return 0;
     if (arena.failed || scratch == 0 || scratch > SIZE_MAX - arena.required_bytes()) return 0;
@@ -166,7 +166,7 @@ inline Status plan_tube_layers(const TubeInput& in, const Options& options, cons
     const size_t mark = arena.mark();
     uint32_t* layer = arena.alloc<uint32_t>(in.count);
     if (arena.failed) return Status::out_of_memory;
-    if (kStagePoints && !(kParallelLayers && options.run_jobs))
+    if (kStagePoints && !has_runner(options))
         *staged = static_cast<Local*>(arena.room_at_end(saturating_product(valid, sizeof(Local))));
     if (!group_by_layer_in_jobs(options, in.reader, in.count, frame, plan, layer, m.layer_start,
                                 m.order, arena))

@@ -145,7 +145,7 @@ inline uint32_t number_vertices(uint32_t* tri, size_t count, size_t point_count,
     return vertices;
 }
 
-// The passes over the vertices, by runs of them (see run_pass) or all at once.
+// The passes over the vertices, by runs of them (see run_pass).
 struct WebVertexPass {
     const CloudReader* reader;
     const WebFrame* frame;
@@ -153,8 +153,8 @@ struct WebVertexPass {
     uint32_t vertices;
     bool medians;  // else the points
 
-    void run(uint32_t k) { over(run_start(vertices, k), run_start(vertices, k + 1)); }
-    void over(size_t begin, size_t end) const {
+    void run(uint32_t k) const {
+        const size_t begin = run_start(vertices, k), end = run_start(vertices, k + 1);
         if (!medians) {
             for (size_t v = begin; v < end; ++v) {
                 if (kFastLoops && v + kWebAhead < end)
@@ -169,13 +169,6 @@ struct WebVertexPass {
         }
     }
 };
-
-inline void run_vertex_pass(const Options& options, WebVertexPass& pass) {
-    if (kParallelLayers && options.run_jobs)
-        run_pass(options, pass);
-    else
-        pass.over(0, pass.vertices);
-}
 
 // The lengths of the edges leaving each vertex, sorted by vertex (a counting sort: each
 // start becomes an end), and each triangle's longest edge. Returns the triangles' area.
@@ -248,10 +241,10 @@ inline bool measure_webs(const Options& options, const CloudReader& reader, size
     const WebFrame f = web_frame(sums);
     WebVertexPass pass = {&reader, &f, &m, number_vertices(triangles, walls, point_count, m),
                           false};
-    run_vertex_pass(options, pass);
+    run_pass(options, pass);
     const double area = edge_lengths(f, triangles, walls, m);
     pass.medians = true;
-    run_vertex_pass(options, pass);
+    run_pass(options, pass);
     Diagnostics& d = rep.diagnostics;
     const double web = find_webs(f, triangles, walls, m, d);
     arena.rewind(mark);

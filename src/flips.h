@@ -386,23 +386,18 @@ struct Seam {
     }
 };
 
-// The seam of a chunk (see above). False with seam.triangles = 0 when it is left as it is;
-// false with arena.failed when the arena is too small.
-inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                      uint32_t* chunk, size_t count, Arena& arena, Seam& seam) {
-    seam.chunk = chunk;
-    seam.triangles = 0;
-    // The tags, over reader indices up to the largest of the chunk's and the loops'.
+// Tags the chunk's points and the loops' with their loop bits, over reader indices up to
+// the largest of theirs; room for `most` seam triangles. False if the arena is too small.
+inline bool tag_seam_points(const SurfaceChain& c, const LoadedLayer& layer,
+                            const LayerLoops& loops, size_t count, size_t most, Arena& arena,
+                            Seam& seam) {
+    const uint32_t* chunk = seam.chunk;
     uint32_t largest = 0;
     for (size_t k = 0; k < 3 * count; ++k) largest = chunk[k] > largest ? chunk[k] : largest;
     for (uint32_t i = 0; i < c.top_count; ++i) largest = c.top[i] > largest ? c.top[i] : largest;
     for (uint32_t i = 0; i < layer.count; ++i)
         largest = layer.ids[i] > largest ? layer.ids[i] : largest;
     seam.tag = arena.alloc<uint32_t>(size_t{largest} + 1);
-    const size_t vertices = layer.count + c.top_count;
-    // More seam triangles: left as it is (and the tags' seam points fit above the bits).
-    size_t most = 3 * vertices / 4;
-    if (most > (kNoIndex >> kLoopBits) / 3) most = (kNoIndex >> kLoopBits) / 3;
     seam.slot = arena.alloc<uint32_t>(most);
     if (arena.failed) return false;
     for (size_t k = 0; k < 3 * count; ++k) seam.tag[chunk[k]] = 0;
@@ -413,16 +408,14 @@ inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
         seam.tag[layer.ids[loops.bottom[i]]] |= kBottomLoopPoint;
     for (uint32_t i = 0; i < loops.top_count; ++i)
         seam.tag[layer.ids[loops.top[i]]] |= kTopLoopPoint;
-    size_t triangles = 0;
-    for (size_t t = 0; t < count; ++t) {
-        const uint32_t* v = chunk + 3 * t;
-        if (!((seam.tag[v[0]] | seam.tag[v[1]] | seam.tag[v[2]]) & (kLoopBelow | kBottomLoopPoint)))
-            continue;
-        if (triangles == most) return false;
-        seam.slot[triangles++] = static_cast<uint32_t>(t);
-    }
-    if (triangles == 0) return false;
-    seam.triangles = static_cast<uint32_t>(triangles);
+    return true;
+}
+
+// Numbers the seam triangles' points (seam.ids, and in their tags) and names their corners
+// by them, with each point's loop bits and seam triangle count. False if the arena is too
+// small.
+inline bool number_seam_points(Arena& arena, Seam& seam) {
+    const size_t triangles = seam.triangles;
     seam.vertex = arena.alloc<uint32_t>(3 * triangles);
     seam.twin = arena.alloc<uint32_t>(3 * triangles);
     seam.ids = arena.alloc<uint32_t>(3 * triangles);
@@ -430,7 +423,7 @@ inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
     uint32_t points = 0;
     for (size_t s = 0; s < triangles; ++s)
         for (uint32_t j = 0; j < 3; ++j) {
-            const uint32_t id = chunk[3 * size_t{seam.slot[s]} + j];
+            const uint32_t id = seam.chunk[3 * size_t{seam.slot[s]} + j];
             if ((seam.tag[id] >> kLoopBits) == 0) {
                 seam.ids[points] = id;
                 seam.tag[id] |= (points + 1) << kLoopBits;
@@ -449,13 +442,19 @@ inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
         seam.degree[v] = 0;
     }
     for (size_t i = 0; i < 3 * triangles; ++i) ++seam.degree[seam.vertex[i]];
-    // Twins through each point's outgoing half-edges.
+    return true;
+}
+
+// Each seam half-edge's twin, found through each point's outgoing half-edges. False if
+// the arena is too small.
+inline bool link_seam_twins(Arena& arena, Seam& seam) {
+    const uint32_t points = seam.points, triangles = seam.triangles;
     size_t mark = arena.mark();
     uint32_t* first = arena.alloc<uint32_t>(size_t{points} + 1);
-    uint32_t* outgoing = arena.alloc<uint32_t>(3 * triangles);
+    uint32_t* outgoing = arena.alloc<uint32_t>(3 * size_t{triangles});
     if (arena.failed) return false;
     std::memset(first, 0, (size_t{points} + 1) * sizeof(uint32_t));
-    for (size_t e = 0; e < 3 * triangles; ++e) ++first[seam.vertex[e] + 1];
+    for (size_t e = 0; e < 3 * size_t{triangles}; ++e) ++first[seam.vertex[e] + 1];
     for (uint32_t v = 0; v < points; ++v) first[v + 1] += first[v];
     for (uint32_t e = 0; e < 3 * triangles; ++e) outgoing[first[seam.vertex[e]]++] = e;
     for (uint32_t v = points; v > 0; --v) first[v] = first[v - 1];
@@ -468,6 +467,30 @@ inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
     }
     arena.rewind(mark);
     return true;
+}
+
+// The seam of a chunk (see above). False with seam.triangles = 0 when it is left as it is;
+// false with arena.failed when the arena is too small.
+inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
+                      uint32_t* chunk, size_t count, Arena& arena, Seam& seam) {
+    seam.chunk = chunk;
+    seam.triangles = 0;
+    const size_t vertices = layer.count + c.top_count;
+    // More seam triangles: left as it is (and the tags' seam points fit above the bits).
+    size_t most = 3 * vertices / 4;
+    if (most > (kNoIndex >> kLoopBits) / 3) most = (kNoIndex >> kLoopBits) / 3;
+    if (!tag_seam_points(c, layer, loops, count, most, arena, seam)) return false;
+    size_t triangles = 0;
+    for (size_t t = 0; t < count; ++t) {
+        const uint32_t* v = chunk + 3 * t;
+        if (!((seam.tag[v[0]] | seam.tag[v[1]] | seam.tag[v[2]]) & (kLoopBelow | kBottomLoopPoint)))
+            continue;
+        if (triangles == most) return false;
+        seam.slot[triangles++] = static_cast<uint32_t>(t);
+    }
+    if (triangles == 0) return false;
+    seam.triangles = static_cast<uint32_t>(triangles);
+    return number_seam_points(arena, seam) && link_seam_twins(arena, seam);
 }
 
 // Seam point v's normal.

@@ -3926,7 +3926,7 @@ STRATMESH_SMALL_NOINLINE inline void report_frame(const Frame& frame, Report& re
 namespace stratmesh {
 namespace detail {
 
-inline void notify(const Options& options, Phase phase, double fraction) {
+static inline void notify(const Options& options, Phase phase, double fraction) {
     if (options.progress) options.progress(options.progress_user, phase, fraction);
 }
 
@@ -3937,7 +3937,7 @@ inline void notify(const Options& options, Phase phase, double fraction) {
 // again does nothing, and a job the runner skipped is done afterwards as the batch says.
 
 // Whether work is cut into jobs: a runner given, in a build that has them.
-inline bool has_runner(const Options& options) {
+static inline bool has_runner(const Options& options) {
     return kParallelLayers && options.run_jobs != nullptr;
 }
 
@@ -3947,7 +3947,7 @@ template <class Job> struct JobBatch {
     bool done[kMaxJobs];
 };
 
-template <class Job> inline void run_batch_job(void* context, uint32_t index) {
+template <class Job> static inline void run_batch_job(void* context, uint32_t index) {
     JobBatch<Job>& batch = *static_cast<JobBatch<Job>*>(context);
     if (index >= batch.count || batch.done[index]) return;  // no job of ours, or done already
     (*batch.job)(index);
@@ -3959,7 +3959,8 @@ template <class Job> inline void run_batch_job(void* context, uint32_t index) {
 // then run here in order; else it is left undone (the layers not done ahead are
 // triangulated by their groups).
 template <class Job>
-inline void run_jobs(const Options& options, uint32_t count, bool redo_skipped, const Job& job) {
+static inline void run_jobs(const Options& options, uint32_t count, bool redo_skipped,
+                            const Job& job) {
     JobBatch<Job> batch = {&job, count, {}};
     if (has_runner(options)) options.run_jobs(options.jobs_user, count, run_batch_job<Job>, &batch);
     for (uint32_t k = 0; redo_skipped && k < count; ++k)
@@ -3974,12 +3975,12 @@ const uint32_t kPassRuns = 16;
 static_assert(kPassRuns <= kMaxJobs, "a pass's runs are one batch of jobs");
 
 // The first point of run k of `count` points.
-inline size_t run_start(size_t count, uint32_t k) {
+static inline size_t run_start(size_t count, uint32_t k) {
     return static_cast<size_t>(static_cast<uint64_t>(count) * k / kPassRuns);
 }
 
 // Runs pass.run(k) for every run k: as jobs with a runner, else in order.
-template <class Pass> inline void run_pass(const Options& options, Pass& pass) {
+template <class Pass> static inline void run_pass(const Options& options, Pass& pass) {
     run_jobs(options, kPassRuns, true, [&pass](uint32_t k) { pass.run(k); });
 }
 
@@ -4026,13 +4027,13 @@ const size_t kMinLayerPoints = 16;
 // contour, passes.
 const double kMinLayerRows = 1.5;
 
-inline bool thick_enough(size_t points, double height, double radius) {
+static inline bool thick_enough(size_t points, double height, double radius) {
     const double two_pi = 6.28318530717958647693;
     return static_cast<double>(points) * height >= kMinLayerRows * kMinLayerRows * two_pi * radius;
 }
 
 // The number of layers the options can ask for, before empty layers are dropped.
-inline size_t planned_layer_limit(size_t point_count, const Options& options) {
+static inline size_t planned_layer_limit(size_t point_count, const Options& options) {
     if (options.cuts && options.cut_count > 0) return options.cut_count + 1;
     if (options.layer_count > 0)
         return options.layer_count < point_count ? options.layer_count : (point_count > 0 ? point_count : 1);
@@ -4041,7 +4042,7 @@ inline size_t planned_layer_limit(size_t point_count, const Options& options) {
     return kMaxAutomaticLayers;
 }
 
-inline Status validate_layer_options(const Options& options) {
+static inline Status validate_layer_options(const Options& options) {
     if (options.cuts && options.cut_count > 0) {
         if (options.cut_count > kMaxPoints) return Status::invalid_layers;
         for (size_t i = 0; i < options.cut_count; ++i)
@@ -4054,7 +4055,7 @@ inline Status validate_layer_options(const Options& options) {
     return Status::ok;
 }
 
-inline bool automatic_layers(const Options& options) {
+static inline bool automatic_layers(const Options& options) {
     return !(options.cuts && options.cut_count > 0) && options.layer_count == 0 &&
            options.layer_height == 0;
 }
@@ -4062,8 +4063,8 @@ inline bool automatic_layers(const Options& options) {
 // Fills plan.bounds (room for planned_layer_limit + 1 entries) for heights [lo, hi] from
 // the user's layer options (not automatic_layers): the cuts are coordinates along the axis
 // (Frame::user_height of frame heights), layer_height a length in the cloud's units.
-inline void plan_layers(const Options& options, double lo, double hi, size_t point_count,
-                        const Frame& frame, LayerPlan& plan) {
+static inline void plan_layers(const Options& options, double lo, double hi, size_t point_count,
+                               const Frame& frame, LayerPlan& plan) {
     const double cut_offset = dot(frame.origin, frame.axis);
     double* b = plan.bounds;
     uint32_t n = 0;
@@ -4152,27 +4153,27 @@ struct BinRange {
     uint32_t first, end;
 };
 
-inline uint32_t profile_bin_count(size_t valid_points) {
+static inline uint32_t profile_bin_count(size_t valid_points) {
     size_t bins = valid_points / kPointsPerProfileBin;
     if (bins > kMaxAutomaticLayers) bins = kMaxAutomaticLayers;
     return bins < 1 ? 1u : static_cast<uint32_t>(bins);
 }
 
 // The scratch the automatic planner takes (released before the layers are built).
-inline void allocate_profile(Arena& arena, uint32_t bins, ProfileBin** profile, BinRange** ranges,
-                             double** cuts) {
+static inline void allocate_profile(Arena& arena, uint32_t bins, ProfileBin** profile,
+                                    BinRange** ranges, double** cuts) {
     *profile = arena.alloc<ProfileBin>(bins);
     *ranges = arena.alloc<BinRange>(bins);
     *cuts = arena.alloc<double>(bins);
 }
 
-inline uint32_t sector_of(double dx, double dy) {
+static inline uint32_t sector_of(double dx, double dy) {
     uint32_t s = (dx < 0 ? 4u : 0u) + (dy < 0 ? 2u : 0u);
     return s + (abs_value(dx) < abs_value(dy) ? 1u : 0u);
 }
 
-inline void build_profile(const CloudReader& cloud, size_t count, const Frame& frame, double lo,
-                          double hi, ProfileBin* profile, uint32_t bins) {
+static inline void build_profile(const CloudReader& cloud, size_t count, const Frame& frame,
+                                 double lo, double hi, ProfileBin* profile, uint32_t bins) {
     std::memset(static_cast<void*>(profile), 0, sizeof(ProfileBin) * bins);
     const double per_height = static_cast<double>(bins) / (hi - lo);
     auto bin_of = [&](double h) {
@@ -4217,8 +4218,8 @@ inline void build_profile(const CloudReader& cloud, size_t count, const Frame& f
     }
 }
 
-inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_height,
-                          size_t most_points) {
+static inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_height,
+                                 size_t most_points) {
     double cx = 0, cy = 0, radius = 0;
     size_t points = 0;
     for (uint32_t b = range.first; b < range.end; ++b) {
@@ -4247,7 +4248,7 @@ inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_
 }
 
 // How much the surface changes between bins b - 1 and b, plus the density penalty.
-inline double cut_cost(const ProfileBin* profile, uint32_t b, double mean_count) {
+static inline double cut_cost(const ProfileBin* profile, uint32_t b, double mean_count) {
     const ProfileBin& below = profile[b - 1];
     const ProfileBin& above = profile[b];
     double radius = below.mean_radius > above.mean_radius ? below.mean_radius : above.mean_radius;
@@ -4260,9 +4261,10 @@ inline double cut_cost(const ProfileBin* profile, uint32_t b, double mean_count)
 
 // Fills plan.bounds for heights [lo, hi] by the rule above; profile, ranges and cuts hold
 // `bins` entries each.
-inline void plan_automatic_layers(const CloudReader& cloud, size_t count, size_t valid,
-                                  const Frame& frame, double lo, double hi, ProfileBin* profile,
-                                  BinRange* ranges, double* cuts, uint32_t bins, LayerPlan& plan) {
+static inline void plan_automatic_layers(const CloudReader& cloud, size_t count, size_t valid,
+                                         const Frame& frame, double lo, double hi,
+                                         ProfileBin* profile, BinRange* ranges, double* cuts,
+                                         uint32_t bins, LayerPlan& plan) {
     build_profile(cloud, count, frame, lo, hi, profile, bins);
     const double bin_height = (hi - lo) / bins;
     const double mean_count = static_cast<double>(valid) / bins;
@@ -4304,7 +4306,7 @@ inline void plan_automatic_layers(const CloudReader& cloud, size_t count, size_t
 // layers were equal, which they are unless cuts or the automatic plan set them, is tried
 // first, with one branch that a million points in no order still predict (a binary
 // search's would not); the search is for the rest.
-inline uint32_t layer_of(const LayerPlan& plan, double h, double per_height) {
+static inline uint32_t layer_of(const LayerPlan& plan, double h, double per_height) {
     const double* bounds = plan.bounds;
     const double tolerance = plan.tolerance;
     const uint32_t last = plan.count - 1;
@@ -4328,9 +4330,9 @@ inline uint32_t layer_of(const LayerPlan& plan, double h, double per_height) {
 // point's layer kept in `layer` (count entries of scratch) between its two passes. With
 // `staged` (optional, as many entries as valid points), the points in frame coordinates
 // go there in the same order.
-inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& frame,
-                           const LayerPlan& plan, uint32_t* layer, Local* staged,
-                           uint32_t* layer_start, uint32_t* order) {
+static inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& frame,
+                                  const LayerPlan& plan, uint32_t* layer, Local* staged,
+                                  uint32_t* layer_start, uint32_t* order) {
     std::memset(layer_start, 0, sizeof(uint32_t) * (plan.count + 2));
     const double per_height =
         kFastLoops ? plan.count / (plan.bounds[plan.count] - plan.bounds[0]) : 0;
@@ -4385,10 +4387,10 @@ struct GroupingPass {
 
 // group_by_layer without staging, as jobs; false (nothing done) where its three tables of a
 // count per run and layer would take more than one count per point, or do not fit.
-inline bool group_by_layer_in_jobs(const Options& options, const CloudReader& cloud,
-                                   size_t count, const Frame& frame, const LayerPlan& plan,
-                                   uint32_t* layer, uint32_t* layer_start, uint32_t* order,
-                                   Arena& arena) {
+static inline bool group_by_layer_in_jobs(const Options& options, const CloudReader& cloud,
+                                          size_t count, const Frame& frame, const LayerPlan& plan,
+                                          uint32_t* layer, uint32_t* layer_start, uint32_t* order,
+                                          Arena& arena) {
     const size_t table = kPassRuns * static_cast<size_t>(plan.count);
     if (!has_runner(options) || 3 * table > count) return false;
     const size_t mark = arena.mark();
@@ -5273,7 +5275,8 @@ namespace detail {
 // Rotates loop[0..n) and its strip coordinates so that entry `first` comes first; the
 // entries moved to the end are shifted by `turn` (one period of the strip), so angles
 // keep increasing along the loop.
-inline void rotate_loop(uint32_t* loop, double* uv, uint32_t n, uint32_t first, double turn) {
+static inline void rotate_loop(uint32_t* loop, double* uv, uint32_t n, uint32_t first,
+                               double turn) {
     for (uint32_t i = 0; i < first; ++i) uv[2 * i] += turn;
     // Three reversals rotate in place.
     auto reverse = [&](uint32_t lo, uint32_t hi) {  // the range [lo, hi)
@@ -5295,7 +5298,7 @@ inline void rotate_loop(uint32_t* loop, double* uv, uint32_t n, uint32_t first, 
 }
 
 // Rotates loop[0..n) so its smallest angle comes first (angles in [0, turn)).
-inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
+static inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
     uint32_t first = 0;
     for (uint32_t i = 1; i < n; ++i)
         if (uv[2 * i] < uv[2 * first]) first = i;
@@ -5354,11 +5357,11 @@ struct Band {
 // A step sequence is a band only if no rung repeats: walking all of A while B stands
 // still (or all of B) would return to the rung it started from. That happens exactly when
 // the cyclic sequence has a single run of A steps, so a band needs at least two.
-inline bool starts_a_run(const unsigned char* steps, uint32_t length, uint32_t k) {
+static inline bool starts_a_run(const unsigned char* steps, uint32_t length, uint32_t k) {
     return steps[k % length] == 0 && steps[(k + length - 1) % length] == 1;
 }
 
-inline uint32_t count_a_runs(const unsigned char* steps, uint32_t length) {
+static inline uint32_t count_a_runs(const unsigned char* steps, uint32_t length) {
     uint32_t runs = 0;
     for (uint32_t k = 0; k < length; ++k) runs += starts_a_run(steps, length, k);
     return runs;
@@ -5366,7 +5369,8 @@ inline uint32_t count_a_runs(const unsigned char* steps, uint32_t length) {
 
 // Whether swapping steps t and t + 1 keeps at least two runs of A (only the run starts at
 // t, t + 1 and t + 2 can change).
-inline bool swap_keeps_band(unsigned char* steps, uint32_t length, uint32_t t, uint32_t runs) {
+static inline bool swap_keeps_band(unsigned char* steps, uint32_t length, uint32_t t,
+                                   uint32_t runs) {
     uint32_t before = 0, after = 0;
     for (uint32_t k = t; k < t + 3; ++k) before += starts_a_run(steps, length, k);
     unsigned char s = steps[t];
@@ -5380,7 +5384,7 @@ inline bool swap_keeps_band(unsigned char* steps, uint32_t length, uint32_t t, u
 
 // Merges the loops by angle; if that walks one loop in a single run (tiny or skewed
 // loops), one boundary step is swapped so the band is a band.
-inline void zip_by_angle(Band& band) {
+static inline void zip_by_angle(Band& band) {
     const uint32_t length = band.p + band.q;
     uint32_t i = 0, j = 0, t = 0;
     while (i < band.p || j < band.q) {
@@ -5402,7 +5406,7 @@ inline void zip_by_angle(Band& band) {
 }
 
 // Lawson flips over the step sequence; returns the number of swaps.
-inline size_t swap_diagonals(Band& band) {
+static inline size_t swap_diagonals(Band& band) {
     const uint32_t length = band.p + band.q;
     const size_t limit = 16 * static_cast<size_t>(length) + 64;
     uint32_t runs = count_a_runs(band.steps, length);
@@ -5440,7 +5444,7 @@ inline size_t swap_diagonals(Band& band) {
 // other loop's next (or previous) vertex; only the triangles of that stretch change, and
 // the move is kept when they all turn counter-clockwise and the band keeps two runs of A.
 // Returns the adjacent exchanges made.
-inline size_t untangle_runs(Band& band) {
+static inline size_t untangle_runs(Band& band) {
     // Longer runs (a fan from one vertex over many of the other loop) are left as they
     // are: this bounds the work at kLongestUntangledRun steps per step of the band.
     const uint32_t kLongestUntangledRun = 64;
@@ -5500,7 +5504,7 @@ inline size_t untangle_runs(Band& band) {
 
 // Rotates the band (its loops and steps) to start half-way round. False if the half-way
 // point does not fall between the ends of both loops (the band stays as it is).
-inline bool restart_half_way(Band& band) {
+static inline bool restart_half_way(Band& band) {
     const uint32_t length = band.p + band.q, half = length / 2;
     uint32_t i_half = 0, j_half = 0;
     for (uint32_t t = 0; t < half; ++t) (band.steps[t] == 0 ? i_half : j_half) += 1;
@@ -5523,7 +5527,7 @@ inline bool restart_half_way(Band& band) {
 }
 
 // Whether every step of the band is counter-clockwise on the strip.
-inline bool band_is_proper(Band& band) {
+static inline bool band_is_proper(Band& band) {
     uint32_t i = 0, j = 0;
     for (uint32_t t = 0; t < band.p + band.q; ++t) {
         if (!band.proper(t, i, j)) return false;
@@ -5536,7 +5540,7 @@ inline bool band_is_proper(Band& band) {
 // clockwise steps. The closing rung is held fixed by both: the band restarts half-way round
 // and swaps again, so the quads around it get their test too, and where a clockwise step is
 // left next to it, untangles once more from there.
-inline void settle_band(Band& band, size_t* swaps) {
+static inline void settle_band(Band& band, size_t* swaps) {
     zip_by_angle(band);
     *swaps += swap_diagonals(band);
     if (restart_half_way(band)) *swaps += swap_diagonals(band);
@@ -5549,7 +5553,7 @@ inline void settle_band(Band& band, size_t* swaps) {
 // peeling (pass 0; entry 0 is one). A peeled vertex came off an edge between entries of
 // earlier passes in its group, so the group put back whole leaves the loop as it was
 // there, and the other groups' peeling as it is.
-inline void unpeel_around(unsigned char* flags, uint32_t n, uint32_t k) {
+static inline void unpeel_around(unsigned char* flags, uint32_t n, uint32_t k) {
     auto unpeel = [flags](uint32_t i) {
         if (!(flags[i] & kPassBits)) return false;
         flags[i] |= kUnpeeled;
@@ -5561,13 +5565,13 @@ inline void unpeel_around(unsigned char* flags, uint32_t n, uint32_t k) {
 }
 
 // Marks every peeled entry of flags[0..n) kUnpeeled or, with !on, none.
-inline void mark_unpeeled(unsigned char* flags, uint32_t n, bool on) {
+static inline void mark_unpeeled(unsigned char* flags, uint32_t n, bool on) {
     for (uint32_t i = 0; i < n; ++i)
         flags[i] = static_cast<unsigned char>(on && (flags[i] & kPassBits) ? flags[i] | kUnpeeled
                                                                            : flags[i] & ~kUnpeeled);
 }
 
-inline size_t count_unpeeled(const unsigned char* flags, uint32_t n) {
+static inline size_t count_unpeeled(const unsigned char* flags, uint32_t n) {
     size_t marked = 0;
     for (uint32_t i = 0; i < n; ++i) marked += (flags[i] & kUnpeeled) != 0;
     return marked;
@@ -5607,7 +5611,7 @@ struct Stitch {
 // vertex is marked kUnpeeled, else all: vertex x, peeled in pass k, came off the edge
 // between the nearest loop vertices before and after it from earlier passes (entry 0 is on
 // the hull or the link).
-inline void put_back_peeled(const Stitch& st, bool top, TriangleSink& sink) {
+static inline void put_back_peeled(const Stitch& st, bool top, TriangleSink& sink) {
     const unsigned char* flags = top ? st.a_flags : st.loops->bottom_flags;
     const uint32_t n = top ? st.a_length : st.loops->bottom_count;
     auto pass = [flags](uint32_t i) { return flags[i] & kPassBits; };
@@ -5627,7 +5631,7 @@ inline void put_back_peeled(const Stitch& st, bool top, TriangleSink& sink) {
 // Carves the band's loops from the arena and fills them with the entries of A (reader
 // indices a_ids) and of the layer's bottom loop that are not left out (see stitch_layers),
 // A's points copied. False if the arena is too small.
-inline bool gather_band_loops(Stitch& st, const uint32_t* a_ids, bool unpeel, Arena& arena) {
+static inline bool gather_band_loops(Stitch& st, const uint32_t* a_ids, bool unpeel, Arena& arena) {
     const LayerLoops& loops = *st.loops;
     Band& band = st.band;
     band.a = arena.alloc<uint32_t>(st.a_length);
@@ -5653,7 +5657,7 @@ inline bool gather_band_loops(Stitch& st, const uint32_t* a_ids, bool unpeel, Ar
 }
 
 // Unrolls both loops around the centre (cx, cy) and settles the band there.
-inline void settle_band_around(Stitch& st, double cx, double cy, size_t* swaps) {
+static inline void settle_band_around(Stitch& st, double cx, double cy, size_t* swaps) {
     Band& band = st.band;
     st.shared.cx = cx;
     st.shared.cy = cy;
@@ -5669,7 +5673,7 @@ inline void settle_band_around(Stitch& st, double cx, double cy, size_t* swaps) 
 // folds: those around the state's a[i] and b[j], which hold the triangle's third corner
 // too unless it is on the loop since before peeling. B's entry of b[j] is found walking
 // loops.bottom along (b is in its order, rotated), once around at most.
-inline size_t walk_band(const Stitch& st, TriangleSink* sink, double* area) {
+static inline size_t walk_band(const Stitch& st, TriangleSink* sink, double* area) {
     const Band& band = st.band;
     const LayerLoops& loops = *st.loops;
     const uint32_t p = band.p, q = band.q;
@@ -5705,7 +5709,7 @@ inline size_t walk_band(const Stitch& st, TriangleSink* sink, double* area) {
 // of the midpoint and the two layers' centres whose settled band has the least area. Trial
 // 3 settles the band again around that one, unless it was the last tried. Returns the
 // swaps of the band kept.
-inline size_t settle_least_area(Stitch& st, const Cylinder& ca, const Cylinder& cb) {
+static inline size_t settle_least_area(Stitch& st, const Cylinder& ca, const Cylinder& cb) {
     const Cylinder* centres[3] = {nullptr, &ca, &cb};  // 0: the midpoint
     double least = 0;
     uint32_t best = 0;
@@ -5737,10 +5741,10 @@ inline size_t settle_least_area(Stitch& st, const Cylinder& ca, const Cylinder& 
 // peel groups around its corners kUnpeeled (unpeel_around) for a next attempt. The band's
 // triangles name the upper layer's points by layer-local index and the i-th point of A by
 // layer.count + i.
-inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cylinder& ca,
-                          const uint32_t* a_ids, unsigned char* a_flags, uint32_t p,
-                          const LoadedLayer& layer, const LayerLoops& loops, bool unpeel,
-                          Arena& arena, TriangleSink& sink, size_t* swaps) {
+static inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cylinder& ca,
+                                 const uint32_t* a_ids, unsigned char* a_flags, uint32_t p,
+                                 const LoadedLayer& layer, const LayerLoops& loops, bool unpeel,
+                                 Arena& arena, TriangleSink& sink, size_t* swaps) {
     const Cylinder& cb = layer.cyl;
     Stitch st;
     st.cloud = &cloud;
@@ -6129,7 +6133,7 @@ struct SurfaceChain {
     size_t groups, duplicates, collisions, swaps, removed, used, trailing;
 };
 
-inline bool allocate_chain(SurfaceChain& c, size_t points, Arena& arena) {
+static inline bool allocate_chain(SurfaceChain& c, size_t points, Arena& arena) {
     c.top = arena.alloc<uint32_t>(points);
     c.next_top = arena.alloc<uint32_t>(points);
     c.bottom = arena.alloc<uint32_t>(points);
@@ -6146,7 +6150,8 @@ inline bool allocate_chain(SurfaceChain& c, size_t points, Arena& arena) {
 // and the one from the previous.
 const unsigned char kUnusedBelow = 1, kHasNextEdge = 2, kHasPreviousEdge = 4;
 
-inline void count_corners(const uint32_t* tri, size_t count, uint32_t* degree, size_t vertices) {
+static inline void count_corners(const uint32_t* tri, size_t count, uint32_t* degree,
+                                 size_t vertices) {
     std::memset(degree, 0, vertices * sizeof(uint32_t));
     for (size_t k = 0; k < 3 * count; ++k) ++degree[tri[k]];
 }
@@ -6154,8 +6159,8 @@ inline void count_corners(const uint32_t* tri, size_t count, uint32_t* degree, s
 // For the loop whose point i has id `id_of(i)` (n points, in loop order): which of the
 // loop's edges the triangles use, as kHasNextEdge / kHasPreviousEdge bits added to flags[i].
 // position[v] is v's place in the loop or kNoIndex, for every id v in the triangles.
-inline void mark_loop_edges(const uint32_t* tri, size_t count, const uint32_t* position,
-                            uint32_t n, unsigned char* flags) {
+static inline void mark_loop_edges(const uint32_t* tri, size_t count, const uint32_t* position,
+                                   uint32_t n, unsigned char* flags) {
     for (size_t t = 0; t < count; ++t)
         for (size_t k = 0; k < 3; ++k) {
             uint32_t i = position[tri[3 * t + k]], j = position[tri[3 * t + (k + 1) % 3]];
@@ -6178,8 +6183,8 @@ inline void mark_loop_edges(const uint32_t* tri, size_t count, const uint32_t* p
 // loop point with triangles on both sides shares an edge. `below` flags the loop points
 // from their own chunk; seam ids are below_count + i. Returns the triangles removed, or
 // SIZE_MAX if the arena is too small.
-inline size_t seal_seam(uint32_t* tri, size_t& count, size_t below_count, size_t vertices,
-                        const unsigned char* below, uint32_t* degree, Arena& arena) {
+static inline size_t seal_seam(uint32_t* tri, size_t& count, size_t below_count, size_t vertices,
+                               const unsigned char* below, uint32_t* degree, Arena& arena) {
     const uint32_t n = static_cast<uint32_t>(vertices - below_count);
     size_t mark = arena.mark();
     uint32_t* position = arena.alloc<uint32_t>(vertices);
@@ -6218,8 +6223,8 @@ inline size_t seal_seam(uint32_t* tri, size_t& count, size_t below_count, size_t
 // Whether the safety net would remove nothing from the chunk: whether the fans of the
 // vertices the band joins (the layer's bottom loop, the loop below) are whole. The others
 // are by construction (see >>manifold).
-inline bool loop_fans_are_one_piece(const uint32_t* tri, size_t count, size_t below,
-                                    size_t vertices, const LayerLoops& loops, Arena& arena) {
+static inline bool loop_fans_are_one_piece(const uint32_t* tri, size_t count, size_t below,
+                                           size_t vertices, const LayerLoops& loops, Arena& arena) {
     size_t mark = arena.mark();
     unsigned char* checked = arena.alloc<unsigned char>(vertices);
     if (arena.failed) return false;
@@ -6234,8 +6239,8 @@ inline bool loop_fans_are_one_piece(const uint32_t* tri, size_t count, size_t be
 // Triangles of a chunk from layer-local and band indices to reader indices, and on to
 // output indices unless the seam's flips (see "flips across the seam"), which read the
 // points, come between: then name_output_points does that step.
-inline void name_chunk_points(const SurfaceChain& c, const LoadedLayer& layer, uint32_t* tri,
-                              size_t count) {
+static inline void name_chunk_points(const SurfaceChain& c, const LoadedLayer& layer, uint32_t* tri,
+                                     size_t count) {
     for (size_t k = 0; k < 3 * count; ++k) {
         uint32_t l = tri[k];
         uint32_t id = l < layer.count ? layer.ids[l] : c.top[l - layer.count];
@@ -6244,7 +6249,7 @@ inline void name_chunk_points(const SurfaceChain& c, const LoadedLayer& layer, u
 }
 
 // A final chunk's triangles from reader indices to output indices (with kSurfaceFlips).
-inline void name_output_points(const SurfaceChain& c, uint32_t* tri, size_t count) {
+static inline void name_output_points(const SurfaceChain& c, uint32_t* tri, size_t count) {
     if (!kSurfaceFlips || !c.output_id) return;
     for (size_t k = 0; k < 3 * count; ++k) tri[k] = c.output_id[tri[k]];
 }
@@ -6256,9 +6261,9 @@ inline void name_output_points(const SurfaceChain& c, uint32_t* tri, size_t coun
 // as built and the fans of the loop vertices are whole (see >>manifold); then the chunk's
 // points that became vertices are counted and the next seam's flags set, as finish_chunk
 // would. Otherwise nothing changes.
-inline bool chunk_is_sound(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                           const uint32_t* at_loops, size_t count, size_t interior_used,
-                           Arena& arena) {
+static inline bool chunk_is_sound(SurfaceChain& c, const LoadedLayer& layer,
+                                  const LayerLoops& loops, const uint32_t* at_loops, size_t count,
+                                  size_t interior_used, Arena& arena) {
     // The seam is as built when every loop point below has both its loop edges there or no
     // triangle at all: then seal_seam would find nothing to do either, since the band has
     // every edge of the loop.
@@ -6294,8 +6299,9 @@ inline bool chunk_is_sound(SurfaceChain& c, const LoadedLayer& layer, const Laye
 
 // The safety net over the chunk sink[chunk_start ..), then its indices from layer-local and
 // band indices to output indices; counts the points that became vertices.
-inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                           size_t chunk_start, Arena& arena, TriangleSink& sink) {
+static inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer,
+                                  const LayerLoops& loops, size_t chunk_start, Arena& arena,
+                                  TriangleSink& sink) {
     uint32_t* tri = sink.triangles + 3 * chunk_start;
     size_t count = sink.count - chunk_start;
     const size_t below = layer.count, vertices = layer.count + c.top_count;
@@ -6354,8 +6360,8 @@ inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const Laye
 const uint32_t kRingGap = 3;
 
 // sectors_held by planned layers [first, last] around (cx, cy), read from the cloud.
-inline uint32_t planned_sectors(const SurfaceChain& c, const LayerQueue& q, uint32_t first,
-                                uint32_t last, double cx, double cy) {
+static inline uint32_t planned_sectors(const SurfaceChain& c, const LayerQueue& q, uint32_t first,
+                                       uint32_t last, double cx, double cy) {
     const uint32_t* ids = q.ids + q.start[first];
     return sectors_held([&c, ids](size_t i) { return c.frame.local(c.reader.point(ids[i])); },
                         q.start[last + 1] - q.start[first], cx, cy);
@@ -6366,7 +6372,7 @@ inline uint32_t planned_sectors(const SurfaceChain& c, const LayerQueue& q, uint
 // points uniform on a circle leave g of its 32 sectors empty in a row with probability
 // below m (1 - g/32)^(m-1)): a sparse layer's gaps are not crescents, nor is an empty
 // one. Else 0.
-inline uint32_t crescent_gap(uint32_t held, size_t count) {
+static inline uint32_t crescent_gap(uint32_t held, size_t count) {
     const uint32_t gap = widest_gap(held);
     if (gap <= kRingGap || count == 0) return 0;
     const size_t stride = gap_sample_stride(count);
@@ -6380,8 +6386,8 @@ inline uint32_t crescent_gap(uint32_t held, size_t count) {
 // Whether the group [first, last] joins the next planned layer (see kRingGap). First a
 // look from the group's fitted centre; where it or the next layer leaves a gap, the gaps
 // are taken again from the centre fitted to both, which a crescent does not pull aside.
-inline bool joins_crescent(const SurfaceChain& c, const LayerQueue& q, uint32_t first,
-                           uint32_t last, const Cylinder& fitted, uint32_t own) {
+static inline bool joins_crescent(const SurfaceChain& c, const LayerQueue& q, uint32_t first,
+                                  uint32_t last, const Cylinder& fitted, uint32_t own) {
     const size_t own_count = q.start[last + 1] - q.start[first];
     const size_t next_count = q.start[last + 2] - q.start[last + 1];
     uint32_t next = planned_sectors(c, q, last + 1, last + 1, fitted.cx, fitted.cy);
@@ -6400,7 +6406,7 @@ inline bool joins_crescent(const SurfaceChain& c, const LayerQueue& q, uint32_t 
 
 // Whether a group of n points over `height` around `radius` is triangulated on its own
 // (else it joins the next planned layer; the final group only needs 3 points).
-inline bool group_stands(size_t n, double height, double radius, bool final) {
+static inline bool group_stands(size_t n, double height, double radius, bool final) {
     return n >= 3 && (final || (n >= kMinLayerPoints && thick_enough(n, height, radius)));
 }
 
@@ -6440,8 +6446,8 @@ struct GroupResult {
 };
 
 // What triangulate_layer would do now, from a job's result.
-inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops& loops,
-                         LayerCounts& counts) {
+static inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops& loops,
+                                LayerCounts& counts) {
     if (ahead.status != Status::ok) return ahead.status;
     if (sink.count < sink.capacity) {
         size_t room = sink.capacity - sink.count;
@@ -6465,9 +6471,9 @@ inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops
 // chunk_is_sound holds for the border the job kept and the band, only the band is named in
 // reader indices. Returns false when it does not (nothing changed): the caller then builds
 // the chunk again in order, to the same triangles, and runs finish_chunk.
-inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                         const LayerAhead& ahead, size_t chunk_start, Arena& arena,
-                         TriangleSink& sink) {
+static inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
+                                const LayerAhead& ahead, size_t chunk_start, Arena& arena,
+                                TriangleSink& sink) {
     if (!ahead.replayable || c.output_id) return false;
     uint32_t* band = sink.triangles + 3 * (chunk_start + ahead.triangle_count);
     const size_t band_count = sink.count - chunk_start - ahead.triangle_count;
@@ -6556,7 +6562,7 @@ const double kBendGain = 3;  // a flip for the bend alone must bend 3 times less
 
 const double kWidestAngle = -0.86602540378443865;  // cosine of 150 degrees
 
-inline Vec3 vec_of(const Local& p) { return Vec3{p.x, p.y, p.h}; }
+static inline Vec3 vec_of(const Local& p) { return Vec3{p.x, p.y, p.h}; }
 
 struct Box3 {
     Vec3 low, high;
@@ -6566,7 +6572,7 @@ struct Box3 {
     }
 };
 
-inline Box3 box_of(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
+static inline Box3 box_of(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
     Box3 box = {a, a};
     const Vec3 rest[3] = {b, c, d};
     for (const Vec3& p : rest) {
@@ -6581,7 +6587,7 @@ inline Box3 box_of(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
 // Whether the angles at p and q facing the segment ab sum to more than 180 degrees: then
 // sin(angle_p + angle_q), a sum of sine-cosine products, is negative. Two acute angles
 // (most edges) are settled by two dot products.
-inline bool flip_helps(Vec3 a, Vec3 b, Vec3 p, Vec3 q) {
+static inline bool flip_helps(Vec3 a, Vec3 b, Vec3 p, Vec3 q) {
     const Vec3 pa = a - p, pb = b - p, qa = a - q, qb = b - q;
     const double cos_p = dot(pa, pb), cos_q = dot(qa, qb);
     if (cos_p >= 0 && cos_q >= 0) return false;
@@ -6594,7 +6600,7 @@ inline bool flip_helps(Vec3 a, Vec3 b, Vec3 p, Vec3 q) {
 // Whether triangles u and v, each shrunk by kShrink about its centroid, overlap along every
 // axis that could separate them: their normals, the cross products of their edges, and
 // each normal crossed with the triangle's own edges (for coplanar triangles).
-inline bool triangles_meet(const Vec3* u, const Vec3* v) {
+static inline bool triangles_meet(const Vec3* u, const Vec3* v) {
     Vec3 s[3], t[3];
     const Vec3 cu = scaled(Vec3{u[0].x + u[1].x + u[2].x, u[0].y + u[1].y + u[2].y,
                                 u[0].z + u[1].z + u[2].z}, 1.0 / 3);
@@ -6637,7 +6643,7 @@ inline bool triangles_meet(const Vec3* u, const Vec3* v) {
 // around it, until visit returns false. False if a visit did, or the vertex has more than
 // kFanLimit neighbours.
 template <class Visit>
-inline bool around_vertex(const Triangulation& tr, uint32_t from, Visit visit) {
+static inline bool around_vertex(const Triangulation& tr, uint32_t from, Visit visit) {
     uint32_t e = from;
     for (uint32_t steps = 0; steps < kFanLimit; ++steps) {
         if (!visit(e)) return false;
@@ -6692,12 +6698,12 @@ struct VertexNormals {
 
 // How much the surface bends along edge ab, with unit normals na and nb at its ends (see
 // above).
-inline double bend_along(Vec3 a, Vec3 b, Vec3 na, Vec3 nb) {
+static inline double bend_along(Vec3 a, Vec3 b, Vec3 na, Vec3 nb) {
     return std::fabs(dot(b - a, nb - na));
 }
 
 // The cosine of the widest angle of triangle abc.
-inline double widest_angle_cosine(Vec3 a, Vec3 b, Vec3 c) {
+static inline double widest_angle_cosine(Vec3 a, Vec3 b, Vec3 c) {
     const Vec3 corner[3] = {a, b, c};
     double widest = 1;
     for (int k = 0; k < 3; ++k) {
@@ -6712,8 +6718,8 @@ inline double widest_angle_cosine(Vec3 a, Vec3 b, Vec3 c) {
 // Whether the surface wants ab of triangles abp and baq turned into pq, by the two rules
 // (see above; na .. nq the corners' unit normals, none zero) without an angle wider than
 // kWidestAngle (unless the old pair had a wider one).
-inline bool flip_wanted(const Local& la, const Local& lb, const Local& lp, const Local& lq,
-                        Vec3 na, Vec3 nb, Vec3 np, Vec3 nq) {
+static inline bool flip_wanted(const Local& la, const Local& lb, const Local& lp, const Local& lq,
+                               Vec3 na, Vec3 nb, Vec3 np, Vec3 nq) {
     if (dot(na, na) == 0 || dot(nb, nb) == 0 || dot(np, np) == 0 || dot(nq, nq) == 0)
         return false;
     const double bend_before = bend_along(vec_of(la), vec_of(lb), na, nb);
@@ -6732,7 +6738,7 @@ inline bool flip_wanted(const Local& la, const Local& lb, const Local& lp, const
 
 // Whether both new triangles (p, a, q) and (q, b, p) of that flip have normals within
 // kGentleFlip of the old pair's mean.
-inline bool gentle_flip(const Local& la, const Local& lb, const Local& lp, const Local& lq) {
+static inline bool gentle_flip(const Local& la, const Local& lb, const Local& lp, const Local& lq) {
     Vec3 mean = normal_of(la, lb, lp);
     const Vec3 other_normal = normal_of(lb, la, lq);
     mean = Vec3{mean.x + other_normal.x, mean.y + other_normal.y, mean.z + other_normal.z};
@@ -6742,8 +6748,8 @@ inline bool gentle_flip(const Local& la, const Local& lb, const Local& lp, const
 }
 
 // Flips half-edge e of a layer's triangulation on the surface if that helps (see above).
-inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32_t* flags,
-                            VertexNormals& normals, const Cylinder& cyl, uint32_t e) {
+static inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32_t* flags,
+                                   VertexNormals& normals, const Cylinder& cyl, uint32_t e) {
     const uint32_t f = tr.twin[e];
     const uint32_t t = e / 3, u = f / 3;
     if (!on_surface(tr, u)) return false;
@@ -6792,8 +6798,9 @@ inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32
 // `flags` holds a word per vertex (see triangulate_layer); the bits kFlippedBefore and
 // kFlippedNow are used here and cleared. `room` is the annulus coordinates, two doubles a
 // vertex, overwritten. Returns the number of flips.
-inline size_t flip_layer_on_surface(Triangulation& tr, const Local* points, const Cylinder& cyl,
-                                    uint32_t* flags, double* room, size_t vertices) {
+static inline size_t flip_layer_on_surface(Triangulation& tr, const Local* points,
+                                           const Cylinder& cyl, uint32_t* flags, double* room,
+                                           size_t vertices) {
     VertexNormals normals = {room};
     size_t flips = 0;
     for (uint32_t sweep = 0; sweep < kSurfaceFlipSweeps; ++sweep) {
@@ -6880,9 +6887,9 @@ struct Seam {
 
 // Tags the chunk's points and the loops' with their loop bits, over reader indices up to
 // the largest of theirs; room for `most` seam triangles. False if the arena is too small.
-inline bool tag_seam_points(const SurfaceChain& c, const LoadedLayer& layer,
-                            const LayerLoops& loops, size_t count, size_t most, Arena& arena,
-                            Seam& seam) {
+static inline bool tag_seam_points(const SurfaceChain& c, const LoadedLayer& layer,
+                                   const LayerLoops& loops, size_t count, size_t most, Arena& arena,
+                                   Seam& seam) {
     const uint32_t* chunk = seam.chunk;
     uint32_t largest = 0;
     for (size_t k = 0; k < 3 * count; ++k) largest = chunk[k] > largest ? chunk[k] : largest;
@@ -6906,7 +6913,7 @@ inline bool tag_seam_points(const SurfaceChain& c, const LoadedLayer& layer,
 // Numbers the seam triangles' points (seam.ids, and in their tags) and names their corners
 // by them, with each point's loop bits and seam triangle count. False if the arena is too
 // small.
-inline bool number_seam_points(Arena& arena, Seam& seam) {
+static inline bool number_seam_points(Arena& arena, Seam& seam) {
     const size_t triangles = seam.triangles;
     seam.vertex = arena.alloc<uint32_t>(3 * triangles);
     seam.twin = arena.alloc<uint32_t>(3 * triangles);
@@ -6939,7 +6946,7 @@ inline bool number_seam_points(Arena& arena, Seam& seam) {
 
 // Each seam half-edge's twin, found through each point's outgoing half-edges. False if
 // the arena is too small.
-inline bool link_seam_twins(Arena& arena, Seam& seam) {
+static inline bool link_seam_twins(Arena& arena, Seam& seam) {
     const uint32_t points = seam.points, triangles = seam.triangles;
     size_t mark = arena.mark();
     uint32_t* first = arena.alloc<uint32_t>(size_t{points} + 1);
@@ -6963,8 +6970,9 @@ inline bool link_seam_twins(Arena& arena, Seam& seam) {
 
 // The seam of a chunk (see above). False with seam.triangles = 0 when it is left as it is;
 // false with arena.failed when the arena is too small.
-inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                      uint32_t* chunk, size_t count, Arena& arena, Seam& seam) {
+static inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer,
+                             const LayerLoops& loops, uint32_t* chunk, size_t count, Arena& arena,
+                             Seam& seam) {
     seam.chunk = chunk;
     seam.triangles = 0;
     const size_t vertices = layer.count + c.top_count;
@@ -6986,15 +6994,15 @@ inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
 }
 
 // Seam point v's normal.
-inline Vec3 seam_normal(const Seam& seam, uint32_t v) {
+static inline Vec3 seam_normal(const Seam& seam, uint32_t v) {
     const float* n = seam.normal + 3 * size_t{v};
     return Vec3{static_cast<double>(n[0]), static_cast<double>(n[1]),
                 static_cast<double>(n[2])};
 }
 
 // Adds triangle v's unit normal to sums[3 k] for each corner k of it that is a seam point.
-inline void add_seam_normal(const SurfaceChain& c, const Seam& seam, const uint32_t* v,
-                            float* sums) {
+static inline void add_seam_normal(const SurfaceChain& c, const Seam& seam, const uint32_t* v,
+                                   float* sums) {
     const uint32_t at[3] = {seam.point_of(v[0]), seam.point_of(v[1]), seam.point_of(v[2])};
     if (at[0] == kNoIndex && at[1] == kNoIndex && at[2] == kNoIndex) return;
     Vec3 n = normal_of(c.frame.local(c.reader.point(v[0])), c.frame.local(c.reader.point(v[1])),
@@ -7012,7 +7020,7 @@ inline void add_seam_normal(const SurfaceChain& c, const Seam& seam, const uint3
 }
 
 // The sums of the unit normals of the chunk's triangles off the seam, at the seam's points.
-inline void sum_fixed_normals(const SurfaceChain& c, const Seam& seam, size_t count) {
+static inline void sum_fixed_normals(const SurfaceChain& c, const Seam& seam, size_t count) {
     std::memset(seam.fixed_normal, 0, 3 * size_t{seam.points} * sizeof(float));
     uint32_t next = 0;  // seam.slot is increasing
     for (size_t t = 0; t < count; ++t) {
@@ -7026,7 +7034,7 @@ inline void sum_fixed_normals(const SurfaceChain& c, const Seam& seam, size_t co
 
 // The seam's vertex normals over every triangle of the chunk (see VertexNormals): the fixed
 // sums and the seam's own triangles, made unit.
-inline void estimate_seam_normals(const SurfaceChain& c, const Seam& seam) {
+static inline void estimate_seam_normals(const SurfaceChain& c, const Seam& seam) {
     std::memcpy(seam.normal, seam.fixed_normal, 3 * size_t{seam.points} * sizeof(float));
     for (uint32_t s = 0; s < seam.triangles; ++s)
         add_seam_normal(c, seam, seam.chunk + 3 * size_t{seam.slot[s]}, seam.normal);
@@ -7043,7 +7051,7 @@ inline void estimate_seam_normals(const SurfaceChain& c, const Seam& seam) {
 
 // Whether seam point x's triangles, walked around it from half-edge `from` (leaving x) both
 // ways, are all of its seam triangles and none has an edge to y.
-inline bool fan_misses(const Seam& seam, uint32_t from, uint32_t x, uint32_t y) {
+static inline bool fan_misses(const Seam& seam, uint32_t from, uint32_t x, uint32_t y) {
     uint32_t seen = 0;
     auto clear = [&seam, y](uint32_t g) {
         return seam.vertex[next_edge(g)] != y && seam.vertex[prev_edge(g)] != y;
@@ -7069,7 +7077,8 @@ inline bool fan_misses(const Seam& seam, uint32_t from, uint32_t x, uint32_t y) 
 }
 
 // Flips half-edge e of the seam if that helps (see above and flip_on_surface).
-inline bool flip_seam_edge(const SurfaceChain& c, Seam& seam, const Cylinder& cyl, uint32_t e) {
+static inline bool flip_seam_edge(const SurfaceChain& c, Seam& seam, const Cylinder& cyl,
+                                  uint32_t e) {
     const uint32_t f = seam.twin[e];
     if (f == kNoIndex) return false;
     const uint32_t a = seam.vertex[e], b = seam.vertex[next_edge(e)];
@@ -7122,8 +7131,8 @@ inline bool flip_seam_edge(const SurfaceChain& c, Seam& seam, const Cylinder& cy
 
 // Flips a final chunk's seam (reader indices) on the surface, sweep after sweep as
 // flip_layer_on_surface does. Returns false if the arena is too small.
-inline bool flip_seam(const SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                      uint32_t* chunk, size_t count, Arena& arena) {
+static inline bool flip_seam(const SurfaceChain& c, const LoadedLayer& layer,
+                             const LayerLoops& loops, uint32_t* chunk, size_t count, Arena& arena) {
     size_t mark = arena.mark();
     Seam seam;
     if (!find_seam(c, layer, loops, chunk, count, arena, seam)) {
@@ -7163,8 +7172,8 @@ namespace detail {
 // lump the inner rings together. The strip has the cylinder's proportions (angle in
 // radians, height over the radius), as the curve's cells are square. False if the arena
 // is too small.
-inline bool roll_in_insertion_order(LoadedLayer& layer, uint32_t* order, double* xy,
-                                    Arena& arena) {
+static inline bool roll_in_insertion_order(LoadedLayer& layer, uint32_t* order, double* xy,
+                                           Arena& arena) {
     const size_t count = layer.count;
     Local* points = layer.points;
     const Cylinder& cyl = layer.cyl;
@@ -7196,8 +7205,8 @@ inline bool roll_in_insertion_order(LoadedLayer& layer, uint32_t* order, double*
 
 // Peels the layer's loops (see "peeling"): the passes and the slope of a loop. The
 // surface's end loops of a layer that folds peel further; its other loops not at all.
-inline void peel_layer_loops(Triangulation& tr, const LoadedLayer& layer, size_t folds,
-                             uint32_t* flags, LayerLoops& loops) {
+static inline void peel_layer_loops(Triangulation& tr, const LoadedLayer& layer, size_t folds,
+                                    uint32_t* flags, LayerLoops& loops) {
     auto passes = [&layer, folds](uint32_t end) {
         if (folds == 0) return kPeelPasses;
         return (layer.ends & end) ? kFoldedEndPeelPasses : 0;
@@ -7216,8 +7225,8 @@ inline void peel_layer_loops(Triangulation& tr, const LoadedLayer& layer, size_t
 // Writes the surface triangles to the sink in layer-local indices, those at the bottom loop
 // (the border) last, so that a chunk's triangles at its loop vertices are one stretch of
 // the sink with the band (see chunk_is_sound); counts the points off that loop with one.
-inline void emit_layer(const Triangulation& tr, const uint32_t* order, uint32_t* flags,
-                       size_t total, TriangleSink& sink, LayerLoops& loops) {
+static inline void emit_layer(const Triangulation& tr, const uint32_t* order, uint32_t* flags,
+                              size_t total, TriangleSink& sink, LayerLoops& loops) {
     for (uint32_t at_border = 0; at_border < 2; ++at_border) {
         if (at_border) loops.border_start = sink.count;
         for (uint32_t t = 0; t < tr.triangle_count; ++t) {
@@ -7245,8 +7254,8 @@ inline void emit_layer(const Triangulation& tr, const uint32_t* order, uint32_t*
 // it with the next one), out_of_memory or internal_error. Its scratch is released; the
 // layer's points are left in insertion order (layer.points[k] is layer-local point
 // order[k], an order not kept).
-inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Arena& arena,
-                                TriangleSink& sink, LayerLoops& loops, LayerCounts& counts) {
+static inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Arena& arena,
+                                       TriangleSink& sink, LayerLoops& loops, LayerCounts& counts) {
     const size_t count = layer.count, total = count + 1;  // vertex 0 is the centre
     choose_centre(layer, arena);
     size_t mark = arena.mark();
@@ -8375,8 +8384,8 @@ struct WebMemory {
     float* lengths;
 };
 
-inline bool allocate_webs(WebMemory& m, size_t point_count, size_t triangle_count,
-                          Arena& arena) {
+static inline bool allocate_webs(WebMemory& m, size_t point_count, size_t triangle_count,
+                                 Arena& arena) {
     m.points = arena.alloc<Vec3>(point_count);
     m.ends = arena.alloc<size_t>(point_count);
     m.spacings = arena.alloc<float>(point_count);
@@ -8390,7 +8399,7 @@ inline bool allocate_webs(WebMemory& m, size_t point_count, size_t triangle_coun
 }
 
 // The workspace measure_webs() takes.
-inline size_t webs_workspace_size(size_t point_count, size_t triangle_count) {
+static inline size_t webs_workspace_size(size_t point_count, size_t triangle_count) {
     Arena arena = Arena::measuring();
     WebMemory m;
     return allocate_webs(m, point_count, triangle_count, arena) ? arena.required_bytes() : 0;
@@ -8415,7 +8424,7 @@ struct WebFrame {
     }
 };
 
-inline WebFrame web_frame(const CloudSums& s) {
+static inline WebFrame web_frame(const CloudSums& s) {
     const Vec3 low = {s.lowest[0], s.lowest[1], s.lowest[2]};
     const Vec3 high = {s.highest[0], s.highest[1], s.highest[2]};
     const Vec3 size = high - low, half = scaled(high, 0.5) - scaled(low, 0.5);
@@ -8425,7 +8434,7 @@ inline WebFrame web_frame(const CloudSums& s) {
 }
 
 // a, b in order (as min and max, which compile without a branch).
-inline void order(float& a, float& b) {
+static inline void order(float& a, float& b) {
     const float low = b < a ? b : a, high = a < b ? b : a;
     a = low;
     b = high;
@@ -8433,7 +8442,7 @@ inline void order(float& a, float& b) {
 
 // The lower median of v[0 .. count), count > 0: by a sorting network for a vertex's few
 // edges (no branch to mispredict), by heapsort for a large fan.
-inline float lower_median(float* v, size_t count) {
+static inline float lower_median(float* v, size_t count) {
     if (count > 8) {
         heap_sort(v, count);
         return v[(count - 1) / 2];
@@ -8455,8 +8464,8 @@ const size_t kWebAhead = 16;
 
 // Numbers the vertices, renumbers the triangles' corners and counts the edges leaving each
 // vertex, then turns the counts into starts; returns how many vertices there are.
-inline uint32_t number_vertices(uint32_t* tri, size_t count, size_t point_count,
-                                const WebMemory& m) {
+static inline uint32_t number_vertices(uint32_t* tri, size_t count, size_t point_count,
+                                       const WebMemory& m) {
     for (size_t v = 0; v < point_count; ++v) m.id[v] = kNoIndex;
     uint32_t vertices = 0;
     for (size_t k = 0; k < 3 * count; ++k) {
@@ -8506,8 +8515,8 @@ struct WebVertexPass {
 
 // The lengths of the edges leaving each vertex, sorted by vertex (a counting sort: each
 // start becomes an end), and each triangle's longest edge. Returns the triangles' area.
-inline double edge_lengths(const WebFrame& f, const uint32_t* tri, size_t count,
-                           const WebMemory& m) {
+static inline double edge_lengths(const WebFrame& f, const uint32_t* tri, size_t count,
+                                  const WebMemory& m) {
     double area = 0;
     for (size_t t = 0; t < count; ++t) {
         const uint32_t* c = tri + 3 * t;
@@ -8528,8 +8537,8 @@ inline double edge_lengths(const WebFrame& f, const uint32_t* tri, size_t count,
 
 // The web triangles among the renumbered triangles (see Diagnostics), into d, while their
 // corners are numbered back; returns their area.
-inline double find_webs(const WebFrame& f, uint32_t* tri, size_t count, const WebMemory& m,
-                        Diagnostics& d) {
+static inline double find_webs(const WebFrame& f, uint32_t* tri, size_t count, const WebMemory& m,
+                               Diagnostics& d) {
     double web = 0;
     Vec3 low = {DBL_MAX, DBL_MAX, DBL_MAX}, high = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
     for (size_t t = 0; t < count; ++t) {
@@ -8565,9 +8574,9 @@ inline double find_webs(const WebFrame& f, uint32_t* tri, size_t count, const We
 // Measures the webs of triangles[0 .. count) less the last `caps` into rep.diagnostics;
 // the triangles are renumbered meanwhile and come back as they were. False if the
 // workspace is too small (nothing is measured).
-inline bool measure_webs(const Options& options, const CloudReader& reader, size_t point_count,
-                         const CloudSums& sums, uint32_t* triangles, size_t count, size_t caps,
-                         Arena& arena, Report& rep) {
+static inline bool measure_webs(const Options& options, const CloudReader& reader,
+                                size_t point_count, const CloudSums& sums, uint32_t* triangles,
+                                size_t count, size_t caps, Arena& arena, Report& rep) {
     const size_t walls = caps < count ? count - caps : 0;
     const size_t mark = arena.mark();
     WebMemory m;
@@ -8602,11 +8611,11 @@ struct SinkMark {
     size_t count, folds, swaps;
 };
 
-inline SinkMark mark_sink(const SurfaceChain& c, const TriangleSink& sink) {
+static inline SinkMark mark_sink(const SurfaceChain& c, const TriangleSink& sink) {
     return {sink.count, sink.folds, c.swaps};
 }
 
-inline void rewind_sink(SurfaceChain& c, TriangleSink& sink, const SinkMark& m) {
+static inline void rewind_sink(SurfaceChain& c, TriangleSink& sink, const SinkMark& m) {
     sink.count = m.count;
     sink.folds = m.folds;
     c.swaps = m.swaps;
@@ -8634,8 +8643,8 @@ struct GroupTry {
 
 // Sets up the try for planned layers [g.first, g.last] and loads their points, unless the
 // layer done ahead is the group. False if the arena is too small.
-inline bool load_group(const SurfaceChain& c, const LayerQueue& q, const LayerAhead* ahead,
-                       Arena& arena, GroupTry& g) {
+static inline bool load_group(const SurfaceChain& c, const LayerQueue& q, const LayerAhead* ahead,
+                              Arena& arena, GroupTry& g) {
     g.ids = q.ids + q.start[g.first];
     g.staged = q.staged ? q.staged + q.start[g.first] : nullptr;
     g.n = q.start[g.last + 1] - q.start[g.first];
@@ -8659,8 +8668,8 @@ enum class Growth { none, next_layer, rest, wait };
 
 // A crescent, the group or the next planned layer (see kRingGap), joins the next layer; a
 // rest too small or thin to stand joins the group once the queue is complete.
-inline Growth group_growth(const SurfaceChain& c, const LayerQueue& q, const LayerAhead* ahead,
-                           const GroupTry& g) {
+static inline Growth group_growth(const SurfaceChain& c, const LayerQueue& q,
+                                  const LayerAhead* ahead, const GroupTry& g) {
     if (g.final) return Growth::none;
     if (kCrescentLayers &&
         joins_crescent(c, q, g.first, g.last,
@@ -8675,7 +8684,7 @@ inline Growth group_growth(const SurfaceChain& c, const LayerQueue& q, const Lay
 }
 
 // Whether an entry of either loop of the band was peeled.
-inline bool band_loops_peeled(const SurfaceChain& c, const LayerLoops& loops) {
+static inline bool band_loops_peeled(const SurfaceChain& c, const LayerLoops& loops) {
     for (uint32_t i = 0; i < c.top_count; ++i)
         if (c.top_unused[i] & kPassBits) return true;
     for (uint32_t j = 0; j < loops.bottom_count; ++j)
@@ -8684,7 +8693,7 @@ inline bool band_loops_peeled(const SurfaceChain& c, const LayerLoops& loops) {
 }
 
 // The entries of the band's loops marked kUnpeeled.
-inline size_t band_loops_unpeeled(const SurfaceChain& c, const LayerLoops& loops) {
+static inline size_t band_loops_unpeeled(const SurfaceChain& c, const LayerLoops& loops) {
     return count_unpeeled(c.top_unused, c.top_count) +
            count_unpeeled(loops.bottom_flags, loops.bottom_count);
 }
@@ -8695,7 +8704,7 @@ inline size_t band_loops_unpeeled(const SurfaceChain& c, const LayerLoops& loops
 // triangulation and kUnpeelRounds); where it still folds, or no peeled entry is near a
 // fold, between the loops as they were before peeling, with all their peeled triangles
 // put back.
-inline void stitch_to_chain(SurfaceChain& c, GroupTry& g, Arena& arena, TriangleSink& sink) {
+static inline void stitch_to_chain(SurfaceChain& c, GroupTry& g, Arena& arena, TriangleSink& sink) {
     if (g.status != Status::ok || c.top_count == 0) return;
     const SinkMark band = mark_sink(c, sink);
     // Rounds before the last put back the groups marked; the last, all.
@@ -8720,8 +8729,8 @@ inline void stitch_to_chain(SurfaceChain& c, GroupTry& g, Arena& arena, Triangle
 
 // The group's chunk before the safety net: its layer's triangles (the job's or made here)
 // and the band to the chain's top loop.
-inline void make_chunk(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
-                       TriangleSink& sink, GroupResult& result, GroupTry& g) {
+static inline void make_chunk(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
+                              TriangleSink& sink, GroupResult& result, GroupTry& g) {
     g.chunk = mark_sink(c, sink);
     g.loops = {c.bottom, 0, c.next_top, 0, c.bottom_flags, c.next_unused, 0, 0};
     if (kParallelLayers && g.triangulated) {
@@ -8745,7 +8754,7 @@ struct FoldMerge {
 // Whether the try just made is dropped for another, with g.last set for that one (see
 // "Folding layers" at add_group). Decided before the chunk is named (naming counts its
 // points).
-inline bool try_joined(FoldMerge& m, size_t folds, GroupTry& g) {
+static inline bool try_joined(FoldMerge& m, size_t folds, GroupTry& g) {
     if (!kFoldMerge || m.settled ||
         !(m.joined > 0 || (g.status == Status::ok && folds > 0 && !g.final)))
         return false;
@@ -8773,8 +8782,8 @@ inline bool try_joined(FoldMerge& m, size_t folds, GroupTry& g) {
 // Else one the job left in reader indices is loaded and triangulated again, in order, to
 // the same triangles; one left in layer-local indices (not replayable) goes through the
 // safety net as it is.
-inline bool replay_ahead(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
-                         TriangleSink& sink, GroupResult& result, GroupTry& g) {
+static inline bool replay_ahead(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
+                                TriangleSink& sink, GroupResult& result, GroupTry& g) {
     if (g.status != Status::ok || sink.count > sink.capacity ||
         (ahead->replayable &&
          replay_chunk(c, g.layer, g.loops, *ahead, g.chunk.count, arena, sink)))
@@ -8792,7 +8801,7 @@ inline bool replay_ahead(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
 
 // The chunk's safety net, into output indices; a chunk triangulated here whose border and
 // band show it sound is only renamed.
-inline void seal_chunk(SurfaceChain& c, Arena& arena, TriangleSink& sink, GroupTry& g) {
+static inline void seal_chunk(SurfaceChain& c, Arena& arena, TriangleSink& sink, GroupTry& g) {
     if (g.status != Status::ok || sink.count > sink.capacity) return;
     if (kNetShortcut && !(kParallelLayers && g.triangulated) &&
         chunk_is_sound(c, g.layer, g.loops, sink.triangles + 3 * g.loops.border_start,
@@ -8804,8 +8813,8 @@ inline void seal_chunk(SurfaceChain& c, Arena& arena, TriangleSink& sink, GroupT
 }
 
 // The flips across the seam below the sealed chunk, then its output indices.
-inline void flip_chunk_seam(const SurfaceChain& c, Arena& arena, TriangleSink& sink,
-                            GroupTry& g) {
+static inline void flip_chunk_seam(const SurfaceChain& c, Arena& arena, TriangleSink& sink,
+                                   GroupTry& g) {
     if (g.status != Status::ok || sink.count > sink.capacity) return;
     uint32_t* chunk = sink.triangles + 3 * g.chunk.count;
     const size_t in_chunk = sink.count - g.chunk.count;
@@ -8819,7 +8828,7 @@ inline void flip_chunk_seam(const SurfaceChain& c, Arena& arena, TriangleSink& s
 
 // The finished group's top loop, in reader indices, becomes the chain's, and its counts
 // join the chain's and the result.
-inline void advance_chain(SurfaceChain& c, const GroupTry& g, GroupResult& result) {
+static inline void advance_chain(SurfaceChain& c, const GroupTry& g, GroupResult& result) {
     for (uint32_t i = 0; i < g.loops.top_count; ++i) g.loops.top[i] = g.ids[g.loops.top[i]];
     uint32_t* top = c.top;
     unsigned char* unused = c.top_unused;
@@ -8839,8 +8848,8 @@ inline void advance_chain(SurfaceChain& c, const GroupTry& g, GroupResult& resul
 
 // Finishes the group's chunk (see replay_ahead, seal_chunk, flip_chunk_seam) and, if that
 // went well, adds the group to the chain.
-inline void finish_group(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
-                         TriangleSink& sink, GroupResult& result, GroupTry& g) {
+static inline void finish_group(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
+                                TriangleSink& sink, GroupResult& result, GroupTry& g) {
     const bool finished =
         kParallelLayers && g.triangulated && replay_ahead(c, ahead, arena, sink, result, g);
     result.triangles = sink.count - g.chunk.count;
@@ -8869,8 +8878,8 @@ inline void finish_group(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
 // triangulations more, only where a layer folds (at most seven times that layer's time);
 // the stream waits for the layers above as it does for crescents, and makes the same
 // groups.
-inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Arena& arena,
-                        TriangleSink& sink, GroupResult& result, const LayerAhead* ahead) {
+static inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Arena& arena,
+                               TriangleSink& sink, GroupResult& result, const LayerAhead* ahead) {
     result.waiting = false;
     GroupTry g;
     g.first = g.last = first;
@@ -8914,7 +8923,7 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
 
 // The scratch of a group of up to `count` points: its points, then the triangulation or the
 // band, then the safety net.
-inline Arena group_scratch(size_t count) {
+static inline Arena group_scratch(size_t count) {
     size_t total = count + 1;
     Arena group = Arena::measuring();
     group.alloc<Local>(count);
@@ -8959,7 +8968,7 @@ inline Arena group_scratch(size_t count) {
 
 // The scratch of planning the layers of `count` points: the automatic layers' profile,
 // then each point's layer while the points are grouped.
-inline Arena planning_scratch(size_t count) {
+static inline Arena planning_scratch(size_t count) {
     Arena planning = Arena::measuring();
     ProfileBin* bins = nullptr;
     BinRange* ranges = nullptr;
@@ -8974,7 +8983,7 @@ inline Arena planning_scratch(size_t count) {
 // The largest scratch any phase takes on top of the plan, for groups of up to `count`
 // points; 0 if that is beyond what size_t can count. With `close`, the caps: every point
 // on a boundary loop, as many triangles as the output can hold.
-inline size_t reconstruct_scratch_size(size_t count, bool close) {
+static inline size_t reconstruct_scratch_size(size_t count, bool close) {
     const Arena group = group_scratch(count), planning = planning_scratch(count);
     Arena caps = Arena::measuring();
     if (close) {
@@ -9037,9 +9046,9 @@ struct ParallelLayers {
 
 // Room for the results of `slots` layers holding `points` points in all, out of `layers`
 // planned layers.
-inline bool allocate_ahead(ParallelLayers& p, uint32_t slots, size_t points, size_t layers,
-                           Arena& arena, uint32_t** triangles, uint32_t** loops,
-                           unsigned char** loop_flags, uint32_t** borders) {
+static inline bool allocate_ahead(ParallelLayers& p, uint32_t slots, size_t points, size_t layers,
+                                  Arena& arena, uint32_t** triangles, uint32_t** loops,
+                                  unsigned char** loop_flags, uint32_t** borders) {
     p.ahead = arena.alloc<LayerAhead>(slots);
     p.layer_of_slot = arena.alloc<uint32_t>(slots);
     p.slot_of_layer = arena.alloc<uint32_t>(layers);
@@ -9053,16 +9062,16 @@ inline bool allocate_ahead(ParallelLayers& p, uint32_t slots, size_t points, siz
 // The border a layer of n points may keep for replay_chunk: its bottom loop holds a few
 // times the square root of n points in a sound layer, with two or three triangles each.
 // A thin layer's border can be most of its triangles: it is finished in order instead.
-inline size_t border_capacity(size_t n) { return n / 4 + 4; }
+static inline size_t border_capacity(size_t n) { return n / 4 + 4; }
 
-inline bool may_stand_alone(const LayerQueue& q, uint32_t k) {
+static inline bool may_stand_alone(const LayerQueue& q, uint32_t k) {
     size_t n = q.start[k + 1] - q.start[k];
     return n >= kMinLayerPoints || (k + 1 == q.planned && n >= 3);
 }
 
 // The job scratch bound: a run of layers needs the scratch of its largest, and scratch grows
 // linearly with rounding, so jobs over n points in all need at most this.
-inline size_t job_scratch_bound(size_t points) {
+static inline size_t job_scratch_bound(size_t points) {
     size_t whole = reconstruct_scratch_size(points, false), one = reconstruct_scratch_size(0, false);
     const size_t slack = 1024;  // the rounding of every allocation, with room to spare
     if (whole == 0 || one > (SIZE_MAX - whole) / kMaxJobs - slack) return 0;
@@ -9071,7 +9080,7 @@ inline size_t job_scratch_bound(size_t points) {
 
 // What replay_chunk needs of a job's layer (see LayerAhead), then, if it can replay them,
 // its triangles in reader indices (`ids`).
-inline void keep_border(LayerAhead& a, const uint32_t* ids, size_t n, Arena& arena) {
+static inline void keep_border(LayerAhead& a, const uint32_t* ids, size_t n, Arena& arena) {
     const unsigned char on_bottom = 1, has_triangle = 2;
     unsigned char* flags = arena.alloc<unsigned char>(n);
     a.replayable = flags != nullptr;
@@ -9097,7 +9106,7 @@ inline void keep_border(LayerAhead& a, const uint32_t* ids, size_t n, Arena& are
 
 // Job `job`: triangulates the layers of slots first_slot[job] .. first_slot[job + 1] - 1 in
 // the job's own scratch.
-inline void triangulate_job(const ParallelLayers& p, uint32_t job) {
+static inline void triangulate_job(const ParallelLayers& p, uint32_t job) {
     const LayerQueue& q = *p.queue;
     Arena arena = Arena::over(p.scratch[job], p.scratch_bytes[job]);
     for (uint32_t slot = p.first_slot[job]; slot < p.first_slot[job + 1]; ++slot) {
@@ -9133,7 +9142,7 @@ inline void triangulate_job(const ParallelLayers& p, uint32_t job) {
 
 // Gives each layer that may stand alone a slot: its part of the results carved from the
 // arena (false if they do not fit). `points` are the slots' points in all.
-inline bool assign_slots(ParallelLayers& p, uint32_t slots, size_t points, Arena& arena) {
+static inline bool assign_slots(ParallelLayers& p, uint32_t slots, size_t points, Arena& arena) {
     const LayerQueue& q = *p.queue;
     uint32_t* triangles = nullptr;
     uint32_t* loops = nullptr;
@@ -9169,7 +9178,7 @@ inline bool assign_slots(ParallelLayers& p, uint32_t slots, size_t points, Arena
 // Cuts the slots into jobs: runs of slots with about equal point counts. A slot goes to the
 // share of the points its middle falls in, so equal layers get a job each (a threshold on
 // a running count would put a layer slightly under the mean together with the next).
-inline void divide_jobs(ParallelLayers& p, size_t points) {
+static inline void divide_jobs(ParallelLayers& p, size_t points) {
     const LayerQueue& q = *p.queue;
     const uint32_t most = p.slots < kMaxJobs ? p.slots : kMaxJobs;
     uint32_t job = 0;
@@ -9190,7 +9199,7 @@ inline void divide_jobs(ParallelLayers& p, size_t points) {
 }
 
 // Each job's scratch: that of its largest layer. False if they do not fit.
-inline bool allocate_job_scratch(ParallelLayers& p, Arena& arena) {
+static inline bool allocate_job_scratch(ParallelLayers& p, Arena& arena) {
     const LayerQueue& q = *p.queue;
     for (uint32_t j = 0; j < p.job_count; ++j) {
         size_t largest = 0;
@@ -9209,7 +9218,7 @@ inline bool allocate_job_scratch(ParallelLayers& p, Arena& arena) {
 // them. Returns with p.ready false (and the arena as it was) when there is nothing to gain or
 // no room: the groups are then triangulated in order. The results stay in the arena; the
 // jobs' scratch is released.
-inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& arena) {
+static inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& arena) {
     p.ready = false;
     const LayerQueue& q = *p.queue;
     uint32_t slots = 0;
@@ -9236,9 +9245,9 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
 }
 
 // Starts the jobs for reconstruct(); returns the layers they triangulated.
-inline size_t start_parallel_layers(const Options& options, const CloudReader& reader,
-                                    const Frame& frame, const LayerQueue& queue, Arena& arena,
-                                    ParallelLayers& parallel) {
+static inline size_t start_parallel_layers(const Options& options, const CloudReader& reader,
+                                           const Frame& frame, const LayerQueue& queue,
+                                           Arena& arena, ParallelLayers& parallel) {
     parallel.ready = false;
     if (!has_runner(options)) return 0;
     parallel.reader = &reader;
@@ -9253,8 +9262,8 @@ inline size_t start_parallel_layers(const Options& options, const CloudReader& r
 
 // What the layers done ahead add to the workspace bound: their results, which stay, in
 // `arena`; the jobs' scratch, which comes and goes before the groups' own, in *scratch.
-inline bool plan_parallel_workspace(size_t point_count, size_t layer_limit, Arena& arena,
-                                    size_t* scratch) {
+static inline bool plan_parallel_workspace(size_t point_count, size_t layer_limit, Arena& arena,
+                                           size_t* scratch) {
     ParallelLayers p;
     uint32_t* triangles = nullptr;
     uint32_t* loops = nullptr;
@@ -9275,13 +9284,13 @@ struct ParallelLayers {
     const LayerAhead* ahead_of(uint32_t) const { return nullptr; }
 };
 
-inline size_t start_parallel_layers(const Options&, const CloudReader&, const Frame&,
-                                    const LayerQueue&, Arena&, ParallelLayers& parallel) {
+static inline size_t start_parallel_layers(const Options&, const CloudReader&, const Frame&,
+                                           const LayerQueue&, Arena&, ParallelLayers& parallel) {
     parallel.ready = false;
     return 0;
 }
 
-inline bool plan_parallel_workspace(size_t, size_t, Arena&, size_t*) { return true; }
+static inline bool plan_parallel_workspace(size_t, size_t, Arena&, size_t*) { return true; }
 
 #endif  // STRATMESH_NO_PARALLEL_LAYERS
 
@@ -9310,16 +9319,17 @@ struct ReconstructMemory {
     SurfaceChain chain;
 };
 
-inline bool plan_reconstruct(ReconstructMemory& m, size_t count, size_t layer_limit,
-                             Arena& arena) {
+static inline bool plan_reconstruct(ReconstructMemory& m, size_t count, size_t layer_limit,
+                                    Arena& arena) {
     m.bounds = arena.alloc<double>(layer_limit + 1);
     m.layer_start = arena.alloc<uint32_t>(layer_limit + 2);
     m.order = arena.alloc<uint32_t>(count);
     return allocate_chain(m.chain, count, arena);
 }
 
-inline void describe_layer(const Frame& frame, const Cylinder& cyl, double bottom, double top,
-                           size_t points, size_t triangles, size_t folds, LayerInfo& info) {
+static inline void describe_layer(const Frame& frame, const Cylinder& cyl, double bottom,
+                                  double top, size_t points, size_t triangles, size_t folds,
+                                  LayerInfo& info) {
     info.bottom = frame.user_height(bottom);
     info.top = frame.user_height(top);
     double mid = (bottom + top) / 2 / frame.scale, cx = cyl.cx / frame.scale, cy = cyl.cy / frame.scale;
@@ -9337,7 +9347,7 @@ inline void describe_layer(const Frame& frame, const Cylinder& cyl, double botto
 }
 
 // The workspace bound of mesh_tube() (with read_cloud()) for point_count points.
-inline size_t tube_workspace_size(size_t point_count, const Options& options) {
+static inline size_t tube_workspace_size(size_t point_count, const Options& options) {
     if (point_count > kMaxPoints - 1) return 0;
     Arena arena = Arena::measuring();
     // drop_outliers, as find_outliers allocates: the bitmap stays, the grid comes and goes
@@ -9367,7 +9377,7 @@ inline size_t tube_workspace_size(size_t point_count, const Options& options) {
 }
 
 // The chain's counts into the report, with the reason when a valid point is not a vertex.
-inline void report_chain(const SurfaceChain& chain, size_t valid, Report& rep) {
+static inline void report_chain(const SurfaceChain& chain, size_t valid, Report& rep) {
     rep.points.duplicate_count = chain.duplicates;
     rep.diagnostics.illegal_removed_count = chain.removed;
     rep.points.used_count = chain.used;
@@ -9388,9 +9398,9 @@ inline void report_chain(const SurfaceChain& chain, size_t valid, Report& rep) {
 // it out), its repeats are unused too, so where some points are not vertices they are
 // counted again from the output, with a hash table of the vertices' coordinates in the
 // workspace. Returns SIZE_MAX if the workspace is too small.
-inline size_t repeats_of_vertices(const CloudReader& reader, size_t count,
-                                  const uint32_t* triangles, size_t triangle_count,
-                                  Arena& arena) {
+static inline size_t repeats_of_vertices(const CloudReader& reader, size_t count,
+                                         const uint32_t* triangles, size_t triangle_count,
+                                         Arena& arena) {
     const size_t mark = arena.mark();
     unsigned char* used = arena.alloc<unsigned char>(count / 8 + 1);
     size_t slots = 1;
@@ -9425,9 +9435,10 @@ inline size_t repeats_of_vertices(const CloudReader& reader, size_t count,
 }
 
 // Plans the layers of a tube along the frame's axis and groups its points by layer.
-inline Status plan_tube_layers(const TubeInput& in, const Options& options, const Frame& frame,
-                               double lo, double hi, Arena& arena, ReconstructMemory& m,
-                               LayerPlan& plan, Local** staged, Report& rep) {
+static inline Status plan_tube_layers(const TubeInput& in, const Options& options,
+                                      const Frame& frame, double lo, double hi, Arena& arena,
+                                      ReconstructMemory& m, LayerPlan& plan, Local** staged,
+                                      Report& rep) {
     const size_t valid = in.sums.valid;
     const size_t layer_limit = planned_layer_limit(in.count, options);
     if (!plan_reconstruct(m, in.count, layer_limit, arena)) return Status::out_of_memory;
@@ -9467,9 +9478,10 @@ inline Status plan_tube_layers(const TubeInput& in, const Options& options, cons
 
 // Triangulates the planned layers one group after another, each stitched to the one below,
 // into `sink`; the layers used go to the report.
-inline Status triangulate_tube(const TubeInput& in, const Options& options, const Frame& frame,
-                               const LayerPlan& plan, Local* staged, Arena& arena,
-                               ReconstructMemory& m, TriangleSink& sink, Report& rep) {
+static inline Status triangulate_tube(const TubeInput& in, const Options& options,
+                                      const Frame& frame, const LayerPlan& plan, Local* staged,
+                                      Arena& arena, ReconstructMemory& m, TriangleSink& sink,
+                                      Report& rep) {
     notify(options, Phase::triangulate, 0);
     SurfaceChain& chain = m.chain;
     chain.frame = frame;
@@ -9519,8 +9531,8 @@ const size_t kAreaSample = 1024;
 
 // Whether the triangles, every k-th of them, have next to no area beside the square of the
 // cloud's own extent (about frame.cloud_share in the frame).
-inline bool has_no_area(const CloudReader& reader, const Frame& frame, const uint32_t* tri,
-                        size_t count) {
+static inline bool has_no_area(const CloudReader& reader, const Frame& frame, const uint32_t* tri,
+                               size_t count) {
     const size_t step = count > kAreaSample ? count / kAreaSample : 1;
     double area = 0;
     size_t seen = 0;
@@ -9535,9 +9547,9 @@ inline bool has_no_area(const CloudReader& reader, const Frame& frame, const uin
 }
 
 // Closes the tube's boundary loops with caps (close_ends) and fills the caps' report.
-inline Status cap_tube(const TubeInput& in, const Options& options, const Frame& frame,
-                       Arena& arena, uint32_t* triangles, size_t capacity, size_t& count,
-                       size_t* triangle_count, Report& rep) {
+static inline Status cap_tube(const TubeInput& in, const Options& options, const Frame& frame,
+                              Arena& arena, uint32_t* triangles, size_t capacity, size_t& count,
+                              size_t* triangle_count, Report& rep) {
     notify(options, Phase::manifold, 0);
     if (!(options.flags & close_ends)) return Status::ok;
     CapCounts caps = {0, 0, 0, 0};
@@ -9559,9 +9571,9 @@ inline Status cap_tube(const TubeInput& in, const Options& options, const Frame&
 // One tube through the kept points of `in`: the frame, the layers, their triangulation and
 // stitching, the caps. `rep` holds the counts of read_cloud; Report::points.unused_count
 // is left to the caller.
-inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& arena,
-                        uint32_t* triangles, size_t triangle_capacity, size_t* triangle_count,
-                        Report& rep) {
+static inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& arena,
+                               uint32_t* triangles, size_t triangle_capacity,
+                               size_t* triangle_count, Report& rep) {
     Frame frame;
     Status status = choose_frame(in.sums, options, frame);
     if (status != Status::ok) return status;
@@ -9666,7 +9678,7 @@ namespace detail {
 const double kStreamRange = 0x1p60;
 
 // Everything a stream holds for a window of `capacity` points.
-inline bool layout_stream(Stream& s, size_t capacity, Arena& arena) {
+static inline bool layout_stream(Stream& s, size_t capacity, Arena& arena) {
     s.capacity = capacity;
     s.slot_capacity = static_cast<uint32_t>(capacity + 1);
     s.points = arena.alloc<Vec3>(capacity);
@@ -9679,7 +9691,7 @@ inline bool layout_stream(Stream& s, size_t capacity, Arena& arena) {
     return allocate_chain(s.chain, capacity, arena) && !arena.failed;
 }
 
-inline size_t stream_bytes(size_t capacity) {
+static inline size_t stream_bytes(size_t capacity) {
     if (capacity > kMaxPoints - 1) return 0;
     Arena arena = Arena::measuring();
     arena.alloc<Stream>(1);
@@ -9690,14 +9702,14 @@ inline size_t stream_bytes(size_t capacity) {
     return arena.required_bytes() + scratch;
 }
 
-inline void publish(Stream& s) {
+static inline void publish(Stream& s) {
     s.rep.points.unused_count = s.rep.points.in_count - s.rep.points.used_count - s.rep.points.duplicate_count - s.rep.points.rejected_count;
     s.rep.workspace_used_bytes = s.arena.peak_from_buffer();
     if (s.user_report) *s.user_report = s.rep;
 }
 
 // A push refused: the stream is as it was; the report says why.
-inline Status refuse_push(Stream& s, Status status, const char* detail) {
+static inline Status refuse_push(Stream& s, Status status, const char* detail) {
     s.rep.detail = detail;
     publish(s);
     return status;
@@ -9705,7 +9717,7 @@ inline Status refuse_push(Stream& s, Status status, const char* detail) {
 
 // Keeps the last group's top loop (moved to the front of the window) and the pushes after
 // planned layer `last`.
-inline void drop_group(Stream& s, uint32_t last) {
+static inline void drop_group(Stream& s, uint32_t last) {
     const uint32_t loop = s.chain.top_count;
     const size_t rest_from = s.start[last + 1], rest = s.fill - rest_from;
     size_t mark = s.arena.mark();
@@ -9732,7 +9744,7 @@ inline void drop_group(Stream& s, uint32_t last) {
 }
 
 // Forms, emits and drops every group the held pushes decide.
-inline Status advance(Stream& s, bool complete) {
+static inline Status advance(Stream& s, bool complete) {
     while (s.planned > 0) {
         const LayerQueue queue = {s.positions, nullptr, s.start, s.bounds, s.planned, complete};
         GroupResult group;
@@ -9756,8 +9768,8 @@ inline Status advance(Stream& s, bool complete) {
 
 // Why a push's arguments are refused, with *why, or ok with the pushed cloud's reader: its
 // layout, its top and its count are checked.
-inline Status check_push(const Stream& s, const Cloud& points, double top, CloudReader* reader,
-                         const char** why) {
+static inline Status check_push(const Stream& s, const Cloud& points, double top,
+                                CloudReader* reader, const char** why) {
     const size_t scalar = points.scalar == Scalar::float32 ? sizeof(float)
                         : points.scalar == Scalar::float64 ? sizeof(double) : 0;
     const size_t stride = points.stride_bytes ? points.stride_bytes : 3 * scalar;
@@ -9785,9 +9797,9 @@ const char* const kTopBelow = "a pushed layer's top is below the previous layer'
 // The heights of the push's valid points in the frame, *low to *high, or why the push is
 // refused, with *why (and the point's index where one is to blame): a point far beyond the
 // first layer, or outside its own layer, between lower_limit and top_height.
-inline Status push_heights(Stream& s, const CloudReader& reader, size_t count,
-                           const Frame& frame, double lower_limit, double top_height,
-                           double* low, double* high, const char** why) {
+static inline Status push_heights(Stream& s, const CloudReader& reader, size_t count,
+                                  const Frame& frame, double lower_limit, double top_height,
+                                  double* low, double* high, const char** why) {
     auto slack = [](double h) { return 0x1p-40 * (1 + abs_value(h)); };
     *low = DBL_MAX;
     *high = -DBL_MAX;
@@ -9813,8 +9825,8 @@ inline Status push_heights(Stream& s, const CloudReader& reader, size_t count,
 
 // Holds the checked push as the next planned layer, its valid points from heights `low` to
 // `high` in the window; the first push with points sets the stream's frame.
-inline void hold_push(Stream& s, const CloudReader& reader, size_t count, const Frame& frame,
-                      double low, double high, double top_height) {
+static inline void hold_push(Stream& s, const CloudReader& reader, size_t count, const Frame& frame,
+                             double low, double high, double top_height) {
     if (!s.has_frame) {
         s.has_frame = true;
         s.chain.frame = frame;

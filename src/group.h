@@ -9,11 +9,11 @@ struct SinkMark {
     size_t count, folds, swaps;
 };
 
-inline SinkMark mark_sink(const SurfaceChain& c, const TriangleSink& sink) {
+static inline SinkMark mark_sink(const SurfaceChain& c, const TriangleSink& sink) {
     return {sink.count, sink.folds, c.swaps};
 }
 
-inline void rewind_sink(SurfaceChain& c, TriangleSink& sink, const SinkMark& m) {
+static inline void rewind_sink(SurfaceChain& c, TriangleSink& sink, const SinkMark& m) {
     sink.count = m.count;
     sink.folds = m.folds;
     c.swaps = m.swaps;
@@ -41,8 +41,8 @@ struct GroupTry {
 
 // Sets up the try for planned layers [g.first, g.last] and loads their points, unless the
 // layer done ahead is the group. False if the arena is too small.
-inline bool load_group(const SurfaceChain& c, const LayerQueue& q, const LayerAhead* ahead,
-                       Arena& arena, GroupTry& g) {
+static inline bool load_group(const SurfaceChain& c, const LayerQueue& q, const LayerAhead* ahead,
+                              Arena& arena, GroupTry& g) {
     g.ids = q.ids + q.start[g.first];
     g.staged = q.staged ? q.staged + q.start[g.first] : nullptr;
     g.n = q.start[g.last + 1] - q.start[g.first];
@@ -66,8 +66,8 @@ enum class Growth { none, next_layer, rest, wait };
 
 // A crescent, the group or the next planned layer (see kRingGap), joins the next layer; a
 // rest too small or thin to stand joins the group once the queue is complete.
-inline Growth group_growth(const SurfaceChain& c, const LayerQueue& q, const LayerAhead* ahead,
-                           const GroupTry& g) {
+static inline Growth group_growth(const SurfaceChain& c, const LayerQueue& q,
+                                  const LayerAhead* ahead, const GroupTry& g) {
     if (g.final) return Growth::none;
     if (kCrescentLayers &&
         joins_crescent(c, q, g.first, g.last,
@@ -82,7 +82,7 @@ inline Growth group_growth(const SurfaceChain& c, const LayerQueue& q, const Lay
 }
 
 // Whether an entry of either loop of the band was peeled.
-inline bool band_loops_peeled(const SurfaceChain& c, const LayerLoops& loops) {
+static inline bool band_loops_peeled(const SurfaceChain& c, const LayerLoops& loops) {
     for (uint32_t i = 0; i < c.top_count; ++i)
         if (c.top_unused[i] & kPassBits) return true;
     for (uint32_t j = 0; j < loops.bottom_count; ++j)
@@ -91,7 +91,7 @@ inline bool band_loops_peeled(const SurfaceChain& c, const LayerLoops& loops) {
 }
 
 // The entries of the band's loops marked kUnpeeled.
-inline size_t band_loops_unpeeled(const SurfaceChain& c, const LayerLoops& loops) {
+static inline size_t band_loops_unpeeled(const SurfaceChain& c, const LayerLoops& loops) {
     return count_unpeeled(c.top_unused, c.top_count) +
            count_unpeeled(loops.bottom_flags, loops.bottom_count);
 }
@@ -102,7 +102,7 @@ inline size_t band_loops_unpeeled(const SurfaceChain& c, const LayerLoops& loops
 // triangulation and kUnpeelRounds); where it still folds, or no peeled entry is near a
 // fold, between the loops as they were before peeling, with all their peeled triangles
 // put back.
-inline void stitch_to_chain(SurfaceChain& c, GroupTry& g, Arena& arena, TriangleSink& sink) {
+static inline void stitch_to_chain(SurfaceChain& c, GroupTry& g, Arena& arena, TriangleSink& sink) {
     if (g.status != Status::ok || c.top_count == 0) return;
     const SinkMark band = mark_sink(c, sink);
     // Rounds before the last put back the groups marked; the last, all.
@@ -127,8 +127,8 @@ inline void stitch_to_chain(SurfaceChain& c, GroupTry& g, Arena& arena, Triangle
 
 // The group's chunk before the safety net: its layer's triangles (the job's or made here)
 // and the band to the chain's top loop.
-inline void make_chunk(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
-                       TriangleSink& sink, GroupResult& result, GroupTry& g) {
+static inline void make_chunk(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
+                              TriangleSink& sink, GroupResult& result, GroupTry& g) {
     g.chunk = mark_sink(c, sink);
     g.loops = {c.bottom, 0, c.next_top, 0, c.bottom_flags, c.next_unused, 0, 0};
     if (kParallelLayers && g.triangulated) {
@@ -152,7 +152,7 @@ struct FoldMerge {
 // Whether the try just made is dropped for another, with g.last set for that one (see
 // "Folding layers" at add_group). Decided before the chunk is named (naming counts its
 // points).
-inline bool try_joined(FoldMerge& m, size_t folds, GroupTry& g) {
+static inline bool try_joined(FoldMerge& m, size_t folds, GroupTry& g) {
     if (!kFoldMerge || m.settled ||
         !(m.joined > 0 || (g.status == Status::ok && folds > 0 && !g.final)))
         return false;
@@ -180,8 +180,8 @@ inline bool try_joined(FoldMerge& m, size_t folds, GroupTry& g) {
 // Else one the job left in reader indices is loaded and triangulated again, in order, to
 // the same triangles; one left in layer-local indices (not replayable) goes through the
 // safety net as it is.
-inline bool replay_ahead(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
-                         TriangleSink& sink, GroupResult& result, GroupTry& g) {
+static inline bool replay_ahead(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
+                                TriangleSink& sink, GroupResult& result, GroupTry& g) {
     if (g.status != Status::ok || sink.count > sink.capacity ||
         (ahead->replayable &&
          replay_chunk(c, g.layer, g.loops, *ahead, g.chunk.count, arena, sink)))
@@ -199,7 +199,7 @@ inline bool replay_ahead(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
 
 // The chunk's safety net, into output indices; a chunk triangulated here whose border and
 // band show it sound is only renamed.
-inline void seal_chunk(SurfaceChain& c, Arena& arena, TriangleSink& sink, GroupTry& g) {
+static inline void seal_chunk(SurfaceChain& c, Arena& arena, TriangleSink& sink, GroupTry& g) {
     if (g.status != Status::ok || sink.count > sink.capacity) return;
     if (kNetShortcut && !(kParallelLayers && g.triangulated) &&
         chunk_is_sound(c, g.layer, g.loops, sink.triangles + 3 * g.loops.border_start,
@@ -211,8 +211,8 @@ inline void seal_chunk(SurfaceChain& c, Arena& arena, TriangleSink& sink, GroupT
 }
 
 // The flips across the seam below the sealed chunk, then its output indices.
-inline void flip_chunk_seam(const SurfaceChain& c, Arena& arena, TriangleSink& sink,
-                            GroupTry& g) {
+static inline void flip_chunk_seam(const SurfaceChain& c, Arena& arena, TriangleSink& sink,
+                                   GroupTry& g) {
     if (g.status != Status::ok || sink.count > sink.capacity) return;
     uint32_t* chunk = sink.triangles + 3 * g.chunk.count;
     const size_t in_chunk = sink.count - g.chunk.count;
@@ -226,7 +226,7 @@ inline void flip_chunk_seam(const SurfaceChain& c, Arena& arena, TriangleSink& s
 
 // The finished group's top loop, in reader indices, becomes the chain's, and its counts
 // join the chain's and the result.
-inline void advance_chain(SurfaceChain& c, const GroupTry& g, GroupResult& result) {
+static inline void advance_chain(SurfaceChain& c, const GroupTry& g, GroupResult& result) {
     for (uint32_t i = 0; i < g.loops.top_count; ++i) g.loops.top[i] = g.ids[g.loops.top[i]];
     uint32_t* top = c.top;
     unsigned char* unused = c.top_unused;
@@ -246,8 +246,8 @@ inline void advance_chain(SurfaceChain& c, const GroupTry& g, GroupResult& resul
 
 // Finishes the group's chunk (see replay_ahead, seal_chunk, flip_chunk_seam) and, if that
 // went well, adds the group to the chain.
-inline void finish_group(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
-                         TriangleSink& sink, GroupResult& result, GroupTry& g) {
+static inline void finish_group(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
+                                TriangleSink& sink, GroupResult& result, GroupTry& g) {
     const bool finished =
         kParallelLayers && g.triangulated && replay_ahead(c, ahead, arena, sink, result, g);
     result.triangles = sink.count - g.chunk.count;
@@ -276,8 +276,8 @@ inline void finish_group(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
 // triangulations more, only where a layer folds (at most seven times that layer's time);
 // the stream waits for the layers above as it does for crescents, and makes the same
 // groups.
-inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Arena& arena,
-                        TriangleSink& sink, GroupResult& result, const LayerAhead* ahead) {
+static inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Arena& arena,
+                               TriangleSink& sink, GroupResult& result, const LayerAhead* ahead) {
     result.waiting = false;
     GroupTry g;
     g.first = g.last = first;
@@ -321,7 +321,7 @@ inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Ar
 
 // The scratch of a group of up to `count` points: its points, then the triangulation or the
 // band, then the safety net.
-inline Arena group_scratch(size_t count) {
+static inline Arena group_scratch(size_t count) {
     size_t total = count + 1;
     Arena group = Arena::measuring();
     group.alloc<Local>(count);
@@ -366,7 +366,7 @@ inline Arena group_scratch(size_t count) {
 
 // The scratch of planning the layers of `count` points: the automatic layers' profile,
 // then each point's layer while the points are grouped.
-inline Arena planning_scratch(size_t count) {
+static inline Arena planning_scratch(size_t count) {
     Arena planning = Arena::measuring();
     ProfileBin* bins = nullptr;
     BinRange* ranges = nullptr;
@@ -381,7 +381,7 @@ inline Arena planning_scratch(size_t count) {
 // The largest scratch any phase takes on top of the plan, for groups of up to `count`
 // points; 0 if that is beyond what size_t can count. With `close`, the caps: every point
 // on a boundary loop, as many triangles as the output can hold.
-inline size_t reconstruct_scratch_size(size_t count, bool close) {
+static inline size_t reconstruct_scratch_size(size_t count, bool close) {
     const Arena group = group_scratch(count), planning = planning_scratch(count);
     Arena caps = Arena::measuring();
     if (close) {

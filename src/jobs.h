@@ -4,7 +4,7 @@
 namespace stratmesh {
 namespace detail {
 
-inline void notify(const Options& options, Phase phase, double fraction) {
+static inline void notify(const Options& options, Phase phase, double fraction) {
     if (options.progress) options.progress(options.progress_user, phase, fraction);
 }
 
@@ -15,7 +15,7 @@ inline void notify(const Options& options, Phase phase, double fraction) {
 // again does nothing, and a job the runner skipped is done afterwards as the batch says.
 
 // Whether work is cut into jobs: a runner given, in a build that has them.
-inline bool has_runner(const Options& options) {
+static inline bool has_runner(const Options& options) {
     return kParallelLayers && options.run_jobs != nullptr;
 }
 
@@ -25,7 +25,7 @@ template <class Job> struct JobBatch {
     bool done[kMaxJobs];
 };
 
-template <class Job> inline void run_batch_job(void* context, uint32_t index) {
+template <class Job> static inline void run_batch_job(void* context, uint32_t index) {
     JobBatch<Job>& batch = *static_cast<JobBatch<Job>*>(context);
     if (index >= batch.count || batch.done[index]) return;  // no job of ours, or done already
     (*batch.job)(index);
@@ -37,7 +37,8 @@ template <class Job> inline void run_batch_job(void* context, uint32_t index) {
 // then run here in order; else it is left undone (the layers not done ahead are
 // triangulated by their groups).
 template <class Job>
-inline void run_jobs(const Options& options, uint32_t count, bool redo_skipped, const Job& job) {
+static inline void run_jobs(const Options& options, uint32_t count, bool redo_skipped,
+                            const Job& job) {
     JobBatch<Job> batch = {&job, count, {}};
     if (has_runner(options)) options.run_jobs(options.jobs_user, count, run_batch_job<Job>, &batch);
     for (uint32_t k = 0; redo_skipped && k < count; ++k)
@@ -52,12 +53,12 @@ const uint32_t kPassRuns = 16;
 static_assert(kPassRuns <= kMaxJobs, "a pass's runs are one batch of jobs");
 
 // The first point of run k of `count` points.
-inline size_t run_start(size_t count, uint32_t k) {
+static inline size_t run_start(size_t count, uint32_t k) {
     return static_cast<size_t>(static_cast<uint64_t>(count) * k / kPassRuns);
 }
 
 // Runs pass.run(k) for every run k: as jobs with a runner, else in order.
-template <class Pass> inline void run_pass(const Options& options, Pass& pass) {
+template <class Pass> static inline void run_pass(const Options& options, Pass& pass) {
     run_jobs(options, kPassRuns, true, [&pass](uint32_t k) { pass.run(k); });
 }
 

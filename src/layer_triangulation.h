@@ -11,8 +11,8 @@ namespace detail {
 // lump the inner rings together. The strip has the cylinder's proportions (angle in
 // radians, height over the radius), as the curve's cells are square. False if the arena
 // is too small.
-inline bool roll_in_insertion_order(LoadedLayer& layer, uint32_t* order, double* xy,
-                                    Arena& arena) {
+static inline bool roll_in_insertion_order(LoadedLayer& layer, uint32_t* order, double* xy,
+                                           Arena& arena) {
     const size_t count = layer.count;
     Local* points = layer.points;
     const Cylinder& cyl = layer.cyl;
@@ -44,8 +44,8 @@ inline bool roll_in_insertion_order(LoadedLayer& layer, uint32_t* order, double*
 
 // Peels the layer's loops (see "peeling"): the passes and the slope of a loop. The
 // surface's end loops of a layer that folds peel further; its other loops not at all.
-inline void peel_layer_loops(Triangulation& tr, const LoadedLayer& layer, size_t folds,
-                             uint32_t* flags, LayerLoops& loops) {
+static inline void peel_layer_loops(Triangulation& tr, const LoadedLayer& layer, size_t folds,
+                                    uint32_t* flags, LayerLoops& loops) {
     auto passes = [&layer, folds](uint32_t end) {
         if (folds == 0) return kPeelPasses;
         return (layer.ends & end) ? kFoldedEndPeelPasses : 0;
@@ -64,8 +64,8 @@ inline void peel_layer_loops(Triangulation& tr, const LoadedLayer& layer, size_t
 // Writes the surface triangles to the sink in layer-local indices, those at the bottom loop
 // (the border) last, so that a chunk's triangles at its loop vertices are one stretch of
 // the sink with the band (see chunk_is_sound); counts the points off that loop with one.
-inline void emit_layer(const Triangulation& tr, const uint32_t* order, uint32_t* flags,
-                       size_t total, TriangleSink& sink, LayerLoops& loops) {
+static inline void emit_layer(const Triangulation& tr, const uint32_t* order, uint32_t* flags,
+                              size_t total, TriangleSink& sink, LayerLoops& loops) {
     for (uint32_t at_border = 0; at_border < 2; ++at_border) {
         if (at_border) loops.border_start = sink.count;
         for (uint32_t t = 0; t < tr.triangle_count; ++t) {
@@ -93,8 +93,8 @@ inline void emit_layer(const Triangulation& tr, const uint32_t* order, uint32_t*
 // it with the next one), out_of_memory or internal_error. Its scratch is released; the
 // layer's points are left in insertion order (layer.points[k] is layer-local point
 // order[k], an order not kept).
-inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Arena& arena,
-                                TriangleSink& sink, LayerLoops& loops, LayerCounts& counts) {
+static inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Arena& arena,
+                                       TriangleSink& sink, LayerLoops& loops, LayerCounts& counts) {
     const size_t count = layer.count, total = count + 1;  // vertex 0 is the centre
     choose_centre(layer, arena);
     size_t mark = arena.mark();

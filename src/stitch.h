@@ -29,7 +29,8 @@ namespace detail {
 // Rotates loop[0..n) and its strip coordinates so that entry `first` comes first; the
 // entries moved to the end are shifted by `turn` (one period of the strip), so angles
 // keep increasing along the loop.
-inline void rotate_loop(uint32_t* loop, double* uv, uint32_t n, uint32_t first, double turn) {
+static inline void rotate_loop(uint32_t* loop, double* uv, uint32_t n, uint32_t first,
+                               double turn) {
     for (uint32_t i = 0; i < first; ++i) uv[2 * i] += turn;
     // Three reversals rotate in place.
     auto reverse = [&](uint32_t lo, uint32_t hi) {  // the range [lo, hi)
@@ -51,7 +52,7 @@ inline void rotate_loop(uint32_t* loop, double* uv, uint32_t n, uint32_t first, 
 }
 
 // Rotates loop[0..n) so its smallest angle comes first (angles in [0, turn)).
-inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
+static inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
     uint32_t first = 0;
     for (uint32_t i = 1; i < n; ++i)
         if (uv[2 * i] < uv[2 * first]) first = i;
@@ -110,11 +111,11 @@ struct Band {
 // A step sequence is a band only if no rung repeats: walking all of A while B stands
 // still (or all of B) would return to the rung it started from. That happens exactly when
 // the cyclic sequence has a single run of A steps, so a band needs at least two.
-inline bool starts_a_run(const unsigned char* steps, uint32_t length, uint32_t k) {
+static inline bool starts_a_run(const unsigned char* steps, uint32_t length, uint32_t k) {
     return steps[k % length] == 0 && steps[(k + length - 1) % length] == 1;
 }
 
-inline uint32_t count_a_runs(const unsigned char* steps, uint32_t length) {
+static inline uint32_t count_a_runs(const unsigned char* steps, uint32_t length) {
     uint32_t runs = 0;
     for (uint32_t k = 0; k < length; ++k) runs += starts_a_run(steps, length, k);
     return runs;
@@ -122,7 +123,8 @@ inline uint32_t count_a_runs(const unsigned char* steps, uint32_t length) {
 
 // Whether swapping steps t and t + 1 keeps at least two runs of A (only the run starts at
 // t, t + 1 and t + 2 can change).
-inline bool swap_keeps_band(unsigned char* steps, uint32_t length, uint32_t t, uint32_t runs) {
+static inline bool swap_keeps_band(unsigned char* steps, uint32_t length, uint32_t t,
+                                   uint32_t runs) {
     uint32_t before = 0, after = 0;
     for (uint32_t k = t; k < t + 3; ++k) before += starts_a_run(steps, length, k);
     unsigned char s = steps[t];
@@ -136,7 +138,7 @@ inline bool swap_keeps_band(unsigned char* steps, uint32_t length, uint32_t t, u
 
 // Merges the loops by angle; if that walks one loop in a single run (tiny or skewed
 // loops), one boundary step is swapped so the band is a band.
-inline void zip_by_angle(Band& band) {
+static inline void zip_by_angle(Band& band) {
     const uint32_t length = band.p + band.q;
     uint32_t i = 0, j = 0, t = 0;
     while (i < band.p || j < band.q) {
@@ -158,7 +160,7 @@ inline void zip_by_angle(Band& band) {
 }
 
 // Lawson flips over the step sequence; returns the number of swaps.
-inline size_t swap_diagonals(Band& band) {
+static inline size_t swap_diagonals(Band& band) {
     const uint32_t length = band.p + band.q;
     const size_t limit = 16 * static_cast<size_t>(length) + 64;
     uint32_t runs = count_a_runs(band.steps, length);
@@ -196,7 +198,7 @@ inline size_t swap_diagonals(Band& band) {
 // other loop's next (or previous) vertex; only the triangles of that stretch change, and
 // the move is kept when they all turn counter-clockwise and the band keeps two runs of A.
 // Returns the adjacent exchanges made.
-inline size_t untangle_runs(Band& band) {
+static inline size_t untangle_runs(Band& band) {
     // Longer runs (a fan from one vertex over many of the other loop) are left as they
     // are: this bounds the work at kLongestUntangledRun steps per step of the band.
     const uint32_t kLongestUntangledRun = 64;
@@ -256,7 +258,7 @@ inline size_t untangle_runs(Band& band) {
 
 // Rotates the band (its loops and steps) to start half-way round. False if the half-way
 // point does not fall between the ends of both loops (the band stays as it is).
-inline bool restart_half_way(Band& band) {
+static inline bool restart_half_way(Band& band) {
     const uint32_t length = band.p + band.q, half = length / 2;
     uint32_t i_half = 0, j_half = 0;
     for (uint32_t t = 0; t < half; ++t) (band.steps[t] == 0 ? i_half : j_half) += 1;
@@ -279,7 +281,7 @@ inline bool restart_half_way(Band& band) {
 }
 
 // Whether every step of the band is counter-clockwise on the strip.
-inline bool band_is_proper(Band& band) {
+static inline bool band_is_proper(Band& band) {
     uint32_t i = 0, j = 0;
     for (uint32_t t = 0; t < band.p + band.q; ++t) {
         if (!band.proper(t, i, j)) return false;
@@ -292,7 +294,7 @@ inline bool band_is_proper(Band& band) {
 // clockwise steps. The closing rung is held fixed by both: the band restarts half-way round
 // and swaps again, so the quads around it get their test too, and where a clockwise step is
 // left next to it, untangles once more from there.
-inline void settle_band(Band& band, size_t* swaps) {
+static inline void settle_band(Band& band, size_t* swaps) {
     zip_by_angle(band);
     *swaps += swap_diagonals(band);
     if (restart_half_way(band)) *swaps += swap_diagonals(band);
@@ -305,7 +307,7 @@ inline void settle_band(Band& band, size_t* swaps) {
 // peeling (pass 0; entry 0 is one). A peeled vertex came off an edge between entries of
 // earlier passes in its group, so the group put back whole leaves the loop as it was
 // there, and the other groups' peeling as it is.
-inline void unpeel_around(unsigned char* flags, uint32_t n, uint32_t k) {
+static inline void unpeel_around(unsigned char* flags, uint32_t n, uint32_t k) {
     auto unpeel = [flags](uint32_t i) {
         if (!(flags[i] & kPassBits)) return false;
         flags[i] |= kUnpeeled;
@@ -317,13 +319,13 @@ inline void unpeel_around(unsigned char* flags, uint32_t n, uint32_t k) {
 }
 
 // Marks every peeled entry of flags[0..n) kUnpeeled or, with !on, none.
-inline void mark_unpeeled(unsigned char* flags, uint32_t n, bool on) {
+static inline void mark_unpeeled(unsigned char* flags, uint32_t n, bool on) {
     for (uint32_t i = 0; i < n; ++i)
         flags[i] = static_cast<unsigned char>(on && (flags[i] & kPassBits) ? flags[i] | kUnpeeled
                                                                            : flags[i] & ~kUnpeeled);
 }
 
-inline size_t count_unpeeled(const unsigned char* flags, uint32_t n) {
+static inline size_t count_unpeeled(const unsigned char* flags, uint32_t n) {
     size_t marked = 0;
     for (uint32_t i = 0; i < n; ++i) marked += (flags[i] & kUnpeeled) != 0;
     return marked;
@@ -363,7 +365,7 @@ struct Stitch {
 // vertex is marked kUnpeeled, else all: vertex x, peeled in pass k, came off the edge
 // between the nearest loop vertices before and after it from earlier passes (entry 0 is on
 // the hull or the link).
-inline void put_back_peeled(const Stitch& st, bool top, TriangleSink& sink) {
+static inline void put_back_peeled(const Stitch& st, bool top, TriangleSink& sink) {
     const unsigned char* flags = top ? st.a_flags : st.loops->bottom_flags;
     const uint32_t n = top ? st.a_length : st.loops->bottom_count;
     auto pass = [flags](uint32_t i) { return flags[i] & kPassBits; };
@@ -383,7 +385,7 @@ inline void put_back_peeled(const Stitch& st, bool top, TriangleSink& sink) {
 // Carves the band's loops from the arena and fills them with the entries of A (reader
 // indices a_ids) and of the layer's bottom loop that are not left out (see stitch_layers),
 // A's points copied. False if the arena is too small.
-inline bool gather_band_loops(Stitch& st, const uint32_t* a_ids, bool unpeel, Arena& arena) {
+static inline bool gather_band_loops(Stitch& st, const uint32_t* a_ids, bool unpeel, Arena& arena) {
     const LayerLoops& loops = *st.loops;
     Band& band = st.band;
     band.a = arena.alloc<uint32_t>(st.a_length);
@@ -409,7 +411,7 @@ inline bool gather_band_loops(Stitch& st, const uint32_t* a_ids, bool unpeel, Ar
 }
 
 // Unrolls both loops around the centre (cx, cy) and settles the band there.
-inline void settle_band_around(Stitch& st, double cx, double cy, size_t* swaps) {
+static inline void settle_band_around(Stitch& st, double cx, double cy, size_t* swaps) {
     Band& band = st.band;
     st.shared.cx = cx;
     st.shared.cy = cy;
@@ -425,7 +427,7 @@ inline void settle_band_around(Stitch& st, double cx, double cy, size_t* swaps) 
 // folds: those around the state's a[i] and b[j], which hold the triangle's third corner
 // too unless it is on the loop since before peeling. B's entry of b[j] is found walking
 // loops.bottom along (b is in its order, rotated), once around at most.
-inline size_t walk_band(const Stitch& st, TriangleSink* sink, double* area) {
+static inline size_t walk_band(const Stitch& st, TriangleSink* sink, double* area) {
     const Band& band = st.band;
     const LayerLoops& loops = *st.loops;
     const uint32_t p = band.p, q = band.q;
@@ -461,7 +463,7 @@ inline size_t walk_band(const Stitch& st, TriangleSink* sink, double* area) {
 // of the midpoint and the two layers' centres whose settled band has the least area. Trial
 // 3 settles the band again around that one, unless it was the last tried. Returns the
 // swaps of the band kept.
-inline size_t settle_least_area(Stitch& st, const Cylinder& ca, const Cylinder& cb) {
+static inline size_t settle_least_area(Stitch& st, const Cylinder& ca, const Cylinder& cb) {
     const Cylinder* centres[3] = {nullptr, &ca, &cb};  // 0: the midpoint
     double least = 0;
     uint32_t best = 0;
@@ -493,10 +495,10 @@ inline size_t settle_least_area(Stitch& st, const Cylinder& ca, const Cylinder& 
 // peel groups around its corners kUnpeeled (unpeel_around) for a next attempt. The band's
 // triangles name the upper layer's points by layer-local index and the i-th point of A by
 // layer.count + i.
-inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cylinder& ca,
-                          const uint32_t* a_ids, unsigned char* a_flags, uint32_t p,
-                          const LoadedLayer& layer, const LayerLoops& loops, bool unpeel,
-                          Arena& arena, TriangleSink& sink, size_t* swaps) {
+static inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cylinder& ca,
+                                 const uint32_t* a_ids, unsigned char* a_flags, uint32_t p,
+                                 const LoadedLayer& layer, const LayerLoops& loops, bool unpeel,
+                                 Arena& arena, TriangleSink& sink, size_t* swaps) {
     const Cylinder& cb = layer.cyl;
     Stitch st;
     st.cloud = &cloud;

@@ -49,7 +49,7 @@ namespace detail {
 const double kStreamRange = 0x1p60;
 
 // Everything a stream holds for a window of `capacity` points.
-inline bool layout_stream(Stream& s, size_t capacity, Arena& arena) {
+static inline bool layout_stream(Stream& s, size_t capacity, Arena& arena) {
     s.capacity = capacity;
     s.slot_capacity = static_cast<uint32_t>(capacity + 1);
     s.points = arena.alloc<Vec3>(capacity);
@@ -62,7 +62,7 @@ inline bool layout_stream(Stream& s, size_t capacity, Arena& arena) {
     return allocate_chain(s.chain, capacity, arena) && !arena.failed;
 }
 
-inline size_t stream_bytes(size_t capacity) {
+static inline size_t stream_bytes(size_t capacity) {
     if (capacity > kMaxPoints - 1) return 0;
     Arena arena = Arena::measuring();
     arena.alloc<Stream>(1);
@@ -73,14 +73,14 @@ inline size_t stream_bytes(size_t capacity) {
     return arena.required_bytes() + scratch;
 }
 
-inline void publish(Stream& s) {
+static inline void publish(Stream& s) {
     s.rep.points.unused_count = s.rep.points.in_count - s.rep.points.used_count - s.rep.points.duplicate_count - s.rep.points.rejected_count;
     s.rep.workspace_used_bytes = s.arena.peak_from_buffer();
     if (s.user_report) *s.user_report = s.rep;
 }
 
 // A push refused: the stream is as it was; the report says why.
-inline Status refuse_push(Stream& s, Status status, const char* detail) {
+static inline Status refuse_push(Stream& s, Status status, const char* detail) {
     s.rep.detail = detail;
     publish(s);
     return status;
@@ -88,7 +88,7 @@ inline Status refuse_push(Stream& s, Status status, const char* detail) {
 
 // Keeps the last group's top loop (moved to the front of the window) and the pushes after
 // planned layer `last`.
-inline void drop_group(Stream& s, uint32_t last) {
+static inline void drop_group(Stream& s, uint32_t last) {
     const uint32_t loop = s.chain.top_count;
     const size_t rest_from = s.start[last + 1], rest = s.fill - rest_from;
     size_t mark = s.arena.mark();
@@ -115,7 +115,7 @@ inline void drop_group(Stream& s, uint32_t last) {
 }
 
 // Forms, emits and drops every group the held pushes decide.
-inline Status advance(Stream& s, bool complete) {
+static inline Status advance(Stream& s, bool complete) {
     while (s.planned > 0) {
         const LayerQueue queue = {s.positions, nullptr, s.start, s.bounds, s.planned, complete};
         GroupResult group;
@@ -139,8 +139,8 @@ inline Status advance(Stream& s, bool complete) {
 
 // Why a push's arguments are refused, with *why, or ok with the pushed cloud's reader: its
 // layout, its top and its count are checked.
-inline Status check_push(const Stream& s, const Cloud& points, double top, CloudReader* reader,
-                         const char** why) {
+static inline Status check_push(const Stream& s, const Cloud& points, double top,
+                                CloudReader* reader, const char** why) {
     const size_t scalar = points.scalar == Scalar::float32 ? sizeof(float)
                         : points.scalar == Scalar::float64 ? sizeof(double) : 0;
     const size_t stride = points.stride_bytes ? points.stride_bytes : 3 * scalar;
@@ -168,9 +168,9 @@ const char* const kTopBelow = "a pushed layer's top is below the previous layer'
 // The heights of the push's valid points in the frame, *low to *high, or why the push is
 // refused, with *why (and the point's index where one is to blame): a point far beyond the
 // first layer, or outside its own layer, between lower_limit and top_height.
-inline Status push_heights(Stream& s, const CloudReader& reader, size_t count,
-                           const Frame& frame, double lower_limit, double top_height,
-                           double* low, double* high, const char** why) {
+static inline Status push_heights(Stream& s, const CloudReader& reader, size_t count,
+                                  const Frame& frame, double lower_limit, double top_height,
+                                  double* low, double* high, const char** why) {
     auto slack = [](double h) { return 0x1p-40 * (1 + abs_value(h)); };
     *low = DBL_MAX;
     *high = -DBL_MAX;
@@ -196,8 +196,8 @@ inline Status push_heights(Stream& s, const CloudReader& reader, size_t count,
 
 // Holds the checked push as the next planned layer, its valid points from heights `low` to
 // `high` in the window; the first push with points sets the stream's frame.
-inline void hold_push(Stream& s, const CloudReader& reader, size_t count, const Frame& frame,
-                      double low, double high, double top_height) {
+static inline void hold_push(Stream& s, const CloudReader& reader, size_t count, const Frame& frame,
+                             double low, double high, double top_height) {
     if (!s.has_frame) {
         s.has_frame = true;
         s.chain.frame = frame;

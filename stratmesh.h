@@ -1377,8 +1377,8 @@ stratmesh_status stratmesh_stream_close(stratmesh_stream* stream);
 //   >>cloud               reading the cloud: invalid points refused or counted, outliers
 //                         left out, sums
 //   >>frame               the frame the layers are cut in: its axis, origin and scale
-//   >>jobs                the caller's callbacks: progress, and passes split into jobs for
-//                         the runner
+//   >>jobs                the caller's callbacks: progress, and batches of jobs for the
+//                         runner
 //   >>layer plan          cuts along the axis: explicit, equal, by height or automatic;
 //                         points grouped by layer
 //   >>unroll              a layer onto its annulus (cylinder and closed ends)
@@ -3921,45 +3921,67 @@ STRATMESH_SMALL_NOINLINE inline void report_frame(const Frame& frame, Report& re
 }  // namespace stratmesh
 
 // >>jobs =================================================================================
-// The caller's callbacks: progress, and passes split into jobs for the runner.
+// The caller's callbacks: progress, and batches of jobs for the runner.
 
 namespace stratmesh {
 namespace detail {
 
-inline void notify(const Options& options, Phase phase, double fraction) {
+static inline void notify(const Options& options, Phase phase, double fraction) {
     if (options.progress) options.progress(options.progress_user, phase, fraction);
+}
+
+// ---- jobs on the caller's runner ----
+//
+// Every batch of jobs reaches Options::run_jobs through run_jobs below, which holds the
+// runner to its contract (see JobRunner): an index outside the batch is ignored, a job run
+// again does nothing, and a job the runner skipped is done afterwards as the batch says.
+
+// Whether work is cut into jobs: a runner given, in a build that has them.
+static inline bool has_runner(const Options& options) {
+    return kParallelLayers && options.run_jobs != nullptr;
+}
+
+template <class Job> struct JobBatch {
+    const Job* job;
+    uint32_t count;
+    bool done[kMaxJobs];
+};
+
+template <class Job> static inline void run_batch_job(void* context, uint32_t index) {
+    JobBatch<Job>& batch = *static_cast<JobBatch<Job>*>(context);
+    if (index >= batch.count || batch.done[index]) return;  // no job of ours, or done already
+    (*batch.job)(index);
+    batch.done[index] = true;
+}
+
+// Runs job(k) for k in [0, count), count <= kMaxJobs, on the caller's runner where there is
+// one. With `redo_skipped`, each job the runner skipped, or every job without a runner, is
+// then run here in order; else it is left undone (the layers not done ahead are
+// triangulated by their groups).
+template <class Job>
+static inline void run_jobs(const Options& options, uint32_t count, bool redo_skipped,
+                            const Job& job) {
+    JobBatch<Job> batch = {&job, count, {}};
+    if (has_runner(options)) options.run_jobs(options.jobs_user, count, run_batch_job<Job>, &batch);
+    for (uint32_t k = 0; redo_skipped && k < count; ++k)
+        if (!batch.done[k]) job(k);
 }
 
 // ---- passes over all points as jobs ----
 //
-// With Options::run_jobs, a pass over all points that gives the same bits in any order
-// (grouping the points by layer) is cut into kPassRuns runs of consecutive points, run as
-// jobs. As for the layers' jobs (see JobRunner), a run the runner skips is done in order
-// afterwards, and a run done again changes nothing.
+// With a runner, a pass over all points that gives the same bits in any order (grouping
+// the points by layer) is cut into kPassRuns runs of consecutive points, run as jobs.
 const uint32_t kPassRuns = 16;
+static_assert(kPassRuns <= kMaxJobs, "a pass's runs are one batch of jobs");
 
 // The first point of run k of `count` points.
-inline size_t run_start(size_t count, uint32_t k) {
+static inline size_t run_start(size_t count, uint32_t k) {
     return static_cast<size_t>(static_cast<uint64_t>(count) * k / kPassRuns);
 }
 
-template <class Pass> struct PassJobs {
-    Pass* pass;
-    bool done[kPassRuns];
-};
-
-template <class Pass> inline void run_pass_job(void* context, uint32_t index) {
-    PassJobs<Pass>& jobs = *static_cast<PassJobs<Pass>*>(context);
-    if (index >= kPassRuns) return;  // a runner's mistake: no run of ours
-    jobs.pass->run(index);
-    jobs.done[index] = true;
-}
-
-template <class Pass> inline void run_pass(const Options& options, Pass& pass) {
-    PassJobs<Pass> jobs = {&pass, {}};
-    options.run_jobs(options.jobs_user, kPassRuns, run_pass_job<Pass>, &jobs);
-    for (uint32_t k = 0; k < kPassRuns; ++k)
-        if (!jobs.done[k]) pass.run(k);
+// Runs pass.run(k) for every run k: as jobs with a runner, else in order.
+template <class Pass> static inline void run_pass(const Options& options, Pass& pass) {
+    run_jobs(options, kPassRuns, true, [&pass](uint32_t k) { pass.run(k); });
 }
 
 }  // namespace detail
@@ -4005,13 +4027,13 @@ const size_t kMinLayerPoints = 16;
 // contour, passes.
 const double kMinLayerRows = 1.5;
 
-inline bool thick_enough(size_t points, double height, double radius) {
+static inline bool thick_enough(size_t points, double height, double radius) {
     const double two_pi = 6.28318530717958647693;
     return static_cast<double>(points) * height >= kMinLayerRows * kMinLayerRows * two_pi * radius;
 }
 
 // The number of layers the options can ask for, before empty layers are dropped.
-inline size_t planned_layer_limit(size_t point_count, const Options& options) {
+static inline size_t planned_layer_limit(size_t point_count, const Options& options) {
     if (options.cuts && options.cut_count > 0) return options.cut_count + 1;
     if (options.layer_count > 0)
         return options.layer_count < point_count ? options.layer_count : (point_count > 0 ? point_count : 1);
@@ -4020,7 +4042,7 @@ inline size_t planned_layer_limit(size_t point_count, const Options& options) {
     return kMaxAutomaticLayers;
 }
 
-inline Status validate_layer_options(const Options& options) {
+static inline Status validate_layer_options(const Options& options) {
     if (options.cuts && options.cut_count > 0) {
         if (options.cut_count > kMaxPoints) return Status::invalid_layers;
         for (size_t i = 0; i < options.cut_count; ++i)
@@ -4033,7 +4055,7 @@ inline Status validate_layer_options(const Options& options) {
     return Status::ok;
 }
 
-inline bool automatic_layers(const Options& options) {
+static inline bool automatic_layers(const Options& options) {
     return !(options.cuts && options.cut_count > 0) && options.layer_count == 0 &&
            options.layer_height == 0;
 }
@@ -4041,8 +4063,8 @@ inline bool automatic_layers(const Options& options) {
 // Fills plan.bounds (room for planned_layer_limit + 1 entries) for heights [lo, hi] from
 // the user's layer options (not automatic_layers): the cuts are coordinates along the axis
 // (Frame::user_height of frame heights), layer_height a length in the cloud's units.
-inline void plan_layers(const Options& options, double lo, double hi, size_t point_count,
-                        const Frame& frame, LayerPlan& plan) {
+static inline void plan_layers(const Options& options, double lo, double hi, size_t point_count,
+                               const Frame& frame, LayerPlan& plan) {
     const double cut_offset = dot(frame.origin, frame.axis);
     double* b = plan.bounds;
     uint32_t n = 0;
@@ -4131,27 +4153,27 @@ struct BinRange {
     uint32_t first, end;
 };
 
-inline uint32_t profile_bin_count(size_t valid_points) {
+static inline uint32_t profile_bin_count(size_t valid_points) {
     size_t bins = valid_points / kPointsPerProfileBin;
     if (bins > kMaxAutomaticLayers) bins = kMaxAutomaticLayers;
     return bins < 1 ? 1u : static_cast<uint32_t>(bins);
 }
 
 // The scratch the automatic planner takes (released before the layers are built).
-inline void allocate_profile(Arena& arena, uint32_t bins, ProfileBin** profile, BinRange** ranges,
-                             double** cuts) {
+static inline void allocate_profile(Arena& arena, uint32_t bins, ProfileBin** profile,
+                                    BinRange** ranges, double** cuts) {
     *profile = arena.alloc<ProfileBin>(bins);
     *ranges = arena.alloc<BinRange>(bins);
     *cuts = arena.alloc<double>(bins);
 }
 
-inline uint32_t sector_of(double dx, double dy) {
+static inline uint32_t sector_of(double dx, double dy) {
     uint32_t s = (dx < 0 ? 4u : 0u) + (dy < 0 ? 2u : 0u);
     return s + (abs_value(dx) < abs_value(dy) ? 1u : 0u);
 }
 
-inline void build_profile(const CloudReader& cloud, size_t count, const Frame& frame, double lo,
-                          double hi, ProfileBin* profile, uint32_t bins) {
+static inline void build_profile(const CloudReader& cloud, size_t count, const Frame& frame,
+                                 double lo, double hi, ProfileBin* profile, uint32_t bins) {
     std::memset(static_cast<void*>(profile), 0, sizeof(ProfileBin) * bins);
     const double per_height = static_cast<double>(bins) / (hi - lo);
     auto bin_of = [&](double h) {
@@ -4196,8 +4218,8 @@ inline void build_profile(const CloudReader& cloud, size_t count, const Frame& f
     }
 }
 
-inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_height,
-                          size_t most_points) {
+static inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_height,
+                                 size_t most_points) {
     double cx = 0, cy = 0, radius = 0;
     size_t points = 0;
     for (uint32_t b = range.first; b < range.end; ++b) {
@@ -4226,7 +4248,7 @@ inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_
 }
 
 // How much the surface changes between bins b - 1 and b, plus the density penalty.
-inline double cut_cost(const ProfileBin* profile, uint32_t b, double mean_count) {
+static inline double cut_cost(const ProfileBin* profile, uint32_t b, double mean_count) {
     const ProfileBin& below = profile[b - 1];
     const ProfileBin& above = profile[b];
     double radius = below.mean_radius > above.mean_radius ? below.mean_radius : above.mean_radius;
@@ -4239,9 +4261,10 @@ inline double cut_cost(const ProfileBin* profile, uint32_t b, double mean_count)
 
 // Fills plan.bounds for heights [lo, hi] by the rule above; profile, ranges and cuts hold
 // `bins` entries each.
-inline void plan_automatic_layers(const CloudReader& cloud, size_t count, size_t valid,
-                                  const Frame& frame, double lo, double hi, ProfileBin* profile,
-                                  BinRange* ranges, double* cuts, uint32_t bins, LayerPlan& plan) {
+static inline void plan_automatic_layers(const CloudReader& cloud, size_t count, size_t valid,
+                                         const Frame& frame, double lo, double hi,
+                                         ProfileBin* profile, BinRange* ranges, double* cuts,
+                                         uint32_t bins, LayerPlan& plan) {
     build_profile(cloud, count, frame, lo, hi, profile, bins);
     const double bin_height = (hi - lo) / bins;
     const double mean_count = static_cast<double>(valid) / bins;
@@ -4283,7 +4306,7 @@ inline void plan_automatic_layers(const CloudReader& cloud, size_t count, size_t
 // layers were equal, which they are unless cuts or the automatic plan set them, is tried
 // first, with one branch that a million points in no order still predict (a binary
 // search's would not); the search is for the rest.
-inline uint32_t layer_of(const LayerPlan& plan, double h, double per_height) {
+static inline uint32_t layer_of(const LayerPlan& plan, double h, double per_height) {
     const double* bounds = plan.bounds;
     const double tolerance = plan.tolerance;
     const uint32_t last = plan.count - 1;
@@ -4307,9 +4330,9 @@ inline uint32_t layer_of(const LayerPlan& plan, double h, double per_height) {
 // point's layer kept in `layer` (count entries of scratch) between its two passes. With
 // `staged` (optional, as many entries as valid points), the points in frame coordinates
 // go there in the same order.
-inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& frame,
-                           const LayerPlan& plan, uint32_t* layer, Local* staged,
-                           uint32_t* layer_start, uint32_t* order) {
+static inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& frame,
+                                  const LayerPlan& plan, uint32_t* layer, Local* staged,
+                                  uint32_t* layer_start, uint32_t* order) {
     std::memset(layer_start, 0, sizeof(uint32_t) * (plan.count + 2));
     const double per_height =
         kFastLoops ? plan.count / (plan.bounds[plan.count] - plan.bounds[0]) : 0;
@@ -4364,12 +4387,12 @@ struct GroupingPass {
 
 // group_by_layer without staging, as jobs; false (nothing done) where its three tables of a
 // count per run and layer would take more than one count per point, or do not fit.
-inline bool group_by_layer_in_jobs(const Options& options, const CloudReader& cloud,
-                                   size_t count, const Frame& frame, const LayerPlan& plan,
-                                   uint32_t* layer, uint32_t* layer_start, uint32_t* order,
-                                   Arena& arena) {
+static inline bool group_by_layer_in_jobs(const Options& options, const CloudReader& cloud,
+                                          size_t count, const Frame& frame, const LayerPlan& plan,
+                                          uint32_t* layer, uint32_t* layer_start, uint32_t* order,
+                                          Arena& arena) {
     const size_t table = kPassRuns * static_cast<size_t>(plan.count);
-    if (!kParallelLayers || !options.run_jobs || 3 * table > count) return false;
+    if (!has_runner(options) || 3 * table > count) return false;
     const size_t mark = arena.mark();
     GroupingPass pass = {&cloud, &frame, &plan, 0, count, layer, order,
                          arena.alloc<uint32_t>(table), arena.alloc<uint32_t>(table),
@@ -5252,7 +5275,8 @@ namespace detail {
 // Rotates loop[0..n) and its strip coordinates so that entry `first` comes first; the
 // entries moved to the end are shifted by `turn` (one period of the strip), so angles
 // keep increasing along the loop.
-inline void rotate_loop(uint32_t* loop, double* uv, uint32_t n, uint32_t first, double turn) {
+static inline void rotate_loop(uint32_t* loop, double* uv, uint32_t n, uint32_t first,
+                               double turn) {
     for (uint32_t i = 0; i < first; ++i) uv[2 * i] += turn;
     // Three reversals rotate in place.
     auto reverse = [&](uint32_t lo, uint32_t hi) {  // the range [lo, hi)
@@ -5274,7 +5298,7 @@ inline void rotate_loop(uint32_t* loop, double* uv, uint32_t n, uint32_t first, 
 }
 
 // Rotates loop[0..n) so its smallest angle comes first (angles in [0, turn)).
-inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
+static inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
     uint32_t first = 0;
     for (uint32_t i = 1; i < n; ++i)
         if (uv[2 * i] < uv[2 * first]) first = i;
@@ -5333,11 +5357,11 @@ struct Band {
 // A step sequence is a band only if no rung repeats: walking all of A while B stands
 // still (or all of B) would return to the rung it started from. That happens exactly when
 // the cyclic sequence has a single run of A steps, so a band needs at least two.
-inline bool starts_a_run(const unsigned char* steps, uint32_t length, uint32_t k) {
+static inline bool starts_a_run(const unsigned char* steps, uint32_t length, uint32_t k) {
     return steps[k % length] == 0 && steps[(k + length - 1) % length] == 1;
 }
 
-inline uint32_t count_a_runs(const unsigned char* steps, uint32_t length) {
+static inline uint32_t count_a_runs(const unsigned char* steps, uint32_t length) {
     uint32_t runs = 0;
     for (uint32_t k = 0; k < length; ++k) runs += starts_a_run(steps, length, k);
     return runs;
@@ -5345,7 +5369,8 @@ inline uint32_t count_a_runs(const unsigned char* steps, uint32_t length) {
 
 // Whether swapping steps t and t + 1 keeps at least two runs of A (only the run starts at
 // t, t + 1 and t + 2 can change).
-inline bool swap_keeps_band(unsigned char* steps, uint32_t length, uint32_t t, uint32_t runs) {
+static inline bool swap_keeps_band(unsigned char* steps, uint32_t length, uint32_t t,
+                                   uint32_t runs) {
     uint32_t before = 0, after = 0;
     for (uint32_t k = t; k < t + 3; ++k) before += starts_a_run(steps, length, k);
     unsigned char s = steps[t];
@@ -5359,7 +5384,7 @@ inline bool swap_keeps_band(unsigned char* steps, uint32_t length, uint32_t t, u
 
 // Merges the loops by angle; if that walks one loop in a single run (tiny or skewed
 // loops), one boundary step is swapped so the band is a band.
-inline void zip_by_angle(Band& band) {
+static inline void zip_by_angle(Band& band) {
     const uint32_t length = band.p + band.q;
     uint32_t i = 0, j = 0, t = 0;
     while (i < band.p || j < band.q) {
@@ -5381,7 +5406,7 @@ inline void zip_by_angle(Band& band) {
 }
 
 // Lawson flips over the step sequence; returns the number of swaps.
-inline size_t swap_diagonals(Band& band) {
+static inline size_t swap_diagonals(Band& band) {
     const uint32_t length = band.p + band.q;
     const size_t limit = 16 * static_cast<size_t>(length) + 64;
     uint32_t runs = count_a_runs(band.steps, length);
@@ -5419,7 +5444,7 @@ inline size_t swap_diagonals(Band& band) {
 // other loop's next (or previous) vertex; only the triangles of that stretch change, and
 // the move is kept when they all turn counter-clockwise and the band keeps two runs of A.
 // Returns the adjacent exchanges made.
-inline size_t untangle_runs(Band& band) {
+static inline size_t untangle_runs(Band& band) {
     // Longer runs (a fan from one vertex over many of the other loop) are left as they
     // are: this bounds the work at kLongestUntangledRun steps per step of the band.
     const uint32_t kLongestUntangledRun = 64;
@@ -5479,7 +5504,7 @@ inline size_t untangle_runs(Band& band) {
 
 // Rotates the band (its loops and steps) to start half-way round. False if the half-way
 // point does not fall between the ends of both loops (the band stays as it is).
-inline bool restart_half_way(Band& band) {
+static inline bool restart_half_way(Band& band) {
     const uint32_t length = band.p + band.q, half = length / 2;
     uint32_t i_half = 0, j_half = 0;
     for (uint32_t t = 0; t < half; ++t) (band.steps[t] == 0 ? i_half : j_half) += 1;
@@ -5502,7 +5527,7 @@ inline bool restart_half_way(Band& band) {
 }
 
 // Whether every step of the band is counter-clockwise on the strip.
-inline bool band_is_proper(Band& band) {
+static inline bool band_is_proper(Band& band) {
     uint32_t i = 0, j = 0;
     for (uint32_t t = 0; t < band.p + band.q; ++t) {
         if (!band.proper(t, i, j)) return false;
@@ -5515,7 +5540,7 @@ inline bool band_is_proper(Band& band) {
 // clockwise steps. The closing rung is held fixed by both: the band restarts half-way round
 // and swaps again, so the quads around it get their test too, and where a clockwise step is
 // left next to it, untangles once more from there.
-inline void settle_band(Band& band, size_t* swaps) {
+static inline void settle_band(Band& band, size_t* swaps) {
     zip_by_angle(band);
     *swaps += swap_diagonals(band);
     if (restart_half_way(band)) *swaps += swap_diagonals(band);
@@ -5528,7 +5553,7 @@ inline void settle_band(Band& band, size_t* swaps) {
 // peeling (pass 0; entry 0 is one). A peeled vertex came off an edge between entries of
 // earlier passes in its group, so the group put back whole leaves the loop as it was
 // there, and the other groups' peeling as it is.
-inline void unpeel_around(unsigned char* flags, uint32_t n, uint32_t k) {
+static inline void unpeel_around(unsigned char* flags, uint32_t n, uint32_t k) {
     auto unpeel = [flags](uint32_t i) {
         if (!(flags[i] & kPassBits)) return false;
         flags[i] |= kUnpeeled;
@@ -5540,27 +5565,57 @@ inline void unpeel_around(unsigned char* flags, uint32_t n, uint32_t k) {
 }
 
 // Marks every peeled entry of flags[0..n) kUnpeeled or, with !on, none.
-inline void mark_unpeeled(unsigned char* flags, uint32_t n, bool on) {
+static inline void mark_unpeeled(unsigned char* flags, uint32_t n, bool on) {
     for (uint32_t i = 0; i < n; ++i)
         flags[i] = static_cast<unsigned char>(on && (flags[i] & kPassBits) ? flags[i] | kUnpeeled
                                                                            : flags[i] & ~kUnpeeled);
 }
 
-inline size_t count_unpeeled(const unsigned char* flags, uint32_t n) {
+static inline size_t count_unpeeled(const unsigned char* flags, uint32_t n) {
     size_t marked = 0;
     for (uint32_t i = 0; i < n; ++i) marked += (flags[i] & kUnpeeled) != 0;
     return marked;
 }
 
-// Emits the triangles peeled off a loop (see "peeling" in >>layer triangulation), with
-// kLocalUnpeel those whose vertex is marked kUnpeeled, else all: vertex x, peeled in pass
-// k, came off the edge between the nearest loop vertices before and after it from earlier
-// passes (entry 0 is on the hull or the link). id(i) is entry i's band index, point(id) its
-// point.
-template <class IdOf, class PointOf>
-inline void put_back_peeled(const unsigned char* flags, uint32_t n, bool top, const IdOf& id,
-                            const PointOf& point, const Cylinder& cyl, TriangleSink& sink) {
+// A band being stitched (see stitch_layers): its loops in band indices, where their points
+// come from, and the strip they are unrolled on.
+struct Stitch {
+    const CloudReader* cloud;
+    const Frame* frame;
+    const LoadedLayer* layer;
+    const LayerLoops* loops;
+    unsigned char* a_flags;  // loop A's, every entry (a_length)
+    uint32_t a_length;
+    uint32_t below;          // the band index of A's entry 0: layer.count
+    Local* a_points;         // A's points, every entry
+    Cylinder shared;         // the strip's cylinder; its centre is set per trial
+    double unrolled_radius;
+    Band band;
+
+    // The point of band index id. The layer's points are read again (the loaded ones are in
+    // triangulate_layer's order, or were never loaded when a job triangulated the layer):
+    // only the loop's are read.
+    Local point(uint32_t id) const {
+        if (id >= below) return a_points[id - below];
+        return frame->local(cloud->point(layer->ids[id]));
+    }
+    void unroll(uint32_t id, double* uv) const {
+        const Local l = point(id);
+        uv[0] = unrolled_radius * polar_angle(l.x - shared.cx, l.y - shared.cy);
+        uv[1] = l.h - shared.h0;
+    }
+};
+
+// Emits the triangles peeled off loop A (`top`: the lower layer's top loop) or the layer's
+// bottom loop (see "peeling" in >>layer triangulation), with kLocalUnpeel those whose
+// vertex is marked kUnpeeled, else all: vertex x, peeled in pass k, came off the edge
+// between the nearest loop vertices before and after it from earlier passes (entry 0 is on
+// the hull or the link).
+static inline void put_back_peeled(const Stitch& st, bool top, TriangleSink& sink) {
+    const unsigned char* flags = top ? st.a_flags : st.loops->bottom_flags;
+    const uint32_t n = top ? st.a_length : st.loops->bottom_count;
     auto pass = [flags](uint32_t i) { return flags[i] & kPassBits; };
+    auto id = [&st, top](uint32_t i) { return top ? st.below + i : st.loops->bottom[i]; };
     for (uint32_t x = 0; x < n; ++x) {
         if (!pass(x) || (kLocalUnpeel && !(flags[x] & kUnpeeled))) continue;
         uint32_t before = x - 1, after = (x + 1) % n;
@@ -5569,8 +5624,112 @@ inline void put_back_peeled(const unsigned char* flags, uint32_t n, bool top, co
         // Counter-clockwise on the annulus: the top loop's edge ran before -> after, the
         // bottom loop's after -> before.
         uint32_t u = id(top ? before : after), v = id(top ? after : before), w = id(x);
-        sink.emit(u, v, w, point(u), point(v), point(w), cyl);
+        sink.emit(u, v, w, st.point(u), st.point(v), st.point(w), st.shared);
     }
+}
+
+// Carves the band's loops from the arena and fills them with the entries of A (reader
+// indices a_ids) and of the layer's bottom loop that are not left out (see stitch_layers),
+// A's points copied. False if the arena is too small.
+static inline bool gather_band_loops(Stitch& st, const uint32_t* a_ids, bool unpeel, Arena& arena) {
+    const LayerLoops& loops = *st.loops;
+    Band& band = st.band;
+    band.a = arena.alloc<uint32_t>(st.a_length);
+    band.b = arena.alloc<uint32_t>(loops.bottom_count);
+    st.a_points = arena.alloc<Local>(st.a_length);
+    band.xa = arena.alloc<double>(2 * static_cast<size_t>(st.a_length));
+    band.xb = arena.alloc<double>(2 * static_cast<size_t>(loops.bottom_count));
+    band.steps = arena.alloc<unsigned char>(static_cast<size_t>(st.a_length) + loops.bottom_count);
+    band.scratch = arena.alloc<double>(kIncircleScratch);
+    if (arena.failed) return false;
+    auto left_out = [unpeel](unsigned char f) {
+        return (f & kPassBits) && (unpeel || (kLocalUnpeel && (f & kUnpeeled)));
+    };
+    band.p = 0;
+    for (uint32_t i = 0; i < st.a_length; ++i) {
+        if (!left_out(st.a_flags[i])) band.a[band.p++] = st.below + i;
+        st.a_points[i] = st.frame->local(st.cloud->point(a_ids[i]));
+    }
+    band.q = 0;
+    for (uint32_t j = 0; j < loops.bottom_count; ++j)
+        if (!left_out(loops.bottom_flags[j])) band.b[band.q++] = loops.bottom[j];
+    return true;
+}
+
+// Unrolls both loops around the centre (cx, cy) and settles the band there.
+static inline void settle_band_around(Stitch& st, double cx, double cy, size_t* swaps) {
+    Band& band = st.band;
+    st.shared.cx = cx;
+    st.shared.cy = cy;
+    for (uint32_t i = 0; i < band.p; ++i) st.unroll(band.a[i], band.xa + 2 * i);
+    for (uint32_t j = 0; j < band.q; ++j) st.unroll(band.b[j], band.xb + 2 * j);
+    rotate_to_first_angle(band.a, band.xa, band.p);
+    rotate_to_first_angle(band.b, band.xb, band.q);
+    settle_band(band, swaps);
+}
+
+// Walks the settled band: returns its folds, adds its doubled area to *area and, with a
+// sink, writes its triangles there and (kLocalUnpeel) marks the peel groups around the
+// folds: those around the state's a[i] and b[j], which hold the triangle's third corner
+// too unless it is on the loop since before peeling. B's entry of b[j] is found walking
+// loops.bottom along (b is in its order, rotated), once around at most.
+static inline size_t walk_band(const Stitch& st, TriangleSink* sink, double* area) {
+    const Band& band = st.band;
+    const LayerLoops& loops = *st.loops;
+    const uint32_t p = band.p, q = band.q;
+    size_t folds = 0;
+    uint32_t i = 0, j = 0, entry = 0;
+    for (uint32_t t = 0; t < p + q; ++t) {
+        uint32_t x, y, z;  // counter-clockwise on the annulus
+        const uint32_t a0 = band.a[i % p], b0 = band.b[j % q];
+        if (band.steps[t] == 0) {
+            x = band.a[(i + 1) % p], y = a0, z = b0;
+            ++i;
+        } else {
+            x = b0, y = band.b[(j + 1) % q], z = a0;
+            ++j;
+        }
+        const Local px = st.point(x), py = st.point(y), pz = st.point(z);
+        const bool folded = faces_axis(px, pz, py, st.shared);
+        folds += folded;
+        *area += doubled_area(px, py, pz);
+        if (sink) sink->write(x, y, z);
+        if (!kLocalUnpeel || !sink || !folded) continue;
+        for (uint32_t k = 0; k < loops.bottom_count && loops.bottom[entry] != b0; ++k)
+            entry = (entry + 1) % loops.bottom_count;
+        unpeel_around(st.a_flags, st.a_length, a0 - st.below);
+        unpeel_around(loops.bottom_flags, loops.bottom_count, entry);
+    }
+    return folds;
+}
+
+// Settles the band around the strip's centre: the cylinders' midpoint; where the band
+// folds around it (the loops turn back around it: after choose_centre moved one of the
+// centres, the midpoint may lie outside what both loops are star-shaped around), the one
+// of the midpoint and the two layers' centres whose settled band has the least area. Trial
+// 3 settles the band again around that one, unless it was the last tried. Returns the
+// swaps of the band kept.
+static inline size_t settle_least_area(Stitch& st, const Cylinder& ca, const Cylinder& cb) {
+    const Cylinder* centres[3] = {nullptr, &ca, &cb};  // 0: the midpoint
+    double least = 0;
+    uint32_t best = 0;
+    size_t best_swaps = 0;
+    for (uint32_t trial = 0; trial < 4 && !(trial == 3 && best == 2); ++trial) {
+        const uint32_t k = trial < 3 ? trial : best;
+        size_t trial_swaps = 0;
+        settle_band_around(st, k ? centres[k]->cx : (ca.cx + cb.cx) / 2,
+                           k ? centres[k]->cy : (ca.cy + cb.cy) / 2, &trial_swaps);
+        if (trial == 3) break;
+        double area = 0;
+        const size_t folds = walk_band(st, nullptr, &area);
+        if (trial == 0 || area < least) {
+            least = area;
+            best = k;
+            best_swaps = trial_swaps;
+        }
+        if (folds == 0 && trial == 0) break;
+    }
+    return best_swaps;
 }
 
 // Stitches loop A (the lower layer's top loop: reader indices a_ids with their seam flags,
@@ -5582,122 +5741,35 @@ inline void put_back_peeled(const unsigned char* flags, uint32_t n, bool top, co
 // peel groups around its corners kUnpeeled (unpeel_around) for a next attempt. The band's
 // triangles name the upper layer's points by layer-local index and the i-th point of A by
 // layer.count + i.
-inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cylinder& ca,
-                          const uint32_t* a_ids, unsigned char* a_flags, uint32_t p,
-                          const LoadedLayer& layer, const LayerLoops& loops, bool unpeel,
-                          Arena& arena, TriangleSink& sink, size_t* swaps) {
+static inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cylinder& ca,
+                                 const uint32_t* a_ids, unsigned char* a_flags, uint32_t p,
+                                 const LoadedLayer& layer, const LayerLoops& loops, bool unpeel,
+                                 Arena& arena, TriangleSink& sink, size_t* swaps) {
     const Cylinder& cb = layer.cyl;
-    const uint32_t below = static_cast<uint32_t>(layer.count);
-    size_t mark = arena.mark();
-    uint32_t q = loops.bottom_count;
-    uint32_t* a = arena.alloc<uint32_t>(p);
-    uint32_t* b = arena.alloc<uint32_t>(q);
-    Local* a_points = arena.alloc<Local>(p);
-    double* xa = arena.alloc<double>(2 * static_cast<size_t>(p));
-    double* xb = arena.alloc<double>(2 * static_cast<size_t>(q));
-    unsigned char* steps = arena.alloc<unsigned char>(static_cast<size_t>(p) + q);
-    double* scratch = arena.alloc<double>(kIncircleScratch);
-    if (arena.failed) return false;
-    const uint32_t a_length = p;
-    auto left_out = [unpeel](unsigned char f) {
-        return (f & kPassBits) && (unpeel || (kLocalUnpeel && (f & kUnpeeled)));
-    };
-    p = 0;
-    for (uint32_t i = 0; i < a_length; ++i) {
-        if (!left_out(a_flags[i])) a[p++] = below + i;
-        a_points[i] = frame.local(cloud.point(a_ids[i]));
-    }
-    q = 0;
-    for (uint32_t j = 0; j < loops.bottom_count; ++j)
-        if (!left_out(loops.bottom_flags[j])) b[q++] = loops.bottom[j];
-    // The layer's points are read again (the loaded ones are in triangulate_layer's order,
-    // or were never loaded when a job triangulated the layer): only the loop's are read.
-    auto point = [&](uint32_t id) -> Local {
-        if (id >= below) return a_points[id - below];
-        return frame.local(cloud.point(layer.ids[id]));
-    };
-    Cylinder shared;
-    shared.poles = 0;
-    shared.radius = (ca.radius + cb.radius) / 2;
-    shared.h0 = cb.h0;
-    shared.scale = (ca.scale + cb.scale) / 2;
-    const double unrolled_radius = 1 / shared.scale;
-    auto unroll = [&](uint32_t id, double* uv) {
-        const Local l = point(id);
-        uv[0] = unrolled_radius * polar_angle(l.x - shared.cx, l.y - shared.cy);
-        uv[1] = l.h - shared.h0;
-    };
+    Stitch st;
+    st.cloud = &cloud;
+    st.frame = &frame;
+    st.layer = &layer;
+    st.loops = &loops;
+    st.a_flags = a_flags;
+    st.a_length = p;
+    st.below = static_cast<uint32_t>(layer.count);
+    const size_t mark = arena.mark();
+    if (!gather_band_loops(st, a_ids, unpeel, arena)) return false;
+    st.shared.poles = 0;
+    st.shared.radius = (ca.radius + cb.radius) / 2;
+    st.shared.h0 = cb.h0;
+    st.shared.scale = (ca.scale + cb.scale) / 2;
+    st.unrolled_radius = 1 / st.shared.scale;
     const double two_pi = 6.28318530717958647693;
-    Band band = {a, xa, p, b, xb, q, two_pi * unrolled_radius, steps, scratch, {}};
-    // Walks the settled band: returns its folds, adds its doubled area to *area and, with
-    // `emit`, writes its triangles to the sink and (kLocalUnpeel) marks the peel groups
-    // around the folds: those around the state's a[i] and b[j], which hold the triangle's
-    // third corner too unless it is on the loop since before peeling. B's entry of b[j] is
-    // found walking loops.bottom along (b is in its order, rotated), once around at most.
-    auto walk_band = [&](bool emit, double* area) {
-        size_t folds = 0;
-        uint32_t i = 0, j = 0, entry = 0;
-        for (uint32_t t = 0; t < p + q; ++t) {
-            uint32_t x, y, z;  // counter-clockwise on the annulus
-            const uint32_t a0 = a[i % p], b0 = b[j % q];
-            if (steps[t] == 0) {
-                x = a[(i + 1) % p], y = a0, z = b0;
-                ++i;
-            } else {
-                x = b0, y = b[(j + 1) % q], z = a0;
-                ++j;
-            }
-            const Local px = point(x), py = point(y), pz = point(z);
-            const bool folded = faces_axis(px, pz, py, shared);
-            folds += folded;
-            *area += doubled_area(px, py, pz);
-            if (emit) sink.write(x, y, z);
-            if (!kLocalUnpeel || !emit || !folded) continue;
-            for (uint32_t k = 0; k < loops.bottom_count && loops.bottom[entry] != b0; ++k)
-                entry = (entry + 1) % loops.bottom_count;
-            unpeel_around(a_flags, a_length, a0 - below);
-            unpeel_around(loops.bottom_flags, loops.bottom_count, entry);
-        }
-        return folds;
-    };
-    // The strip's centre: the cylinders' midpoint; where the band folds around it (the loops
-    // turn back around it: after choose_centre moved one of the centres, the midpoint may
-    // lie outside what both loops are star-shaped around), the one of the midpoint and the
-    // two layers' centres whose settled band has the least area. Trial 3 settles the band
-    // again around that one, unless it was the last tried.
-    const Cylinder* centres[3] = {nullptr, &ca, &cb};  // 0: the midpoint
-    double least = 0;
-    uint32_t best = 0;
-    size_t best_swaps = 0;
-    for (uint32_t trial = 0; trial < 4 && !(trial == 3 && best == 2); ++trial) {
-        const uint32_t k = trial < 3 ? trial : best;
-        shared.cx = k ? centres[k]->cx : (ca.cx + cb.cx) / 2;
-        shared.cy = k ? centres[k]->cy : (ca.cy + cb.cy) / 2;
-        for (uint32_t i = 0; i < p; ++i) unroll(a[i], xa + 2 * i);
-        for (uint32_t j = 0; j < q; ++j) unroll(b[j], xb + 2 * j);
-        rotate_to_first_angle(a, xa, p);
-        rotate_to_first_angle(b, xb, q);
-        size_t trial_swaps = 0;
-        settle_band(band, &trial_swaps);
-        if (trial == 3) break;
-        double area = 0;
-        const size_t folds = walk_band(false, &area);
-        if (trial == 0 || area < least) {
-            least = area;
-            best = k;
-            best_swaps = trial_swaps;
-        }
-        if (folds == 0 && trial == 0) break;
-    }
-    *swaps += best_swaps;
+    st.band.turn = two_pi * st.unrolled_radius;
+    *swaps += settle_least_area(st, ca, cb);
     if (kLocalUnpeel || unpeel) {
-        put_back_peeled(a_flags, a_length, true, [below](uint32_t i) { return below + i; },
-                        point, shared, sink);
-        put_back_peeled(loops.bottom_flags, loops.bottom_count, false,
-                        [&loops](uint32_t j) { return loops.bottom[j]; }, point, shared, sink);
+        put_back_peeled(st, true, sink);
+        put_back_peeled(st, false, sink);
     }
     double area = 0;
-    sink.folds += walk_band(true, &area);
+    sink.folds += walk_band(st, &sink, &area);
     arena.rewind(mark);
     return true;
 }
@@ -6061,7 +6133,7 @@ struct SurfaceChain {
     size_t groups, duplicates, collisions, swaps, removed, used, trailing;
 };
 
-inline bool allocate_chain(SurfaceChain& c, size_t points, Arena& arena) {
+static inline bool allocate_chain(SurfaceChain& c, size_t points, Arena& arena) {
     c.top = arena.alloc<uint32_t>(points);
     c.next_top = arena.alloc<uint32_t>(points);
     c.bottom = arena.alloc<uint32_t>(points);
@@ -6078,7 +6150,8 @@ inline bool allocate_chain(SurfaceChain& c, size_t points, Arena& arena) {
 // and the one from the previous.
 const unsigned char kUnusedBelow = 1, kHasNextEdge = 2, kHasPreviousEdge = 4;
 
-inline void count_corners(const uint32_t* tri, size_t count, uint32_t* degree, size_t vertices) {
+static inline void count_corners(const uint32_t* tri, size_t count, uint32_t* degree,
+                                 size_t vertices) {
     std::memset(degree, 0, vertices * sizeof(uint32_t));
     for (size_t k = 0; k < 3 * count; ++k) ++degree[tri[k]];
 }
@@ -6086,8 +6159,8 @@ inline void count_corners(const uint32_t* tri, size_t count, uint32_t* degree, s
 // For the loop whose point i has id `id_of(i)` (n points, in loop order): which of the
 // loop's edges the triangles use, as kHasNextEdge / kHasPreviousEdge bits added to flags[i].
 // position[v] is v's place in the loop or kNoIndex, for every id v in the triangles.
-inline void mark_loop_edges(const uint32_t* tri, size_t count, const uint32_t* position,
-                            uint32_t n, unsigned char* flags) {
+static inline void mark_loop_edges(const uint32_t* tri, size_t count, const uint32_t* position,
+                                   uint32_t n, unsigned char* flags) {
     for (size_t t = 0; t < count; ++t)
         for (size_t k = 0; k < 3; ++k) {
             uint32_t i = position[tri[3 * t + k]], j = position[tri[3 * t + (k + 1) % 3]];
@@ -6110,8 +6183,8 @@ inline void mark_loop_edges(const uint32_t* tri, size_t count, const uint32_t* p
 // loop point with triangles on both sides shares an edge. `below` flags the loop points
 // from their own chunk; seam ids are below_count + i. Returns the triangles removed, or
 // SIZE_MAX if the arena is too small.
-inline size_t seal_seam(uint32_t* tri, size_t& count, size_t below_count, size_t vertices,
-                        const unsigned char* below, uint32_t* degree, Arena& arena) {
+static inline size_t seal_seam(uint32_t* tri, size_t& count, size_t below_count, size_t vertices,
+                               const unsigned char* below, uint32_t* degree, Arena& arena) {
     const uint32_t n = static_cast<uint32_t>(vertices - below_count);
     size_t mark = arena.mark();
     uint32_t* position = arena.alloc<uint32_t>(vertices);
@@ -6150,8 +6223,8 @@ inline size_t seal_seam(uint32_t* tri, size_t& count, size_t below_count, size_t
 // Whether the safety net would remove nothing from the chunk: whether the fans of the
 // vertices the band joins (the layer's bottom loop, the loop below) are whole. The others
 // are by construction (see >>manifold).
-inline bool loop_fans_are_one_piece(const uint32_t* tri, size_t count, size_t below,
-                                    size_t vertices, const LayerLoops& loops, Arena& arena) {
+static inline bool loop_fans_are_one_piece(const uint32_t* tri, size_t count, size_t below,
+                                           size_t vertices, const LayerLoops& loops, Arena& arena) {
     size_t mark = arena.mark();
     unsigned char* checked = arena.alloc<unsigned char>(vertices);
     if (arena.failed) return false;
@@ -6166,8 +6239,8 @@ inline bool loop_fans_are_one_piece(const uint32_t* tri, size_t count, size_t be
 // Triangles of a chunk from layer-local and band indices to reader indices, and on to
 // output indices unless the seam's flips (see "flips across the seam"), which read the
 // points, come between: then name_output_points does that step.
-inline void name_chunk_points(const SurfaceChain& c, const LoadedLayer& layer, uint32_t* tri,
-                              size_t count) {
+static inline void name_chunk_points(const SurfaceChain& c, const LoadedLayer& layer, uint32_t* tri,
+                                     size_t count) {
     for (size_t k = 0; k < 3 * count; ++k) {
         uint32_t l = tri[k];
         uint32_t id = l < layer.count ? layer.ids[l] : c.top[l - layer.count];
@@ -6176,7 +6249,7 @@ inline void name_chunk_points(const SurfaceChain& c, const LoadedLayer& layer, u
 }
 
 // A final chunk's triangles from reader indices to output indices (with kSurfaceFlips).
-inline void name_output_points(const SurfaceChain& c, uint32_t* tri, size_t count) {
+static inline void name_output_points(const SurfaceChain& c, uint32_t* tri, size_t count) {
     if (!kSurfaceFlips || !c.output_id) return;
     for (size_t k = 0; k < 3 * count; ++k) tri[k] = c.output_id[tri[k]];
 }
@@ -6188,9 +6261,9 @@ inline void name_output_points(const SurfaceChain& c, uint32_t* tri, size_t coun
 // as built and the fans of the loop vertices are whole (see >>manifold); then the chunk's
 // points that became vertices are counted and the next seam's flags set, as finish_chunk
 // would. Otherwise nothing changes.
-inline bool chunk_is_sound(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                           const uint32_t* at_loops, size_t count, size_t interior_used,
-                           Arena& arena) {
+static inline bool chunk_is_sound(SurfaceChain& c, const LoadedLayer& layer,
+                                  const LayerLoops& loops, const uint32_t* at_loops, size_t count,
+                                  size_t interior_used, Arena& arena) {
     // The seam is as built when every loop point below has both its loop edges there or no
     // triangle at all: then seal_seam would find nothing to do either, since the band has
     // every edge of the loop.
@@ -6226,8 +6299,9 @@ inline bool chunk_is_sound(SurfaceChain& c, const LoadedLayer& layer, const Laye
 
 // The safety net over the chunk sink[chunk_start ..), then its indices from layer-local and
 // band indices to output indices; counts the points that became vertices.
-inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                           size_t chunk_start, Arena& arena, TriangleSink& sink) {
+static inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer,
+                                  const LayerLoops& loops, size_t chunk_start, Arena& arena,
+                                  TriangleSink& sink) {
     uint32_t* tri = sink.triangles + 3 * chunk_start;
     size_t count = sink.count - chunk_start;
     const size_t below = layer.count, vertices = layer.count + c.top_count;
@@ -6286,8 +6360,8 @@ inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const Laye
 const uint32_t kRingGap = 3;
 
 // sectors_held by planned layers [first, last] around (cx, cy), read from the cloud.
-inline uint32_t planned_sectors(const SurfaceChain& c, const LayerQueue& q, uint32_t first,
-                                uint32_t last, double cx, double cy) {
+static inline uint32_t planned_sectors(const SurfaceChain& c, const LayerQueue& q, uint32_t first,
+                                       uint32_t last, double cx, double cy) {
     const uint32_t* ids = q.ids + q.start[first];
     return sectors_held([&c, ids](size_t i) { return c.frame.local(c.reader.point(ids[i])); },
                         q.start[last + 1] - q.start[first], cx, cy);
@@ -6298,7 +6372,7 @@ inline uint32_t planned_sectors(const SurfaceChain& c, const LayerQueue& q, uint
 // points uniform on a circle leave g of its 32 sectors empty in a row with probability
 // below m (1 - g/32)^(m-1)): a sparse layer's gaps are not crescents, nor is an empty
 // one. Else 0.
-inline uint32_t crescent_gap(uint32_t held, size_t count) {
+static inline uint32_t crescent_gap(uint32_t held, size_t count) {
     const uint32_t gap = widest_gap(held);
     if (gap <= kRingGap || count == 0) return 0;
     const size_t stride = gap_sample_stride(count);
@@ -6312,8 +6386,8 @@ inline uint32_t crescent_gap(uint32_t held, size_t count) {
 // Whether the group [first, last] joins the next planned layer (see kRingGap). First a
 // look from the group's fitted centre; where it or the next layer leaves a gap, the gaps
 // are taken again from the centre fitted to both, which a crescent does not pull aside.
-inline bool joins_crescent(const SurfaceChain& c, const LayerQueue& q, uint32_t first,
-                           uint32_t last, const Cylinder& fitted, uint32_t own) {
+static inline bool joins_crescent(const SurfaceChain& c, const LayerQueue& q, uint32_t first,
+                                  uint32_t last, const Cylinder& fitted, uint32_t own) {
     const size_t own_count = q.start[last + 1] - q.start[first];
     const size_t next_count = q.start[last + 2] - q.start[last + 1];
     uint32_t next = planned_sectors(c, q, last + 1, last + 1, fitted.cx, fitted.cy);
@@ -6332,7 +6406,7 @@ inline bool joins_crescent(const SurfaceChain& c, const LayerQueue& q, uint32_t 
 
 // Whether a group of n points over `height` around `radius` is triangulated on its own
 // (else it joins the next planned layer; the final group only needs 3 points).
-inline bool group_stands(size_t n, double height, double radius, bool final) {
+static inline bool group_stands(size_t n, double height, double radius, bool final) {
     return n >= 3 && (final || (n >= kMinLayerPoints && thick_enough(n, height, radius)));
 }
 
@@ -6372,8 +6446,8 @@ struct GroupResult {
 };
 
 // What triangulate_layer would do now, from a job's result.
-inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops& loops,
-                         LayerCounts& counts) {
+static inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops& loops,
+                                LayerCounts& counts) {
     if (ahead.status != Status::ok) return ahead.status;
     if (sink.count < sink.capacity) {
         size_t room = sink.capacity - sink.count;
@@ -6397,9 +6471,9 @@ inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops
 // chunk_is_sound holds for the border the job kept and the band, only the band is named in
 // reader indices. Returns false when it does not (nothing changed): the caller then builds
 // the chunk again in order, to the same triangles, and runs finish_chunk.
-inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                         const LayerAhead& ahead, size_t chunk_start, Arena& arena,
-                         TriangleSink& sink) {
+static inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
+                                const LayerAhead& ahead, size_t chunk_start, Arena& arena,
+                                TriangleSink& sink) {
     if (!ahead.replayable || c.output_id) return false;
     uint32_t* band = sink.triangles + 3 * (chunk_start + ahead.triangle_count);
     const size_t band_count = sink.count - chunk_start - ahead.triangle_count;
@@ -6488,7 +6562,7 @@ const double kBendGain = 3;  // a flip for the bend alone must bend 3 times less
 
 const double kWidestAngle = -0.86602540378443865;  // cosine of 150 degrees
 
-inline Vec3 vec_of(const Local& p) { return Vec3{p.x, p.y, p.h}; }
+static inline Vec3 vec_of(const Local& p) { return Vec3{p.x, p.y, p.h}; }
 
 struct Box3 {
     Vec3 low, high;
@@ -6498,7 +6572,7 @@ struct Box3 {
     }
 };
 
-inline Box3 box_of(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
+static inline Box3 box_of(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
     Box3 box = {a, a};
     const Vec3 rest[3] = {b, c, d};
     for (const Vec3& p : rest) {
@@ -6513,7 +6587,7 @@ inline Box3 box_of(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
 // Whether the angles at p and q facing the segment ab sum to more than 180 degrees: then
 // sin(angle_p + angle_q), a sum of sine-cosine products, is negative. Two acute angles
 // (most edges) are settled by two dot products.
-inline bool flip_helps(Vec3 a, Vec3 b, Vec3 p, Vec3 q) {
+static inline bool flip_helps(Vec3 a, Vec3 b, Vec3 p, Vec3 q) {
     const Vec3 pa = a - p, pb = b - p, qa = a - q, qb = b - q;
     const double cos_p = dot(pa, pb), cos_q = dot(qa, qb);
     if (cos_p >= 0 && cos_q >= 0) return false;
@@ -6526,7 +6600,7 @@ inline bool flip_helps(Vec3 a, Vec3 b, Vec3 p, Vec3 q) {
 // Whether triangles u and v, each shrunk by kShrink about its centroid, overlap along every
 // axis that could separate them: their normals, the cross products of their edges, and
 // each normal crossed with the triangle's own edges (for coplanar triangles).
-inline bool triangles_meet(const Vec3* u, const Vec3* v) {
+static inline bool triangles_meet(const Vec3* u, const Vec3* v) {
     Vec3 s[3], t[3];
     const Vec3 cu = scaled(Vec3{u[0].x + u[1].x + u[2].x, u[0].y + u[1].y + u[2].y,
                                 u[0].z + u[1].z + u[2].z}, 1.0 / 3);
@@ -6569,7 +6643,7 @@ inline bool triangles_meet(const Vec3* u, const Vec3* v) {
 // around it, until visit returns false. False if a visit did, or the vertex has more than
 // kFanLimit neighbours.
 template <class Visit>
-inline bool around_vertex(const Triangulation& tr, uint32_t from, Visit visit) {
+static inline bool around_vertex(const Triangulation& tr, uint32_t from, Visit visit) {
     uint32_t e = from;
     for (uint32_t steps = 0; steps < kFanLimit; ++steps) {
         if (!visit(e)) return false;
@@ -6624,12 +6698,12 @@ struct VertexNormals {
 
 // How much the surface bends along edge ab, with unit normals na and nb at its ends (see
 // above).
-inline double bend_along(Vec3 a, Vec3 b, Vec3 na, Vec3 nb) {
+static inline double bend_along(Vec3 a, Vec3 b, Vec3 na, Vec3 nb) {
     return std::fabs(dot(b - a, nb - na));
 }
 
 // The cosine of the widest angle of triangle abc.
-inline double widest_angle_cosine(Vec3 a, Vec3 b, Vec3 c) {
+static inline double widest_angle_cosine(Vec3 a, Vec3 b, Vec3 c) {
     const Vec3 corner[3] = {a, b, c};
     double widest = 1;
     for (int k = 0; k < 3; ++k) {
@@ -6644,8 +6718,8 @@ inline double widest_angle_cosine(Vec3 a, Vec3 b, Vec3 c) {
 // Whether the surface wants ab of triangles abp and baq turned into pq, by the two rules
 // (see above; na .. nq the corners' unit normals, none zero) without an angle wider than
 // kWidestAngle (unless the old pair had a wider one).
-inline bool flip_wanted(const Local& la, const Local& lb, const Local& lp, const Local& lq,
-                        Vec3 na, Vec3 nb, Vec3 np, Vec3 nq) {
+static inline bool flip_wanted(const Local& la, const Local& lb, const Local& lp, const Local& lq,
+                               Vec3 na, Vec3 nb, Vec3 np, Vec3 nq) {
     if (dot(na, na) == 0 || dot(nb, nb) == 0 || dot(np, np) == 0 || dot(nq, nq) == 0)
         return false;
     const double bend_before = bend_along(vec_of(la), vec_of(lb), na, nb);
@@ -6664,7 +6738,7 @@ inline bool flip_wanted(const Local& la, const Local& lb, const Local& lp, const
 
 // Whether both new triangles (p, a, q) and (q, b, p) of that flip have normals within
 // kGentleFlip of the old pair's mean.
-inline bool gentle_flip(const Local& la, const Local& lb, const Local& lp, const Local& lq) {
+static inline bool gentle_flip(const Local& la, const Local& lb, const Local& lp, const Local& lq) {
     Vec3 mean = normal_of(la, lb, lp);
     const Vec3 other_normal = normal_of(lb, la, lq);
     mean = Vec3{mean.x + other_normal.x, mean.y + other_normal.y, mean.z + other_normal.z};
@@ -6674,8 +6748,8 @@ inline bool gentle_flip(const Local& la, const Local& lb, const Local& lp, const
 }
 
 // Flips half-edge e of a layer's triangulation on the surface if that helps (see above).
-inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32_t* flags,
-                            VertexNormals& normals, const Cylinder& cyl, uint32_t e) {
+static inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32_t* flags,
+                                   VertexNormals& normals, const Cylinder& cyl, uint32_t e) {
     const uint32_t f = tr.twin[e];
     const uint32_t t = e / 3, u = f / 3;
     if (!on_surface(tr, u)) return false;
@@ -6724,8 +6798,9 @@ inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32
 // `flags` holds a word per vertex (see triangulate_layer); the bits kFlippedBefore and
 // kFlippedNow are used here and cleared. `room` is the annulus coordinates, two doubles a
 // vertex, overwritten. Returns the number of flips.
-inline size_t flip_layer_on_surface(Triangulation& tr, const Local* points, const Cylinder& cyl,
-                                    uint32_t* flags, double* room, size_t vertices) {
+static inline size_t flip_layer_on_surface(Triangulation& tr, const Local* points,
+                                           const Cylinder& cyl, uint32_t* flags, double* room,
+                                           size_t vertices) {
     VertexNormals normals = {room};
     size_t flips = 0;
     for (uint32_t sweep = 0; sweep < kSurfaceFlipSweeps; ++sweep) {
@@ -6810,23 +6885,18 @@ struct Seam {
     }
 };
 
-// The seam of a chunk (see above). False with seam.triangles = 0 when it is left as it is;
-// false with arena.failed when the arena is too small.
-inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                      uint32_t* chunk, size_t count, Arena& arena, Seam& seam) {
-    seam.chunk = chunk;
-    seam.triangles = 0;
-    // The tags, over reader indices up to the largest of the chunk's and the loops'.
+// Tags the chunk's points and the loops' with their loop bits, over reader indices up to
+// the largest of theirs; room for `most` seam triangles. False if the arena is too small.
+static inline bool tag_seam_points(const SurfaceChain& c, const LoadedLayer& layer,
+                                   const LayerLoops& loops, size_t count, size_t most, Arena& arena,
+                                   Seam& seam) {
+    const uint32_t* chunk = seam.chunk;
     uint32_t largest = 0;
     for (size_t k = 0; k < 3 * count; ++k) largest = chunk[k] > largest ? chunk[k] : largest;
     for (uint32_t i = 0; i < c.top_count; ++i) largest = c.top[i] > largest ? c.top[i] : largest;
     for (uint32_t i = 0; i < layer.count; ++i)
         largest = layer.ids[i] > largest ? layer.ids[i] : largest;
     seam.tag = arena.alloc<uint32_t>(size_t{largest} + 1);
-    const size_t vertices = layer.count + c.top_count;
-    // More seam triangles: left as it is (and the tags' seam points fit above the bits).
-    size_t most = 3 * vertices / 4;
-    if (most > (kNoIndex >> kLoopBits) / 3) most = (kNoIndex >> kLoopBits) / 3;
     seam.slot = arena.alloc<uint32_t>(most);
     if (arena.failed) return false;
     for (size_t k = 0; k < 3 * count; ++k) seam.tag[chunk[k]] = 0;
@@ -6837,16 +6907,14 @@ inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
         seam.tag[layer.ids[loops.bottom[i]]] |= kBottomLoopPoint;
     for (uint32_t i = 0; i < loops.top_count; ++i)
         seam.tag[layer.ids[loops.top[i]]] |= kTopLoopPoint;
-    size_t triangles = 0;
-    for (size_t t = 0; t < count; ++t) {
-        const uint32_t* v = chunk + 3 * t;
-        if (!((seam.tag[v[0]] | seam.tag[v[1]] | seam.tag[v[2]]) & (kLoopBelow | kBottomLoopPoint)))
-            continue;
-        if (triangles == most) return false;
-        seam.slot[triangles++] = static_cast<uint32_t>(t);
-    }
-    if (triangles == 0) return false;
-    seam.triangles = static_cast<uint32_t>(triangles);
+    return true;
+}
+
+// Numbers the seam triangles' points (seam.ids, and in their tags) and names their corners
+// by them, with each point's loop bits and seam triangle count. False if the arena is too
+// small.
+static inline bool number_seam_points(Arena& arena, Seam& seam) {
+    const size_t triangles = seam.triangles;
     seam.vertex = arena.alloc<uint32_t>(3 * triangles);
     seam.twin = arena.alloc<uint32_t>(3 * triangles);
     seam.ids = arena.alloc<uint32_t>(3 * triangles);
@@ -6854,7 +6922,7 @@ inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
     uint32_t points = 0;
     for (size_t s = 0; s < triangles; ++s)
         for (uint32_t j = 0; j < 3; ++j) {
-            const uint32_t id = chunk[3 * size_t{seam.slot[s]} + j];
+            const uint32_t id = seam.chunk[3 * size_t{seam.slot[s]} + j];
             if ((seam.tag[id] >> kLoopBits) == 0) {
                 seam.ids[points] = id;
                 seam.tag[id] |= (points + 1) << kLoopBits;
@@ -6873,13 +6941,19 @@ inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
         seam.degree[v] = 0;
     }
     for (size_t i = 0; i < 3 * triangles; ++i) ++seam.degree[seam.vertex[i]];
-    // Twins through each point's outgoing half-edges.
+    return true;
+}
+
+// Each seam half-edge's twin, found through each point's outgoing half-edges. False if
+// the arena is too small.
+static inline bool link_seam_twins(Arena& arena, Seam& seam) {
+    const uint32_t points = seam.points, triangles = seam.triangles;
     size_t mark = arena.mark();
     uint32_t* first = arena.alloc<uint32_t>(size_t{points} + 1);
-    uint32_t* outgoing = arena.alloc<uint32_t>(3 * triangles);
+    uint32_t* outgoing = arena.alloc<uint32_t>(3 * size_t{triangles});
     if (arena.failed) return false;
     std::memset(first, 0, (size_t{points} + 1) * sizeof(uint32_t));
-    for (size_t e = 0; e < 3 * triangles; ++e) ++first[seam.vertex[e] + 1];
+    for (size_t e = 0; e < 3 * size_t{triangles}; ++e) ++first[seam.vertex[e] + 1];
     for (uint32_t v = 0; v < points; ++v) first[v + 1] += first[v];
     for (uint32_t e = 0; e < 3 * triangles; ++e) outgoing[first[seam.vertex[e]]++] = e;
     for (uint32_t v = points; v > 0; --v) first[v] = first[v - 1];
@@ -6894,16 +6968,41 @@ inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
     return true;
 }
 
+// The seam of a chunk (see above). False with seam.triangles = 0 when it is left as it is;
+// false with arena.failed when the arena is too small.
+static inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer,
+                             const LayerLoops& loops, uint32_t* chunk, size_t count, Arena& arena,
+                             Seam& seam) {
+    seam.chunk = chunk;
+    seam.triangles = 0;
+    const size_t vertices = layer.count + c.top_count;
+    // More seam triangles: left as it is (and the tags' seam points fit above the bits).
+    size_t most = 3 * vertices / 4;
+    if (most > (kNoIndex >> kLoopBits) / 3) most = (kNoIndex >> kLoopBits) / 3;
+    if (!tag_seam_points(c, layer, loops, count, most, arena, seam)) return false;
+    size_t triangles = 0;
+    for (size_t t = 0; t < count; ++t) {
+        const uint32_t* v = chunk + 3 * t;
+        if (!((seam.tag[v[0]] | seam.tag[v[1]] | seam.tag[v[2]]) & (kLoopBelow | kBottomLoopPoint)))
+            continue;
+        if (triangles == most) return false;
+        seam.slot[triangles++] = static_cast<uint32_t>(t);
+    }
+    if (triangles == 0) return false;
+    seam.triangles = static_cast<uint32_t>(triangles);
+    return number_seam_points(arena, seam) && link_seam_twins(arena, seam);
+}
+
 // Seam point v's normal.
-inline Vec3 seam_normal(const Seam& seam, uint32_t v) {
+static inline Vec3 seam_normal(const Seam& seam, uint32_t v) {
     const float* n = seam.normal + 3 * size_t{v};
     return Vec3{static_cast<double>(n[0]), static_cast<double>(n[1]),
                 static_cast<double>(n[2])};
 }
 
 // Adds triangle v's unit normal to sums[3 k] for each corner k of it that is a seam point.
-inline void add_seam_normal(const SurfaceChain& c, const Seam& seam, const uint32_t* v,
-                            float* sums) {
+static inline void add_seam_normal(const SurfaceChain& c, const Seam& seam, const uint32_t* v,
+                                   float* sums) {
     const uint32_t at[3] = {seam.point_of(v[0]), seam.point_of(v[1]), seam.point_of(v[2])};
     if (at[0] == kNoIndex && at[1] == kNoIndex && at[2] == kNoIndex) return;
     Vec3 n = normal_of(c.frame.local(c.reader.point(v[0])), c.frame.local(c.reader.point(v[1])),
@@ -6921,7 +7020,7 @@ inline void add_seam_normal(const SurfaceChain& c, const Seam& seam, const uint3
 }
 
 // The sums of the unit normals of the chunk's triangles off the seam, at the seam's points.
-inline void sum_fixed_normals(const SurfaceChain& c, const Seam& seam, size_t count) {
+static inline void sum_fixed_normals(const SurfaceChain& c, const Seam& seam, size_t count) {
     std::memset(seam.fixed_normal, 0, 3 * size_t{seam.points} * sizeof(float));
     uint32_t next = 0;  // seam.slot is increasing
     for (size_t t = 0; t < count; ++t) {
@@ -6935,7 +7034,7 @@ inline void sum_fixed_normals(const SurfaceChain& c, const Seam& seam, size_t co
 
 // The seam's vertex normals over every triangle of the chunk (see VertexNormals): the fixed
 // sums and the seam's own triangles, made unit.
-inline void estimate_seam_normals(const SurfaceChain& c, const Seam& seam) {
+static inline void estimate_seam_normals(const SurfaceChain& c, const Seam& seam) {
     std::memcpy(seam.normal, seam.fixed_normal, 3 * size_t{seam.points} * sizeof(float));
     for (uint32_t s = 0; s < seam.triangles; ++s)
         add_seam_normal(c, seam, seam.chunk + 3 * size_t{seam.slot[s]}, seam.normal);
@@ -6952,7 +7051,7 @@ inline void estimate_seam_normals(const SurfaceChain& c, const Seam& seam) {
 
 // Whether seam point x's triangles, walked around it from half-edge `from` (leaving x) both
 // ways, are all of its seam triangles and none has an edge to y.
-inline bool fan_misses(const Seam& seam, uint32_t from, uint32_t x, uint32_t y) {
+static inline bool fan_misses(const Seam& seam, uint32_t from, uint32_t x, uint32_t y) {
     uint32_t seen = 0;
     auto clear = [&seam, y](uint32_t g) {
         return seam.vertex[next_edge(g)] != y && seam.vertex[prev_edge(g)] != y;
@@ -6978,7 +7077,8 @@ inline bool fan_misses(const Seam& seam, uint32_t from, uint32_t x, uint32_t y) 
 }
 
 // Flips half-edge e of the seam if that helps (see above and flip_on_surface).
-inline bool flip_seam_edge(const SurfaceChain& c, Seam& seam, const Cylinder& cyl, uint32_t e) {
+static inline bool flip_seam_edge(const SurfaceChain& c, Seam& seam, const Cylinder& cyl,
+                                  uint32_t e) {
     const uint32_t f = seam.twin[e];
     if (f == kNoIndex) return false;
     const uint32_t a = seam.vertex[e], b = seam.vertex[next_edge(e)];
@@ -7031,8 +7131,8 @@ inline bool flip_seam_edge(const SurfaceChain& c, Seam& seam, const Cylinder& cy
 
 // Flips a final chunk's seam (reader indices) on the surface, sweep after sweep as
 // flip_layer_on_surface does. Returns false if the arena is too small.
-inline bool flip_seam(const SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                      uint32_t* chunk, size_t count, Arena& arena) {
+static inline bool flip_seam(const SurfaceChain& c, const LoadedLayer& layer,
+                             const LayerLoops& loops, uint32_t* chunk, size_t count, Arena& arena) {
     size_t mark = arena.mark();
     Seam seam;
     if (!find_seam(c, layer, loops, chunk, count, arena, seam)) {
@@ -7065,28 +7165,18 @@ inline bool flip_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
 namespace stratmesh {
 namespace detail {
 
-// Triangulates a loaded layer rolled onto the annulus of its cylinder plus the centre (the
-// centre moved first if the layer folds less around another: see choose_centre).
-// Emits the surface triangles and fills the loops, in layer-local indices. Returns ok,
-// not_columnar (the layer does not surround its axis, or is degenerate: the caller merges
-// it with the next one), out_of_memory or internal_error. Its scratch is released; the
-// layer's points are left in insertion order (layer.points[k] is layer-local point
-// order[k], an order not kept).
-inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Arena& arena,
-                                TriangleSink& sink, LayerLoops& loops, LayerCounts& counts) {
-    const size_t count = layer.count, total = count + 1;  // vertex 0 is the centre
-    choose_centre(layer, arena);
+// Puts the layer's points in insertion order (order[k] is the layer-local index of the k-th)
+// and rolls them onto the annulus into xy, after the centre at xy[0..1]. The order is taken
+// on the unrolled strip (angle, height), where the points are spread evenly: on the annulus
+// their density falls off with the radius squared and a curve over its bounding box would
+// lump the inner rings together. The strip has the cylinder's proportions (angle in
+// radians, height over the radius), as the curve's cells are square. False if the arena
+// is too small.
+static inline bool roll_in_insertion_order(LoadedLayer& layer, uint32_t* order, double* xy,
+                                           Arena& arena) {
+    const size_t count = layer.count;
     Local* points = layer.points;
     const Cylinder& cyl = layer.cyl;
-    size_t mark = arena.mark();
-    uint32_t* order = arena.alloc<uint32_t>(count);  // vertex - 1 -> layer-local index
-    double* xy = arena.alloc<double>(2 * total);
-    if (arena.failed) return Status::out_of_memory;
-    // The insertion order is taken on the unrolled strip (angle, height), where the points
-    // are spread evenly: on the annulus their density falls off with the radius squared
-    // and a curve over its bounding box would lump the inner rings together. The strip has
-    // the cylinder's proportions (angle in radians, height over the radius), as the curve's
-    // cells are square. The centre goes first.
     const double quarter_turn = 1.57079632679489661923;  // pseudo_angle's unit, in radians
     BoundingBox2d box = {{0, 0}, {4 * quarter_turn, 0}};
     double* strip = xy + 2;
@@ -7098,18 +7188,81 @@ inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Ar
     }
     if (!spatial_order(reinterpret_cast<const unsigned char*>(strip), 2 * sizeof(double), count,
                        box, order, arena))
-        return Status::out_of_memory;
-    // The points in insertion order, so that unrolling them and the fold test below read
-    // them in sequence, not at random (the copy's room is free again before the
-    // triangulation takes it).
+        return false;
+    // The points in insertion order, so that unrolling them and the fold test read them in
+    // sequence, not at random (the copy's room is free again before the triangulation
+    // takes it).
     size_t copy_mark = arena.mark();
     Local* sorted = arena.alloc<Local>(count);
-    if (arena.failed) return Status::out_of_memory;
+    if (arena.failed) return false;
     for (size_t k = 0; k < count; ++k) sorted[k] = points[order[k]];
     std::memcpy(points, sorted, count * sizeof(Local));
     arena.rewind(copy_mark);
     xy[0] = xy[1] = 0;
     for (size_t k = 0; k < count; ++k) roll(cyl, points[k], xy + 2 * (k + 1));
+    return true;
+}
+
+// Peels the layer's loops (see "peeling"): the passes and the slope of a loop. The
+// surface's end loops of a layer that folds peel further; its other loops not at all.
+static inline void peel_layer_loops(Triangulation& tr, const LoadedLayer& layer, size_t folds,
+                                    uint32_t* flags, LayerLoops& loops) {
+    auto passes = [&layer, folds](uint32_t end) {
+        if (folds == 0) return kPeelPasses;
+        return (layer.ends & end) ? kFoldedEndPeelPasses : 0;
+    };
+    auto slope = [&layer, folds](uint32_t end) {
+        if (!(layer.ends & end)) return kInnerPeelSlope;
+        return folds == 0 ? kPeelSlope : kFoldedEndPeelSlope;
+    };
+    const uint32_t capacity = static_cast<uint32_t>(layer.count);
+    loops.bottom_count = peel_loop(tr, layer.points, flags, loops.bottom, loops.bottom_count,
+                                   capacity, false, slope(kLowPole), passes(kLowPole));
+    loops.top_count = peel_loop(tr, layer.points, flags, loops.top, loops.top_count, capacity,
+                                true, slope(kHighPole), passes(kHighPole));
+}
+
+// Writes the surface triangles to the sink in layer-local indices, those at the bottom loop
+// (the border) last, so that a chunk's triangles at its loop vertices are one stretch of
+// the sink with the band (see chunk_is_sound); counts the points off that loop with one.
+static inline void emit_layer(const Triangulation& tr, const uint32_t* order, uint32_t* flags,
+                              size_t total, TriangleSink& sink, LayerLoops& loops) {
+    for (uint32_t at_border = 0; at_border < 2; ++at_border) {
+        if (at_border) loops.border_start = sink.count;
+        for (uint32_t t = 0; t < tr.triangle_count; ++t) {
+            const uint32_t* v = tr.vertex + 3 * t;
+            if (!on_surface(tr, t) ||
+                ((flags[v[0]] | flags[v[1]] | flags[v[2]]) & kOnBottomLoop) != at_border)
+                continue;
+            if (kNetShortcut) {
+                flags[v[0]] |= kEmitted;
+                flags[v[1]] |= kEmitted;
+                flags[v[2]] |= kEmitted;
+            }
+            sink.write(order[v[0] - 1], order[v[1] - 1], order[v[2] - 1]);
+        }
+    }
+    loops.interior_used = 0;
+    for (size_t v = 1; kNetShortcut && v < total; ++v)
+        loops.interior_used += (flags[v] & (kOnBottomLoop | kEmitted)) == kEmitted;
+}
+
+// Triangulates a loaded layer rolled onto the annulus of its cylinder plus the centre (the
+// centre moved first if the layer folds less around another: see choose_centre).
+// Emits the surface triangles and fills the loops, in layer-local indices. Returns ok,
+// not_columnar (the layer does not surround its axis, or is degenerate: the caller merges
+// it with the next one), out_of_memory or internal_error. Its scratch is released; the
+// layer's points are left in insertion order (layer.points[k] is layer-local point
+// order[k], an order not kept).
+static inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Arena& arena,
+                                       TriangleSink& sink, LayerLoops& loops, LayerCounts& counts) {
+    const size_t count = layer.count, total = count + 1;  // vertex 0 is the centre
+    choose_centre(layer, arena);
+    size_t mark = arena.mark();
+    uint32_t* order = arena.alloc<uint32_t>(count);  // vertex - 1 -> layer-local index
+    double* xy = arena.alloc<double>(2 * total);
+    if (arena.failed || !roll_in_insertion_order(layer, order, xy, arena))
+        return Status::out_of_memory;
     Triangulation tr;
     tr.xy = xy;
     if (!allocate_triangulation(tr, total, arena)) return Status::out_of_memory;
@@ -7128,50 +7281,15 @@ inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Ar
         return Status::not_columnar;
     }
     hull_loop(tr, loops.top, &loops.top_count, flags);
-    size_t folds = count_folds(tr, points, 1, cyl, nullptr);
-    if (folds == 0 || kPeelFoldedEnds) {
-        const uint32_t capacity = static_cast<uint32_t>(count);
-        // The passes and the slope of a loop (see "peeling"): the surface's end loops of a
-        // layer that folds peel further; its other loops not at all.
-        auto passes = [&layer, folds](uint32_t end) {
-            if (folds == 0) return kPeelPasses;
-            return (layer.ends & end) ? kFoldedEndPeelPasses : 0;
-        };
-        auto slope = [&layer, folds](uint32_t end) {
-            if (!(layer.ends & end)) return kInnerPeelSlope;
-            return folds == 0 ? kPeelSlope : kFoldedEndPeelSlope;
-        };
-        loops.bottom_count = peel_loop(tr, points, flags, loops.bottom, loops.bottom_count,
-                                       capacity, false, slope(kLowPole), passes(kLowPole));
-        loops.top_count = peel_loop(tr, points, flags, loops.top, loops.top_count, capacity,
-                                    true, slope(kHighPole), passes(kHighPole));
-    }
+    size_t folds = count_folds(tr, layer.points, 1, layer.cyl, nullptr);
+    if (folds == 0 || kPeelFoldedEnds) peel_layer_loops(tr, layer, folds, flags, loops);
     name_loop(tr, order, flags, loops.bottom, loops.bottom_count, loops.bottom_flags, false);
     name_loop(tr, order, flags, loops.top, loops.top_count, loops.top_flags, true);
     if (kSurfaceFlips && layer.surface_flips &&
-        flip_layer_on_surface(tr, points, cyl, flags, xy, total) && folds)
-        folds = count_folds(tr, points, 1, cyl, nullptr);
-    // The triangles at the bottom loop (the border) go last, so that a chunk's triangles at
-    // its loop vertices are one stretch of the sink with the band (see chunk_is_sound).
-    for (uint32_t at_border = 0; at_border < 2; ++at_border) {
-        if (at_border) loops.border_start = sink.count;
-        for (uint32_t t = 0; t < tr.triangle_count; ++t) {
-            const uint32_t* v = tr.vertex + 3 * t;
-            if (!on_surface(tr, t) ||
-                ((flags[v[0]] | flags[v[1]] | flags[v[2]]) & kOnBottomLoop) != at_border)
-                continue;
-            if (kNetShortcut) {
-                flags[v[0]] |= kEmitted;
-                flags[v[1]] |= kEmitted;
-                flags[v[2]] |= kEmitted;
-            }
-            sink.write(order[v[0] - 1], order[v[1] - 1], order[v[2] - 1]);
-        }
-    }
+        flip_layer_on_surface(tr, layer.points, layer.cyl, flags, xy, total) && folds)
+        folds = count_folds(tr, layer.points, 1, layer.cyl, nullptr);
+    emit_layer(tr, order, flags, total, sink, loops);
     sink.folds += folds;
-    loops.interior_used = 0;
-    for (size_t v = 1; kNetShortcut && v < total; ++v)
-        loops.interior_used += (flags[v] & (kOnBottomLoop | kEmitted)) == kEmitted;
     arena.rewind(mark);
     return Status::ok;
 }
@@ -8266,8 +8384,8 @@ struct WebMemory {
     float* lengths;
 };
 
-inline bool allocate_webs(WebMemory& m, size_t point_count, size_t triangle_count,
-                          Arena& arena) {
+static inline bool allocate_webs(WebMemory& m, size_t point_count, size_t triangle_count,
+                                 Arena& arena) {
     m.points = arena.alloc<Vec3>(point_count);
     m.ends = arena.alloc<size_t>(point_count);
     m.spacings = arena.alloc<float>(point_count);
@@ -8281,7 +8399,7 @@ inline bool allocate_webs(WebMemory& m, size_t point_count, size_t triangle_coun
 }
 
 // The workspace measure_webs() takes.
-inline size_t webs_workspace_size(size_t point_count, size_t triangle_count) {
+static inline size_t webs_workspace_size(size_t point_count, size_t triangle_count) {
     Arena arena = Arena::measuring();
     WebMemory m;
     return allocate_webs(m, point_count, triangle_count, arena) ? arena.required_bytes() : 0;
@@ -8306,7 +8424,7 @@ struct WebFrame {
     }
 };
 
-inline WebFrame web_frame(const CloudSums& s) {
+static inline WebFrame web_frame(const CloudSums& s) {
     const Vec3 low = {s.lowest[0], s.lowest[1], s.lowest[2]};
     const Vec3 high = {s.highest[0], s.highest[1], s.highest[2]};
     const Vec3 size = high - low, half = scaled(high, 0.5) - scaled(low, 0.5);
@@ -8316,7 +8434,7 @@ inline WebFrame web_frame(const CloudSums& s) {
 }
 
 // a, b in order (as min and max, which compile without a branch).
-inline void order(float& a, float& b) {
+static inline void order(float& a, float& b) {
     const float low = b < a ? b : a, high = a < b ? b : a;
     a = low;
     b = high;
@@ -8324,7 +8442,7 @@ inline void order(float& a, float& b) {
 
 // The lower median of v[0 .. count), count > 0: by a sorting network for a vertex's few
 // edges (no branch to mispredict), by heapsort for a large fan.
-inline float lower_median(float* v, size_t count) {
+static inline float lower_median(float* v, size_t count) {
     if (count > 8) {
         heap_sort(v, count);
         return v[(count - 1) / 2];
@@ -8346,8 +8464,8 @@ const size_t kWebAhead = 16;
 
 // Numbers the vertices, renumbers the triangles' corners and counts the edges leaving each
 // vertex, then turns the counts into starts; returns how many vertices there are.
-inline uint32_t number_vertices(uint32_t* tri, size_t count, size_t point_count,
-                                const WebMemory& m) {
+static inline uint32_t number_vertices(uint32_t* tri, size_t count, size_t point_count,
+                                       const WebMemory& m) {
     for (size_t v = 0; v < point_count; ++v) m.id[v] = kNoIndex;
     uint32_t vertices = 0;
     for (size_t k = 0; k < 3 * count; ++k) {
@@ -8370,7 +8488,7 @@ inline uint32_t number_vertices(uint32_t* tri, size_t count, size_t point_count,
     return vertices;
 }
 
-// The passes over the vertices, by runs of them (see run_pass) or all at once.
+// The passes over the vertices, by runs of them (see run_pass).
 struct WebVertexPass {
     const CloudReader* reader;
     const WebFrame* frame;
@@ -8378,8 +8496,8 @@ struct WebVertexPass {
     uint32_t vertices;
     bool medians;  // else the points
 
-    void run(uint32_t k) { over(run_start(vertices, k), run_start(vertices, k + 1)); }
-    void over(size_t begin, size_t end) const {
+    void run(uint32_t k) const {
+        const size_t begin = run_start(vertices, k), end = run_start(vertices, k + 1);
         if (!medians) {
             for (size_t v = begin; v < end; ++v) {
                 if (kFastLoops && v + kWebAhead < end)
@@ -8395,17 +8513,10 @@ struct WebVertexPass {
     }
 };
 
-inline void run_vertex_pass(const Options& options, WebVertexPass& pass) {
-    if (kParallelLayers && options.run_jobs)
-        run_pass(options, pass);
-    else
-        pass.over(0, pass.vertices);
-}
-
 // The lengths of the edges leaving each vertex, sorted by vertex (a counting sort: each
 // start becomes an end), and each triangle's longest edge. Returns the triangles' area.
-inline double edge_lengths(const WebFrame& f, const uint32_t* tri, size_t count,
-                           const WebMemory& m) {
+static inline double edge_lengths(const WebFrame& f, const uint32_t* tri, size_t count,
+                                  const WebMemory& m) {
     double area = 0;
     for (size_t t = 0; t < count; ++t) {
         const uint32_t* c = tri + 3 * t;
@@ -8426,8 +8537,8 @@ inline double edge_lengths(const WebFrame& f, const uint32_t* tri, size_t count,
 
 // The web triangles among the renumbered triangles (see Diagnostics), into d, while their
 // corners are numbered back; returns their area.
-inline double find_webs(const WebFrame& f, uint32_t* tri, size_t count, const WebMemory& m,
-                        Diagnostics& d) {
+static inline double find_webs(const WebFrame& f, uint32_t* tri, size_t count, const WebMemory& m,
+                               Diagnostics& d) {
     double web = 0;
     Vec3 low = {DBL_MAX, DBL_MAX, DBL_MAX}, high = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
     for (size_t t = 0; t < count; ++t) {
@@ -8463,9 +8574,9 @@ inline double find_webs(const WebFrame& f, uint32_t* tri, size_t count, const We
 // Measures the webs of triangles[0 .. count) less the last `caps` into rep.diagnostics;
 // the triangles are renumbered meanwhile and come back as they were. False if the
 // workspace is too small (nothing is measured).
-inline bool measure_webs(const Options& options, const CloudReader& reader, size_t point_count,
-                         const CloudSums& sums, uint32_t* triangles, size_t count, size_t caps,
-                         Arena& arena, Report& rep) {
+static inline bool measure_webs(const Options& options, const CloudReader& reader,
+                                size_t point_count, const CloudSums& sums, uint32_t* triangles,
+                                size_t count, size_t caps, Arena& arena, Report& rep) {
     const size_t walls = caps < count ? count - caps : 0;
     const size_t mark = arena.mark();
     WebMemory m;
@@ -8473,10 +8584,10 @@ inline bool measure_webs(const Options& options, const CloudReader& reader, size
     const WebFrame f = web_frame(sums);
     WebVertexPass pass = {&reader, &f, &m, number_vertices(triangles, walls, point_count, m),
                           false};
-    run_vertex_pass(options, pass);
+    run_pass(options, pass);
     const double area = edge_lengths(f, triangles, walls, m);
     pass.medians = true;
-    run_vertex_pass(options, pass);
+    run_pass(options, pass);
     Diagnostics& d = rep.diagnostics;
     const double web = find_webs(f, triangles, walls, m, d);
     arena.rewind(mark);
@@ -8494,6 +8605,259 @@ inline bool measure_webs(const Options& options, const CloudReader& reader, size
 
 namespace stratmesh {
 namespace detail {
+
+// Where the sink and the chain's swap count stood: a chunk or a band is undone back to it.
+struct SinkMark {
+    size_t count, folds, swaps;
+};
+
+static inline SinkMark mark_sink(const SurfaceChain& c, const TriangleSink& sink) {
+    return {sink.count, sink.folds, c.swaps};
+}
+
+static inline void rewind_sink(SurfaceChain& c, TriangleSink& sink, const SinkMark& m) {
+    sink.count = m.count;
+    sink.folds = m.folds;
+    c.swaps = m.swaps;
+}
+
+// One try at the group of planned layers [first, last]: its points (loaded unless a job
+// triangulated it ahead), its loops, its chunk and how it went.
+struct GroupTry {
+    uint32_t first, last;
+    bool final;             // it takes the last planned layer of a complete queue
+    const uint32_t* ids;    // its points' reader indices
+    const Local* staged;    // their staged coordinates, or null
+    size_t n;
+    double h0, h1;
+    uint32_t ends;          // the surface's ends it holds (kLowPole, kHighPole)
+    // By the job ahead: its triangles come from there. Read with kParallelLayers, so that
+    // a build without jobs drops what only their results reach.
+    bool triangulated;
+    size_t mark;            // the arena before the try
+    LoadedLayer layer;
+    LayerLoops loops;
+    SinkMark chunk;         // the sink before its chunk
+    Status status;
+};
+
+// Sets up the try for planned layers [g.first, g.last] and loads their points, unless the
+// layer done ahead is the group. False if the arena is too small.
+static inline bool load_group(const SurfaceChain& c, const LayerQueue& q, const LayerAhead* ahead,
+                              Arena& arena, GroupTry& g) {
+    g.ids = q.ids + q.start[g.first];
+    g.staged = q.staged ? q.staged + q.start[g.first] : nullptr;
+    g.n = q.start[g.last + 1] - q.start[g.first];
+    g.h0 = q.bounds[g.first];
+    g.h1 = q.bounds[g.last + 1];
+    g.mark = arena.mark();
+    // The surface's ends: its first group, and the group that takes the last planned layer.
+    g.ends = (c.top_count == 0 ? kLowPole : 0) | (g.final ? kHighPole : 0);
+    g.triangulated = kParallelLayers && ahead && ahead->done && g.last == g.first &&
+                     ahead->ends == g.ends;
+    g.layer = {g.ids, g.n, nullptr, g.triangulated ? ahead->cylinder : Cylinder{},
+               kSurfaceFlips && c.frame.surface_flips, g.ends, c.frame.cut_ends};
+    return g.triangulated ||
+           load_layer(c.reader, c.frame, g.ids, g.staged, g.n, g.h0, g.h1, arena, g.layer);
+}
+
+// What a loaded group that does not take the last planned layer grows by before it is
+// triangulated: nothing, the next planned layer, all the rest of the queue, or what the
+// queue has yet to receive (the group waits).
+enum class Growth { none, next_layer, rest, wait };
+
+// A crescent, the group or the next planned layer (see kRingGap), joins the next layer; a
+// rest too small or thin to stand joins the group once the queue is complete.
+static inline Growth group_growth(const SurfaceChain& c, const LayerQueue& q,
+                                  const LayerAhead* ahead, const GroupTry& g) {
+    if (g.final) return Growth::none;
+    if (kCrescentLayers &&
+        joins_crescent(c, q, g.first, g.last,
+                       kParallelLayers && g.triangulated ? ahead->fitted : g.layer.cyl,
+                       kParallelLayers && g.triangulated ? ahead->sectors : layer_sectors(g.layer)))
+        return Growth::next_layer;
+    const size_t rest = q.start[q.planned] - q.start[g.last + 1];
+    const double rest_height = q.bounds[q.planned] - q.bounds[g.last + 1];
+    if (rest >= kMinLayerPoints && thick_enough(rest, rest_height, g.layer.cyl.radius))
+        return Growth::none;
+    return q.complete ? Growth::rest : Growth::wait;
+}
+
+// Whether an entry of either loop of the band was peeled.
+static inline bool band_loops_peeled(const SurfaceChain& c, const LayerLoops& loops) {
+    for (uint32_t i = 0; i < c.top_count; ++i)
+        if (c.top_unused[i] & kPassBits) return true;
+    for (uint32_t j = 0; j < loops.bottom_count; ++j)
+        if (loops.bottom_flags[j] & kPassBits) return true;
+    return false;
+}
+
+// The entries of the band's loops marked kUnpeeled.
+static inline size_t band_loops_unpeeled(const SurfaceChain& c, const LayerLoops& loops) {
+    return count_unpeeled(c.top_unused, c.top_count) +
+           count_unpeeled(loops.bottom_flags, loops.bottom_count);
+}
+
+// Stitches the triangulated group to the chain's top loop, if any. A band between peeled
+// loops that folds (a peeled loop can dip where the other cannot follow) is stitched again
+// with the peel groups around its folds put back (kLocalUnpeel; see "peeling" in >>layer
+// triangulation and kUnpeelRounds); where it still folds, or no peeled entry is near a
+// fold, between the loops as they were before peeling, with all their peeled triangles
+// put back.
+static inline void stitch_to_chain(SurfaceChain& c, GroupTry& g, Arena& arena, TriangleSink& sink) {
+    if (g.status != Status::ok || c.top_count == 0) return;
+    const SinkMark band = mark_sink(c, sink);
+    // Rounds before the last put back the groups marked; the last, all.
+    for (uint32_t round = 0; round < kUnpeelRounds; ++round) {
+        const bool last_round = round + 1 == kUnpeelRounds;
+        if (kLocalUnpeel && (round == 0 || last_round)) {
+            mark_unpeeled(c.top_unused, c.top_count, last_round);
+            mark_unpeeled(g.loops.bottom_flags, g.loops.bottom_count, last_round);
+        }
+        rewind_sink(c, sink, band);
+        const size_t marked = kLocalUnpeel ? band_loops_unpeeled(c, g.loops) : 0;
+        if (!stitch_layers(c.reader, c.frame, c.top_cylinder, c.top, c.top_unused, c.top_count,
+                           g.layer, g.loops, last_round, arena, sink, &c.swaps)) {
+            g.status = Status::out_of_memory;
+            return;
+        }
+        if (sink.folds == band.folds || !band_loops_peeled(c, g.loops)) return;
+        if (kLocalUnpeel && band_loops_unpeeled(c, g.loops) == marked && round + 2 < kUnpeelRounds)
+            round = kUnpeelRounds - 2;  // no group near a fold: the last round
+    }
+}
+
+// The group's chunk before the safety net: its layer's triangles (the job's or made here)
+// and the band to the chain's top loop.
+static inline void make_chunk(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
+                              TriangleSink& sink, GroupResult& result, GroupTry& g) {
+    g.chunk = mark_sink(c, sink);
+    g.loops = {c.bottom, 0, c.next_top, 0, c.bottom_flags, c.next_unused, 0, 0};
+    if (kParallelLayers && g.triangulated) {
+        g.status = take_ahead(*ahead, sink, g.loops, result.counts);
+    } else {
+        find_closed_ends(g.layer, g.ends);
+        g.status = triangulate_layer(c.reader, g.layer, arena, sink, g.loops, result.counts);
+    }
+    stitch_to_chain(c, g, arena, sink);
+    result.folds = sink.folds - g.chunk.folds;
+}
+
+// Folding layers (kFoldMerge): the group's last layer and folds before any layer was
+// joined, the layers joined in the current try, and whether the group is settled.
+struct FoldMerge {
+    uint32_t single_last, joined;
+    size_t single_folds;
+    bool settled;
+};
+
+// Whether the try just made is dropped for another, with g.last set for that one (see
+// "Folding layers" at add_group). Decided before the chunk is named (naming counts its
+// points).
+static inline bool try_joined(FoldMerge& m, size_t folds, GroupTry& g) {
+    if (!kFoldMerge || m.settled ||
+        !(m.joined > 0 || (g.status == Status::ok && folds > 0 && !g.final)))
+        return false;
+    if (m.joined > 0 && g.status == Status::ok && folds < m.single_folds) {
+        m.settled = true;
+        return false;
+    }
+    if (m.joined == 0) {
+        m.single_last = g.last;
+        m.single_folds = folds;
+    }
+    if (!g.final && m.joined < kFoldMergeReach) {
+        ++m.joined;
+        ++g.last;
+    } else {
+        m.settled = true;
+        g.last = m.single_last;
+    }
+    return true;
+}
+
+// For a group a job triangulated: whether its chunk is finished as it is (it failed, it is
+// past the caller's capacity, where only the count goes on and triangle_capacity follows,
+// or its triangles in reader indices go in as they are, the chunk needing no safety net).
+// Else one the job left in reader indices is loaded and triangulated again, in order, to
+// the same triangles; one left in layer-local indices (not replayable) goes through the
+// safety net as it is.
+static inline bool replay_ahead(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
+                                TriangleSink& sink, GroupResult& result, GroupTry& g) {
+    if (g.status != Status::ok || sink.count > sink.capacity ||
+        (ahead->replayable &&
+         replay_chunk(c, g.layer, g.loops, *ahead, g.chunk.count, arena, sink)))
+        return true;
+    if (!ahead->replayable) return false;
+    rewind_sink(c, sink, g.chunk);
+    if (!load_layer(c.reader, c.frame, g.ids, g.staged, g.n, g.h0, g.h1, arena, g.layer)) {
+        g.status = Status::out_of_memory;
+        return true;
+    }
+    g.triangulated = false;
+    make_chunk(c, ahead, arena, sink, result, g);
+    return false;
+}
+
+// The chunk's safety net, into output indices; a chunk triangulated here whose border and
+// band show it sound is only renamed.
+static inline void seal_chunk(SurfaceChain& c, Arena& arena, TriangleSink& sink, GroupTry& g) {
+    if (g.status != Status::ok || sink.count > sink.capacity) return;
+    if (kNetShortcut && !(kParallelLayers && g.triangulated) &&
+        chunk_is_sound(c, g.layer, g.loops, sink.triangles + 3 * g.loops.border_start,
+                       sink.count - g.loops.border_start, g.loops.interior_used, arena))
+        name_chunk_points(c, g.layer, sink.triangles + 3 * g.chunk.count,
+                          sink.count - g.chunk.count);
+    else
+        g.status = finish_chunk(c, g.layer, g.loops, g.chunk.count, arena, sink);
+}
+
+// The flips across the seam below the sealed chunk, then its output indices.
+static inline void flip_chunk_seam(const SurfaceChain& c, Arena& arena, TriangleSink& sink,
+                                   GroupTry& g) {
+    if (g.status != Status::ok || sink.count > sink.capacity) return;
+    uint32_t* chunk = sink.triangles + 3 * g.chunk.count;
+    const size_t in_chunk = sink.count - g.chunk.count;
+    if (kSurfaceFlips && g.layer.surface_flips && c.top_count > 0 &&
+        !flip_seam(c, g.layer, g.loops, chunk, in_chunk, arena)) {
+        g.status = Status::out_of_memory;
+        return;
+    }
+    name_output_points(c, chunk, in_chunk);
+}
+
+// The finished group's top loop, in reader indices, becomes the chain's, and its counts
+// join the chain's and the result.
+static inline void advance_chain(SurfaceChain& c, const GroupTry& g, GroupResult& result) {
+    for (uint32_t i = 0; i < g.loops.top_count; ++i) g.loops.top[i] = g.ids[g.loops.top[i]];
+    uint32_t* top = c.top;
+    unsigned char* unused = c.top_unused;
+    c.top = g.loops.top;
+    c.top_unused = c.next_unused;
+    c.top_count = g.loops.top_count;
+    c.next_top = top;
+    c.next_unused = unused;
+    c.top_cylinder = g.layer.cyl;
+    c.duplicates += result.counts.duplicates;
+    c.collisions += result.counts.collisions;
+    ++c.groups;
+    result.last = g.last;
+    result.points = g.n;
+    result.cylinder = g.layer.cyl;
+}
+
+// Finishes the group's chunk (see replay_ahead, seal_chunk, flip_chunk_seam) and, if that
+// went well, adds the group to the chain.
+static inline void finish_group(SurfaceChain& c, const LayerAhead* ahead, Arena& arena,
+                                TriangleSink& sink, GroupResult& result, GroupTry& g) {
+    const bool finished =
+        kParallelLayers && g.triangulated && replay_ahead(c, ahead, arena, sink, result, g);
+    result.triangles = sink.count - g.chunk.count;
+    arena.rewind(g.mark);  // the layer's points are no longer needed: the net takes their room
+    if (!finished) seal_chunk(c, arena, sink, g);
+    flip_chunk_seam(c, arena, sink, g);
+    if (g.status == Status::ok) advance_chain(c, g, result);
+}
 
 // Forms the group starting at planned layer `first`, triangulates it, stitches it to the
 // chain's top loop and finishes the chunk. `ahead` (optional) is planned layer `first`
@@ -8514,215 +8878,53 @@ namespace detail {
 // triangulations more, only where a layer folds (at most seven times that layer's time);
 // the stream waits for the layers above as it does for crescents, and makes the same
 // groups.
-inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Arena& arena,
-                        TriangleSink& sink, GroupResult& result, const LayerAhead* ahead) {
+static inline Status add_group(SurfaceChain& c, const LayerQueue& q, uint32_t first, Arena& arena,
+                               TriangleSink& sink, GroupResult& result, const LayerAhead* ahead) {
     result.waiting = false;
-    uint32_t last = first;
-    // Folding layers: the group's last layer and folds before any layer was joined, the
-    // layers joined in the current try, and whether the group is settled.
-    uint32_t single_last = first, joined = 0;
-    size_t single_folds = 0;
-    bool merge_settled = false;
+    GroupTry g;
+    g.first = g.last = first;
+    FoldMerge merge = {first, 0, 0, false};
     for (;;) {
-        const bool final = q.complete && last + 1 == q.planned;
-        if (!final && last + 1 >= q.planned) {
+        g.final = q.complete && g.last + 1 == q.planned;
+        if (!g.final && g.last + 1 >= q.planned) {
             result.waiting = true;
             return Status::ok;
         }
-        const uint32_t* ids = q.ids + q.start[first];
-        const size_t n = q.start[last + 1] - q.start[first];
-        const double h0 = q.bounds[first], h1 = q.bounds[last + 1];
-        size_t mark = arena.mark();
-        // The surface's ends: its first group, and the group that takes the last planned layer.
-        const uint32_t ends = (c.top_count == 0 ? kLowPole : 0) | (final ? kHighPole : 0);
-        const bool triangulated = kParallelLayers && ahead && ahead->done && last == first &&
-                                  ahead->ends == ends;
-        LoadedLayer layer = {ids, n, nullptr, triangulated ? ahead->cylinder : Cylinder{},
-                             kSurfaceFlips && c.frame.surface_flips, ends,
-                             c.frame.cut_ends};
-        const Local* staged = q.staged ? q.staged + q.start[first] : nullptr;
-        if (!triangulated && !load_layer(c.reader, c.frame, ids, staged, n, h0, h1, arena, layer))
-            return Status::out_of_memory;
-        if (!final) {
-            // Crescents (see kRingGap), the group or the next planned layer.
-            if (kCrescentLayers &&
-                joins_crescent(c, q, first, last, triangulated ? ahead->fitted : layer.cyl,
-                               triangulated ? ahead->sectors : layer_sectors(layer))) {
-                arena.rewind(mark);
-                ++last;
-                continue;
-            }
-            size_t rest = q.start[q.planned] - q.start[last + 1];
-            double rest_height = q.bounds[q.planned] - q.bounds[last + 1];
-            if (!(rest >= kMinLayerPoints && thick_enough(rest, rest_height, layer.cyl.radius))) {
-                arena.rewind(mark);
-                if (!q.complete) {
-                    result.waiting = true;
-                    return Status::ok;
-                }
-                last = q.planned - 1;  // a remainder too small or thin to stand joins this group
-                continue;
-            }
+        if (!load_group(c, q, ahead, arena, g)) return Status::out_of_memory;
+        const Growth growth = group_growth(c, q, ahead, g);
+        if (growth != Growth::none) {
+            arena.rewind(g.mark);
+            result.waiting = growth == Growth::wait;
+            if (result.waiting) return Status::ok;
+            g.last = growth == Growth::rest ? q.planned - 1 : g.last + 1;
+            continue;
         }
-        Status status = Status::not_columnar;
+        g.status = Status::not_columnar;
         // Tiny or thin layers make coarse, folding bands: they join the next layer if any.
-        if (group_stands(n, h1 - h0, layer.cyl.radius, final)) {
-            const size_t chunk_start = sink.count, folds = sink.folds, swaps = c.swaps;
-            LayerLoops loops = {c.bottom, 0, c.next_top, 0, c.bottom_flags, c.next_unused,
-                                0, 0};
-            // A band between peeled loops that folds (a peeled loop can dip where the other
-            // cannot follow) is stitched again with the peel groups around its folds put
-            // back (kLocalUnpeel; see "peeling" in >>layer triangulation and kUnpeelRounds);
-            // where it still folds, or no peeled entry is near a fold, between the loops as
-            // they were before peeling, with all their peeled triangles put back.
-            auto stitch = [&]() {
-                if (status != Status::ok || c.top_count == 0) return;
-                const size_t band_start = sink.count, band_folds = sink.folds;
-                const size_t band_swaps = c.swaps;
-                auto peeled = [&]() {
-                    for (uint32_t i = 0; i < c.top_count; ++i)
-                        if (c.top_unused[i] & kPassBits) return true;
-                    for (uint32_t j = 0; j < loops.bottom_count; ++j)
-                        if (loops.bottom_flags[j] & kPassBits) return true;
-                    return false;
-                };
-                auto unpeeled = [&]() {
-                    return count_unpeeled(c.top_unused, c.top_count) +
-                           count_unpeeled(loops.bottom_flags, loops.bottom_count);
-                };
-                // Rounds before the last put back the groups marked; the last, all.
-                for (uint32_t round = 0; round < kUnpeelRounds; ++round) {
-                    if (kLocalUnpeel && (round == 0 || round + 1 == kUnpeelRounds)) {
-                        mark_unpeeled(c.top_unused, c.top_count, round + 1 == kUnpeelRounds);
-                        mark_unpeeled(loops.bottom_flags, loops.bottom_count,
-                                      round + 1 == kUnpeelRounds);
-                    }
-                    sink.count = band_start;
-                    sink.folds = band_folds;
-                    c.swaps = band_swaps;
-                    const size_t marked = kLocalUnpeel ? unpeeled() : 0;
-                    if (!stitch_layers(c.reader, c.frame, c.top_cylinder, c.top, c.top_unused,
-                                       c.top_count, layer, loops, round + 1 == kUnpeelRounds,
-                                       arena, sink, &c.swaps)) {
-                        status = Status::out_of_memory;
-                        return;
-                    }
-                    if (sink.folds == band_folds || !peeled()) return;
-                    if (kLocalUnpeel && unpeeled() == marked && round + 2 < kUnpeelRounds)
-                        round = kUnpeelRounds - 2;  // no group near a fold: the last round
-                }
-            };
-            auto triangulate_here = [&]() {
-                find_closed_ends(layer, ends);
-                status = triangulate_layer(c.reader, layer, arena, sink, loops, result.counts);
-                stitch();
-            };
-            if (triangulated) {
-                status = take_ahead(*ahead, sink, loops, result.counts);
-                stitch();
-            } else {
-                triangulate_here();
+        if (group_stands(g.n, g.h1 - g.h0, g.layer.cyl.radius, g.final)) {
+            make_chunk(c, ahead, arena, sink, result, g);
+            if (try_joined(merge, result.folds, g)) {
+                rewind_sink(c, sink, g.chunk);
+                arena.rewind(g.mark);
+                continue;
             }
-            result.folds = sink.folds - folds;
-            // Folding layers: decided before the chunk is named (naming counts its points).
-            if (kFoldMerge && !merge_settled &&
-                (joined > 0 || (status == Status::ok && result.folds > 0 && !final))) {
-                if (joined > 0 && status == Status::ok && result.folds < single_folds) {
-                    merge_settled = true;
-                } else {
-                    sink.count = chunk_start;
-                    sink.folds = folds;
-                    c.swaps = swaps;
-                    arena.rewind(mark);
-                    if (joined == 0) {
-                        single_last = last;
-                        single_folds = result.folds;
-                    }
-                    if (!final && joined < kFoldMergeReach) {
-                        ++joined;
-                        ++last;
-                    } else {
-                        merge_settled = true;
-                        last = single_last;
-                    }
-                    continue;
-                }
-            }
-            // A job's result in reader indices goes in as it is when its chunk needs no
-            // safety net; else the layer is loaded and triangulated again, in order, to the
-            // same triangles. One the job left in layer-local indices (not replayable) goes
-            // through finish_chunk. Past the caller's capacity only the count goes on
-            // (triangle_capacity follows).
-            bool finished = false, retriangulate = !triangulated;
-            if (triangulated) {
-                finished = status != Status::ok || sink.count > sink.capacity ||
-                           (ahead->replayable &&
-                            replay_chunk(c, layer, loops, *ahead, chunk_start, arena, sink));
-                if (!finished && ahead->replayable) {
-                    sink.count = chunk_start;
-                    sink.folds = folds;
-                    c.swaps = swaps;
-                    if (!load_layer(c.reader, c.frame, ids, staged, n, h0, h1, arena, layer))
-                        return Status::out_of_memory;
-                    triangulate_here();
-                    retriangulate = true;
-                }
-            }
-            result.triangles = sink.count - chunk_start;
-            // The layer's points are no longer needed: the safety net takes their room. A
-            // chunk triangulated here whose border and band show it sound is only renamed.
-            arena.rewind(mark);
-            if (!finished && status == Status::ok && sink.count <= sink.capacity) {
-                uint32_t* chunk = sink.triangles + 3 * chunk_start;
-                if (kNetShortcut && retriangulate &&
-                    chunk_is_sound(c, layer, loops, sink.triangles + 3 * loops.border_start,
-                                   sink.count - loops.border_start, loops.interior_used, arena))
-                    name_chunk_points(c, layer, chunk, sink.count - chunk_start);
-                else
-                    status = finish_chunk(c, layer, loops, chunk_start, arena, sink);
-            }
-            if (status == Status::ok && sink.count <= sink.capacity) {
-                uint32_t* chunk = sink.triangles + 3 * chunk_start;
-                const size_t in_chunk = sink.count - chunk_start;
-                if (kSurfaceFlips && layer.surface_flips && c.top_count > 0 &&
-                    !flip_seam(c, layer, loops, chunk, in_chunk, arena))
-                    return Status::out_of_memory;
-                name_output_points(c, chunk, in_chunk);
-            }
-            if (status == Status::ok) {
-                for (uint32_t i = 0; i < loops.top_count; ++i) loops.top[i] = ids[loops.top[i]];
-                uint32_t* top = c.top;
-                unsigned char* unused = c.top_unused;
-                c.top = loops.top;
-                c.top_unused = c.next_unused;
-                c.top_count = loops.top_count;
-                c.next_top = top;
-                c.next_unused = unused;
-                c.top_cylinder = layer.cyl;
-                c.duplicates += result.counts.duplicates;
-                c.collisions += result.counts.collisions;
-                ++c.groups;
-                result.last = last;
-                result.points = n;
-                result.cylinder = layer.cyl;
-            }
+            finish_group(c, ahead, arena, sink, result, g);
         }
-        arena.rewind(mark);
-        if (status != Status::not_columnar) return status;
-        if (final) {
-            c.trailing += n;
-            result.last = last;
+        arena.rewind(g.mark);
+        if (g.status != Status::not_columnar) return g.status;
+        if (g.final) {
+            c.trailing += g.n;
+            result.last = g.last;
             return Status::not_columnar;
         }
-        ++last;
+        ++g.last;
     }
 }
 
-// The largest scratch any phase takes on top of the plan, for groups of up to `count`
-// points; 0 if that is beyond what size_t can count.
-inline size_t reconstruct_scratch_size(size_t count, bool close) {
+// The scratch of a group of up to `count` points: its points, then the triangulation or the
+// band, then the safety net.
+static inline Arena group_scratch(size_t count) {
     size_t total = count + 1;
-    // A group: its points, then the triangulation or the band, then the safety net.
     Arena group = Arena::measuring();
     group.alloc<Local>(count);
     size_t loaded = group.mark();
@@ -8759,12 +8961,14 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
     group.alloc<uint32_t>(3 * triangles);
     group.alloc<uint64_t>(triangles);
     for (int k = 0; k < 4; ++k) group.alloc<uint32_t>(triangles);
-
     // (Counting the repeats of the vertices again, repeats_of_vertices takes a bit and at
     // most 16 bytes a point, less than a group's points take above: covered.)
+    return group;
+}
 
-    // Planning the layers: the automatic layers' profile, then each point's layer while the
-    // points are grouped.
+// The scratch of planning the layers of `count` points: the automatic layers' profile,
+// then each point's layer while the points are grouped.
+static inline Arena planning_scratch(size_t count) {
     Arena planning = Arena::measuring();
     ProfileBin* bins = nullptr;
     BinRange* ranges = nullptr;
@@ -8773,16 +8977,21 @@ inline size_t reconstruct_scratch_size(size_t count, bool close) {
     planning.rewind(0);
     planning.alloc<uint32_t>(count);
     planning.alloc<uint32_t>(count);  // grouping in jobs: its tables (see group_by_layer_in_jobs)
+    return planning;
+}
 
-    // The caps: every point on a boundary loop, as many triangles as the output can hold.
+// The largest scratch any phase takes on top of the plan, for groups of up to `count`
+// points; 0 if that is beyond what size_t can count. With `close`, the caps: every point
+// on a boundary loop, as many triangles as the output can hold.
+static inline size_t reconstruct_scratch_size(size_t count, bool close) {
+    const Arena group = group_scratch(count), planning = planning_scratch(count);
     Arena caps = Arena::measuring();
     if (close) {
         CapGraph graph;
         CapLoop loop;
-        allocate_cap_graph(graph, count, triangles, caps);
+        allocate_cap_graph(graph, count, 2 * count, caps);
         allocate_cap_loop(loop, count, caps);
     }
-
     if (group.failed || planning.failed || caps.failed) return 0;  // beyond size_t
     size_t most = group.high_water;
     if (planning.high_water > most) most = planning.high_water;
@@ -8837,9 +9046,9 @@ struct ParallelLayers {
 
 // Room for the results of `slots` layers holding `points` points in all, out of `layers`
 // planned layers.
-inline bool allocate_ahead(ParallelLayers& p, uint32_t slots, size_t points, size_t layers,
-                           Arena& arena, uint32_t** triangles, uint32_t** loops,
-                           unsigned char** loop_flags, uint32_t** borders) {
+static inline bool allocate_ahead(ParallelLayers& p, uint32_t slots, size_t points, size_t layers,
+                                  Arena& arena, uint32_t** triangles, uint32_t** loops,
+                                  unsigned char** loop_flags, uint32_t** borders) {
     p.ahead = arena.alloc<LayerAhead>(slots);
     p.layer_of_slot = arena.alloc<uint32_t>(slots);
     p.slot_of_layer = arena.alloc<uint32_t>(layers);
@@ -8853,16 +9062,16 @@ inline bool allocate_ahead(ParallelLayers& p, uint32_t slots, size_t points, siz
 // The border a layer of n points may keep for replay_chunk: its bottom loop holds a few
 // times the square root of n points in a sound layer, with two or three triangles each.
 // A thin layer's border can be most of its triangles: it is finished in order instead.
-inline size_t border_capacity(size_t n) { return n / 4 + 4; }
+static inline size_t border_capacity(size_t n) { return n / 4 + 4; }
 
-inline bool may_stand_alone(const LayerQueue& q, uint32_t k) {
+static inline bool may_stand_alone(const LayerQueue& q, uint32_t k) {
     size_t n = q.start[k + 1] - q.start[k];
     return n >= kMinLayerPoints || (k + 1 == q.planned && n >= 3);
 }
 
 // The job scratch bound: a run of layers needs the scratch of its largest, and scratch grows
 // linearly with rounding, so jobs over n points in all need at most this.
-inline size_t job_scratch_bound(size_t points) {
+static inline size_t job_scratch_bound(size_t points) {
     size_t whole = reconstruct_scratch_size(points, false), one = reconstruct_scratch_size(0, false);
     const size_t slack = 1024;  // the rounding of every allocation, with room to spare
     if (whole == 0 || one > (SIZE_MAX - whole) / kMaxJobs - slack) return 0;
@@ -8871,7 +9080,7 @@ inline size_t job_scratch_bound(size_t points) {
 
 // What replay_chunk needs of a job's layer (see LayerAhead), then, if it can replay them,
 // its triangles in reader indices (`ids`).
-inline void keep_border(LayerAhead& a, const uint32_t* ids, size_t n, Arena& arena) {
+static inline void keep_border(LayerAhead& a, const uint32_t* ids, size_t n, Arena& arena) {
     const unsigned char on_bottom = 1, has_triangle = 2;
     unsigned char* flags = arena.alloc<unsigned char>(n);
     a.replayable = flags != nullptr;
@@ -8895,12 +9104,12 @@ inline void keep_border(LayerAhead& a, const uint32_t* ids, size_t n, Arena& are
     for (size_t k = 0; k < 3 * a.triangle_count; ++k) a.triangles[k] = ids[a.triangles[k]];
 }
 
-inline void run_layer_job(void* context, uint32_t index) {
-    const ParallelLayers& p = *static_cast<const ParallelLayers*>(context);
-    if (index >= p.job_count) return;  // a runner's mistake: no job of ours
+// Job `job`: triangulates the layers of slots first_slot[job] .. first_slot[job + 1] - 1 in
+// the job's own scratch.
+static inline void triangulate_job(const ParallelLayers& p, uint32_t job) {
     const LayerQueue& q = *p.queue;
-    Arena arena = Arena::over(p.scratch[index], p.scratch_bytes[index]);
-    for (uint32_t slot = p.first_slot[index]; slot < p.first_slot[index + 1]; ++slot) {
+    Arena arena = Arena::over(p.scratch[job], p.scratch_bytes[job]);
+    for (uint32_t slot = p.first_slot[job]; slot < p.first_slot[job + 1]; ++slot) {
         LayerAhead& a = p.ahead[slot];
         const uint32_t k = p.layer_of_slot[slot];
         const size_t n = q.start[k + 1] - q.start[k];
@@ -8931,33 +9140,17 @@ inline void run_layer_job(void* context, uint32_t index) {
     }
 }
 
-// Plans the jobs over the queue, carves their results and scratch from the arena and runs
-// them. Returns with p.ready false (and the arena as it was) when there is nothing to gain or
-// no room: the groups are then triangulated in order. The results stay in the arena; the
-// jobs' scratch is released.
-inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& arena) {
-    p.ready = false;
+// Gives each layer that may stand alone a slot: its part of the results carved from the
+// arena (false if they do not fit). `points` are the slots' points in all.
+static inline bool assign_slots(ParallelLayers& p, uint32_t slots, size_t points, Arena& arena) {
     const LayerQueue& q = *p.queue;
-    uint32_t slots = 0;
-    size_t points = 0;
-    for (uint32_t k = 0; k < q.planned; ++k)
-        if (may_stand_alone(q, k)) {
-            ++slots;
-            points += q.start[k + 1] - q.start[k];
-        }
-    if (slots < 2) return;
-    const size_t mark = arena.mark();
-    auto give_up = [&]() {
-        arena.failed = false;
-        arena.rewind(mark);
-    };
     uint32_t* triangles = nullptr;
     uint32_t* loops = nullptr;
     unsigned char* loop_flags = nullptr;
     uint32_t* borders = nullptr;
     if (!allocate_ahead(p, slots, points, q.planned, arena, &triangles, &loops, &loop_flags,
                         &borders))
-        return give_up();
+        return false;
     p.slots = slots;
     uint32_t slot = 0;
     size_t at = 0, border_at = 0;
@@ -8979,15 +9172,19 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
         p.layer_of_slot[slot] = k;
         p.slot_of_layer[k] = slot++;
     }
-    const size_t results = arena.mark();
-    // Jobs: runs of slots with about equal point counts. A slot goes to the share of the
-    // points its middle falls in, so equal layers get a job each (a threshold on a running
-    // count would put a layer slightly under the mean together with the next).
-    const uint32_t most = slots < kMaxJobs ? slots : kMaxJobs;
+    return true;
+}
+
+// Cuts the slots into jobs: runs of slots with about equal point counts. A slot goes to the
+// share of the points its middle falls in, so equal layers get a job each (a threshold on
+// a running count would put a layer slightly under the mean together with the next).
+static inline void divide_jobs(ParallelLayers& p, size_t points) {
+    const LayerQueue& q = *p.queue;
+    const uint32_t most = p.slots < kMaxJobs ? p.slots : kMaxJobs;
     uint32_t job = 0;
     uint64_t share_of_job = 0, before = 0;
     p.first_slot[0] = 0;
-    for (uint32_t s = 0; s < slots; ++s) {
+    for (uint32_t s = 0; s < p.slots; ++s) {
         const uint32_t k = p.layer_of_slot[s];
         const uint64_t n = q.start[k + 1] - q.start[k];
         const uint64_t share = (before + n / 2) * most / points;
@@ -8998,7 +9195,12 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
         before += n;
     }
     p.job_count = job + 1;
-    p.first_slot[p.job_count] = slots;
+    p.first_slot[p.job_count] = p.slots;
+}
+
+// Each job's scratch: that of its largest layer. False if they do not fit.
+static inline bool allocate_job_scratch(ParallelLayers& p, Arena& arena) {
+    const LayerQueue& q = *p.queue;
     for (uint32_t j = 0; j < p.job_count; ++j) {
         size_t largest = 0;
         for (uint32_t s = p.first_slot[j]; s < p.first_slot[j + 1]; ++s) {
@@ -9009,18 +9211,45 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
         p.scratch_bytes[j] = reconstruct_scratch_size(largest, false) + Arena::kAlign;
         p.scratch[j] = arena.alloc<unsigned char>(p.scratch_bytes[j]);
     }
-    if (arena.failed) return give_up();
-    options.run_jobs(options.jobs_user, p.job_count, run_layer_job, &p);
+    return !arena.failed;
+}
+
+// Plans the jobs over the queue, carves their results and scratch from the arena and runs
+// them. Returns with p.ready false (and the arena as it was) when there is nothing to gain or
+// no room: the groups are then triangulated in order. The results stay in the arena; the
+// jobs' scratch is released.
+static inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& arena) {
+    p.ready = false;
+    const LayerQueue& q = *p.queue;
+    uint32_t slots = 0;
+    size_t points = 0;
+    for (uint32_t k = 0; k < q.planned; ++k)
+        if (may_stand_alone(q, k)) {
+            ++slots;
+            points += q.start[k + 1] - q.start[k];
+        }
+    if (slots < 2) return;
+    const size_t mark = arena.mark();
+    auto give_up = [&]() {
+        arena.failed = false;
+        arena.rewind(mark);
+    };
+    if (!assign_slots(p, slots, points, arena)) return give_up();
+    const size_t results = arena.mark();
+    divide_jobs(p, points);
+    if (!allocate_job_scratch(p, arena)) return give_up();
+    // A job the runner skips leaves its layers to their groups.
+    run_jobs(options, p.job_count, false, [&p](uint32_t job) { triangulate_job(p, job); });
     arena.rewind(results);
     p.ready = true;
 }
 
 // Starts the jobs for reconstruct(); returns the layers they triangulated.
-inline size_t start_parallel_layers(const Options& options, const CloudReader& reader,
-                                    const Frame& frame, const LayerQueue& queue, Arena& arena,
-                                    ParallelLayers& parallel) {
+static inline size_t start_parallel_layers(const Options& options, const CloudReader& reader,
+                                           const Frame& frame, const LayerQueue& queue,
+                                           Arena& arena, ParallelLayers& parallel) {
     parallel.ready = false;
-    if (!options.run_jobs) return 0;
+    if (!has_runner(options)) return 0;
     parallel.reader = &reader;
     parallel.frame = &frame;
     parallel.queue = &queue;
@@ -9033,8 +9262,8 @@ inline size_t start_parallel_layers(const Options& options, const CloudReader& r
 
 // What the layers done ahead add to the workspace bound: their results, which stay, in
 // `arena`; the jobs' scratch, which comes and goes before the groups' own, in *scratch.
-inline bool plan_parallel_workspace(size_t point_count, size_t layer_limit, Arena& arena,
-                                    size_t* scratch) {
+static inline bool plan_parallel_workspace(size_t point_count, size_t layer_limit, Arena& arena,
+                                           size_t* scratch) {
     ParallelLayers p;
     uint32_t* triangles = nullptr;
     uint32_t* loops = nullptr;
@@ -9055,13 +9284,13 @@ struct ParallelLayers {
     const LayerAhead* ahead_of(uint32_t) const { return nullptr; }
 };
 
-inline size_t start_parallel_layers(const Options&, const CloudReader&, const Frame&,
-                                    const LayerQueue&, Arena&, ParallelLayers& parallel) {
+static inline size_t start_parallel_layers(const Options&, const CloudReader&, const Frame&,
+                                           const LayerQueue&, Arena&, ParallelLayers& parallel) {
     parallel.ready = false;
     return 0;
 }
 
-inline bool plan_parallel_workspace(size_t, size_t, Arena&, size_t*) { return true; }
+static inline bool plan_parallel_workspace(size_t, size_t, Arena&, size_t*) { return true; }
 
 #endif  // STRATMESH_NO_PARALLEL_LAYERS
 
@@ -9090,16 +9319,17 @@ struct ReconstructMemory {
     SurfaceChain chain;
 };
 
-inline bool plan_reconstruct(ReconstructMemory& m, size_t count, size_t layer_limit,
-                             Arena& arena) {
+static inline bool plan_reconstruct(ReconstructMemory& m, size_t count, size_t layer_limit,
+                                    Arena& arena) {
     m.bounds = arena.alloc<double>(layer_limit + 1);
     m.layer_start = arena.alloc<uint32_t>(layer_limit + 2);
     m.order = arena.alloc<uint32_t>(count);
     return allocate_chain(m.chain, count, arena);
 }
 
-inline void describe_layer(const Frame& frame, const Cylinder& cyl, double bottom, double top,
-                           size_t points, size_t triangles, size_t folds, LayerInfo& info) {
+static inline void describe_layer(const Frame& frame, const Cylinder& cyl, double bottom,
+                                  double top, size_t points, size_t triangles, size_t folds,
+                                  LayerInfo& info) {
     info.bottom = frame.user_height(bottom);
     info.top = frame.user_height(top);
     double mid = (bottom + top) / 2 / frame.scale, cx = cyl.cx / frame.scale, cy = cyl.cy / frame.scale;
@@ -9117,7 +9347,7 @@ inline void describe_layer(const Frame& frame, const Cylinder& cyl, double botto
 }
 
 // The workspace bound of mesh_tube() (with read_cloud()) for point_count points.
-inline size_t tube_workspace_size(size_t point_count, const Options& options) {
+static inline size_t tube_workspace_size(size_t point_count, const Options& options) {
     if (point_count > kMaxPoints - 1) return 0;
     Arena arena = Arena::measuring();
     // drop_outliers, as find_outliers allocates: the bitmap stays, the grid comes and goes
@@ -9138,7 +9368,7 @@ inline size_t tube_workspace_size(size_t point_count, const Options& options) {
                                                       (options.flags & close_ends) != 0);
     // With a runner, the layers done ahead (at most one per kMinLayerPoints points, plus the
     // last) stay while the groups are formed.
-    if (options.run_jobs &&
+    if (has_runner(options) &&
         !plan_parallel_workspace(point_count, layer_limit, arena, &scratch))
         return 0;
     if (arena.failed || scratch == 0 || scratch > SIZE_MAX - arena.required_bytes()) return 0;
@@ -9147,7 +9377,7 @@ inline size_t tube_workspace_size(size_t point_count, const Options& options) {
 }
 
 // The chain's counts into the report, with the reason when a valid point is not a vertex.
-inline void report_chain(const SurfaceChain& chain, size_t valid, Report& rep) {
+static inline void report_chain(const SurfaceChain& chain, size_t valid, Report& rep) {
     rep.points.duplicate_count = chain.duplicates;
     rep.diagnostics.illegal_removed_count = chain.removed;
     rep.points.used_count = chain.used;
@@ -9168,9 +9398,9 @@ inline void report_chain(const SurfaceChain& chain, size_t valid, Report& rep) {
 // it out), its repeats are unused too, so where some points are not vertices they are
 // counted again from the output, with a hash table of the vertices' coordinates in the
 // workspace. Returns SIZE_MAX if the workspace is too small.
-inline size_t repeats_of_vertices(const CloudReader& reader, size_t count,
-                                  const uint32_t* triangles, size_t triangle_count,
-                                  Arena& arena) {
+static inline size_t repeats_of_vertices(const CloudReader& reader, size_t count,
+                                         const uint32_t* triangles, size_t triangle_count,
+                                         Arena& arena) {
     const size_t mark = arena.mark();
     unsigned char* used = arena.alloc<unsigned char>(count / 8 + 1);
     size_t slots = 1;
@@ -9205,9 +9435,10 @@ inline size_t repeats_of_vertices(const CloudReader& reader, size_t count,
 }
 
 // Plans the layers of a tube along the frame's axis and groups its points by layer.
-inline Status plan_tube_layers(const TubeInput& in, const Options& options, const Frame& frame,
-                               double lo, double hi, Arena& arena, ReconstructMemory& m,
-                               LayerPlan& plan, Local** staged, Report& rep) {
+static inline Status plan_tube_layers(const TubeInput& in, const Options& options,
+                                      const Frame& frame, double lo, double hi, Arena& arena,
+                                      ReconstructMemory& m, LayerPlan& plan, Local** staged,
+                                      Report& rep) {
     const size_t valid = in.sums.valid;
     const size_t layer_limit = planned_layer_limit(in.count, options);
     if (!plan_reconstruct(m, in.count, layer_limit, arena)) return Status::out_of_memory;
@@ -9236,7 +9467,7 @@ inline Status plan_tube_layers(const TubeInput& in, const Options& options, cons
     const size_t mark = arena.mark();
     uint32_t* layer = arena.alloc<uint32_t>(in.count);
     if (arena.failed) return Status::out_of_memory;
-    if (kStagePoints && !(kParallelLayers && options.run_jobs))
+    if (kStagePoints && !has_runner(options))
         *staged = static_cast<Local*>(arena.room_at_end(saturating_product(valid, sizeof(Local))));
     if (!group_by_layer_in_jobs(options, in.reader, in.count, frame, plan, layer, m.layer_start,
                                 m.order, arena))
@@ -9247,9 +9478,10 @@ inline Status plan_tube_layers(const TubeInput& in, const Options& options, cons
 
 // Triangulates the planned layers one group after another, each stitched to the one below,
 // into `sink`; the layers used go to the report.
-inline Status triangulate_tube(const TubeInput& in, const Options& options, const Frame& frame,
-                               const LayerPlan& plan, Local* staged, Arena& arena,
-                               ReconstructMemory& m, TriangleSink& sink, Report& rep) {
+static inline Status triangulate_tube(const TubeInput& in, const Options& options,
+                                      const Frame& frame, const LayerPlan& plan, Local* staged,
+                                      Arena& arena, ReconstructMemory& m, TriangleSink& sink,
+                                      Report& rep) {
     notify(options, Phase::triangulate, 0);
     SurfaceChain& chain = m.chain;
     chain.frame = frame;
@@ -9299,8 +9531,8 @@ const size_t kAreaSample = 1024;
 
 // Whether the triangles, every k-th of them, have next to no area beside the square of the
 // cloud's own extent (about frame.cloud_share in the frame).
-inline bool has_no_area(const CloudReader& reader, const Frame& frame, const uint32_t* tri,
-                        size_t count) {
+static inline bool has_no_area(const CloudReader& reader, const Frame& frame, const uint32_t* tri,
+                               size_t count) {
     const size_t step = count > kAreaSample ? count / kAreaSample : 1;
     double area = 0;
     size_t seen = 0;
@@ -9315,9 +9547,9 @@ inline bool has_no_area(const CloudReader& reader, const Frame& frame, const uin
 }
 
 // Closes the tube's boundary loops with caps (close_ends) and fills the caps' report.
-inline Status cap_tube(const TubeInput& in, const Options& options, const Frame& frame,
-                       Arena& arena, uint32_t* triangles, size_t capacity, size_t& count,
-                       size_t* triangle_count, Report& rep) {
+static inline Status cap_tube(const TubeInput& in, const Options& options, const Frame& frame,
+                              Arena& arena, uint32_t* triangles, size_t capacity, size_t& count,
+                              size_t* triangle_count, Report& rep) {
     notify(options, Phase::manifold, 0);
     if (!(options.flags & close_ends)) return Status::ok;
     CapCounts caps = {0, 0, 0, 0};
@@ -9339,9 +9571,9 @@ inline Status cap_tube(const TubeInput& in, const Options& options, const Frame&
 // One tube through the kept points of `in`: the frame, the layers, their triangulation and
 // stitching, the caps. `rep` holds the counts of read_cloud; Report::points.unused_count
 // is left to the caller.
-inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& arena,
-                        uint32_t* triangles, size_t triangle_capacity, size_t* triangle_count,
-                        Report& rep) {
+static inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& arena,
+                               uint32_t* triangles, size_t triangle_capacity,
+                               size_t* triangle_count, Report& rep) {
     Frame frame;
     Status status = choose_frame(in.sums, options, frame);
     if (status != Status::ok) return status;
@@ -9446,7 +9678,7 @@ namespace detail {
 const double kStreamRange = 0x1p60;
 
 // Everything a stream holds for a window of `capacity` points.
-inline bool layout_stream(Stream& s, size_t capacity, Arena& arena) {
+static inline bool layout_stream(Stream& s, size_t capacity, Arena& arena) {
     s.capacity = capacity;
     s.slot_capacity = static_cast<uint32_t>(capacity + 1);
     s.points = arena.alloc<Vec3>(capacity);
@@ -9459,7 +9691,7 @@ inline bool layout_stream(Stream& s, size_t capacity, Arena& arena) {
     return allocate_chain(s.chain, capacity, arena) && !arena.failed;
 }
 
-inline size_t stream_bytes(size_t capacity) {
+static inline size_t stream_bytes(size_t capacity) {
     if (capacity > kMaxPoints - 1) return 0;
     Arena arena = Arena::measuring();
     arena.alloc<Stream>(1);
@@ -9470,14 +9702,14 @@ inline size_t stream_bytes(size_t capacity) {
     return arena.required_bytes() + scratch;
 }
 
-inline void publish(Stream& s) {
+static inline void publish(Stream& s) {
     s.rep.points.unused_count = s.rep.points.in_count - s.rep.points.used_count - s.rep.points.duplicate_count - s.rep.points.rejected_count;
     s.rep.workspace_used_bytes = s.arena.peak_from_buffer();
     if (s.user_report) *s.user_report = s.rep;
 }
 
 // A push refused: the stream is as it was; the report says why.
-inline Status refuse_push(Stream& s, Status status, const char* detail) {
+static inline Status refuse_push(Stream& s, Status status, const char* detail) {
     s.rep.detail = detail;
     publish(s);
     return status;
@@ -9485,7 +9717,7 @@ inline Status refuse_push(Stream& s, Status status, const char* detail) {
 
 // Keeps the last group's top loop (moved to the front of the window) and the pushes after
 // planned layer `last`.
-inline void drop_group(Stream& s, uint32_t last) {
+static inline void drop_group(Stream& s, uint32_t last) {
     const uint32_t loop = s.chain.top_count;
     const size_t rest_from = s.start[last + 1], rest = s.fill - rest_from;
     size_t mark = s.arena.mark();
@@ -9512,7 +9744,7 @@ inline void drop_group(Stream& s, uint32_t last) {
 }
 
 // Forms, emits and drops every group the held pushes decide.
-inline Status advance(Stream& s, bool complete) {
+static inline Status advance(Stream& s, bool complete) {
     while (s.planned > 0) {
         const LayerQueue queue = {s.positions, nullptr, s.start, s.bounds, s.planned, complete};
         GroupResult group;
@@ -9532,6 +9764,101 @@ inline Status advance(Stream& s, bool complete) {
         drop_group(s, group.last);
     }
     return Status::ok;
+}
+
+// Why a push's arguments are refused, with *why, or ok with the pushed cloud's reader: its
+// layout, its top and its count are checked.
+static inline Status check_push(const Stream& s, const Cloud& points, double top,
+                                CloudReader* reader, const char** why) {
+    const size_t scalar = points.scalar == Scalar::float32 ? sizeof(float)
+                        : points.scalar == Scalar::float64 ? sizeof(double) : 0;
+    const size_t stride = points.stride_bytes ? points.stride_bytes : 3 * scalar;
+    if (scalar == 0 || stride < 3 * scalar || (points.count > 0 && !points.xyz) ||
+        ranges_overlap(strided_range(points.xyz, points.count, stride, 3 * scalar), s.workspace)) {
+        *why = "a pushed cloud has a null pointer with a non-zero count, a stride smaller than "
+               "one point, an unknown scalar type, or points in the stream's workspace";
+        return Status::invalid_argument;
+    }
+    if (!is_finite(top)) {
+        *why = "a pushed layer's top is NaN or infinite";
+        return Status::invalid_layers;
+    }
+    if (points.count > kMaxPoints - 1 - s.rep.points.in_count) {
+        *why = "more points pushed than 32-bit triangle indices can address";
+        return Status::too_many_points;
+    }
+    *reader = {static_cast<const unsigned char*>(points.xyz), stride,
+               points.scalar == Scalar::float32, nullptr};
+    return Status::ok;
+}
+
+const char* const kTopBelow = "a pushed layer's top is below the previous layer's top";
+
+// The heights of the push's valid points in the frame, *low to *high, or why the push is
+// refused, with *why (and the point's index where one is to blame): a point far beyond the
+// first layer, or outside its own layer, between lower_limit and top_height.
+static inline Status push_heights(Stream& s, const CloudReader& reader, size_t count,
+                                  const Frame& frame, double lower_limit, double top_height,
+                                  double* low, double* high, const char** why) {
+    auto slack = [](double h) { return 0x1p-40 * (1 + abs_value(h)); };
+    *low = DBL_MAX;
+    *high = -DBL_MAX;
+    for (size_t i = 0; i < count; ++i) {
+        if (!reader.valid(i)) continue;
+        const Local p = frame.local(reader.point(i));
+        if (!(abs_value(p.x) <= kStreamRange && abs_value(p.y) <= kStreamRange &&
+              abs_value(p.h) <= kStreamRange)) {
+            s.rep.points.first_invalid_index = s.rep.points.in_count + i;
+            *why = "a pushed point lies more than 2^60 times the first layer's size away from it";
+            return Status::invalid_point;
+        }
+        if (p.h > top_height + slack(top_height) || p.h < lower_limit - slack(lower_limit)) {
+            *why = "a pushed point lies outside its layer: below the previous layer's top or "
+                   "above its own";
+            return Status::out_of_order;
+        }
+        if (p.h < *low) *low = p.h;
+        if (p.h > *high) *high = p.h;
+    }
+    return Status::ok;
+}
+
+// Holds the checked push as the next planned layer, its valid points from heights `low` to
+// `high` in the window; the first push with points sets the stream's frame.
+static inline void hold_push(Stream& s, const CloudReader& reader, size_t count, const Frame& frame,
+                             double low, double high, double top_height) {
+    if (!s.has_frame) {
+        s.has_frame = true;
+        s.chain.frame = frame;
+        s.chain.reader = {reinterpret_cast<const unsigned char*>(s.points), sizeof(Vec3), false,
+                          nullptr};
+        s.chain.output_id = s.global;
+        report_frame(frame, s.rep);
+        s.lowest = low;
+        s.highest = high;
+        s.bounds[0] = low;
+        s.start[0] = 0;
+    } else {
+        s.bounds[s.planned] = s.last_top;  // was the highest point so far
+    }
+    for (size_t i = 0; i < count; ++i) {
+        if (!reader.valid(i)) {
+            ++s.rep.points.rejected_count;
+            continue;
+        }
+        const Vec3 p = reader.point(i);
+        s.distinct.add(p);
+        s.points[s.fill] = p;
+        s.global[s.fill] = static_cast<uint32_t>(s.rep.points.in_count + i);
+        ++s.fill;
+    }
+    s.rep.points.in_count += count;
+    if (low <= high && high > s.highest) s.highest = high;
+    ++s.planned;
+    s.start[s.planned] = static_cast<uint32_t>(s.fill);
+    s.bounds[s.planned] = s.highest;
+    s.last_top = top_height;
+    if (s.fill > s.rep.points.held_count) s.rep.points.held_count = s.fill;
 }
 
 }  // namespace detail
@@ -9599,40 +9926,21 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     if (!stream || stream->closed) return Status::invalid_argument;
     Stream& s = *stream;
     if (s.failure != Status::ok) return s.failure;
-    size_t scalar = points.scalar == Scalar::float32 ? sizeof(float)
-                  : points.scalar == Scalar::float64 ? sizeof(double) : 0;
-    size_t stride = points.stride_bytes ? points.stride_bytes : 3 * scalar;
     // A refusal names its own reason, never the one of a push refused before.
-    Status refusal = Status::ok;
     const char* why = nullptr;
-    if (scalar == 0 || stride < 3 * scalar || (points.count > 0 && !points.xyz) ||
-        detail::ranges_overlap(detail::strided_range(points.xyz, points.count, stride, 3 * scalar),
-                               s.workspace)) {
-        refusal = Status::invalid_argument;
-        why = "a pushed cloud has a null pointer with a non-zero count, a stride smaller than "
-              "one point, an unknown scalar type, or points in the stream's workspace";
-    } else if (!detail::is_finite(top)) {
-        refusal = Status::invalid_layers;
-        why = "a pushed layer's top is NaN or infinite";
-    } else if (points.count > detail::kMaxPoints - 1 - s.rep.points.in_count) {
-        refusal = Status::too_many_points;
-        why = "more points pushed than 32-bit triangle indices can address";
-    }
-    if (refusal != Status::ok) return detail::refuse_push(s, refusal, why);
-    const detail::CloudReader reader = {static_cast<const unsigned char*>(points.xyz), stride,
-                                        points.scalar == Scalar::float32, nullptr};
+    detail::CloudReader reader;
+    Status status = detail::check_push(s, points, top, &reader, &why);
+    if (status != Status::ok) return detail::refuse_push(s, status, why);
     // Check everything before anything changes.
     const detail::CloudSums sums = detail::sum_cloud(reader, points.count);
-    const size_t valid = sums.valid;
     const size_t first_invalid = detail::refused_at(reader, points.count, sums, s.options);
     if (first_invalid < points.count) {
         s.rep.points.first_invalid_index = s.rep.points.in_count + first_invalid;
         return detail::refuse_push(s, Status::invalid_point, detail::kInvalidPointDetail);
     }
-    const char* const top_below = "a pushed layer's top is below the previous layer's top";
     if (!s.has_frame && top < s.early_top)
-        return detail::refuse_push(s, Status::out_of_order, top_below);
-    if (!s.has_frame && valid == 0) {  // nothing to place yet: pushes before the first point
+        return detail::refuse_push(s, Status::out_of_order, detail::kTopBelow);
+    if (!s.has_frame && sums.valid == 0) {  // nothing to place yet: pushes before the first point
         s.rep.points.in_count += points.count;
         s.rep.points.rejected_count += points.count;
         s.early_top = top;
@@ -9641,7 +9949,7 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     }
     detail::Frame frame = s.chain.frame;
     if (!s.has_frame) {
-        Status status = detail::choose_frame(sums, s.options, frame);
+        status = detail::choose_frame(sums, s.options, frame);
         if (status == Status::invalid_origin)
             return detail::refuse_push(s, status, detail::origin_refusal(s.options, sums));
         if (status != Status::ok) return status;
@@ -9652,65 +9960,19 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     // first point that of the pushes without points (far below all, or -infinity, if none).
     const double lower_limit =
         s.has_frame ? s.last_top : (s.early_top - axis_origin) * frame.scale;
-    auto slack = [](double h) { return 0x1p-40 * (1 + detail::abs_value(h)); };
-    if (top_height < lower_limit) return detail::refuse_push(s, Status::out_of_order, top_below);
-    double low = DBL_MAX, high = -DBL_MAX;
-    for (size_t i = 0; i < points.count; ++i) {
-        if (!reader.valid(i)) continue;
-        detail::Local p = frame.local(reader.point(i));
-        if (!(detail::abs_value(p.x) <= detail::kStreamRange &&
-              detail::abs_value(p.y) <= detail::kStreamRange &&
-              detail::abs_value(p.h) <= detail::kStreamRange)) {
-            s.rep.points.first_invalid_index = s.rep.points.in_count + i;
-            return detail::refuse_push(s, Status::invalid_point,
-                                       "a pushed point lies more than 2^60 times the first "
-                                       "layer's size away from it");
-        }
-        if (p.h > top_height + slack(top_height) || p.h < lower_limit - slack(lower_limit))
-            return detail::refuse_push(s, Status::out_of_order,
-                                       "a pushed point lies outside its layer: below the previous "
-                                       "layer's top or above its own");
-        if (p.h < low) low = p.h;
-        if (p.h > high) high = p.h;
-    }
-    if (s.fill + valid > s.capacity || s.planned + 1 > s.slot_capacity)
+    if (top_height < lower_limit)
+        return detail::refuse_push(s, Status::out_of_order, detail::kTopBelow);
+    double low = 0, high = 0;
+    status = detail::push_heights(s, reader, points.count, frame, lower_limit, top_height, &low,
+                                  &high, &why);
+    if (status != Status::ok) return detail::refuse_push(s, status, why);
+    if (s.fill + sums.valid > s.capacity || s.planned + 1 > s.slot_capacity)
         return detail::refuse_push(s, Status::out_of_memory,
                                    "the stream would hold more points or layers than its workspace: "
                                    "push thicker layers, or give more workspace (see "
                                    "Report::points.held_count)");
-    // Commit.
-    if (!s.has_frame) {
-        s.has_frame = true;
-        s.chain.frame = frame;
-        s.chain.reader = {reinterpret_cast<const unsigned char*>(s.points), sizeof(detail::Vec3), false, nullptr};
-        s.chain.output_id = s.global;
-        detail::report_frame(frame, s.rep);
-        s.lowest = low;
-        s.highest = high;
-        s.bounds[0] = low;
-        s.start[0] = 0;
-    } else {
-        s.bounds[s.planned] = s.last_top;  // was the highest point so far
-    }
-    for (size_t i = 0; i < points.count; ++i) {
-        if (!reader.valid(i)) {
-            ++s.rep.points.rejected_count;
-            continue;
-        }
-        detail::Vec3 p = reader.point(i);
-        s.distinct.add(p);
-        s.points[s.fill] = p;
-        s.global[s.fill] = static_cast<uint32_t>(s.rep.points.in_count + i);
-        ++s.fill;
-    }
-    s.rep.points.in_count += points.count;
-    if (valid > 0 && high > s.highest) s.highest = high;
-    ++s.planned;
-    s.start[s.planned] = static_cast<uint32_t>(s.fill);
-    s.bounds[s.planned] = s.highest;
-    s.last_top = top_height;
-    if (s.fill > s.rep.points.held_count) s.rep.points.held_count = s.fill;
-    Status status = detail::advance(s, false);
+    detail::hold_push(s, reader, points.count, frame, low, high, top_height);
+    status = detail::advance(s, false);
     if (status != Status::ok) s.failure = status;
     // The counts so far; why a point is not a vertex is only known at the close.
     detail::report_chain(s.chain, s.rep.points.in_count - s.rep.points.rejected_count, s.rep);

@@ -49,7 +49,7 @@ struct SurfaceChain {
     size_t groups, duplicates, collisions, swaps, removed, used, trailing;
 };
 
-inline bool allocate_chain(SurfaceChain& c, size_t points, Arena& arena) {
+static inline bool allocate_chain(SurfaceChain& c, size_t points, Arena& arena) {
     c.top = arena.alloc<uint32_t>(points);
     c.next_top = arena.alloc<uint32_t>(points);
     c.bottom = arena.alloc<uint32_t>(points);
@@ -66,7 +66,8 @@ inline bool allocate_chain(SurfaceChain& c, size_t points, Arena& arena) {
 // and the one from the previous.
 const unsigned char kUnusedBelow = 1, kHasNextEdge = 2, kHasPreviousEdge = 4;
 
-inline void count_corners(const uint32_t* tri, size_t count, uint32_t* degree, size_t vertices) {
+static inline void count_corners(const uint32_t* tri, size_t count, uint32_t* degree,
+                                 size_t vertices) {
     std::memset(degree, 0, vertices * sizeof(uint32_t));
     for (size_t k = 0; k < 3 * count; ++k) ++degree[tri[k]];
 }
@@ -74,8 +75,8 @@ inline void count_corners(const uint32_t* tri, size_t count, uint32_t* degree, s
 // For the loop whose point i has id `id_of(i)` (n points, in loop order): which of the
 // loop's edges the triangles use, as kHasNextEdge / kHasPreviousEdge bits added to flags[i].
 // position[v] is v's place in the loop or kNoIndex, for every id v in the triangles.
-inline void mark_loop_edges(const uint32_t* tri, size_t count, const uint32_t* position,
-                            uint32_t n, unsigned char* flags) {
+static inline void mark_loop_edges(const uint32_t* tri, size_t count, const uint32_t* position,
+                                   uint32_t n, unsigned char* flags) {
     for (size_t t = 0; t < count; ++t)
         for (size_t k = 0; k < 3; ++k) {
             uint32_t i = position[tri[3 * t + k]], j = position[tri[3 * t + (k + 1) % 3]];
@@ -98,8 +99,8 @@ inline void mark_loop_edges(const uint32_t* tri, size_t count, const uint32_t* p
 // loop point with triangles on both sides shares an edge. `below` flags the loop points
 // from their own chunk; seam ids are below_count + i. Returns the triangles removed, or
 // SIZE_MAX if the arena is too small.
-inline size_t seal_seam(uint32_t* tri, size_t& count, size_t below_count, size_t vertices,
-                        const unsigned char* below, uint32_t* degree, Arena& arena) {
+static inline size_t seal_seam(uint32_t* tri, size_t& count, size_t below_count, size_t vertices,
+                               const unsigned char* below, uint32_t* degree, Arena& arena) {
     const uint32_t n = static_cast<uint32_t>(vertices - below_count);
     size_t mark = arena.mark();
     uint32_t* position = arena.alloc<uint32_t>(vertices);
@@ -138,8 +139,8 @@ inline size_t seal_seam(uint32_t* tri, size_t& count, size_t below_count, size_t
 // Whether the safety net would remove nothing from the chunk: whether the fans of the
 // vertices the band joins (the layer's bottom loop, the loop below) are whole. The others
 // are by construction (see >>manifold).
-inline bool loop_fans_are_one_piece(const uint32_t* tri, size_t count, size_t below,
-                                    size_t vertices, const LayerLoops& loops, Arena& arena) {
+static inline bool loop_fans_are_one_piece(const uint32_t* tri, size_t count, size_t below,
+                                           size_t vertices, const LayerLoops& loops, Arena& arena) {
     size_t mark = arena.mark();
     unsigned char* checked = arena.alloc<unsigned char>(vertices);
     if (arena.failed) return false;
@@ -154,8 +155,8 @@ inline bool loop_fans_are_one_piece(const uint32_t* tri, size_t count, size_t be
 // Triangles of a chunk from layer-local and band indices to reader indices, and on to
 // output indices unless the seam's flips (see "flips across the seam"), which read the
 // points, come between: then name_output_points does that step.
-inline void name_chunk_points(const SurfaceChain& c, const LoadedLayer& layer, uint32_t* tri,
-                              size_t count) {
+static inline void name_chunk_points(const SurfaceChain& c, const LoadedLayer& layer, uint32_t* tri,
+                                     size_t count) {
     for (size_t k = 0; k < 3 * count; ++k) {
         uint32_t l = tri[k];
         uint32_t id = l < layer.count ? layer.ids[l] : c.top[l - layer.count];
@@ -164,7 +165,7 @@ inline void name_chunk_points(const SurfaceChain& c, const LoadedLayer& layer, u
 }
 
 // A final chunk's triangles from reader indices to output indices (with kSurfaceFlips).
-inline void name_output_points(const SurfaceChain& c, uint32_t* tri, size_t count) {
+static inline void name_output_points(const SurfaceChain& c, uint32_t* tri, size_t count) {
     if (!kSurfaceFlips || !c.output_id) return;
     for (size_t k = 0; k < 3 * count; ++k) tri[k] = c.output_id[tri[k]];
 }
@@ -176,9 +177,9 @@ inline void name_output_points(const SurfaceChain& c, uint32_t* tri, size_t coun
 // as built and the fans of the loop vertices are whole (see >>manifold); then the chunk's
 // points that became vertices are counted and the next seam's flags set, as finish_chunk
 // would. Otherwise nothing changes.
-inline bool chunk_is_sound(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                           const uint32_t* at_loops, size_t count, size_t interior_used,
-                           Arena& arena) {
+static inline bool chunk_is_sound(SurfaceChain& c, const LoadedLayer& layer,
+                                  const LayerLoops& loops, const uint32_t* at_loops, size_t count,
+                                  size_t interior_used, Arena& arena) {
     // The seam is as built when every loop point below has both its loop edges there or no
     // triangle at all: then seal_seam would find nothing to do either, since the band has
     // every edge of the loop.
@@ -214,8 +215,9 @@ inline bool chunk_is_sound(SurfaceChain& c, const LoadedLayer& layer, const Laye
 
 // The safety net over the chunk sink[chunk_start ..), then its indices from layer-local and
 // band indices to output indices; counts the points that became vertices.
-inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                           size_t chunk_start, Arena& arena, TriangleSink& sink) {
+static inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer,
+                                  const LayerLoops& loops, size_t chunk_start, Arena& arena,
+                                  TriangleSink& sink) {
     uint32_t* tri = sink.triangles + 3 * chunk_start;
     size_t count = sink.count - chunk_start;
     const size_t below = layer.count, vertices = layer.count + c.top_count;
@@ -274,8 +276,8 @@ inline Status finish_chunk(SurfaceChain& c, const LoadedLayer& layer, const Laye
 const uint32_t kRingGap = 3;
 
 // sectors_held by planned layers [first, last] around (cx, cy), read from the cloud.
-inline uint32_t planned_sectors(const SurfaceChain& c, const LayerQueue& q, uint32_t first,
-                                uint32_t last, double cx, double cy) {
+static inline uint32_t planned_sectors(const SurfaceChain& c, const LayerQueue& q, uint32_t first,
+                                       uint32_t last, double cx, double cy) {
     const uint32_t* ids = q.ids + q.start[first];
     return sectors_held([&c, ids](size_t i) { return c.frame.local(c.reader.point(ids[i])); },
                         q.start[last + 1] - q.start[first], cx, cy);
@@ -286,7 +288,7 @@ inline uint32_t planned_sectors(const SurfaceChain& c, const LayerQueue& q, uint
 // points uniform on a circle leave g of its 32 sectors empty in a row with probability
 // below m (1 - g/32)^(m-1)): a sparse layer's gaps are not crescents, nor is an empty
 // one. Else 0.
-inline uint32_t crescent_gap(uint32_t held, size_t count) {
+static inline uint32_t crescent_gap(uint32_t held, size_t count) {
     const uint32_t gap = widest_gap(held);
     if (gap <= kRingGap || count == 0) return 0;
     const size_t stride = gap_sample_stride(count);
@@ -300,8 +302,8 @@ inline uint32_t crescent_gap(uint32_t held, size_t count) {
 // Whether the group [first, last] joins the next planned layer (see kRingGap). First a
 // look from the group's fitted centre; where it or the next layer leaves a gap, the gaps
 // are taken again from the centre fitted to both, which a crescent does not pull aside.
-inline bool joins_crescent(const SurfaceChain& c, const LayerQueue& q, uint32_t first,
-                           uint32_t last, const Cylinder& fitted, uint32_t own) {
+static inline bool joins_crescent(const SurfaceChain& c, const LayerQueue& q, uint32_t first,
+                                  uint32_t last, const Cylinder& fitted, uint32_t own) {
     const size_t own_count = q.start[last + 1] - q.start[first];
     const size_t next_count = q.start[last + 2] - q.start[last + 1];
     uint32_t next = planned_sectors(c, q, last + 1, last + 1, fitted.cx, fitted.cy);
@@ -320,7 +322,7 @@ inline bool joins_crescent(const SurfaceChain& c, const LayerQueue& q, uint32_t 
 
 // Whether a group of n points over `height` around `radius` is triangulated on its own
 // (else it joins the next planned layer; the final group only needs 3 points).
-inline bool group_stands(size_t n, double height, double radius, bool final) {
+static inline bool group_stands(size_t n, double height, double radius, bool final) {
     return n >= 3 && (final || (n >= kMinLayerPoints && thick_enough(n, height, radius)));
 }
 
@@ -360,8 +362,8 @@ struct GroupResult {
 };
 
 // What triangulate_layer would do now, from a job's result.
-inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops& loops,
-                         LayerCounts& counts) {
+static inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops& loops,
+                                LayerCounts& counts) {
     if (ahead.status != Status::ok) return ahead.status;
     if (sink.count < sink.capacity) {
         size_t room = sink.capacity - sink.count;
@@ -385,9 +387,9 @@ inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops
 // chunk_is_sound holds for the border the job kept and the band, only the band is named in
 // reader indices. Returns false when it does not (nothing changed): the caller then builds
 // the chunk again in order, to the same triangles, and runs finish_chunk.
-inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                         const LayerAhead& ahead, size_t chunk_start, Arena& arena,
-                         TriangleSink& sink) {
+static inline bool replay_chunk(SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
+                                const LayerAhead& ahead, size_t chunk_start, Arena& arena,
+                                TriangleSink& sink) {
     if (!ahead.replayable || c.output_id) return false;
     uint32_t* band = sink.triangles + 3 * (chunk_start + ahead.triangle_count);
     const size_t band_count = sink.count - chunk_start - ahead.triangle_count;

@@ -64,7 +64,7 @@ const double kBendGain = 3;  // a flip for the bend alone must bend 3 times less
 
 const double kWidestAngle = -0.86602540378443865;  // cosine of 150 degrees
 
-inline Vec3 vec_of(const Local& p) { return Vec3{p.x, p.y, p.h}; }
+static inline Vec3 vec_of(const Local& p) { return Vec3{p.x, p.y, p.h}; }
 
 struct Box3 {
     Vec3 low, high;
@@ -74,7 +74,7 @@ struct Box3 {
     }
 };
 
-inline Box3 box_of(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
+static inline Box3 box_of(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
     Box3 box = {a, a};
     const Vec3 rest[3] = {b, c, d};
     for (const Vec3& p : rest) {
@@ -89,7 +89,7 @@ inline Box3 box_of(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
 // Whether the angles at p and q facing the segment ab sum to more than 180 degrees: then
 // sin(angle_p + angle_q), a sum of sine-cosine products, is negative. Two acute angles
 // (most edges) are settled by two dot products.
-inline bool flip_helps(Vec3 a, Vec3 b, Vec3 p, Vec3 q) {
+static inline bool flip_helps(Vec3 a, Vec3 b, Vec3 p, Vec3 q) {
     const Vec3 pa = a - p, pb = b - p, qa = a - q, qb = b - q;
     const double cos_p = dot(pa, pb), cos_q = dot(qa, qb);
     if (cos_p >= 0 && cos_q >= 0) return false;
@@ -102,7 +102,7 @@ inline bool flip_helps(Vec3 a, Vec3 b, Vec3 p, Vec3 q) {
 // Whether triangles u and v, each shrunk by kShrink about its centroid, overlap along every
 // axis that could separate them: their normals, the cross products of their edges, and
 // each normal crossed with the triangle's own edges (for coplanar triangles).
-inline bool triangles_meet(const Vec3* u, const Vec3* v) {
+static inline bool triangles_meet(const Vec3* u, const Vec3* v) {
     Vec3 s[3], t[3];
     const Vec3 cu = scaled(Vec3{u[0].x + u[1].x + u[2].x, u[0].y + u[1].y + u[2].y,
                                 u[0].z + u[1].z + u[2].z}, 1.0 / 3);
@@ -145,7 +145,7 @@ inline bool triangles_meet(const Vec3* u, const Vec3* v) {
 // around it, until visit returns false. False if a visit did, or the vertex has more than
 // kFanLimit neighbours.
 template <class Visit>
-inline bool around_vertex(const Triangulation& tr, uint32_t from, Visit visit) {
+static inline bool around_vertex(const Triangulation& tr, uint32_t from, Visit visit) {
     uint32_t e = from;
     for (uint32_t steps = 0; steps < kFanLimit; ++steps) {
         if (!visit(e)) return false;
@@ -200,12 +200,12 @@ struct VertexNormals {
 
 // How much the surface bends along edge ab, with unit normals na and nb at its ends (see
 // above).
-inline double bend_along(Vec3 a, Vec3 b, Vec3 na, Vec3 nb) {
+static inline double bend_along(Vec3 a, Vec3 b, Vec3 na, Vec3 nb) {
     return std::fabs(dot(b - a, nb - na));
 }
 
 // The cosine of the widest angle of triangle abc.
-inline double widest_angle_cosine(Vec3 a, Vec3 b, Vec3 c) {
+static inline double widest_angle_cosine(Vec3 a, Vec3 b, Vec3 c) {
     const Vec3 corner[3] = {a, b, c};
     double widest = 1;
     for (int k = 0; k < 3; ++k) {
@@ -220,8 +220,8 @@ inline double widest_angle_cosine(Vec3 a, Vec3 b, Vec3 c) {
 // Whether the surface wants ab of triangles abp and baq turned into pq, by the two rules
 // (see above; na .. nq the corners' unit normals, none zero) without an angle wider than
 // kWidestAngle (unless the old pair had a wider one).
-inline bool flip_wanted(const Local& la, const Local& lb, const Local& lp, const Local& lq,
-                        Vec3 na, Vec3 nb, Vec3 np, Vec3 nq) {
+static inline bool flip_wanted(const Local& la, const Local& lb, const Local& lp, const Local& lq,
+                               Vec3 na, Vec3 nb, Vec3 np, Vec3 nq) {
     if (dot(na, na) == 0 || dot(nb, nb) == 0 || dot(np, np) == 0 || dot(nq, nq) == 0)
         return false;
     const double bend_before = bend_along(vec_of(la), vec_of(lb), na, nb);
@@ -240,7 +240,7 @@ inline bool flip_wanted(const Local& la, const Local& lb, const Local& lp, const
 
 // Whether both new triangles (p, a, q) and (q, b, p) of that flip have normals within
 // kGentleFlip of the old pair's mean.
-inline bool gentle_flip(const Local& la, const Local& lb, const Local& lp, const Local& lq) {
+static inline bool gentle_flip(const Local& la, const Local& lb, const Local& lp, const Local& lq) {
     Vec3 mean = normal_of(la, lb, lp);
     const Vec3 other_normal = normal_of(lb, la, lq);
     mean = Vec3{mean.x + other_normal.x, mean.y + other_normal.y, mean.z + other_normal.z};
@@ -250,8 +250,8 @@ inline bool gentle_flip(const Local& la, const Local& lb, const Local& lp, const
 }
 
 // Flips half-edge e of a layer's triangulation on the surface if that helps (see above).
-inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32_t* flags,
-                            VertexNormals& normals, const Cylinder& cyl, uint32_t e) {
+static inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32_t* flags,
+                                   VertexNormals& normals, const Cylinder& cyl, uint32_t e) {
     const uint32_t f = tr.twin[e];
     const uint32_t t = e / 3, u = f / 3;
     if (!on_surface(tr, u)) return false;
@@ -300,8 +300,9 @@ inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32
 // `flags` holds a word per vertex (see triangulate_layer); the bits kFlippedBefore and
 // kFlippedNow are used here and cleared. `room` is the annulus coordinates, two doubles a
 // vertex, overwritten. Returns the number of flips.
-inline size_t flip_layer_on_surface(Triangulation& tr, const Local* points, const Cylinder& cyl,
-                                    uint32_t* flags, double* room, size_t vertices) {
+static inline size_t flip_layer_on_surface(Triangulation& tr, const Local* points,
+                                           const Cylinder& cyl, uint32_t* flags, double* room,
+                                           size_t vertices) {
     VertexNormals normals = {room};
     size_t flips = 0;
     for (uint32_t sweep = 0; sweep < kSurfaceFlipSweeps; ++sweep) {
@@ -386,23 +387,18 @@ struct Seam {
     }
 };
 
-// The seam of a chunk (see above). False with seam.triangles = 0 when it is left as it is;
-// false with arena.failed when the arena is too small.
-inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                      uint32_t* chunk, size_t count, Arena& arena, Seam& seam) {
-    seam.chunk = chunk;
-    seam.triangles = 0;
-    // The tags, over reader indices up to the largest of the chunk's and the loops'.
+// Tags the chunk's points and the loops' with their loop bits, over reader indices up to
+// the largest of theirs; room for `most` seam triangles. False if the arena is too small.
+static inline bool tag_seam_points(const SurfaceChain& c, const LoadedLayer& layer,
+                                   const LayerLoops& loops, size_t count, size_t most, Arena& arena,
+                                   Seam& seam) {
+    const uint32_t* chunk = seam.chunk;
     uint32_t largest = 0;
     for (size_t k = 0; k < 3 * count; ++k) largest = chunk[k] > largest ? chunk[k] : largest;
     for (uint32_t i = 0; i < c.top_count; ++i) largest = c.top[i] > largest ? c.top[i] : largest;
     for (uint32_t i = 0; i < layer.count; ++i)
         largest = layer.ids[i] > largest ? layer.ids[i] : largest;
     seam.tag = arena.alloc<uint32_t>(size_t{largest} + 1);
-    const size_t vertices = layer.count + c.top_count;
-    // More seam triangles: left as it is (and the tags' seam points fit above the bits).
-    size_t most = 3 * vertices / 4;
-    if (most > (kNoIndex >> kLoopBits) / 3) most = (kNoIndex >> kLoopBits) / 3;
     seam.slot = arena.alloc<uint32_t>(most);
     if (arena.failed) return false;
     for (size_t k = 0; k < 3 * count; ++k) seam.tag[chunk[k]] = 0;
@@ -413,16 +409,14 @@ inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
         seam.tag[layer.ids[loops.bottom[i]]] |= kBottomLoopPoint;
     for (uint32_t i = 0; i < loops.top_count; ++i)
         seam.tag[layer.ids[loops.top[i]]] |= kTopLoopPoint;
-    size_t triangles = 0;
-    for (size_t t = 0; t < count; ++t) {
-        const uint32_t* v = chunk + 3 * t;
-        if (!((seam.tag[v[0]] | seam.tag[v[1]] | seam.tag[v[2]]) & (kLoopBelow | kBottomLoopPoint)))
-            continue;
-        if (triangles == most) return false;
-        seam.slot[triangles++] = static_cast<uint32_t>(t);
-    }
-    if (triangles == 0) return false;
-    seam.triangles = static_cast<uint32_t>(triangles);
+    return true;
+}
+
+// Numbers the seam triangles' points (seam.ids, and in their tags) and names their corners
+// by them, with each point's loop bits and seam triangle count. False if the arena is too
+// small.
+static inline bool number_seam_points(Arena& arena, Seam& seam) {
+    const size_t triangles = seam.triangles;
     seam.vertex = arena.alloc<uint32_t>(3 * triangles);
     seam.twin = arena.alloc<uint32_t>(3 * triangles);
     seam.ids = arena.alloc<uint32_t>(3 * triangles);
@@ -430,7 +424,7 @@ inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
     uint32_t points = 0;
     for (size_t s = 0; s < triangles; ++s)
         for (uint32_t j = 0; j < 3; ++j) {
-            const uint32_t id = chunk[3 * size_t{seam.slot[s]} + j];
+            const uint32_t id = seam.chunk[3 * size_t{seam.slot[s]} + j];
             if ((seam.tag[id] >> kLoopBits) == 0) {
                 seam.ids[points] = id;
                 seam.tag[id] |= (points + 1) << kLoopBits;
@@ -449,13 +443,19 @@ inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
         seam.degree[v] = 0;
     }
     for (size_t i = 0; i < 3 * triangles; ++i) ++seam.degree[seam.vertex[i]];
-    // Twins through each point's outgoing half-edges.
+    return true;
+}
+
+// Each seam half-edge's twin, found through each point's outgoing half-edges. False if
+// the arena is too small.
+static inline bool link_seam_twins(Arena& arena, Seam& seam) {
+    const uint32_t points = seam.points, triangles = seam.triangles;
     size_t mark = arena.mark();
     uint32_t* first = arena.alloc<uint32_t>(size_t{points} + 1);
-    uint32_t* outgoing = arena.alloc<uint32_t>(3 * triangles);
+    uint32_t* outgoing = arena.alloc<uint32_t>(3 * size_t{triangles});
     if (arena.failed) return false;
     std::memset(first, 0, (size_t{points} + 1) * sizeof(uint32_t));
-    for (size_t e = 0; e < 3 * triangles; ++e) ++first[seam.vertex[e] + 1];
+    for (size_t e = 0; e < 3 * size_t{triangles}; ++e) ++first[seam.vertex[e] + 1];
     for (uint32_t v = 0; v < points; ++v) first[v + 1] += first[v];
     for (uint32_t e = 0; e < 3 * triangles; ++e) outgoing[first[seam.vertex[e]]++] = e;
     for (uint32_t v = points; v > 0; --v) first[v] = first[v - 1];
@@ -470,16 +470,41 @@ inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer, const Lay
     return true;
 }
 
+// The seam of a chunk (see above). False with seam.triangles = 0 when it is left as it is;
+// false with arena.failed when the arena is too small.
+static inline bool find_seam(const SurfaceChain& c, const LoadedLayer& layer,
+                             const LayerLoops& loops, uint32_t* chunk, size_t count, Arena& arena,
+                             Seam& seam) {
+    seam.chunk = chunk;
+    seam.triangles = 0;
+    const size_t vertices = layer.count + c.top_count;
+    // More seam triangles: left as it is (and the tags' seam points fit above the bits).
+    size_t most = 3 * vertices / 4;
+    if (most > (kNoIndex >> kLoopBits) / 3) most = (kNoIndex >> kLoopBits) / 3;
+    if (!tag_seam_points(c, layer, loops, count, most, arena, seam)) return false;
+    size_t triangles = 0;
+    for (size_t t = 0; t < count; ++t) {
+        const uint32_t* v = chunk + 3 * t;
+        if (!((seam.tag[v[0]] | seam.tag[v[1]] | seam.tag[v[2]]) & (kLoopBelow | kBottomLoopPoint)))
+            continue;
+        if (triangles == most) return false;
+        seam.slot[triangles++] = static_cast<uint32_t>(t);
+    }
+    if (triangles == 0) return false;
+    seam.triangles = static_cast<uint32_t>(triangles);
+    return number_seam_points(arena, seam) && link_seam_twins(arena, seam);
+}
+
 // Seam point v's normal.
-inline Vec3 seam_normal(const Seam& seam, uint32_t v) {
+static inline Vec3 seam_normal(const Seam& seam, uint32_t v) {
     const float* n = seam.normal + 3 * size_t{v};
     return Vec3{static_cast<double>(n[0]), static_cast<double>(n[1]),
                 static_cast<double>(n[2])};
 }
 
 // Adds triangle v's unit normal to sums[3 k] for each corner k of it that is a seam point.
-inline void add_seam_normal(const SurfaceChain& c, const Seam& seam, const uint32_t* v,
-                            float* sums) {
+static inline void add_seam_normal(const SurfaceChain& c, const Seam& seam, const uint32_t* v,
+                                   float* sums) {
     const uint32_t at[3] = {seam.point_of(v[0]), seam.point_of(v[1]), seam.point_of(v[2])};
     if (at[0] == kNoIndex && at[1] == kNoIndex && at[2] == kNoIndex) return;
     Vec3 n = normal_of(c.frame.local(c.reader.point(v[0])), c.frame.local(c.reader.point(v[1])),
@@ -497,7 +522,7 @@ inline void add_seam_normal(const SurfaceChain& c, const Seam& seam, const uint3
 }
 
 // The sums of the unit normals of the chunk's triangles off the seam, at the seam's points.
-inline void sum_fixed_normals(const SurfaceChain& c, const Seam& seam, size_t count) {
+static inline void sum_fixed_normals(const SurfaceChain& c, const Seam& seam, size_t count) {
     std::memset(seam.fixed_normal, 0, 3 * size_t{seam.points} * sizeof(float));
     uint32_t next = 0;  // seam.slot is increasing
     for (size_t t = 0; t < count; ++t) {
@@ -511,7 +536,7 @@ inline void sum_fixed_normals(const SurfaceChain& c, const Seam& seam, size_t co
 
 // The seam's vertex normals over every triangle of the chunk (see VertexNormals): the fixed
 // sums and the seam's own triangles, made unit.
-inline void estimate_seam_normals(const SurfaceChain& c, const Seam& seam) {
+static inline void estimate_seam_normals(const SurfaceChain& c, const Seam& seam) {
     std::memcpy(seam.normal, seam.fixed_normal, 3 * size_t{seam.points} * sizeof(float));
     for (uint32_t s = 0; s < seam.triangles; ++s)
         add_seam_normal(c, seam, seam.chunk + 3 * size_t{seam.slot[s]}, seam.normal);
@@ -528,7 +553,7 @@ inline void estimate_seam_normals(const SurfaceChain& c, const Seam& seam) {
 
 // Whether seam point x's triangles, walked around it from half-edge `from` (leaving x) both
 // ways, are all of its seam triangles and none has an edge to y.
-inline bool fan_misses(const Seam& seam, uint32_t from, uint32_t x, uint32_t y) {
+static inline bool fan_misses(const Seam& seam, uint32_t from, uint32_t x, uint32_t y) {
     uint32_t seen = 0;
     auto clear = [&seam, y](uint32_t g) {
         return seam.vertex[next_edge(g)] != y && seam.vertex[prev_edge(g)] != y;
@@ -554,7 +579,8 @@ inline bool fan_misses(const Seam& seam, uint32_t from, uint32_t x, uint32_t y) 
 }
 
 // Flips half-edge e of the seam if that helps (see above and flip_on_surface).
-inline bool flip_seam_edge(const SurfaceChain& c, Seam& seam, const Cylinder& cyl, uint32_t e) {
+static inline bool flip_seam_edge(const SurfaceChain& c, Seam& seam, const Cylinder& cyl,
+                                  uint32_t e) {
     const uint32_t f = seam.twin[e];
     if (f == kNoIndex) return false;
     const uint32_t a = seam.vertex[e], b = seam.vertex[next_edge(e)];
@@ -607,8 +633,8 @@ inline bool flip_seam_edge(const SurfaceChain& c, Seam& seam, const Cylinder& cy
 
 // Flips a final chunk's seam (reader indices) on the surface, sweep after sweep as
 // flip_layer_on_surface does. Returns false if the arena is too small.
-inline bool flip_seam(const SurfaceChain& c, const LoadedLayer& layer, const LayerLoops& loops,
-                      uint32_t* chunk, size_t count, Arena& arena) {
+static inline bool flip_seam(const SurfaceChain& c, const LoadedLayer& layer,
+                             const LayerLoops& loops, uint32_t* chunk, size_t count, Arena& arena) {
     size_t mark = arena.mark();
     Seam seam;
     if (!find_seam(c, layer, loops, chunk, count, arena, seam)) {

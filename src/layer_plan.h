@@ -38,13 +38,13 @@ const size_t kMinLayerPoints = 16;
 // contour, passes.
 const double kMinLayerRows = 1.5;
 
-inline bool thick_enough(size_t points, double height, double radius) {
+static inline bool thick_enough(size_t points, double height, double radius) {
     const double two_pi = 6.28318530717958647693;
     return static_cast<double>(points) * height >= kMinLayerRows * kMinLayerRows * two_pi * radius;
 }
 
 // The number of layers the options can ask for, before empty layers are dropped.
-inline size_t planned_layer_limit(size_t point_count, const Options& options) {
+static inline size_t planned_layer_limit(size_t point_count, const Options& options) {
     if (options.cuts && options.cut_count > 0) return options.cut_count + 1;
     if (options.layer_count > 0)
         return options.layer_count < point_count ? options.layer_count : (point_count > 0 ? point_count : 1);
@@ -53,7 +53,7 @@ inline size_t planned_layer_limit(size_t point_count, const Options& options) {
     return kMaxAutomaticLayers;
 }
 
-inline Status validate_layer_options(const Options& options) {
+static inline Status validate_layer_options(const Options& options) {
     if (options.cuts && options.cut_count > 0) {
         if (options.cut_count > kMaxPoints) return Status::invalid_layers;
         for (size_t i = 0; i < options.cut_count; ++i)
@@ -66,7 +66,7 @@ inline Status validate_layer_options(const Options& options) {
     return Status::ok;
 }
 
-inline bool automatic_layers(const Options& options) {
+static inline bool automatic_layers(const Options& options) {
     return !(options.cuts && options.cut_count > 0) && options.layer_count == 0 &&
            options.layer_height == 0;
 }
@@ -74,8 +74,8 @@ inline bool automatic_layers(const Options& options) {
 // Fills plan.bounds (room for planned_layer_limit + 1 entries) for heights [lo, hi] from
 // the user's layer options (not automatic_layers): the cuts are coordinates along the axis
 // (Frame::user_height of frame heights), layer_height a length in the cloud's units.
-inline void plan_layers(const Options& options, double lo, double hi, size_t point_count,
-                        const Frame& frame, LayerPlan& plan) {
+static inline void plan_layers(const Options& options, double lo, double hi, size_t point_count,
+                               const Frame& frame, LayerPlan& plan) {
     const double cut_offset = dot(frame.origin, frame.axis);
     double* b = plan.bounds;
     uint32_t n = 0;
@@ -164,27 +164,27 @@ struct BinRange {
     uint32_t first, end;
 };
 
-inline uint32_t profile_bin_count(size_t valid_points) {
+static inline uint32_t profile_bin_count(size_t valid_points) {
     size_t bins = valid_points / kPointsPerProfileBin;
     if (bins > kMaxAutomaticLayers) bins = kMaxAutomaticLayers;
     return bins < 1 ? 1u : static_cast<uint32_t>(bins);
 }
 
 // The scratch the automatic planner takes (released before the layers are built).
-inline void allocate_profile(Arena& arena, uint32_t bins, ProfileBin** profile, BinRange** ranges,
-                             double** cuts) {
+static inline void allocate_profile(Arena& arena, uint32_t bins, ProfileBin** profile,
+                                    BinRange** ranges, double** cuts) {
     *profile = arena.alloc<ProfileBin>(bins);
     *ranges = arena.alloc<BinRange>(bins);
     *cuts = arena.alloc<double>(bins);
 }
 
-inline uint32_t sector_of(double dx, double dy) {
+static inline uint32_t sector_of(double dx, double dy) {
     uint32_t s = (dx < 0 ? 4u : 0u) + (dy < 0 ? 2u : 0u);
     return s + (abs_value(dx) < abs_value(dy) ? 1u : 0u);
 }
 
-inline void build_profile(const CloudReader& cloud, size_t count, const Frame& frame, double lo,
-                          double hi, ProfileBin* profile, uint32_t bins) {
+static inline void build_profile(const CloudReader& cloud, size_t count, const Frame& frame,
+                                 double lo, double hi, ProfileBin* profile, uint32_t bins) {
     std::memset(static_cast<void*>(profile), 0, sizeof(ProfileBin) * bins);
     const double per_height = static_cast<double>(bins) / (hi - lo);
     auto bin_of = [&](double h) {
@@ -229,8 +229,8 @@ inline void build_profile(const CloudReader& cloud, size_t count, const Frame& f
     }
 }
 
-inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_height,
-                          size_t most_points) {
+static inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_height,
+                                 size_t most_points) {
     double cx = 0, cy = 0, radius = 0;
     size_t points = 0;
     for (uint32_t b = range.first; b < range.end; ++b) {
@@ -259,7 +259,7 @@ inline bool well_unrolled(const ProfileBin* profile, BinRange range, double bin_
 }
 
 // How much the surface changes between bins b - 1 and b, plus the density penalty.
-inline double cut_cost(const ProfileBin* profile, uint32_t b, double mean_count) {
+static inline double cut_cost(const ProfileBin* profile, uint32_t b, double mean_count) {
     const ProfileBin& below = profile[b - 1];
     const ProfileBin& above = profile[b];
     double radius = below.mean_radius > above.mean_radius ? below.mean_radius : above.mean_radius;
@@ -272,9 +272,10 @@ inline double cut_cost(const ProfileBin* profile, uint32_t b, double mean_count)
 
 // Fills plan.bounds for heights [lo, hi] by the rule above; profile, ranges and cuts hold
 // `bins` entries each.
-inline void plan_automatic_layers(const CloudReader& cloud, size_t count, size_t valid,
-                                  const Frame& frame, double lo, double hi, ProfileBin* profile,
-                                  BinRange* ranges, double* cuts, uint32_t bins, LayerPlan& plan) {
+static inline void plan_automatic_layers(const CloudReader& cloud, size_t count, size_t valid,
+                                         const Frame& frame, double lo, double hi,
+                                         ProfileBin* profile, BinRange* ranges, double* cuts,
+                                         uint32_t bins, LayerPlan& plan) {
     build_profile(cloud, count, frame, lo, hi, profile, bins);
     const double bin_height = (hi - lo) / bins;
     const double mean_count = static_cast<double>(valid) / bins;
@@ -316,7 +317,7 @@ inline void plan_automatic_layers(const CloudReader& cloud, size_t count, size_t
 // layers were equal, which they are unless cuts or the automatic plan set them, is tried
 // first, with one branch that a million points in no order still predict (a binary
 // search's would not); the search is for the rest.
-inline uint32_t layer_of(const LayerPlan& plan, double h, double per_height) {
+static inline uint32_t layer_of(const LayerPlan& plan, double h, double per_height) {
     const double* bounds = plan.bounds;
     const double tolerance = plan.tolerance;
     const uint32_t last = plan.count - 1;
@@ -340,9 +341,9 @@ inline uint32_t layer_of(const LayerPlan& plan, double h, double per_height) {
 // point's layer kept in `layer` (count entries of scratch) between its two passes. With
 // `staged` (optional, as many entries as valid points), the points in frame coordinates
 // go there in the same order.
-inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& frame,
-                           const LayerPlan& plan, uint32_t* layer, Local* staged,
-                           uint32_t* layer_start, uint32_t* order) {
+static inline void group_by_layer(const CloudReader& cloud, size_t count, const Frame& frame,
+                                  const LayerPlan& plan, uint32_t* layer, Local* staged,
+                                  uint32_t* layer_start, uint32_t* order) {
     std::memset(layer_start, 0, sizeof(uint32_t) * (plan.count + 2));
     const double per_height =
         kFastLoops ? plan.count / (plan.bounds[plan.count] - plan.bounds[0]) : 0;
@@ -397,12 +398,12 @@ struct GroupingPass {
 
 // group_by_layer without staging, as jobs; false (nothing done) where its three tables of a
 // count per run and layer would take more than one count per point, or do not fit.
-inline bool group_by_layer_in_jobs(const Options& options, const CloudReader& cloud,
-                                   size_t count, const Frame& frame, const LayerPlan& plan,
-                                   uint32_t* layer, uint32_t* layer_start, uint32_t* order,
-                                   Arena& arena) {
+static inline bool group_by_layer_in_jobs(const Options& options, const CloudReader& cloud,
+                                          size_t count, const Frame& frame, const LayerPlan& plan,
+                                          uint32_t* layer, uint32_t* layer_start, uint32_t* order,
+                                          Arena& arena) {
     const size_t table = kPassRuns * static_cast<size_t>(plan.count);
-    if (!kParallelLayers || !options.run_jobs || 3 * table > count) return false;
+    if (!has_runner(options) || 3 * table > count) return false;
     const size_t mark = arena.mark();
     GroupingPass pass = {&cloud, &frame, &plan, 0, count, layer, order,
                          arena.alloc<uint32_t>(table), arena.alloc<uint32_t>(table),

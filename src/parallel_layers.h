@@ -42,9 +42,9 @@ struct ParallelLayers {
 
 // Room for the results of `slots` layers holding `points` points in all, out of `layers`
 // planned layers.
-inline bool allocate_ahead(ParallelLayers& p, uint32_t slots, size_t points, size_t layers,
-                           Arena& arena, uint32_t** triangles, uint32_t** loops,
-                           unsigned char** loop_flags, uint32_t** borders) {
+static inline bool allocate_ahead(ParallelLayers& p, uint32_t slots, size_t points, size_t layers,
+                                  Arena& arena, uint32_t** triangles, uint32_t** loops,
+                                  unsigned char** loop_flags, uint32_t** borders) {
     p.ahead = arena.alloc<LayerAhead>(slots);
     p.layer_of_slot = arena.alloc<uint32_t>(slots);
     p.slot_of_layer = arena.alloc<uint32_t>(layers);
@@ -58,16 +58,16 @@ inline bool allocate_ahead(ParallelLayers& p, uint32_t slots, size_t points, siz
 // The border a layer of n points may keep for replay_chunk: its bottom loop holds a few
 // times the square root of n points in a sound layer, with two or three triangles each.
 // A thin layer's border can be most of its triangles: it is finished in order instead.
-inline size_t border_capacity(size_t n) { return n / 4 + 4; }
+static inline size_t border_capacity(size_t n) { return n / 4 + 4; }
 
-inline bool may_stand_alone(const LayerQueue& q, uint32_t k) {
+static inline bool may_stand_alone(const LayerQueue& q, uint32_t k) {
     size_t n = q.start[k + 1] - q.start[k];
     return n >= kMinLayerPoints || (k + 1 == q.planned && n >= 3);
 }
 
 // The job scratch bound: a run of layers needs the scratch of its largest, and scratch grows
 // linearly with rounding, so jobs over n points in all need at most this.
-inline size_t job_scratch_bound(size_t points) {
+static inline size_t job_scratch_bound(size_t points) {
     size_t whole = reconstruct_scratch_size(points, false), one = reconstruct_scratch_size(0, false);
     const size_t slack = 1024;  // the rounding of every allocation, with room to spare
     if (whole == 0 || one > (SIZE_MAX - whole) / kMaxJobs - slack) return 0;
@@ -76,7 +76,7 @@ inline size_t job_scratch_bound(size_t points) {
 
 // What replay_chunk needs of a job's layer (see LayerAhead), then, if it can replay them,
 // its triangles in reader indices (`ids`).
-inline void keep_border(LayerAhead& a, const uint32_t* ids, size_t n, Arena& arena) {
+static inline void keep_border(LayerAhead& a, const uint32_t* ids, size_t n, Arena& arena) {
     const unsigned char on_bottom = 1, has_triangle = 2;
     unsigned char* flags = arena.alloc<unsigned char>(n);
     a.replayable = flags != nullptr;
@@ -100,12 +100,12 @@ inline void keep_border(LayerAhead& a, const uint32_t* ids, size_t n, Arena& are
     for (size_t k = 0; k < 3 * a.triangle_count; ++k) a.triangles[k] = ids[a.triangles[k]];
 }
 
-inline void run_layer_job(void* context, uint32_t index) {
-    const ParallelLayers& p = *static_cast<const ParallelLayers*>(context);
-    if (index >= p.job_count) return;  // a runner's mistake: no job of ours
+// Job `job`: triangulates the layers of slots first_slot[job] .. first_slot[job + 1] - 1 in
+// the job's own scratch.
+static inline void triangulate_job(const ParallelLayers& p, uint32_t job) {
     const LayerQueue& q = *p.queue;
-    Arena arena = Arena::over(p.scratch[index], p.scratch_bytes[index]);
-    for (uint32_t slot = p.first_slot[index]; slot < p.first_slot[index + 1]; ++slot) {
+    Arena arena = Arena::over(p.scratch[job], p.scratch_bytes[job]);
+    for (uint32_t slot = p.first_slot[job]; slot < p.first_slot[job + 1]; ++slot) {
         LayerAhead& a = p.ahead[slot];
         const uint32_t k = p.layer_of_slot[slot];
         const size_t n = q.start[k + 1] - q.start[k];
@@ -136,33 +136,17 @@ inline void run_layer_job(void* context, uint32_t index) {
     }
 }
 
-// Plans the jobs over the queue, carves their results and scratch from the arena and runs
-// them. Returns with p.ready false (and the arena as it was) when there is nothing to gain or
-// no room: the groups are then triangulated in order. The results stay in the arena; the
-// jobs' scratch is released.
-inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& arena) {
-    p.ready = false;
+// Gives each layer that may stand alone a slot: its part of the results carved from the
+// arena (false if they do not fit). `points` are the slots' points in all.
+static inline bool assign_slots(ParallelLayers& p, uint32_t slots, size_t points, Arena& arena) {
     const LayerQueue& q = *p.queue;
-    uint32_t slots = 0;
-    size_t points = 0;
-    for (uint32_t k = 0; k < q.planned; ++k)
-        if (may_stand_alone(q, k)) {
-            ++slots;
-            points += q.start[k + 1] - q.start[k];
-        }
-    if (slots < 2) return;
-    const size_t mark = arena.mark();
-    auto give_up = [&]() {
-        arena.failed = false;
-        arena.rewind(mark);
-    };
     uint32_t* triangles = nullptr;
     uint32_t* loops = nullptr;
     unsigned char* loop_flags = nullptr;
     uint32_t* borders = nullptr;
     if (!allocate_ahead(p, slots, points, q.planned, arena, &triangles, &loops, &loop_flags,
                         &borders))
-        return give_up();
+        return false;
     p.slots = slots;
     uint32_t slot = 0;
     size_t at = 0, border_at = 0;
@@ -184,15 +168,19 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
         p.layer_of_slot[slot] = k;
         p.slot_of_layer[k] = slot++;
     }
-    const size_t results = arena.mark();
-    // Jobs: runs of slots with about equal point counts. A slot goes to the share of the
-    // points its middle falls in, so equal layers get a job each (a threshold on a running
-    // count would put a layer slightly under the mean together with the next).
-    const uint32_t most = slots < kMaxJobs ? slots : kMaxJobs;
+    return true;
+}
+
+// Cuts the slots into jobs: runs of slots with about equal point counts. A slot goes to the
+// share of the points its middle falls in, so equal layers get a job each (a threshold on
+// a running count would put a layer slightly under the mean together with the next).
+static inline void divide_jobs(ParallelLayers& p, size_t points) {
+    const LayerQueue& q = *p.queue;
+    const uint32_t most = p.slots < kMaxJobs ? p.slots : kMaxJobs;
     uint32_t job = 0;
     uint64_t share_of_job = 0, before = 0;
     p.first_slot[0] = 0;
-    for (uint32_t s = 0; s < slots; ++s) {
+    for (uint32_t s = 0; s < p.slots; ++s) {
         const uint32_t k = p.layer_of_slot[s];
         const uint64_t n = q.start[k + 1] - q.start[k];
         const uint64_t share = (before + n / 2) * most / points;
@@ -203,7 +191,12 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
         before += n;
     }
     p.job_count = job + 1;
-    p.first_slot[p.job_count] = slots;
+    p.first_slot[p.job_count] = p.slots;
+}
+
+// Each job's scratch: that of its largest layer. False if they do not fit.
+static inline bool allocate_job_scratch(ParallelLayers& p, Arena& arena) {
+    const LayerQueue& q = *p.queue;
     for (uint32_t j = 0; j < p.job_count; ++j) {
         size_t largest = 0;
         for (uint32_t s = p.first_slot[j]; s < p.first_slot[j + 1]; ++s) {
@@ -214,18 +207,45 @@ inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& 
         p.scratch_bytes[j] = reconstruct_scratch_size(largest, false) + Arena::kAlign;
         p.scratch[j] = arena.alloc<unsigned char>(p.scratch_bytes[j]);
     }
-    if (arena.failed) return give_up();
-    options.run_jobs(options.jobs_user, p.job_count, run_layer_job, &p);
+    return !arena.failed;
+}
+
+// Plans the jobs over the queue, carves their results and scratch from the arena and runs
+// them. Returns with p.ready false (and the arena as it was) when there is nothing to gain or
+// no room: the groups are then triangulated in order. The results stay in the arena; the
+// jobs' scratch is released.
+static inline void triangulate_ahead(const Options& options, ParallelLayers& p, Arena& arena) {
+    p.ready = false;
+    const LayerQueue& q = *p.queue;
+    uint32_t slots = 0;
+    size_t points = 0;
+    for (uint32_t k = 0; k < q.planned; ++k)
+        if (may_stand_alone(q, k)) {
+            ++slots;
+            points += q.start[k + 1] - q.start[k];
+        }
+    if (slots < 2) return;
+    const size_t mark = arena.mark();
+    auto give_up = [&]() {
+        arena.failed = false;
+        arena.rewind(mark);
+    };
+    if (!assign_slots(p, slots, points, arena)) return give_up();
+    const size_t results = arena.mark();
+    divide_jobs(p, points);
+    if (!allocate_job_scratch(p, arena)) return give_up();
+    // A job the runner skips leaves its layers to their groups.
+    run_jobs(options, p.job_count, false, [&p](uint32_t job) { triangulate_job(p, job); });
     arena.rewind(results);
     p.ready = true;
 }
 
 // Starts the jobs for reconstruct(); returns the layers they triangulated.
-inline size_t start_parallel_layers(const Options& options, const CloudReader& reader,
-                                    const Frame& frame, const LayerQueue& queue, Arena& arena,
-                                    ParallelLayers& parallel) {
+static inline size_t start_parallel_layers(const Options& options, const CloudReader& reader,
+                                           const Frame& frame, const LayerQueue& queue,
+                                           Arena& arena, ParallelLayers& parallel) {
     parallel.ready = false;
-    if (!options.run_jobs) return 0;
+    if (!has_runner(options)) return 0;
     parallel.reader = &reader;
     parallel.frame = &frame;
     parallel.queue = &queue;
@@ -238,8 +258,8 @@ inline size_t start_parallel_layers(const Options& options, const CloudReader& r
 
 // What the layers done ahead add to the workspace bound: their results, which stay, in
 // `arena`; the jobs' scratch, which comes and goes before the groups' own, in *scratch.
-inline bool plan_parallel_workspace(size_t point_count, size_t layer_limit, Arena& arena,
-                                    size_t* scratch) {
+static inline bool plan_parallel_workspace(size_t point_count, size_t layer_limit, Arena& arena,
+                                           size_t* scratch) {
     ParallelLayers p;
     uint32_t* triangles = nullptr;
     uint32_t* loops = nullptr;
@@ -260,13 +280,13 @@ struct ParallelLayers {
     const LayerAhead* ahead_of(uint32_t) const { return nullptr; }
 };
 
-inline size_t start_parallel_layers(const Options&, const CloudReader&, const Frame&,
-                                    const LayerQueue&, Arena&, ParallelLayers& parallel) {
+static inline size_t start_parallel_layers(const Options&, const CloudReader&, const Frame&,
+                                           const LayerQueue&, Arena&, ParallelLayers& parallel) {
     parallel.ready = false;
     return 0;
 }
 
-inline bool plan_parallel_workspace(size_t, size_t, Arena&, size_t*) { return true; }
+static inline bool plan_parallel_workspace(size_t, size_t, Arena&, size_t*) { return true; }
 
 #endif  // STRATMESH_NO_PARALLEL_LAYERS
 

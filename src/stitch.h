@@ -29,7 +29,8 @@ namespace detail {
 // Rotates loop[0..n) and its strip coordinates so that entry `first` comes first; the
 // entries moved to the end are shifted by `turn` (one period of the strip), so angles
 // keep increasing along the loop.
-inline void rotate_loop(uint32_t* loop, double* uv, uint32_t n, uint32_t first, double turn) {
+static inline void rotate_loop(uint32_t* loop, double* uv, uint32_t n, uint32_t first,
+                               double turn) {
     for (uint32_t i = 0; i < first; ++i) uv[2 * i] += turn;
     // Three reversals rotate in place.
     auto reverse = [&](uint32_t lo, uint32_t hi) {  // the range [lo, hi)
@@ -51,7 +52,7 @@ inline void rotate_loop(uint32_t* loop, double* uv, uint32_t n, uint32_t first, 
 }
 
 // Rotates loop[0..n) so its smallest angle comes first (angles in [0, turn)).
-inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
+static inline void rotate_to_first_angle(uint32_t* loop, double* uv, uint32_t n) {
     uint32_t first = 0;
     for (uint32_t i = 1; i < n; ++i)
         if (uv[2 * i] < uv[2 * first]) first = i;
@@ -110,11 +111,11 @@ struct Band {
 // A step sequence is a band only if no rung repeats: walking all of A while B stands
 // still (or all of B) would return to the rung it started from. That happens exactly when
 // the cyclic sequence has a single run of A steps, so a band needs at least two.
-inline bool starts_a_run(const unsigned char* steps, uint32_t length, uint32_t k) {
+static inline bool starts_a_run(const unsigned char* steps, uint32_t length, uint32_t k) {
     return steps[k % length] == 0 && steps[(k + length - 1) % length] == 1;
 }
 
-inline uint32_t count_a_runs(const unsigned char* steps, uint32_t length) {
+static inline uint32_t count_a_runs(const unsigned char* steps, uint32_t length) {
     uint32_t runs = 0;
     for (uint32_t k = 0; k < length; ++k) runs += starts_a_run(steps, length, k);
     return runs;
@@ -122,7 +123,8 @@ inline uint32_t count_a_runs(const unsigned char* steps, uint32_t length) {
 
 // Whether swapping steps t and t + 1 keeps at least two runs of A (only the run starts at
 // t, t + 1 and t + 2 can change).
-inline bool swap_keeps_band(unsigned char* steps, uint32_t length, uint32_t t, uint32_t runs) {
+static inline bool swap_keeps_band(unsigned char* steps, uint32_t length, uint32_t t,
+                                   uint32_t runs) {
     uint32_t before = 0, after = 0;
     for (uint32_t k = t; k < t + 3; ++k) before += starts_a_run(steps, length, k);
     unsigned char s = steps[t];
@@ -136,7 +138,7 @@ inline bool swap_keeps_band(unsigned char* steps, uint32_t length, uint32_t t, u
 
 // Merges the loops by angle; if that walks one loop in a single run (tiny or skewed
 // loops), one boundary step is swapped so the band is a band.
-inline void zip_by_angle(Band& band) {
+static inline void zip_by_angle(Band& band) {
     const uint32_t length = band.p + band.q;
     uint32_t i = 0, j = 0, t = 0;
     while (i < band.p || j < band.q) {
@@ -158,7 +160,7 @@ inline void zip_by_angle(Band& band) {
 }
 
 // Lawson flips over the step sequence; returns the number of swaps.
-inline size_t swap_diagonals(Band& band) {
+static inline size_t swap_diagonals(Band& band) {
     const uint32_t length = band.p + band.q;
     const size_t limit = 16 * static_cast<size_t>(length) + 64;
     uint32_t runs = count_a_runs(band.steps, length);
@@ -196,7 +198,7 @@ inline size_t swap_diagonals(Band& band) {
 // other loop's next (or previous) vertex; only the triangles of that stretch change, and
 // the move is kept when they all turn counter-clockwise and the band keeps two runs of A.
 // Returns the adjacent exchanges made.
-inline size_t untangle_runs(Band& band) {
+static inline size_t untangle_runs(Band& band) {
     // Longer runs (a fan from one vertex over many of the other loop) are left as they
     // are: this bounds the work at kLongestUntangledRun steps per step of the band.
     const uint32_t kLongestUntangledRun = 64;
@@ -256,7 +258,7 @@ inline size_t untangle_runs(Band& band) {
 
 // Rotates the band (its loops and steps) to start half-way round. False if the half-way
 // point does not fall between the ends of both loops (the band stays as it is).
-inline bool restart_half_way(Band& band) {
+static inline bool restart_half_way(Band& band) {
     const uint32_t length = band.p + band.q, half = length / 2;
     uint32_t i_half = 0, j_half = 0;
     for (uint32_t t = 0; t < half; ++t) (band.steps[t] == 0 ? i_half : j_half) += 1;
@@ -279,7 +281,7 @@ inline bool restart_half_way(Band& band) {
 }
 
 // Whether every step of the band is counter-clockwise on the strip.
-inline bool band_is_proper(Band& band) {
+static inline bool band_is_proper(Band& band) {
     uint32_t i = 0, j = 0;
     for (uint32_t t = 0; t < band.p + band.q; ++t) {
         if (!band.proper(t, i, j)) return false;
@@ -292,7 +294,7 @@ inline bool band_is_proper(Band& band) {
 // clockwise steps. The closing rung is held fixed by both: the band restarts half-way round
 // and swaps again, so the quads around it get their test too, and where a clockwise step is
 // left next to it, untangles once more from there.
-inline void settle_band(Band& band, size_t* swaps) {
+static inline void settle_band(Band& band, size_t* swaps) {
     zip_by_angle(band);
     *swaps += swap_diagonals(band);
     if (restart_half_way(band)) *swaps += swap_diagonals(band);
@@ -305,7 +307,7 @@ inline void settle_band(Band& band, size_t* swaps) {
 // peeling (pass 0; entry 0 is one). A peeled vertex came off an edge between entries of
 // earlier passes in its group, so the group put back whole leaves the loop as it was
 // there, and the other groups' peeling as it is.
-inline void unpeel_around(unsigned char* flags, uint32_t n, uint32_t k) {
+static inline void unpeel_around(unsigned char* flags, uint32_t n, uint32_t k) {
     auto unpeel = [flags](uint32_t i) {
         if (!(flags[i] & kPassBits)) return false;
         flags[i] |= kUnpeeled;
@@ -317,27 +319,57 @@ inline void unpeel_around(unsigned char* flags, uint32_t n, uint32_t k) {
 }
 
 // Marks every peeled entry of flags[0..n) kUnpeeled or, with !on, none.
-inline void mark_unpeeled(unsigned char* flags, uint32_t n, bool on) {
+static inline void mark_unpeeled(unsigned char* flags, uint32_t n, bool on) {
     for (uint32_t i = 0; i < n; ++i)
         flags[i] = static_cast<unsigned char>(on && (flags[i] & kPassBits) ? flags[i] | kUnpeeled
                                                                            : flags[i] & ~kUnpeeled);
 }
 
-inline size_t count_unpeeled(const unsigned char* flags, uint32_t n) {
+static inline size_t count_unpeeled(const unsigned char* flags, uint32_t n) {
     size_t marked = 0;
     for (uint32_t i = 0; i < n; ++i) marked += (flags[i] & kUnpeeled) != 0;
     return marked;
 }
 
-// Emits the triangles peeled off a loop (see "peeling" in >>layer triangulation), with
-// kLocalUnpeel those whose vertex is marked kUnpeeled, else all: vertex x, peeled in pass
-// k, came off the edge between the nearest loop vertices before and after it from earlier
-// passes (entry 0 is on the hull or the link). id(i) is entry i's band index, point(id) its
-// point.
-template <class IdOf, class PointOf>
-inline void put_back_peeled(const unsigned char* flags, uint32_t n, bool top, const IdOf& id,
-                            const PointOf& point, const Cylinder& cyl, TriangleSink& sink) {
+// A band being stitched (see stitch_layers): its loops in band indices, where their points
+// come from, and the strip they are unrolled on.
+struct Stitch {
+    const CloudReader* cloud;
+    const Frame* frame;
+    const LoadedLayer* layer;
+    const LayerLoops* loops;
+    unsigned char* a_flags;  // loop A's, every entry (a_length)
+    uint32_t a_length;
+    uint32_t below;          // the band index of A's entry 0: layer.count
+    Local* a_points;         // A's points, every entry
+    Cylinder shared;         // the strip's cylinder; its centre is set per trial
+    double unrolled_radius;
+    Band band;
+
+    // The point of band index id. The layer's points are read again (the loaded ones are in
+    // triangulate_layer's order, or were never loaded when a job triangulated the layer):
+    // only the loop's are read.
+    Local point(uint32_t id) const {
+        if (id >= below) return a_points[id - below];
+        return frame->local(cloud->point(layer->ids[id]));
+    }
+    void unroll(uint32_t id, double* uv) const {
+        const Local l = point(id);
+        uv[0] = unrolled_radius * polar_angle(l.x - shared.cx, l.y - shared.cy);
+        uv[1] = l.h - shared.h0;
+    }
+};
+
+// Emits the triangles peeled off loop A (`top`: the lower layer's top loop) or the layer's
+// bottom loop (see "peeling" in >>layer triangulation), with kLocalUnpeel those whose
+// vertex is marked kUnpeeled, else all: vertex x, peeled in pass k, came off the edge
+// between the nearest loop vertices before and after it from earlier passes (entry 0 is on
+// the hull or the link).
+static inline void put_back_peeled(const Stitch& st, bool top, TriangleSink& sink) {
+    const unsigned char* flags = top ? st.a_flags : st.loops->bottom_flags;
+    const uint32_t n = top ? st.a_length : st.loops->bottom_count;
     auto pass = [flags](uint32_t i) { return flags[i] & kPassBits; };
+    auto id = [&st, top](uint32_t i) { return top ? st.below + i : st.loops->bottom[i]; };
     for (uint32_t x = 0; x < n; ++x) {
         if (!pass(x) || (kLocalUnpeel && !(flags[x] & kUnpeeled))) continue;
         uint32_t before = x - 1, after = (x + 1) % n;
@@ -346,8 +378,112 @@ inline void put_back_peeled(const unsigned char* flags, uint32_t n, bool top, co
         // Counter-clockwise on the annulus: the top loop's edge ran before -> after, the
         // bottom loop's after -> before.
         uint32_t u = id(top ? before : after), v = id(top ? after : before), w = id(x);
-        sink.emit(u, v, w, point(u), point(v), point(w), cyl);
+        sink.emit(u, v, w, st.point(u), st.point(v), st.point(w), st.shared);
     }
+}
+
+// Carves the band's loops from the arena and fills them with the entries of A (reader
+// indices a_ids) and of the layer's bottom loop that are not left out (see stitch_layers),
+// A's points copied. False if the arena is too small.
+static inline bool gather_band_loops(Stitch& st, const uint32_t* a_ids, bool unpeel, Arena& arena) {
+    const LayerLoops& loops = *st.loops;
+    Band& band = st.band;
+    band.a = arena.alloc<uint32_t>(st.a_length);
+    band.b = arena.alloc<uint32_t>(loops.bottom_count);
+    st.a_points = arena.alloc<Local>(st.a_length);
+    band.xa = arena.alloc<double>(2 * static_cast<size_t>(st.a_length));
+    band.xb = arena.alloc<double>(2 * static_cast<size_t>(loops.bottom_count));
+    band.steps = arena.alloc<unsigned char>(static_cast<size_t>(st.a_length) + loops.bottom_count);
+    band.scratch = arena.alloc<double>(kIncircleScratch);
+    if (arena.failed) return false;
+    auto left_out = [unpeel](unsigned char f) {
+        return (f & kPassBits) && (unpeel || (kLocalUnpeel && (f & kUnpeeled)));
+    };
+    band.p = 0;
+    for (uint32_t i = 0; i < st.a_length; ++i) {
+        if (!left_out(st.a_flags[i])) band.a[band.p++] = st.below + i;
+        st.a_points[i] = st.frame->local(st.cloud->point(a_ids[i]));
+    }
+    band.q = 0;
+    for (uint32_t j = 0; j < loops.bottom_count; ++j)
+        if (!left_out(loops.bottom_flags[j])) band.b[band.q++] = loops.bottom[j];
+    return true;
+}
+
+// Unrolls both loops around the centre (cx, cy) and settles the band there.
+static inline void settle_band_around(Stitch& st, double cx, double cy, size_t* swaps) {
+    Band& band = st.band;
+    st.shared.cx = cx;
+    st.shared.cy = cy;
+    for (uint32_t i = 0; i < band.p; ++i) st.unroll(band.a[i], band.xa + 2 * i);
+    for (uint32_t j = 0; j < band.q; ++j) st.unroll(band.b[j], band.xb + 2 * j);
+    rotate_to_first_angle(band.a, band.xa, band.p);
+    rotate_to_first_angle(band.b, band.xb, band.q);
+    settle_band(band, swaps);
+}
+
+// Walks the settled band: returns its folds, adds its doubled area to *area and, with a
+// sink, writes its triangles there and (kLocalUnpeel) marks the peel groups around the
+// folds: those around the state's a[i] and b[j], which hold the triangle's third corner
+// too unless it is on the loop since before peeling. B's entry of b[j] is found walking
+// loops.bottom along (b is in its order, rotated), once around at most.
+static inline size_t walk_band(const Stitch& st, TriangleSink* sink, double* area) {
+    const Band& band = st.band;
+    const LayerLoops& loops = *st.loops;
+    const uint32_t p = band.p, q = band.q;
+    size_t folds = 0;
+    uint32_t i = 0, j = 0, entry = 0;
+    for (uint32_t t = 0; t < p + q; ++t) {
+        uint32_t x, y, z;  // counter-clockwise on the annulus
+        const uint32_t a0 = band.a[i % p], b0 = band.b[j % q];
+        if (band.steps[t] == 0) {
+            x = band.a[(i + 1) % p], y = a0, z = b0;
+            ++i;
+        } else {
+            x = b0, y = band.b[(j + 1) % q], z = a0;
+            ++j;
+        }
+        const Local px = st.point(x), py = st.point(y), pz = st.point(z);
+        const bool folded = faces_axis(px, pz, py, st.shared);
+        folds += folded;
+        *area += doubled_area(px, py, pz);
+        if (sink) sink->write(x, y, z);
+        if (!kLocalUnpeel || !sink || !folded) continue;
+        for (uint32_t k = 0; k < loops.bottom_count && loops.bottom[entry] != b0; ++k)
+            entry = (entry + 1) % loops.bottom_count;
+        unpeel_around(st.a_flags, st.a_length, a0 - st.below);
+        unpeel_around(loops.bottom_flags, loops.bottom_count, entry);
+    }
+    return folds;
+}
+
+// Settles the band around the strip's centre: the cylinders' midpoint; where the band
+// folds around it (the loops turn back around it: after choose_centre moved one of the
+// centres, the midpoint may lie outside what both loops are star-shaped around), the one
+// of the midpoint and the two layers' centres whose settled band has the least area. Trial
+// 3 settles the band again around that one, unless it was the last tried. Returns the
+// swaps of the band kept.
+static inline size_t settle_least_area(Stitch& st, const Cylinder& ca, const Cylinder& cb) {
+    const Cylinder* centres[3] = {nullptr, &ca, &cb};  // 0: the midpoint
+    double least = 0;
+    uint32_t best = 0;
+    size_t best_swaps = 0;
+    for (uint32_t trial = 0; trial < 4 && !(trial == 3 && best == 2); ++trial) {
+        const uint32_t k = trial < 3 ? trial : best;
+        size_t trial_swaps = 0;
+        settle_band_around(st, k ? centres[k]->cx : (ca.cx + cb.cx) / 2,
+                           k ? centres[k]->cy : (ca.cy + cb.cy) / 2, &trial_swaps);
+        if (trial == 3) break;
+        double area = 0;
+        const size_t folds = walk_band(st, nullptr, &area);
+        if (trial == 0 || area < least) {
+            least = area;
+            best = k;
+            best_swaps = trial_swaps;
+        }
+        if (folds == 0 && trial == 0) break;
+    }
+    return best_swaps;
 }
 
 // Stitches loop A (the lower layer's top loop: reader indices a_ids with their seam flags,
@@ -359,122 +495,35 @@ inline void put_back_peeled(const unsigned char* flags, uint32_t n, bool top, co
 // peel groups around its corners kUnpeeled (unpeel_around) for a next attempt. The band's
 // triangles name the upper layer's points by layer-local index and the i-th point of A by
 // layer.count + i.
-inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cylinder& ca,
-                          const uint32_t* a_ids, unsigned char* a_flags, uint32_t p,
-                          const LoadedLayer& layer, const LayerLoops& loops, bool unpeel,
-                          Arena& arena, TriangleSink& sink, size_t* swaps) {
+static inline bool stitch_layers(const CloudReader& cloud, const Frame& frame, const Cylinder& ca,
+                                 const uint32_t* a_ids, unsigned char* a_flags, uint32_t p,
+                                 const LoadedLayer& layer, const LayerLoops& loops, bool unpeel,
+                                 Arena& arena, TriangleSink& sink, size_t* swaps) {
     const Cylinder& cb = layer.cyl;
-    const uint32_t below = static_cast<uint32_t>(layer.count);
-    size_t mark = arena.mark();
-    uint32_t q = loops.bottom_count;
-    uint32_t* a = arena.alloc<uint32_t>(p);
-    uint32_t* b = arena.alloc<uint32_t>(q);
-    Local* a_points = arena.alloc<Local>(p);
-    double* xa = arena.alloc<double>(2 * static_cast<size_t>(p));
-    double* xb = arena.alloc<double>(2 * static_cast<size_t>(q));
-    unsigned char* steps = arena.alloc<unsigned char>(static_cast<size_t>(p) + q);
-    double* scratch = arena.alloc<double>(kIncircleScratch);
-    if (arena.failed) return false;
-    const uint32_t a_length = p;
-    auto left_out = [unpeel](unsigned char f) {
-        return (f & kPassBits) && (unpeel || (kLocalUnpeel && (f & kUnpeeled)));
-    };
-    p = 0;
-    for (uint32_t i = 0; i < a_length; ++i) {
-        if (!left_out(a_flags[i])) a[p++] = below + i;
-        a_points[i] = frame.local(cloud.point(a_ids[i]));
-    }
-    q = 0;
-    for (uint32_t j = 0; j < loops.bottom_count; ++j)
-        if (!left_out(loops.bottom_flags[j])) b[q++] = loops.bottom[j];
-    // The layer's points are read again (the loaded ones are in triangulate_layer's order,
-    // or were never loaded when a job triangulated the layer): only the loop's are read.
-    auto point = [&](uint32_t id) -> Local {
-        if (id >= below) return a_points[id - below];
-        return frame.local(cloud.point(layer.ids[id]));
-    };
-    Cylinder shared;
-    shared.poles = 0;
-    shared.radius = (ca.radius + cb.radius) / 2;
-    shared.h0 = cb.h0;
-    shared.scale = (ca.scale + cb.scale) / 2;
-    const double unrolled_radius = 1 / shared.scale;
-    auto unroll = [&](uint32_t id, double* uv) {
-        const Local l = point(id);
-        uv[0] = unrolled_radius * polar_angle(l.x - shared.cx, l.y - shared.cy);
-        uv[1] = l.h - shared.h0;
-    };
+    Stitch st;
+    st.cloud = &cloud;
+    st.frame = &frame;
+    st.layer = &layer;
+    st.loops = &loops;
+    st.a_flags = a_flags;
+    st.a_length = p;
+    st.below = static_cast<uint32_t>(layer.count);
+    const size_t mark = arena.mark();
+    if (!gather_band_loops(st, a_ids, unpeel, arena)) return false;
+    st.shared.poles = 0;
+    st.shared.radius = (ca.radius + cb.radius) / 2;
+    st.shared.h0 = cb.h0;
+    st.shared.scale = (ca.scale + cb.scale) / 2;
+    st.unrolled_radius = 1 / st.shared.scale;
     const double two_pi = 6.28318530717958647693;
-    Band band = {a, xa, p, b, xb, q, two_pi * unrolled_radius, steps, scratch, {}};
-    // Walks the settled band: returns its folds, adds its doubled area to *area and, with
-    // `emit`, writes its triangles to the sink and (kLocalUnpeel) marks the peel groups
-    // around the folds: those around the state's a[i] and b[j], which hold the triangle's
-    // third corner too unless it is on the loop since before peeling. B's entry of b[j] is
-    // found walking loops.bottom along (b is in its order, rotated), once around at most.
-    auto walk_band = [&](bool emit, double* area) {
-        size_t folds = 0;
-        uint32_t i = 0, j = 0, entry = 0;
-        for (uint32_t t = 0; t < p + q; ++t) {
-            uint32_t x, y, z;  // counter-clockwise on the annulus
-            const uint32_t a0 = a[i % p], b0 = b[j % q];
-            if (steps[t] == 0) {
-                x = a[(i + 1) % p], y = a0, z = b0;
-                ++i;
-            } else {
-                x = b0, y = b[(j + 1) % q], z = a0;
-                ++j;
-            }
-            const Local px = point(x), py = point(y), pz = point(z);
-            const bool folded = faces_axis(px, pz, py, shared);
-            folds += folded;
-            *area += doubled_area(px, py, pz);
-            if (emit) sink.write(x, y, z);
-            if (!kLocalUnpeel || !emit || !folded) continue;
-            for (uint32_t k = 0; k < loops.bottom_count && loops.bottom[entry] != b0; ++k)
-                entry = (entry + 1) % loops.bottom_count;
-            unpeel_around(a_flags, a_length, a0 - below);
-            unpeel_around(loops.bottom_flags, loops.bottom_count, entry);
-        }
-        return folds;
-    };
-    // The strip's centre: the cylinders' midpoint; where the band folds around it (the loops
-    // turn back around it: after choose_centre moved one of the centres, the midpoint may
-    // lie outside what both loops are star-shaped around), the one of the midpoint and the
-    // two layers' centres whose settled band has the least area. Trial 3 settles the band
-    // again around that one, unless it was the last tried.
-    const Cylinder* centres[3] = {nullptr, &ca, &cb};  // 0: the midpoint
-    double least = 0;
-    uint32_t best = 0;
-    size_t best_swaps = 0;
-    for (uint32_t trial = 0; trial < 4 && !(trial == 3 && best == 2); ++trial) {
-        const uint32_t k = trial < 3 ? trial : best;
-        shared.cx = k ? centres[k]->cx : (ca.cx + cb.cx) / 2;
-        shared.cy = k ? centres[k]->cy : (ca.cy + cb.cy) / 2;
-        for (uint32_t i = 0; i < p; ++i) unroll(a[i], xa + 2 * i);
-        for (uint32_t j = 0; j < q; ++j) unroll(b[j], xb + 2 * j);
-        rotate_to_first_angle(a, xa, p);
-        rotate_to_first_angle(b, xb, q);
-        size_t trial_swaps = 0;
-        settle_band(band, &trial_swaps);
-        if (trial == 3) break;
-        double area = 0;
-        const size_t folds = walk_band(false, &area);
-        if (trial == 0 || area < least) {
-            least = area;
-            best = k;
-            best_swaps = trial_swaps;
-        }
-        if (folds == 0 && trial == 0) break;
-    }
-    *swaps += best_swaps;
+    st.band.turn = two_pi * st.unrolled_radius;
+    *swaps += settle_least_area(st, ca, cb);
     if (kLocalUnpeel || unpeel) {
-        put_back_peeled(a_flags, a_length, true, [below](uint32_t i) { return below + i; },
-                        point, shared, sink);
-        put_back_peeled(loops.bottom_flags, loops.bottom_count, false,
-                        [&loops](uint32_t j) { return loops.bottom[j]; }, point, shared, sink);
+        put_back_peeled(st, true, sink);
+        put_back_peeled(st, false, sink);
     }
     double area = 0;
-    sink.folds += walk_band(true, &area);
+    sink.folds += walk_band(st, &sink, &area);
     arena.rewind(mark);
     return true;
 }

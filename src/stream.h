@@ -49,7 +49,7 @@ namespace detail {
 const double kStreamRange = 0x1p60;
 
 // Everything a stream holds for a window of `capacity` points.
-inline bool layout_stream(Stream& s, size_t capacity, Arena& arena) {
+static inline bool layout_stream(Stream& s, size_t capacity, Arena& arena) {
     s.capacity = capacity;
     s.slot_capacity = static_cast<uint32_t>(capacity + 1);
     s.points = arena.alloc<Vec3>(capacity);
@@ -62,7 +62,7 @@ inline bool layout_stream(Stream& s, size_t capacity, Arena& arena) {
     return allocate_chain(s.chain, capacity, arena) && !arena.failed;
 }
 
-inline size_t stream_bytes(size_t capacity) {
+static inline size_t stream_bytes(size_t capacity) {
     if (capacity > kMaxPoints - 1) return 0;
     Arena arena = Arena::measuring();
     arena.alloc<Stream>(1);
@@ -73,14 +73,14 @@ inline size_t stream_bytes(size_t capacity) {
     return arena.required_bytes() + scratch;
 }
 
-inline void publish(Stream& s) {
+static inline void publish(Stream& s) {
     s.rep.points.unused_count = s.rep.points.in_count - s.rep.points.used_count - s.rep.points.duplicate_count - s.rep.points.rejected_count;
     s.rep.workspace_used_bytes = s.arena.peak_from_buffer();
     if (s.user_report) *s.user_report = s.rep;
 }
 
 // A push refused: the stream is as it was; the report says why.
-inline Status refuse_push(Stream& s, Status status, const char* detail) {
+static inline Status refuse_push(Stream& s, Status status, const char* detail) {
     s.rep.detail = detail;
     publish(s);
     return status;
@@ -88,7 +88,7 @@ inline Status refuse_push(Stream& s, Status status, const char* detail) {
 
 // Keeps the last group's top loop (moved to the front of the window) and the pushes after
 // planned layer `last`.
-inline void drop_group(Stream& s, uint32_t last) {
+static inline void drop_group(Stream& s, uint32_t last) {
     const uint32_t loop = s.chain.top_count;
     const size_t rest_from = s.start[last + 1], rest = s.fill - rest_from;
     size_t mark = s.arena.mark();
@@ -115,7 +115,7 @@ inline void drop_group(Stream& s, uint32_t last) {
 }
 
 // Forms, emits and drops every group the held pushes decide.
-inline Status advance(Stream& s, bool complete) {
+static inline Status advance(Stream& s, bool complete) {
     while (s.planned > 0) {
         const LayerQueue queue = {s.positions, nullptr, s.start, s.bounds, s.planned, complete};
         GroupResult group;
@@ -135,6 +135,101 @@ inline Status advance(Stream& s, bool complete) {
         drop_group(s, group.last);
     }
     return Status::ok;
+}
+
+// Why a push's arguments are refused, with *why, or ok with the pushed cloud's reader: its
+// layout, its top and its count are checked.
+static inline Status check_push(const Stream& s, const Cloud& points, double top,
+                                CloudReader* reader, const char** why) {
+    const size_t scalar = points.scalar == Scalar::float32 ? sizeof(float)
+                        : points.scalar == Scalar::float64 ? sizeof(double) : 0;
+    const size_t stride = points.stride_bytes ? points.stride_bytes : 3 * scalar;
+    if (scalar == 0 || stride < 3 * scalar || (points.count > 0 && !points.xyz) ||
+        ranges_overlap(strided_range(points.xyz, points.count, stride, 3 * scalar), s.workspace)) {
+        *why = "a pushed cloud has a null pointer with a non-zero count, a stride smaller than "
+               "one point, an unknown scalar type, or points in the stream's workspace";
+        return Status::invalid_argument;
+    }
+    if (!is_finite(top)) {
+        *why = "a pushed layer's top is NaN or infinite";
+        return Status::invalid_layers;
+    }
+    if (points.count > kMaxPoints - 1 - s.rep.points.in_count) {
+        *why = "more points pushed than 32-bit triangle indices can address";
+        return Status::too_many_points;
+    }
+    *reader = {static_cast<const unsigned char*>(points.xyz), stride,
+               points.scalar == Scalar::float32, nullptr};
+    return Status::ok;
+}
+
+const char* const kTopBelow = "a pushed layer's top is below the previous layer's top";
+
+// The heights of the push's valid points in the frame, *low to *high, or why the push is
+// refused, with *why (and the point's index where one is to blame): a point far beyond the
+// first layer, or outside its own layer, between lower_limit and top_height.
+static inline Status push_heights(Stream& s, const CloudReader& reader, size_t count,
+                                  const Frame& frame, double lower_limit, double top_height,
+                                  double* low, double* high, const char** why) {
+    auto slack = [](double h) { return 0x1p-40 * (1 + abs_value(h)); };
+    *low = DBL_MAX;
+    *high = -DBL_MAX;
+    for (size_t i = 0; i < count; ++i) {
+        if (!reader.valid(i)) continue;
+        const Local p = frame.local(reader.point(i));
+        if (!(abs_value(p.x) <= kStreamRange && abs_value(p.y) <= kStreamRange &&
+              abs_value(p.h) <= kStreamRange)) {
+            s.rep.points.first_invalid_index = s.rep.points.in_count + i;
+            *why = "a pushed point lies more than 2^60 times the first layer's size away from it";
+            return Status::invalid_point;
+        }
+        if (p.h > top_height + slack(top_height) || p.h < lower_limit - slack(lower_limit)) {
+            *why = "a pushed point lies outside its layer: below the previous layer's top or "
+                   "above its own";
+            return Status::out_of_order;
+        }
+        if (p.h < *low) *low = p.h;
+        if (p.h > *high) *high = p.h;
+    }
+    return Status::ok;
+}
+
+// Holds the checked push as the next planned layer, its valid points from heights `low` to
+// `high` in the window; the first push with points sets the stream's frame.
+static inline void hold_push(Stream& s, const CloudReader& reader, size_t count, const Frame& frame,
+                             double low, double high, double top_height) {
+    if (!s.has_frame) {
+        s.has_frame = true;
+        s.chain.frame = frame;
+        s.chain.reader = {reinterpret_cast<const unsigned char*>(s.points), sizeof(Vec3), false,
+                          nullptr};
+        s.chain.output_id = s.global;
+        report_frame(frame, s.rep);
+        s.lowest = low;
+        s.highest = high;
+        s.bounds[0] = low;
+        s.start[0] = 0;
+    } else {
+        s.bounds[s.planned] = s.last_top;  // was the highest point so far
+    }
+    for (size_t i = 0; i < count; ++i) {
+        if (!reader.valid(i)) {
+            ++s.rep.points.rejected_count;
+            continue;
+        }
+        const Vec3 p = reader.point(i);
+        s.distinct.add(p);
+        s.points[s.fill] = p;
+        s.global[s.fill] = static_cast<uint32_t>(s.rep.points.in_count + i);
+        ++s.fill;
+    }
+    s.rep.points.in_count += count;
+    if (low <= high && high > s.highest) s.highest = high;
+    ++s.planned;
+    s.start[s.planned] = static_cast<uint32_t>(s.fill);
+    s.bounds[s.planned] = s.highest;
+    s.last_top = top_height;
+    if (s.fill > s.rep.points.held_count) s.rep.points.held_count = s.fill;
 }
 
 }  // namespace detail
@@ -202,40 +297,21 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     if (!stream || stream->closed) return Status::invalid_argument;
     Stream& s = *stream;
     if (s.failure != Status::ok) return s.failure;
-    size_t scalar = points.scalar == Scalar::float32 ? sizeof(float)
-                  : points.scalar == Scalar::float64 ? sizeof(double) : 0;
-    size_t stride = points.stride_bytes ? points.stride_bytes : 3 * scalar;
     // A refusal names its own reason, never the one of a push refused before.
-    Status refusal = Status::ok;
     const char* why = nullptr;
-    if (scalar == 0 || stride < 3 * scalar || (points.count > 0 && !points.xyz) ||
-        detail::ranges_overlap(detail::strided_range(points.xyz, points.count, stride, 3 * scalar),
-                               s.workspace)) {
-        refusal = Status::invalid_argument;
-        why = "a pushed cloud has a null pointer with a non-zero count, a stride smaller than "
-              "one point, an unknown scalar type, or points in the stream's workspace";
-    } else if (!detail::is_finite(top)) {
-        refusal = Status::invalid_layers;
-        why = "a pushed layer's top is NaN or infinite";
-    } else if (points.count > detail::kMaxPoints - 1 - s.rep.points.in_count) {
-        refusal = Status::too_many_points;
-        why = "more points pushed than 32-bit triangle indices can address";
-    }
-    if (refusal != Status::ok) return detail::refuse_push(s, refusal, why);
-    const detail::CloudReader reader = {static_cast<const unsigned char*>(points.xyz), stride,
-                                        points.scalar == Scalar::float32, nullptr};
+    detail::CloudReader reader;
+    Status status = detail::check_push(s, points, top, &reader, &why);
+    if (status != Status::ok) return detail::refuse_push(s, status, why);
     // Check everything before anything changes.
     const detail::CloudSums sums = detail::sum_cloud(reader, points.count);
-    const size_t valid = sums.valid;
     const size_t first_invalid = detail::refused_at(reader, points.count, sums, s.options);
     if (first_invalid < points.count) {
         s.rep.points.first_invalid_index = s.rep.points.in_count + first_invalid;
         return detail::refuse_push(s, Status::invalid_point, detail::kInvalidPointDetail);
     }
-    const char* const top_below = "a pushed layer's top is below the previous layer's top";
     if (!s.has_frame && top < s.early_top)
-        return detail::refuse_push(s, Status::out_of_order, top_below);
-    if (!s.has_frame && valid == 0) {  // nothing to place yet: pushes before the first point
+        return detail::refuse_push(s, Status::out_of_order, detail::kTopBelow);
+    if (!s.has_frame && sums.valid == 0) {  // nothing to place yet: pushes before the first point
         s.rep.points.in_count += points.count;
         s.rep.points.rejected_count += points.count;
         s.early_top = top;
@@ -244,7 +320,7 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     }
     detail::Frame frame = s.chain.frame;
     if (!s.has_frame) {
-        Status status = detail::choose_frame(sums, s.options, frame);
+        status = detail::choose_frame(sums, s.options, frame);
         if (status == Status::invalid_origin)
             return detail::refuse_push(s, status, detail::origin_refusal(s.options, sums));
         if (status != Status::ok) return status;
@@ -255,65 +331,19 @@ Status stream_push(Stream* stream, const Cloud& points, double top) {
     // first point that of the pushes without points (far below all, or -infinity, if none).
     const double lower_limit =
         s.has_frame ? s.last_top : (s.early_top - axis_origin) * frame.scale;
-    auto slack = [](double h) { return 0x1p-40 * (1 + detail::abs_value(h)); };
-    if (top_height < lower_limit) return detail::refuse_push(s, Status::out_of_order, top_below);
-    double low = DBL_MAX, high = -DBL_MAX;
-    for (size_t i = 0; i < points.count; ++i) {
-        if (!reader.valid(i)) continue;
-        detail::Local p = frame.local(reader.point(i));
-        if (!(detail::abs_value(p.x) <= detail::kStreamRange &&
-              detail::abs_value(p.y) <= detail::kStreamRange &&
-              detail::abs_value(p.h) <= detail::kStreamRange)) {
-            s.rep.points.first_invalid_index = s.rep.points.in_count + i;
-            return detail::refuse_push(s, Status::invalid_point,
-                                       "a pushed point lies more than 2^60 times the first "
-                                       "layer's size away from it");
-        }
-        if (p.h > top_height + slack(top_height) || p.h < lower_limit - slack(lower_limit))
-            return detail::refuse_push(s, Status::out_of_order,
-                                       "a pushed point lies outside its layer: below the previous "
-                                       "layer's top or above its own");
-        if (p.h < low) low = p.h;
-        if (p.h > high) high = p.h;
-    }
-    if (s.fill + valid > s.capacity || s.planned + 1 > s.slot_capacity)
+    if (top_height < lower_limit)
+        return detail::refuse_push(s, Status::out_of_order, detail::kTopBelow);
+    double low = 0, high = 0;
+    status = detail::push_heights(s, reader, points.count, frame, lower_limit, top_height, &low,
+                                  &high, &why);
+    if (status != Status::ok) return detail::refuse_push(s, status, why);
+    if (s.fill + sums.valid > s.capacity || s.planned + 1 > s.slot_capacity)
         return detail::refuse_push(s, Status::out_of_memory,
                                    "the stream would hold more points or layers than its workspace: "
                                    "push thicker layers, or give more workspace (see "
                                    "Report::points.held_count)");
-    // Commit.
-    if (!s.has_frame) {
-        s.has_frame = true;
-        s.chain.frame = frame;
-        s.chain.reader = {reinterpret_cast<const unsigned char*>(s.points), sizeof(detail::Vec3), false, nullptr};
-        s.chain.output_id = s.global;
-        detail::report_frame(frame, s.rep);
-        s.lowest = low;
-        s.highest = high;
-        s.bounds[0] = low;
-        s.start[0] = 0;
-    } else {
-        s.bounds[s.planned] = s.last_top;  // was the highest point so far
-    }
-    for (size_t i = 0; i < points.count; ++i) {
-        if (!reader.valid(i)) {
-            ++s.rep.points.rejected_count;
-            continue;
-        }
-        detail::Vec3 p = reader.point(i);
-        s.distinct.add(p);
-        s.points[s.fill] = p;
-        s.global[s.fill] = static_cast<uint32_t>(s.rep.points.in_count + i);
-        ++s.fill;
-    }
-    s.rep.points.in_count += points.count;
-    if (valid > 0 && high > s.highest) s.highest = high;
-    ++s.planned;
-    s.start[s.planned] = static_cast<uint32_t>(s.fill);
-    s.bounds[s.planned] = s.highest;
-    s.last_top = top_height;
-    if (s.fill > s.rep.points.held_count) s.rep.points.held_count = s.fill;
-    Status status = detail::advance(s, false);
+    detail::hold_push(s, reader, points.count, frame, low, high, top_height);
+    status = detail::advance(s, false);
     if (status != Status::ok) s.failure = status;
     // The counts so far; why a point is not a vertex is only known at the close.
     detail::report_chain(s.chain, s.rep.points.in_count - s.rep.points.rejected_count, s.rep);

@@ -20,16 +20,17 @@ struct ReconstructMemory {
     SurfaceChain chain;
 };
 
-inline bool plan_reconstruct(ReconstructMemory& m, size_t count, size_t layer_limit,
-                             Arena& arena) {
+static inline bool plan_reconstruct(ReconstructMemory& m, size_t count, size_t layer_limit,
+                                    Arena& arena) {
     m.bounds = arena.alloc<double>(layer_limit + 1);
     m.layer_start = arena.alloc<uint32_t>(layer_limit + 2);
     m.order = arena.alloc<uint32_t>(count);
     return allocate_chain(m.chain, count, arena);
 }
 
-inline void describe_layer(const Frame& frame, const Cylinder& cyl, double bottom, double top,
-                           size_t points, size_t triangles, size_t folds, LayerInfo& info) {
+static inline void describe_layer(const Frame& frame, const Cylinder& cyl, double bottom,
+                                  double top, size_t points, size_t triangles, size_t folds,
+                                  LayerInfo& info) {
     info.bottom = frame.user_height(bottom);
     info.top = frame.user_height(top);
     double mid = (bottom + top) / 2 / frame.scale, cx = cyl.cx / frame.scale, cy = cyl.cy / frame.scale;
@@ -47,7 +48,7 @@ inline void describe_layer(const Frame& frame, const Cylinder& cyl, double botto
 }
 
 // The workspace bound of mesh_tube() (with read_cloud()) for point_count points.
-inline size_t tube_workspace_size(size_t point_count, const Options& options) {
+static inline size_t tube_workspace_size(size_t point_count, const Options& options) {
     if (point_count > kMaxPoints - 1) return 0;
     Arena arena = Arena::measuring();
     // drop_outliers, as find_outliers allocates: the bitmap stays, the grid comes and goes
@@ -68,7 +69,7 @@ inline size_t tube_workspace_size(size_t point_count, const Options& options) {
                                                       (options.flags & close_ends) != 0);
     // With a runner, the layers done ahead (at most one per kMinLayerPoints points, plus the
     // last) stay while the groups are formed.
-    if (options.run_jobs &&
+    if (has_runner(options) &&
         !plan_parallel_workspace(point_count, layer_limit, arena, &scratch))
         return 0;
     if (arena.failed || scratch == 0 || scratch > SIZE_MAX - arena.required_bytes()) return 0;
@@ -77,7 +78,7 @@ inline size_t tube_workspace_size(size_t point_count, const Options& options) {
 }
 
 // The chain's counts into the report, with the reason when a valid point is not a vertex.
-inline void report_chain(const SurfaceChain& chain, size_t valid, Report& rep) {
+static inline void report_chain(const SurfaceChain& chain, size_t valid, Report& rep) {
     rep.points.duplicate_count = chain.duplicates;
     rep.diagnostics.illegal_removed_count = chain.removed;
     rep.points.used_count = chain.used;
@@ -98,9 +99,9 @@ inline void report_chain(const SurfaceChain& chain, size_t valid, Report& rep) {
 // it out), its repeats are unused too, so where some points are not vertices they are
 // counted again from the output, with a hash table of the vertices' coordinates in the
 // workspace. Returns SIZE_MAX if the workspace is too small.
-inline size_t repeats_of_vertices(const CloudReader& reader, size_t count,
-                                  const uint32_t* triangles, size_t triangle_count,
-                                  Arena& arena) {
+static inline size_t repeats_of_vertices(const CloudReader& reader, size_t count,
+                                         const uint32_t* triangles, size_t triangle_count,
+                                         Arena& arena) {
     const size_t mark = arena.mark();
     unsigned char* used = arena.alloc<unsigned char>(count / 8 + 1);
     size_t slots = 1;
@@ -135,9 +136,10 @@ inline size_t repeats_of_vertices(const CloudReader& reader, size_t count,
 }
 
 // Plans the layers of a tube along the frame's axis and groups its points by layer.
-inline Status plan_tube_layers(const TubeInput& in, const Options& options, const Frame& frame,
-                               double lo, double hi, Arena& arena, ReconstructMemory& m,
-                               LayerPlan& plan, Local** staged, Report& rep) {
+static inline Status plan_tube_layers(const TubeInput& in, const Options& options,
+                                      const Frame& frame, double lo, double hi, Arena& arena,
+                                      ReconstructMemory& m, LayerPlan& plan, Local** staged,
+                                      Report& rep) {
     const size_t valid = in.sums.valid;
     const size_t layer_limit = planned_layer_limit(in.count, options);
     if (!plan_reconstruct(m, in.count, layer_limit, arena)) return Status::out_of_memory;
@@ -166,7 +168,7 @@ inline Status plan_tube_layers(const TubeInput& in, const Options& options, cons
     const size_t mark = arena.mark();
     uint32_t* layer = arena.alloc<uint32_t>(in.count);
     if (arena.failed) return Status::out_of_memory;
-    if (kStagePoints && !(kParallelLayers && options.run_jobs))
+    if (kStagePoints && !has_runner(options))
         *staged = static_cast<Local*>(arena.room_at_end(saturating_product(valid, sizeof(Local))));
     if (!group_by_layer_in_jobs(options, in.reader, in.count, frame, plan, layer, m.layer_start,
                                 m.order, arena))
@@ -177,9 +179,10 @@ inline Status plan_tube_layers(const TubeInput& in, const Options& options, cons
 
 // Triangulates the planned layers one group after another, each stitched to the one below,
 // into `sink`; the layers used go to the report.
-inline Status triangulate_tube(const TubeInput& in, const Options& options, const Frame& frame,
-                               const LayerPlan& plan, Local* staged, Arena& arena,
-                               ReconstructMemory& m, TriangleSink& sink, Report& rep) {
+static inline Status triangulate_tube(const TubeInput& in, const Options& options,
+                                      const Frame& frame, const LayerPlan& plan, Local* staged,
+                                      Arena& arena, ReconstructMemory& m, TriangleSink& sink,
+                                      Report& rep) {
     notify(options, Phase::triangulate, 0);
     SurfaceChain& chain = m.chain;
     chain.frame = frame;
@@ -229,8 +232,8 @@ const size_t kAreaSample = 1024;
 
 // Whether the triangles, every k-th of them, have next to no area beside the square of the
 // cloud's own extent (about frame.cloud_share in the frame).
-inline bool has_no_area(const CloudReader& reader, const Frame& frame, const uint32_t* tri,
-                        size_t count) {
+static inline bool has_no_area(const CloudReader& reader, const Frame& frame, const uint32_t* tri,
+                               size_t count) {
     const size_t step = count > kAreaSample ? count / kAreaSample : 1;
     double area = 0;
     size_t seen = 0;
@@ -245,9 +248,9 @@ inline bool has_no_area(const CloudReader& reader, const Frame& frame, const uin
 }
 
 // Closes the tube's boundary loops with caps (close_ends) and fills the caps' report.
-inline Status cap_tube(const TubeInput& in, const Options& options, const Frame& frame,
-                       Arena& arena, uint32_t* triangles, size_t capacity, size_t& count,
-                       size_t* triangle_count, Report& rep) {
+static inline Status cap_tube(const TubeInput& in, const Options& options, const Frame& frame,
+                              Arena& arena, uint32_t* triangles, size_t capacity, size_t& count,
+                              size_t* triangle_count, Report& rep) {
     notify(options, Phase::manifold, 0);
     if (!(options.flags & close_ends)) return Status::ok;
     CapCounts caps = {0, 0, 0, 0};
@@ -269,9 +272,9 @@ inline Status cap_tube(const TubeInput& in, const Options& options, const Frame&
 // One tube through the kept points of `in`: the frame, the layers, their triangulation and
 // stitching, the caps. `rep` holds the counts of read_cloud; Report::points.unused_count
 // is left to the caller.
-inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& arena,
-                        uint32_t* triangles, size_t triangle_capacity, size_t* triangle_count,
-                        Report& rep) {
+static inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& arena,
+                               uint32_t* triangles, size_t triangle_capacity,
+                               size_t* triangle_count, Report& rep) {
     Frame frame;
     Status status = choose_frame(in.sums, options, frame);
     if (status != Status::ok) return status;

@@ -41,8 +41,8 @@ struct WebMemory {
     float* lengths;
 };
 
-inline bool allocate_webs(WebMemory& m, size_t point_count, size_t triangle_count,
-                          Arena& arena) {
+static inline bool allocate_webs(WebMemory& m, size_t point_count, size_t triangle_count,
+                                 Arena& arena) {
     m.points = arena.alloc<Vec3>(point_count);
     m.ends = arena.alloc<size_t>(point_count);
     m.spacings = arena.alloc<float>(point_count);
@@ -56,7 +56,7 @@ inline bool allocate_webs(WebMemory& m, size_t point_count, size_t triangle_coun
 }
 
 // The workspace measure_webs() takes.
-inline size_t webs_workspace_size(size_t point_count, size_t triangle_count) {
+static inline size_t webs_workspace_size(size_t point_count, size_t triangle_count) {
     Arena arena = Arena::measuring();
     WebMemory m;
     return allocate_webs(m, point_count, triangle_count, arena) ? arena.required_bytes() : 0;
@@ -81,7 +81,7 @@ struct WebFrame {
     }
 };
 
-inline WebFrame web_frame(const CloudSums& s) {
+static inline WebFrame web_frame(const CloudSums& s) {
     const Vec3 low = {s.lowest[0], s.lowest[1], s.lowest[2]};
     const Vec3 high = {s.highest[0], s.highest[1], s.highest[2]};
     const Vec3 size = high - low, half = scaled(high, 0.5) - scaled(low, 0.5);
@@ -91,7 +91,7 @@ inline WebFrame web_frame(const CloudSums& s) {
 }
 
 // a, b in order (as min and max, which compile without a branch).
-inline void order(float& a, float& b) {
+static inline void order(float& a, float& b) {
     const float low = b < a ? b : a, high = a < b ? b : a;
     a = low;
     b = high;
@@ -99,7 +99,7 @@ inline void order(float& a, float& b) {
 
 // The lower median of v[0 .. count), count > 0: by a sorting network for a vertex's few
 // edges (no branch to mispredict), by heapsort for a large fan.
-inline float lower_median(float* v, size_t count) {
+static inline float lower_median(float* v, size_t count) {
     if (count > 8) {
         heap_sort(v, count);
         return v[(count - 1) / 2];
@@ -121,8 +121,8 @@ const size_t kWebAhead = 16;
 
 // Numbers the vertices, renumbers the triangles' corners and counts the edges leaving each
 // vertex, then turns the counts into starts; returns how many vertices there are.
-inline uint32_t number_vertices(uint32_t* tri, size_t count, size_t point_count,
-                                const WebMemory& m) {
+static inline uint32_t number_vertices(uint32_t* tri, size_t count, size_t point_count,
+                                       const WebMemory& m) {
     for (size_t v = 0; v < point_count; ++v) m.id[v] = kNoIndex;
     uint32_t vertices = 0;
     for (size_t k = 0; k < 3 * count; ++k) {
@@ -145,7 +145,7 @@ inline uint32_t number_vertices(uint32_t* tri, size_t count, size_t point_count,
     return vertices;
 }
 
-// The passes over the vertices, by runs of them (see run_pass) or all at once.
+// The passes over the vertices, by runs of them (see run_pass).
 struct WebVertexPass {
     const CloudReader* reader;
     const WebFrame* frame;
@@ -153,8 +153,8 @@ struct WebVertexPass {
     uint32_t vertices;
     bool medians;  // else the points
 
-    void run(uint32_t k) { over(run_start(vertices, k), run_start(vertices, k + 1)); }
-    void over(size_t begin, size_t end) const {
+    void run(uint32_t k) const {
+        const size_t begin = run_start(vertices, k), end = run_start(vertices, k + 1);
         if (!medians) {
             for (size_t v = begin; v < end; ++v) {
                 if (kFastLoops && v + kWebAhead < end)
@@ -170,17 +170,10 @@ struct WebVertexPass {
     }
 };
 
-inline void run_vertex_pass(const Options& options, WebVertexPass& pass) {
-    if (kParallelLayers && options.run_jobs)
-        run_pass(options, pass);
-    else
-        pass.over(0, pass.vertices);
-}
-
 // The lengths of the edges leaving each vertex, sorted by vertex (a counting sort: each
 // start becomes an end), and each triangle's longest edge. Returns the triangles' area.
-inline double edge_lengths(const WebFrame& f, const uint32_t* tri, size_t count,
-                           const WebMemory& m) {
+static inline double edge_lengths(const WebFrame& f, const uint32_t* tri, size_t count,
+                                  const WebMemory& m) {
     double area = 0;
     for (size_t t = 0; t < count; ++t) {
         const uint32_t* c = tri + 3 * t;
@@ -201,8 +194,8 @@ inline double edge_lengths(const WebFrame& f, const uint32_t* tri, size_t count,
 
 // The web triangles among the renumbered triangles (see Diagnostics), into d, while their
 // corners are numbered back; returns their area.
-inline double find_webs(const WebFrame& f, uint32_t* tri, size_t count, const WebMemory& m,
-                        Diagnostics& d) {
+static inline double find_webs(const WebFrame& f, uint32_t* tri, size_t count, const WebMemory& m,
+                               Diagnostics& d) {
     double web = 0;
     Vec3 low = {DBL_MAX, DBL_MAX, DBL_MAX}, high = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
     for (size_t t = 0; t < count; ++t) {
@@ -238,9 +231,9 @@ inline double find_webs(const WebFrame& f, uint32_t* tri, size_t count, const We
 // Measures the webs of triangles[0 .. count) less the last `caps` into rep.diagnostics;
 // the triangles are renumbered meanwhile and come back as they were. False if the
 // workspace is too small (nothing is measured).
-inline bool measure_webs(const Options& options, const CloudReader& reader, size_t point_count,
-                         const CloudSums& sums, uint32_t* triangles, size_t count, size_t caps,
-                         Arena& arena, Report& rep) {
+static inline bool measure_webs(const Options& options, const CloudReader& reader,
+                                size_t point_count, const CloudSums& sums, uint32_t* triangles,
+                                size_t count, size_t caps, Arena& arena, Report& rep) {
     const size_t walls = caps < count ? count - caps : 0;
     const size_t mark = arena.mark();
     WebMemory m;
@@ -248,10 +241,10 @@ inline bool measure_webs(const Options& options, const CloudReader& reader, size
     const WebFrame f = web_frame(sums);
     WebVertexPass pass = {&reader, &f, &m, number_vertices(triangles, walls, point_count, m),
                           false};
-    run_vertex_pass(options, pass);
+    run_pass(options, pass);
     const double area = edge_lengths(f, triangles, walls, m);
     pass.medians = true;
-    run_vertex_pass(options, pass);
+    run_pass(options, pass);
     Diagnostics& d = rep.diagnostics;
     const double web = find_webs(f, triangles, walls, m, d);
     arena.rewind(mark);

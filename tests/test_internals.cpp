@@ -1,6 +1,7 @@
 // Internal functions whose fast paths must answer as the plain way does, bit for bit:
-// the frame's height range from the extremes, the layer of a height. This suite compiles
-// the implementation itself, to reach them.
+// the frame's height range from the extremes, the layer of a height; and the one place
+// that hands jobs to the caller's runner. This suite compiles the implementation itself,
+// to reach them.
 #define STRATMESH_IMPLEMENTATION
 #include "stratmesh.h"
 
@@ -138,4 +139,58 @@ TEST_CASE("internals: exp_portable is within two ulp of exp, monotone, and clamp
     CHECK(stratmesh::detail::exp_portable(-1e300) == stratmesh::detail::exp_portable(-64));
     CHECK(stratmesh::detail::exp_portable(std::nan("")) == stratmesh::detail::exp_portable(-64));
     CHECK(stratmesh::detail::exp_portable(0) == 1);
+}
+
+namespace {
+
+// Runners that break the contract in the ways JobRunner allows for; each counts its calls
+// in *user.
+void run_twice_and_strangers(void* user, uint32_t count, stratmesh::JobFunction job,
+                             void* context) {
+    ++*static_cast<int*>(user);
+    job(context, count);
+    for (int round = 0; round < 2; ++round)
+        for (uint32_t i = 0; i < count; ++i) job(context, i);
+    job(context, 0xFFFFFFFFu);
+}
+
+void run_even_jobs(void* user, uint32_t count, stratmesh::JobFunction job, void* context) {
+    ++*static_cast<int*>(user);
+    for (uint32_t i = 0; i < count; i += 2) job(context, i);
+}
+
+}  // namespace
+
+TEST_CASE("internals: run_jobs runs each job once whatever the runner does, skipped ones after") {
+    // Without parallel layers in the build the runner is never called: all run in order.
+    const bool jobs = stratmesh::detail::kParallelLayers;
+    const std::vector<uint32_t> in_order = {0, 1, 2, 3, 4, 5, 6};
+    const std::vector<uint32_t> none = {};
+    struct Case {
+        const char* name;
+        stratmesh::JobRunner runner;
+        bool redo_skipped;
+        std::vector<uint32_t> ran;  // the jobs run, in the order they ran
+    };
+    const Case cases[] = {
+        {"no runner", nullptr, true, in_order},
+        {"no runner, skipped jobs left undone", nullptr, false, none},
+        {"each job twice, indices past the batch", run_twice_and_strangers, true, in_order},
+        {"every other job", run_even_jobs, true,
+         jobs ? std::vector<uint32_t>{0, 2, 4, 6, 1, 3, 5} : in_order},
+        {"every other job, skipped jobs left undone", run_even_jobs, false,
+         jobs ? std::vector<uint32_t>{0, 2, 4, 6} : none},
+    };
+    for (const Case& c : cases) {
+        INFO(c.name);
+        int runner_calls = 0;
+        Options options = {};
+        options.run_jobs = c.runner;
+        options.jobs_user = &runner_calls;
+        std::vector<uint32_t> ran;
+        stratmesh::detail::run_jobs(options, 7, c.redo_skipped,
+                                    [&ran](uint32_t k) { ran.push_back(k); });
+        CHECK(ran == c.ran);
+        CHECK(runner_calls == (c.runner && jobs ? 1 : 0));
+    }
 }

@@ -155,25 +155,29 @@ inline double normals_along(const double* xyz, const uint32_t* tri, size_t count
     return area > 0 ? along / area : 1;
 }
 
-// Workspace for choose_axis() on a cloud of `valid` kept points, given the flags.
-inline size_t axis_workspace_size(size_t valid, const Options& options);
-
-// Meshes the sample along one candidate; DBL_MAX if it cannot.
-// *along (optional) receives the share of the sample surface's normals along the axis.
-inline double try_axis(const double* sample, size_t count, Vec3 axis, const Options& options,
-                       Arena& arena, double* along) {
-    Options trial = {};
+// What a candidate's sample is meshed as: one layer along `axis`, its ends cut where the
+// tube's are, nothing else asked for and no callback.
+inline TubeRequest trial_request(const TubeRequest& tube, Vec3 axis) {
+    TubeRequest trial = {};
     trial.axis = Axis::direction;
     trial.direction[0] = axis.x;
     trial.direction[1] = axis.y;
     trial.direction[2] = axis.z;
-    trial.flags = options.flags & open_ends;
-    trial.layer_count = 1;
+    trial.cut_ends = tube.cut_ends;
+    trial.layers.count = 1;
+    return trial;
+}
+
+// Meshes the sample along one candidate; DBL_MAX if it cannot.
+// *along (optional) receives the share of the sample surface's normals along the axis.
+inline double try_axis(const double* sample, size_t count, Vec3 axis, const TubeRequest& request,
+                       Arena& arena, double* along) {
+    const TubeRequest trial = trial_request(request, axis);
     const size_t mark = arena.mark();
     uint32_t* tri = arena.alloc<uint32_t>(6 * count);
     if (arena.failed) return DBL_MAX;
     const Cloud cloud = {sample, count, 0, Scalar::float64};
-    TubeInput in = {reader_of(cloud), count, {}, 0};
+    TubeInput in = {reader_of(cloud), count, {}};
     in.sums = sum_cloud(in.reader, count);
     Report rep = {};
     size_t triangles = 0;
@@ -215,7 +219,8 @@ inline double* sample_points(const TubeInput& in, size_t most, Arena& arena, siz
 
 // The axis for Axis::automatic: the candidate whose sample surface is smallest (see above).
 // False if the workspace is too small.
-inline bool choose_axis(const TubeInput& in, const Options& options, Arena& arena, Vec3& axis) {
+inline bool choose_axis(const TubeInput& in, const TubeRequest& request, Arena& arena,
+                        Vec3& axis) {
     const size_t mark = arena.mark();
     size_t taken = 0;
     const double* shape = sample_points(in, kAxisShapeSample, arena, &taken);
@@ -227,9 +232,9 @@ inline bool choose_axis(const TubeInput& in, const Options& options, Arena& aren
     if (!sample) return false;
     axis = candidates[0];
     double along = 1;
-    double best = try_axis(sample, taken, candidates[0], options, arena, &along);
+    double best = try_axis(sample, taken, candidates[0], request, arena, &along);
     for (uint32_t k = 1; k < tries && !(along < kAlongSurface); ++k) {
-        const double score = try_axis(sample, taken, candidates[k], options, arena, nullptr);
+        const double score = try_axis(sample, taken, candidates[k], request, arena, nullptr);
         if (score < best) {
             best = score;
             axis = candidates[k];
@@ -239,12 +244,10 @@ inline bool choose_axis(const TubeInput& in, const Options& options, Arena& aren
     return !arena.failed;
 }
 
-inline size_t axis_workspace_size(size_t valid, const Options& options) {
+// Workspace for choose_axis() on a cloud of `valid` kept points.
+inline size_t axis_workspace_size(size_t valid, const TubeRequest& request) {
     const size_t count = valid < kAxisSample ? valid : kAxisSample;
-    Options trial = {};
-    trial.flags = options.flags & open_ends;
-    trial.layer_count = 1;
-    const size_t tube = tube_workspace_size(count, trial);
+    const size_t tube = tube_workspace_size(count, trial_request(request, Vec3{0, 0, 1}));
     if (tube == 0) return 0;
     const size_t shape = valid < kAxisShapeSample ? valid : kAxisShapeSample;
     Arena arena = Arena::measuring();
@@ -253,28 +256,25 @@ inline size_t axis_workspace_size(size_t valid, const Options& options) {
     return arena.failed ? 0 : arena.required_bytes() + tube;
 }
 
-// The options along the axis to use: Axis::automatic resolved by choose_axis().
-inline Status resolve_axis(const TubeInput& in, const Options& options, Arena& arena,
-                           Options& along, Report& rep) {
-    along = options;
-    if (options.axis != Axis::automatic) return Status::ok;
+// Axis::automatic in `request` resolved by choose_axis(); any other axis stays.
+inline Status resolve_axis(const TubeInput& in, Arena& arena, TubeRequest& request,
+                           Report& rep) {
+    if (request.axis != Axis::automatic) return Status::ok;
     if (!kAxisTrials) {
         rep.detail = kNotCompiledDetail;
         return Status::not_compiled;
     }
     if (in.sums.distinct < 3) {  // no surface along any axis: mesh_tube says so
-        along.axis = Axis::z;
+        request.axis = Axis::z;
         return Status::ok;
     }
     Vec3 axis;
-    if (!choose_axis(in, options, arena, axis)) {
+    if (!choose_axis(in, request, arena, axis)) {
         rep.detail = "the workspace is smaller than reconstruct_workspace_size()";
         return Status::out_of_memory;
     }
-    along.axis = Axis::direction;
-    along.direction[0] = axis.x;
-    along.direction[1] = axis.y;
-    along.direction[2] = axis.z;
+    const double direction[3] = {axis.x, axis.y, axis.z};
+    request = along_direction(request, direction);
     return Status::ok;
 }
 

@@ -3736,36 +3736,35 @@ struct TubeRequest {
     bool drop_outliers;     // the cloud is read without its outliers
     const double* origin;   // the frame's reference point, or null for the centroid
     PartsPolicy parts;
-    // The caller's Options, whose callbacks run (progress only where `progress`), or null:
-    // none (an axis trial).
+    // The caller's Options: its job runner, or null for none (an axis trial).
     const Options* caller;
-    bool progress;
+    // The Options whose progress callback is told, or null: none (a branch, whose progress
+    // would run backwards from part to part; an axis trial).
+    const Options* progress;
 };
 
 inline TubeRequest tube_request(const Options& options) {
     const uint32_t f = options.flags;
-    TubeRequest r = {};
-    r.axis = options.axis;
-    for (int k = 0; k < 3; ++k) r.direction[k] = options.direction[k];
-    r.layers = {options.cuts, options.cut_count, options.layer_count, options.layer_height};
-    r.cut_ends = (f & open_ends) ? closed_bottom | closed_top : 0u;
-    r.caps = (f & close_ends) != 0;
-    r.surface_flips = (f & surface_flips) != 0;
-    r.drop_outliers = (f & drop_outliers) != 0;
-    r.origin = (f & origin_given) ? options.origin : nullptr;
-    r.parts = (f & one_tube) ? PartsPolicy::one_tube
-              : (f & keep_parts) ? PartsPolicy::keep
-                                 : PartsPolicy::compare;
-    r.caller = &options;
-    r.progress = true;
-    return r;
+    const PartsPolicy parts = !kFindParts || (f & one_tube) ? PartsPolicy::one_tube
+                              : (f & keep_parts) ? PartsPolicy::keep
+                                                 : PartsPolicy::compare;
+    return {options.axis,
+            {options.direction[0], options.direction[1], options.direction[2]},
+            {options.cuts, options.cut_count, options.layer_count, options.layer_height},
+            kClosedEnds && (f & open_ends) ? closed_bottom | closed_top : 0u,
+            (f & close_ends) != 0,
+            kSurfaceFlips && (f & surface_flips),
+            kDropOutliers && (f & drop_outliers),
+            (f & origin_given) ? options.origin : nullptr,
+            parts,
+            &options,
+            &options};
 }
 
-// The same request along a direction.
-inline TubeRequest along_direction(TubeRequest r, const double* direction) {
-    r.axis = Axis::direction;
-    for (int k = 0; k < 3; ++k) r.direction[k] = direction[k];
-    return r;
+// Sets the request's axis to a direction.
+inline void set_direction(TubeRequest& request, const double* direction) {
+    request.axis = Axis::direction;
+    for (int k = 0; k < 3; ++k) request.direction[k] = direction[k];
 }
 
 const Options kNoCallbacks = {};
@@ -3778,7 +3777,7 @@ inline const Options& jobs_of(const TubeRequest& request) {
 inline void notify(const Options& options, Phase phase, double fraction);  // >>jobs
 
 inline void notify(const TubeRequest& request, Phase phase, double fraction) {
-    if (request.progress && request.caller) notify(*request.caller, phase, fraction);
+    if (request.progress) notify(*request.progress, phase, fraction);
 }
 
 }  // namespace detail
@@ -3836,7 +3835,7 @@ struct Frame {
 };
 
 // The power of two 2^-e with 2^e just above `extent`, within [2^-1000, 2^1000].
-inline double scale_for_extent(double extent) {
+STRATMESH_SMALL_NOINLINE inline double scale_for_extent(double extent) {
     if (!(extent > 0) || !is_finite(extent)) return 1;
     int exponent = 0;
     std::frexp(extent, &exponent);
@@ -3905,7 +3904,7 @@ inline const char* origin_refusal(const double* origin, const CloudSums& sums) {
 }
 
 inline const char* origin_refusal(const Options& options, const CloudSums& sums) {
-    return origin_refusal(tube_request(options).origin, sums);
+    return origin_refusal((options.flags & origin_given) ? options.origin : nullptr, sums);
 }
 
 inline Status choose_frame(const CloudSums& sums, const TubeRequest& request, Frame& frame) {
@@ -3962,8 +3961,8 @@ inline Status choose_frame(const CloudSums& sums, const TubeRequest& request, Fr
     Vec3 e1 = cross(helper, axis);
     if (!normalize(e1)) return Status::invalid_axis;
     frame.axis = axis;
-    frame.surface_flips = kSurfaceFlips && request.surface_flips;
-    frame.cut_ends = kClosedEnds ? request.cut_ends : 0u;
+    frame.surface_flips = request.surface_flips;
+    frame.cut_ends = request.cut_ends;
     frame.e1 = e1;
     frame.e2 = cross(axis, e1);
     return Status::ok;
@@ -9967,26 +9966,12 @@ inline uint32_t axis_candidates(const double* xyz, size_t count, Vec3* out) {
 
 // What a candidate's sample surface measures: its area, plus the area of a triangle per
 // sample point left out (a layer that cannot follow the surface drops points instead of
-// folding).
+// folding). *along (optional) receives the mean squared cosine between the triangles'
+// normals and the unit axis, weighted by their areas: 0 where the surface runs along the
+// axis, 1 where it lies across it.
 inline double sample_surface(const double* xyz, const uint32_t* tri, size_t count,
-                             size_t unused) {
-    double area = 0;
-    for (size_t t = 0; t < count; ++t) {
-        const double* a = xyz + 3 * tri[3 * t];
-        const double* b = xyz + 3 * tri[3 * t + 1];
-        const double* c = xyz + 3 * tri[3 * t + 2];
-        const Vec3 n = cross(Vec3{b[0] - a[0], b[1] - a[1], b[2] - a[2]},
-                             Vec3{c[0] - a[0], c[1] - a[1], c[2] - a[2]});
-        area += std::sqrt(dot(n, n)) / 2;
-    }
-    const double per_triangle = count > 0 ? area / static_cast<double>(count) : 0;
-    return area + 2 * per_triangle * static_cast<double>(unused);
-}
-
-// The mean squared cosine between the triangles' normals and the unit axis, weighted by
-// their areas: 0 where the surface runs along the axis, 1 where it lies across it.
-inline double normals_along(const double* xyz, const uint32_t* tri, size_t count, Vec3 axis) {
-    double along = 0, area = 0;
+                             size_t unused, Vec3 axis, double* along) {
+    double area = 0, along_sum = 0, normals = 0;
     for (size_t t = 0; t < count; ++t) {
         const double* a = xyz + 3 * tri[3 * t];
         const double* b = xyz + 3 * tri[3 * t + 1];
@@ -9994,12 +9979,15 @@ inline double normals_along(const double* xyz, const uint32_t* tri, size_t count
         const Vec3 n = cross(Vec3{b[0] - a[0], b[1] - a[1], b[2] - a[2]},
                              Vec3{c[0] - a[0], c[1] - a[1], c[2] - a[2]});
         const double length = std::sqrt(dot(n, n));
+        area += length / 2;
         if (length == 0) continue;
         const double cosine = dot(n, axis) / length;
-        along += cosine * cosine * length;
-        area += length;
+        along_sum += cosine * cosine * length;
+        normals += length;
     }
-    return area > 0 ? along / area : 1;
+    if (along) *along = normals > 0 ? along_sum / normals : 1;
+    const double per_triangle = count > 0 ? area / static_cast<double>(count) : 0;
+    return area + 2 * per_triangle * static_cast<double>(unused);
 }
 
 // What a candidate's sample is meshed as: one layer along `axis`, its ends cut where the
@@ -10031,9 +10019,9 @@ inline double try_axis(const double* sample, size_t count, Vec3 axis, const Tube
     const Status status = mesh_tube(in, trial, arena, tri, 2 * count, &triangles, rep);
     arena.rewind(mark);
     if (status != Status::ok) return DBL_MAX;
-    if (along) *along = normals_along(sample, tri, triangles, axis);
-    return sample_surface(sample, tri, triangles, in.sums.valid - rep.points.used_count -
-                                                      rep.points.duplicate_count);
+    return sample_surface(sample, tri, triangles,
+                          in.sums.valid - rep.points.used_count - rep.points.duplicate_count,
+                          axis, along);
 }
 
 // Every k-th kept point of `in`, packed, at most `most` of them (and about that many), in
@@ -10103,12 +10091,13 @@ inline size_t axis_workspace_size(size_t valid, const TubeRequest& request) {
     return arena.failed ? 0 : arena.required_bytes() + tube;
 }
 
-// Axis::automatic in `request` resolved by choose_axis(); any other axis stays.
+// Axis::automatic in `request` resolved by choose_axis(); any other axis stays. *detail
+// receives the reason where it fails.
 inline Status resolve_axis(const TubeInput& in, Arena& arena, TubeRequest& request,
-                           Report& rep) {
+                           const char** detail) {
     if (request.axis != Axis::automatic) return Status::ok;
     if (!kAxisTrials) {
-        rep.detail = kNotCompiledDetail;
+        *detail = kNotCompiledDetail;
         return Status::not_compiled;
     }
     if (in.sums.distinct < 3) {  // no surface along any axis: mesh_tube says so
@@ -10117,11 +10106,11 @@ inline Status resolve_axis(const TubeInput& in, Arena& arena, TubeRequest& reque
     }
     Vec3 axis;
     if (!choose_axis(in, request, arena, axis)) {
-        rep.detail = "the workspace is smaller than reconstruct_workspace_size()";
+        *detail = "the workspace is smaller than reconstruct_workspace_size()";
         return Status::out_of_memory;
     }
     const double direction[3] = {axis.x, axis.y, axis.z};
-    request = along_direction(request, direction);
+    set_direction(request, direction);
     return Status::ok;
 }
 
@@ -10213,25 +10202,37 @@ inline void add_to_group(PointGroup& g, Vec3 p, int pass) {
     }
 }
 
-// The groups of why_no_area(): `group_of` numbers the runs of occupied bins from 1 (0:
-// empty); each point joins its bin's group, its box first, its moments after.
-inline uint32_t gather_groups(const TubeInput& in, const Binning& binning, uint32_t* group_of,
-                              PointGroup* groups) {
-    std::memset(group_of, 0, binning.bins * sizeof(uint32_t));
-    for (size_t i = 0; i < in.count; ++i)
-        if (in.reader.valid(i)) group_of[binning.of(in.reader.point(i))] = 1;
+// Numbers the runs of occupied bins (non-zero) from 1, empty bins 0; returns the runs.
+inline uint32_t number_runs(uint32_t* group_of, uint32_t bins) {
     uint32_t count = 0;
-    for (uint32_t b = 0; b < binning.bins; ++b) {
+    for (uint32_t b = 0; b < bins; ++b) {
         const bool occupied = group_of[b] != 0;
         if (occupied && (b == 0 || group_of[b - 1] == 0)) ++count;
         group_of[b] = occupied ? count : 0;
     }
-    std::memset(static_cast<void*>(groups), 0, count * sizeof(PointGroup));
-    for (int pass = 0; pass < 2; ++pass) {
+    return count;
+}
+
+// The groups of why_no_area(): the occupied bins first, numbered by run (number_runs()),
+// then each point joins its bin's group, its box first, its moments after. One loop over
+// the points serves the three passes.
+inline uint32_t gather_groups(const TubeInput& in, const Binning& binning, uint32_t* group_of,
+                              PointGroup* groups) {
+    std::memset(group_of, 0, binning.bins * sizeof(uint32_t));
+    uint32_t count = 0;
+    for (int pass = -1; pass < 2; ++pass) {
         for (size_t i = 0; i < in.count; ++i) {
             if (!in.reader.valid(i)) continue;
             const Vec3 p = in.reader.point(i);
-            add_to_group(groups[group_of[binning.of(p)] - 1], p, pass);
+            uint32_t& group = group_of[binning.of(p)];
+            if (pass < 0)
+                group = 1;
+            else
+                add_to_group(groups[group - 1], p, pass);
+        }
+        if (pass < 0) {
+            count = number_runs(group_of, binning.bins);
+            std::memset(static_cast<void*>(groups), 0, count * sizeof(PointGroup));
         }
         for (uint32_t k = 0; pass == 0 && k < count; ++k)
             groups[k].scale = scale_for_extent(largest_of(groups[k].high - groups[k].low));
@@ -10381,7 +10382,7 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
         }
     const detail::TubeInput in = {reader, cloud.count, sums};
     detail::TubeRequest along = detail::tube_request(options);
-    status = detail::resolve_axis(in, arena, along, checks);
+    status = detail::resolve_axis(in, arena, along, &checks.detail);
     if (status != Status::ok) return finish(status);
     status = detail::cap_surface(in, along, arena, triangles, triangle_capacity, count, caps,
                                  &needed);
@@ -10845,7 +10846,7 @@ inline size_t parting_workspace_size(size_t point_count, const TubeRequest& requ
 // find_parting() along the axis of `request` (its origin, outliers and invalid points as
 // it says) with the fewest points a branch holds given: a sample of the cloud is searched
 // with fewer (see search_parting).
-inline Status find_parting_with(const Cloud& cloud, TubeRequest request, void* workspace,
+inline Status find_parting_with(const Cloud& cloud, const TubeRequest& request, void* workspace,
                                 size_t workspace_bytes, Parting* parting, uint8_t* branch_of,
                                 uint32_t smallest) {
     if (!parting) return Status::invalid_argument;
@@ -10877,10 +10878,11 @@ inline Status find_parting_with(const Cloud& cloud, TubeRequest request, void* w
         sums = sum_cloud(reader, cloud.count);
     }
     const TubeInput in = {reader, cloud.count, sums};
-    status = resolve_axis(in, arena, request, rep);
+    TubeRequest along = request;
+    status = resolve_axis(in, arena, along, &rep.detail);
     if (status != Status::ok) return finish(status);
     Frame frame;
-    status = choose_frame(sums, request, frame);
+    status = choose_frame(sums, along, frame);
     if (status != Status::ok) return finish(status);
     parting->axis[0] = frame.axis.x;
     parting->axis[1] = frame.axis.y;
@@ -12020,15 +12022,7 @@ inline bool cuts_for_tall_ends(const PartsMemory& m, size_t n, const Parting& pa
     return true;
 }
 
-// A part's counts into the whole's report.
-inline void add_part_counts(const Report& part, Report& rep) {
-    rep.points.used_count += part.points.used_count;
-    rep.points.duplicate_count += part.points.duplicate_count;
-    rep.diagnostics.fold_count += part.diagnostics.fold_count;
-    rep.diagnostics.illegal_removed_count += part.diagnostics.illegal_removed_count;
-    rep.diagnostics.diagonal_swap_count += part.diagnostics.diagonal_swap_count;
-}
-
+// A part meshed into the record of the parts, and where meshed, its counts into the whole's.
 inline void record_part(Report& rep, uint8_t label, Status status, const TubeInput& in,
                         const Report& part, size_t triangles, size_t merged) {
     PartCounts& p = rep.parts;
@@ -12037,6 +12031,12 @@ inline void record_part(Report& rep, uint8_t label, Status status, const TubeInp
                                 status == Status::ok ? triangles : 0,
                                 part.diagnostics.fold_count, merged};
     ++p.part_count;
+    if (status != Status::ok) return;
+    rep.points.used_count += part.points.used_count;
+    rep.points.duplicate_count += part.points.duplicate_count;
+    rep.diagnostics.fold_count += part.diagnostics.fold_count;
+    rep.diagnostics.illegal_removed_count += part.diagnostics.illegal_removed_count;
+    rep.diagnostics.diagonal_swap_count += part.diagnostics.diagonal_swap_count;
 }
 
 // ---- the steps ---------------------------------------------------------------------------
@@ -12107,9 +12107,9 @@ inline Status trunk_axis(const TubeInput& whole, PartsWork& w, Arena& arena) {
     if (w.trunk_known) return w.trunk_status;
     w.trunk = w.cut;
     w.trunk.axis = Axis::automatic;
-    Report ignored = {};
+    const char* ignored = nullptr;
     const size_t mark = arena.mark();
-    w.trunk_status = resolve_axis(part_input(whole, w.m, kInTrunk), arena, w.trunk, ignored);
+    w.trunk_status = resolve_axis(part_input(whole, w.m, kInTrunk), arena, w.trunk, &ignored);
     arena.rewind(mark);
     w.trunk_known = true;
     return w.trunk_status;
@@ -12142,7 +12142,8 @@ inline bool square_cut_to_trunk(const Cloud& cloud, const TubeInput& whole, Part
         if (!(std::fabs(lean) < kSquareCutLeast && std::fabs(lean) > kSquareCutMost)) break;
         const Vec3 toward = scaled(trunk, lean < 0 ? -1 : 1);  // the parting's way
         const double mean[3] = {cut.x + toward.x, cut.y + toward.y, cut.z + toward.z};
-        const TubeRequest squared = along_direction(w.cut, mean);
+        TubeRequest squared = w.cut;
+        set_direction(squared, mean);
         Parting again = {};
         if (!search_parting(cloud, whole, squared, w.m, arena, again)) return false;
         if (again.above_branch_count != parting.above_branch_count ||
@@ -12188,10 +12189,9 @@ inline Status one_tube_area(const TubeInput& in, const TubeRequest& request, boo
 
 // The trunk along `along`, its end layers under branches merged where they stand on a
 // closed end; its triangles start the output.
-inline Status mesh_trunk(const TubeInput& trunk, TubeRequest along, const Parting& parting,
+inline Status mesh_trunk(const TubeInput& trunk, const TubeRequest& along, const Parting& parting,
                          const PartsMemory& m, Arena& arena, uint32_t* triangles,
                          size_t capacity, size_t* count, Report& part, size_t* merged) {
-    along.caps = false;  // the caps come once the parts are joined
     part.layers.info = m.layers;
     part.layers.info_capacity = m.layer_capacity;
     const size_t mark = arena.mark();
@@ -12203,7 +12203,8 @@ inline Status mesh_trunk(const TubeInput& trunk, TubeRequest along, const Partin
         !cuts_for_tall_ends(m, part.layers.used_count, parting, &cut_count, merged))
         return status;
     // Again along the same axis, through the layers' own cuts but those merged.
-    TubeRequest again = along_direction(along, part.axis);
+    TubeRequest again = along;
+    set_direction(again, part.axis);
     again.layers = {m.cuts, cut_count, cut_count == 0 ? 1u : 0u, 0};
     part = Report{};
     part.layers.info = m.layers;
@@ -12220,17 +12221,15 @@ inline Status mesh_trunk_part(const TubeInput& whole, PartsWork& w, Arena& arena
                               uint32_t* triangles, size_t capacity, size_t* count, Report& rep) {
     const Parting& parting = rep.parts.parting;
     const TubeInput trunk = part_input(whole, w.m, kInTrunk);
-    TubeRequest along = w.cut;
-    Status status = Status::ok;
-    if (automatic_layers(w.cut.layers)) {
-        status = trunk_axis(whole, w, arena);
-        along = w.trunk;
-        // Pointing the parting's way, so that the trunk's top is on the side above.
-        const double* d = along.direction;
-        if (along.axis == Axis::direction &&
-            d[0] * parting.axis[0] + d[1] * parting.axis[1] + d[2] * parting.axis[2] < 0)
-            for (int k = 0; k < 3; ++k) along.direction[k] = -d[k];
-    }
+    const bool own_axis = automatic_layers(w.cut.layers);
+    Status status = own_axis ? trunk_axis(whole, w, arena) : Status::ok;
+    TubeRequest along = own_axis ? w.trunk : w.cut;
+    along.caps = false;  // the caps come once the parts are joined
+    // Pointing the parting's way, so that the trunk's top is on the side above.
+    const double* d = along.direction;
+    if (own_axis && along.axis == Axis::direction &&
+        d[0] * parting.axis[0] + d[1] * parting.axis[1] + d[2] * parting.axis[2] < 0)
+        for (int k = 0; k < 3; ++k) along.direction[k] = -d[k];
     Report part = {};
     size_t merged = 0;
     if (status == Status::ok)
@@ -12241,7 +12240,6 @@ inline Status mesh_trunk_part(const TubeInput& whole, PartsWork& w, Arena& arena
         rep.parts.outcome = PartsOutcome::undone;
         return status == Status::out_of_memory ? status : Status::ok;
     }
-    add_part_counts(part, rep);
     for (int k = 0; k < 3; ++k) {
         rep.axis[k] = part.axis[k];
         rep.axis_origin[k] = part.axis_origin[k];
@@ -12249,9 +12247,10 @@ inline Status mesh_trunk_part(const TubeInput& whole, PartsWork& w, Arena& arena
     rep.layers.used_count = part.layers.used_count;
     rep.layers.planned_count = part.layers.planned_count;
     rep.layers.parallel_count = part.layers.parallel_count;
-    for (size_t k = 0; k < rep.layers.used_count && k < rep.layers.info_capacity &&
-                       k < w.m.layer_capacity; ++k)
-        rep.layers.info[k] = w.m.layers[k];
+    size_t kept = rep.layers.used_count < w.m.layer_capacity ? rep.layers.used_count
+                                                              : w.m.layer_capacity;
+    kept = kept < rep.layers.info_capacity ? kept : rep.layers.info_capacity;
+    if (kept > 0) std::memcpy(rep.layers.info, w.m.layers, kept * sizeof(LayerInfo));
     return Status::ok;
 }
 
@@ -12263,7 +12262,7 @@ inline TubeRequest branch_request(TubeRequest r) {
     r.layers = LayerRequest{};
     r.origin = nullptr;
     r.caps = false;
-    r.progress = false;
+    r.progress = nullptr;
     return r;
 }
 
@@ -12287,7 +12286,7 @@ inline Status mesh_branches(const TubeInput& whole, const PartsWork& w, Arena& a
         TubeRequest own = branches;
         size_t added = 0;
         const size_t mark = arena.mark();
-        Status status = resolve_axis(branch, arena, own, part);
+        Status status = resolve_axis(branch, arena, own, &part.detail);
         const Vec3 own_axis = {own.direction[0], own.direction[1], own.direction[2]};
         own.cut_ends |= (dot(own_axis, parting_axis) > 0) == above ? kLowPole : kHighPole;
         if (status == Status::ok)
@@ -12301,7 +12300,6 @@ inline Status mesh_branches(const TubeInput& whole, const PartsWork& w, Arena& a
             if (!rep.detail) rep.detail = part.detail;
             continue;
         }
-        add_part_counts(part, rep);
         *count += added;
     }
     return Status::ok;
@@ -12437,11 +12435,12 @@ inline size_t parts_workspace_size(size_t count, const TubeRequest& request) {
     Arena arena = Arena::measuring();
     PartsMemory m;
     allocate_parts(m, count, arena);
-    TubeRequest part = request;  // a part's points are read through the mask
-    part.drop_outliers = false;
-    part.caps = false;
-    TubeRequest tube = request;  // the one tube meshed for its area while the parts' memory is held
+    // The one tube meshed for its area while the parts' memory is held, and the parts (their
+    // points read through the mask): the trunk's tube, without caps, takes no more.
+    TubeRequest tube = request;
     tube.drop_outliers = false;
+    TubeRequest part = tube;
+    part.caps = false;
     const size_t triangles = reconstruct_max_triangles(count, *request.caller);
     const size_t sample = count > kPartingSample
                               ? saturating_product(3 * sizeof(double), kPartingSample) + Arena::kAlign +
@@ -12449,7 +12448,7 @@ inline size_t parts_workspace_size(size_t count, const TubeRequest& request) {
                               : 0;
     const TubeRequest branch = branch_request(part);
     const size_t steps[] = {sample, parting_workspace_size(count, request),
-                            tube_workspace_size(count, part), tube_workspace_size(count, tube),
+                            tube_workspace_size(count, tube),
                             axis_workspace_size(count, branch),
                             tube_workspace_size(count, branch),
                             join_branches_workspace_size(count, triangles),
@@ -12542,7 +12541,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     // and along it a layer would only seem not to surround its axis.
     if (status == Status::ok && kDegenerateCheck && in.sums.distinct >= 3 && on_a_line(in, arena))
         status = Status::degenerate;
-    if (status == Status::ok) status = resolve_axis(in, arena, request, rep);
+    if (status == Status::ok) status = resolve_axis(in, arena, request, &rep.detail);
     if (status == Status::ok)
         status = mesh_cloud(cloud, in, request, arena, triangles, triangle_capacity,
                             triangle_count, rep);
@@ -12618,14 +12617,13 @@ Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
     // small build's stack frame stays within a short instruction's reach).
     LayerInfo* const layer_info = report ? report->layers.info : nullptr;
     const size_t layer_capacity = layer_info ? report->layers.info_capacity : 0;
-    const PartCounts parts = report ? report->parts : PartCounts{};
+    PartInfo* const part_info = report && detail::kFindParts ? report->parts.info : nullptr;
+    const size_t part_capacity = part_info ? report->parts.info_capacity : 0;
     std::memset(&rep, 0, sizeof rep);
     rep.layers.info = layer_info;
     rep.layers.info_capacity = layer_capacity;
-    if (detail::kFindParts) {
-        rep.parts.info = parts.info;
-        rep.parts.info_capacity = parts.info ? parts.info_capacity : 0;
-    }
+    rep.parts.info = part_info;
+    rep.parts.info_capacity = part_capacity;
     rep.points.in_count = cloud.count;
     if (triangle_count) *triangle_count = 0;
     Status status = detail::run_reconstruction(cloud, options, workspace, workspace_bytes,

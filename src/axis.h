@@ -120,26 +120,12 @@ inline uint32_t axis_candidates(const double* xyz, size_t count, Vec3* out) {
 
 // What a candidate's sample surface measures: its area, plus the area of a triangle per
 // sample point left out (a layer that cannot follow the surface drops points instead of
-// folding).
+// folding). *along (optional) receives the mean squared cosine between the triangles'
+// normals and the unit axis, weighted by their areas: 0 where the surface runs along the
+// axis, 1 where it lies across it.
 inline double sample_surface(const double* xyz, const uint32_t* tri, size_t count,
-                             size_t unused) {
-    double area = 0;
-    for (size_t t = 0; t < count; ++t) {
-        const double* a = xyz + 3 * tri[3 * t];
-        const double* b = xyz + 3 * tri[3 * t + 1];
-        const double* c = xyz + 3 * tri[3 * t + 2];
-        const Vec3 n = cross(Vec3{b[0] - a[0], b[1] - a[1], b[2] - a[2]},
-                             Vec3{c[0] - a[0], c[1] - a[1], c[2] - a[2]});
-        area += std::sqrt(dot(n, n)) / 2;
-    }
-    const double per_triangle = count > 0 ? area / static_cast<double>(count) : 0;
-    return area + 2 * per_triangle * static_cast<double>(unused);
-}
-
-// The mean squared cosine between the triangles' normals and the unit axis, weighted by
-// their areas: 0 where the surface runs along the axis, 1 where it lies across it.
-inline double normals_along(const double* xyz, const uint32_t* tri, size_t count, Vec3 axis) {
-    double along = 0, area = 0;
+                             size_t unused, Vec3 axis, double* along) {
+    double area = 0, along_sum = 0, normals = 0;
     for (size_t t = 0; t < count; ++t) {
         const double* a = xyz + 3 * tri[3 * t];
         const double* b = xyz + 3 * tri[3 * t + 1];
@@ -147,12 +133,15 @@ inline double normals_along(const double* xyz, const uint32_t* tri, size_t count
         const Vec3 n = cross(Vec3{b[0] - a[0], b[1] - a[1], b[2] - a[2]},
                              Vec3{c[0] - a[0], c[1] - a[1], c[2] - a[2]});
         const double length = std::sqrt(dot(n, n));
+        area += length / 2;
         if (length == 0) continue;
         const double cosine = dot(n, axis) / length;
-        along += cosine * cosine * length;
-        area += length;
+        along_sum += cosine * cosine * length;
+        normals += length;
     }
-    return area > 0 ? along / area : 1;
+    if (along) *along = normals > 0 ? along_sum / normals : 1;
+    const double per_triangle = count > 0 ? area / static_cast<double>(count) : 0;
+    return area + 2 * per_triangle * static_cast<double>(unused);
 }
 
 // What a candidate's sample is meshed as: one layer along `axis`, its ends cut where the
@@ -184,9 +173,9 @@ inline double try_axis(const double* sample, size_t count, Vec3 axis, const Tube
     const Status status = mesh_tube(in, trial, arena, tri, 2 * count, &triangles, rep);
     arena.rewind(mark);
     if (status != Status::ok) return DBL_MAX;
-    if (along) *along = normals_along(sample, tri, triangles, axis);
-    return sample_surface(sample, tri, triangles, in.sums.valid - rep.points.used_count -
-                                                      rep.points.duplicate_count);
+    return sample_surface(sample, tri, triangles,
+                          in.sums.valid - rep.points.used_count - rep.points.duplicate_count,
+                          axis, along);
 }
 
 // Every k-th kept point of `in`, packed, at most `most` of them (and about that many), in
@@ -256,12 +245,13 @@ inline size_t axis_workspace_size(size_t valid, const TubeRequest& request) {
     return arena.failed ? 0 : arena.required_bytes() + tube;
 }
 
-// Axis::automatic in `request` resolved by choose_axis(); any other axis stays.
+// Axis::automatic in `request` resolved by choose_axis(); any other axis stays. *detail
+// receives the reason where it fails.
 inline Status resolve_axis(const TubeInput& in, Arena& arena, TubeRequest& request,
-                           Report& rep) {
+                           const char** detail) {
     if (request.axis != Axis::automatic) return Status::ok;
     if (!kAxisTrials) {
-        rep.detail = kNotCompiledDetail;
+        *detail = kNotCompiledDetail;
         return Status::not_compiled;
     }
     if (in.sums.distinct < 3) {  // no surface along any axis: mesh_tube says so
@@ -270,11 +260,11 @@ inline Status resolve_axis(const TubeInput& in, Arena& arena, TubeRequest& reque
     }
     Vec3 axis;
     if (!choose_axis(in, request, arena, axis)) {
-        rep.detail = "the workspace is smaller than reconstruct_workspace_size()";
+        *detail = "the workspace is smaller than reconstruct_workspace_size()";
         return Status::out_of_memory;
     }
     const double direction[3] = {axis.x, axis.y, axis.z};
-    request = along_direction(request, direction);
+    set_direction(request, direction);
     return Status::ok;
 }
 

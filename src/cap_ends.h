@@ -77,7 +77,7 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
         }
     const detail::TubeInput in = {reader, cloud.count, sums};
     detail::TubeRequest along = detail::tube_request(options);
-    status = detail::resolve_axis(in, arena, along, checks);
+    status = detail::resolve_axis(in, arena, along, &checks.detail);
     if (status != Status::ok) return finish(status);
     status = detail::cap_surface(in, along, arena, triangles, triangle_capacity, count, caps,
                                  &needed);

@@ -50,7 +50,7 @@ struct Frame {
 };
 
 // The power of two 2^-e with 2^e just above `extent`, within [2^-1000, 2^1000].
-inline double scale_for_extent(double extent) {
+STRATMESH_SMALL_NOINLINE inline double scale_for_extent(double extent) {
     if (!(extent > 0) || !is_finite(extent)) return 1;
     int exponent = 0;
     std::frexp(extent, &exponent);
@@ -119,7 +119,7 @@ inline const char* origin_refusal(const double* origin, const CloudSums& sums) {
 }
 
 inline const char* origin_refusal(const Options& options, const CloudSums& sums) {
-    return origin_refusal(tube_request(options).origin, sums);
+    return origin_refusal((options.flags & origin_given) ? options.origin : nullptr, sums);
 }
 
 inline Status choose_frame(const CloudSums& sums, const TubeRequest& request, Frame& frame) {
@@ -176,8 +176,8 @@ inline Status choose_frame(const CloudSums& sums, const TubeRequest& request, Fr
     Vec3 e1 = cross(helper, axis);
     if (!normalize(e1)) return Status::invalid_axis;
     frame.axis = axis;
-    frame.surface_flips = kSurfaceFlips && request.surface_flips;
-    frame.cut_ends = kClosedEnds ? request.cut_ends : 0u;
+    frame.surface_flips = request.surface_flips;
+    frame.cut_ends = request.cut_ends;
     frame.e1 = e1;
     frame.e2 = cross(axis, e1);
     return Status::ok;

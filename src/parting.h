@@ -443,7 +443,7 @@ inline size_t parting_workspace_size(size_t point_count, const TubeRequest& requ
 // find_parting() along the axis of `request` (its origin, outliers and invalid points as
 // it says) with the fewest points a branch holds given: a sample of the cloud is searched
 // with fewer (see search_parting).
-inline Status find_parting_with(const Cloud& cloud, TubeRequest request, void* workspace,
+inline Status find_parting_with(const Cloud& cloud, const TubeRequest& request, void* workspace,
                                 size_t workspace_bytes, Parting* parting, uint8_t* branch_of,
                                 uint32_t smallest) {
     if (!parting) return Status::invalid_argument;
@@ -475,10 +475,11 @@ inline Status find_parting_with(const Cloud& cloud, TubeRequest request, void* w
         sums = sum_cloud(reader, cloud.count);
     }
     const TubeInput in = {reader, cloud.count, sums};
-    status = resolve_axis(in, arena, request, rep);
+    TubeRequest along = request;
+    status = resolve_axis(in, arena, along, &rep.detail);
     if (status != Status::ok) return finish(status);
     Frame frame;
-    status = choose_frame(sums, request, frame);
+    status = choose_frame(sums, along, frame);
     if (status != Status::ok) return finish(status);
     parting->axis[0] = frame.axis.x;
     parting->axis[1] = frame.axis.y;

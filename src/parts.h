@@ -152,15 +152,7 @@ inline bool cuts_for_tall_ends(const PartsMemory& m, size_t n, const Parting& pa
     return true;
 }
 
-// A part's counts into the whole's report.
-inline void add_part_counts(const Report& part, Report& rep) {
-    rep.points.used_count += part.points.used_count;
-    rep.points.duplicate_count += part.points.duplicate_count;
-    rep.diagnostics.fold_count += part.diagnostics.fold_count;
-    rep.diagnostics.illegal_removed_count += part.diagnostics.illegal_removed_count;
-    rep.diagnostics.diagonal_swap_count += part.diagnostics.diagonal_swap_count;
-}
-
+// A part meshed into the record of the parts, and where meshed, its counts into the whole's.
 inline void record_part(Report& rep, uint8_t label, Status status, const TubeInput& in,
                         const Report& part, size_t triangles, size_t merged) {
     PartCounts& p = rep.parts;
@@ -169,6 +161,12 @@ inline void record_part(Report& rep, uint8_t label, Status status, const TubeInp
                                 status == Status::ok ? triangles : 0,
                                 part.diagnostics.fold_count, merged};
     ++p.part_count;
+    if (status != Status::ok) return;
+    rep.points.used_count += part.points.used_count;
+    rep.points.duplicate_count += part.points.duplicate_count;
+    rep.diagnostics.fold_count += part.diagnostics.fold_count;
+    rep.diagnostics.illegal_removed_count += part.diagnostics.illegal_removed_count;
+    rep.diagnostics.diagonal_swap_count += part.diagnostics.diagonal_swap_count;
 }
 
 // ---- the steps ---------------------------------------------------------------------------
@@ -239,9 +237,9 @@ inline Status trunk_axis(const TubeInput& whole, PartsWork& w, Arena& arena) {
     if (w.trunk_known) return w.trunk_status;
     w.trunk = w.cut;
     w.trunk.axis = Axis::automatic;
-    Report ignored = {};
+    const char* ignored = nullptr;
     const size_t mark = arena.mark();
-    w.trunk_status = resolve_axis(part_input(whole, w.m, kInTrunk), arena, w.trunk, ignored);
+    w.trunk_status = resolve_axis(part_input(whole, w.m, kInTrunk), arena, w.trunk, &ignored);
     arena.rewind(mark);
     w.trunk_known = true;
     return w.trunk_status;
@@ -274,7 +272,8 @@ inline bool square_cut_to_trunk(const Cloud& cloud, const TubeInput& whole, Part
         if (!(std::fabs(lean) < kSquareCutLeast && std::fabs(lean) > kSquareCutMost)) break;
         const Vec3 toward = scaled(trunk, lean < 0 ? -1 : 1);  // the parting's way
         const double mean[3] = {cut.x + toward.x, cut.y + toward.y, cut.z + toward.z};
-        const TubeRequest squared = along_direction(w.cut, mean);
+        TubeRequest squared = w.cut;
+        set_direction(squared, mean);
         Parting again = {};
         if (!search_parting(cloud, whole, squared, w.m, arena, again)) return false;
         if (again.above_branch_count != parting.above_branch_count ||
@@ -320,10 +319,9 @@ inline Status one_tube_area(const TubeInput& in, const TubeRequest& request, boo
 
 // The trunk along `along`, its end layers under branches merged where they stand on a
 // closed end; its triangles start the output.
-inline Status mesh_trunk(const TubeInput& trunk, TubeRequest along, const Parting& parting,
+inline Status mesh_trunk(const TubeInput& trunk, const TubeRequest& along, const Parting& parting,
                          const PartsMemory& m, Arena& arena, uint32_t* triangles,
                          size_t capacity, size_t* count, Report& part, size_t* merged) {
-    along.caps = false;  // the caps come once the parts are joined
     part.layers.info = m.layers;
     part.layers.info_capacity = m.layer_capacity;
     const size_t mark = arena.mark();
@@ -335,7 +333,8 @@ inline Status mesh_trunk(const TubeInput& trunk, TubeRequest along, const Partin
         !cuts_for_tall_ends(m, part.layers.used_count, parting, &cut_count, merged))
         return status;
     // Again along the same axis, through the layers' own cuts but those merged.
-    TubeRequest again = along_direction(along, part.axis);
+    TubeRequest again = along;
+    set_direction(again, part.axis);
     again.layers = {m.cuts, cut_count, cut_count == 0 ? 1u : 0u, 0};
     part = Report{};
     part.layers.info = m.layers;
@@ -352,17 +351,15 @@ inline Status mesh_trunk_part(const TubeInput& whole, PartsWork& w, Arena& arena
                               uint32_t* triangles, size_t capacity, size_t* count, Report& rep) {
     const Parting& parting = rep.parts.parting;
     const TubeInput trunk = part_input(whole, w.m, kInTrunk);
-    TubeRequest along = w.cut;
-    Status status = Status::ok;
-    if (automatic_layers(w.cut.layers)) {
-        status = trunk_axis(whole, w, arena);
-        along = w.trunk;
-        // Pointing the parting's way, so that the trunk's top is on the side above.
-        const double* d = along.direction;
-        if (along.axis == Axis::direction &&
-            d[0] * parting.axis[0] + d[1] * parting.axis[1] + d[2] * parting.axis[2] < 0)
-            for (int k = 0; k < 3; ++k) along.direction[k] = -d[k];
-    }
+    const bool own_axis = automatic_layers(w.cut.layers);
+    Status status = own_axis ? trunk_axis(whole, w, arena) : Status::ok;
+    TubeRequest along = own_axis ? w.trunk : w.cut;
+    along.caps = false;  // the caps come once the parts are joined
+    // Pointing the parting's way, so that the trunk's top is on the side above.
+    const double* d = along.direction;
+    if (own_axis && along.axis == Axis::direction &&
+        d[0] * parting.axis[0] + d[1] * parting.axis[1] + d[2] * parting.axis[2] < 0)
+        for (int k = 0; k < 3; ++k) along.direction[k] = -d[k];
     Report part = {};
     size_t merged = 0;
     if (status == Status::ok)
@@ -373,7 +370,6 @@ inline Status mesh_trunk_part(const TubeInput& whole, PartsWork& w, Arena& arena
         rep.parts.outcome = PartsOutcome::undone;
         return status == Status::out_of_memory ? status : Status::ok;
     }
-    add_part_counts(part, rep);
     for (int k = 0; k < 3; ++k) {
         rep.axis[k] = part.axis[k];
         rep.axis_origin[k] = part.axis_origin[k];
@@ -381,9 +377,10 @@ inline Status mesh_trunk_part(const TubeInput& whole, PartsWork& w, Arena& arena
     rep.layers.used_count = part.layers.used_count;
     rep.layers.planned_count = part.layers.planned_count;
     rep.layers.parallel_count = part.layers.parallel_count;
-    for (size_t k = 0; k < rep.layers.used_count && k < rep.layers.info_capacity &&
-                       k < w.m.layer_capacity; ++k)
-        rep.layers.info[k] = w.m.layers[k];
+    size_t kept = rep.layers.used_count < w.m.layer_capacity ? rep.layers.used_count
+                                                              : w.m.layer_capacity;
+    kept = kept < rep.layers.info_capacity ? kept : rep.layers.info_capacity;
+    if (kept > 0) std::memcpy(rep.layers.info, w.m.layers, kept * sizeof(LayerInfo));
     return Status::ok;
 }
 
@@ -395,7 +392,7 @@ inline TubeRequest branch_request(TubeRequest r) {
     r.layers = LayerRequest{};
     r.origin = nullptr;
     r.caps = false;
-    r.progress = false;
+    r.progress = nullptr;
     return r;
 }
 
@@ -419,7 +416,7 @@ inline Status mesh_branches(const TubeInput& whole, const PartsWork& w, Arena& a
         TubeRequest own = branches;
         size_t added = 0;
         const size_t mark = arena.mark();
-        Status status = resolve_axis(branch, arena, own, part);
+        Status status = resolve_axis(branch, arena, own, &part.detail);
         const Vec3 own_axis = {own.direction[0], own.direction[1], own.direction[2]};
         own.cut_ends |= (dot(own_axis, parting_axis) > 0) == above ? kLowPole : kHighPole;
         if (status == Status::ok)
@@ -433,7 +430,6 @@ inline Status mesh_branches(const TubeInput& whole, const PartsWork& w, Arena& a
             if (!rep.detail) rep.detail = part.detail;
             continue;
         }
-        add_part_counts(part, rep);
         *count += added;
     }
     return Status::ok;
@@ -569,11 +565,12 @@ inline size_t parts_workspace_size(size_t count, const TubeRequest& request) {
     Arena arena = Arena::measuring();
     PartsMemory m;
     allocate_parts(m, count, arena);
-    TubeRequest part = request;  // a part's points are read through the mask
-    part.drop_outliers = false;
-    part.caps = false;
-    TubeRequest tube = request;  // the one tube meshed for its area while the parts' memory is held
+    // The one tube meshed for its area while the parts' memory is held, and the parts (their
+    // points read through the mask): the trunk's tube, without caps, takes no more.
+    TubeRequest tube = request;
     tube.drop_outliers = false;
+    TubeRequest part = tube;
+    part.caps = false;
     const size_t triangles = reconstruct_max_triangles(count, *request.caller);
     const size_t sample = count > kPartingSample
                               ? saturating_product(3 * sizeof(double), kPartingSample) + Arena::kAlign +
@@ -581,7 +578,7 @@ inline size_t parts_workspace_size(size_t count, const TubeRequest& request) {
                               : 0;
     const TubeRequest branch = branch_request(part);
     const size_t steps[] = {sample, parting_workspace_size(count, request),
-                            tube_workspace_size(count, part), tube_workspace_size(count, tube),
+                            tube_workspace_size(count, tube),
                             axis_workspace_size(count, branch),
                             tube_workspace_size(count, branch),
                             join_branches_workspace_size(count, triangles),

@@ -72,7 +72,7 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     // and along it a layer would only seem not to surround its axis.
     if (status == Status::ok && kDegenerateCheck && in.sums.distinct >= 3 && on_a_line(in, arena))
         status = Status::degenerate;
-    if (status == Status::ok) status = resolve_axis(in, arena, request, rep);
+    if (status == Status::ok) status = resolve_axis(in, arena, request, &rep.detail);
     if (status == Status::ok)
         status = mesh_cloud(cloud, in, request, arena, triangles, triangle_capacity,
                             triangle_count, rep);
@@ -148,14 +148,13 @@ Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
     // small build's stack frame stays within a short instruction's reach).
     LayerInfo* const layer_info = report ? report->layers.info : nullptr;
     const size_t layer_capacity = layer_info ? report->layers.info_capacity : 0;
-    const PartCounts parts = report ? report->parts : PartCounts{};
+    PartInfo* const part_info = report && detail::kFindParts ? report->parts.info : nullptr;
+    const size_t part_capacity = part_info ? report->parts.info_capacity : 0;
     std::memset(&rep, 0, sizeof rep);
     rep.layers.info = layer_info;
     rep.layers.info_capacity = layer_capacity;
-    if (detail::kFindParts) {
-        rep.parts.info = parts.info;
-        rep.parts.info_capacity = parts.info ? parts.info_capacity : 0;
-    }
+    rep.parts.info = part_info;
+    rep.parts.info_capacity = part_capacity;
     rep.points.in_count = cloud.count;
     if (triangle_count) *triangle_count = 0;
     Status status = detail::run_reconstruction(cloud, options, workspace, workspace_bytes,

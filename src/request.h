@@ -36,36 +36,35 @@ struct TubeRequest {
     bool drop_outliers;     // the cloud is read without its outliers
     const double* origin;   // the frame's reference point, or null for the centroid
     PartsPolicy parts;
-    // The caller's Options, whose callbacks run (progress only where `progress`), or null:
-    // none (an axis trial).
+    // The caller's Options: its job runner, or null for none (an axis trial).
     const Options* caller;
-    bool progress;
+    // The Options whose progress callback is told, or null: none (a branch, whose progress
+    // would run backwards from part to part; an axis trial).
+    const Options* progress;
 };
 
 inline TubeRequest tube_request(const Options& options) {
     const uint32_t f = options.flags;
-    TubeRequest r = {};
-    r.axis = options.axis;
-    for (int k = 0; k < 3; ++k) r.direction[k] = options.direction[k];
-    r.layers = {options.cuts, options.cut_count, options.layer_count, options.layer_height};
-    r.cut_ends = (f & open_ends) ? closed_bottom | closed_top : 0u;
-    r.caps = (f & close_ends) != 0;
-    r.surface_flips = (f & surface_flips) != 0;
-    r.drop_outliers = (f & drop_outliers) != 0;
-    r.origin = (f & origin_given) ? options.origin : nullptr;
-    r.parts = (f & one_tube) ? PartsPolicy::one_tube
-              : (f & keep_parts) ? PartsPolicy::keep
-                                 : PartsPolicy::compare;
-    r.caller = &options;
-    r.progress = true;
-    return r;
+    const PartsPolicy parts = !kFindParts || (f & one_tube) ? PartsPolicy::one_tube
+                              : (f & keep_parts) ? PartsPolicy::keep
+                                                 : PartsPolicy::compare;
+    return {options.axis,
+            {options.direction[0], options.direction[1], options.direction[2]},
+            {options.cuts, options.cut_count, options.layer_count, options.layer_height},
+            kClosedEnds && (f & open_ends) ? closed_bottom | closed_top : 0u,
+            (f & close_ends) != 0,
+            kSurfaceFlips && (f & surface_flips),
+            kDropOutliers && (f & drop_outliers),
+            (f & origin_given) ? options.origin : nullptr,
+            parts,
+            &options,
+            &options};
 }
 
-// The same request along a direction.
-inline TubeRequest along_direction(TubeRequest r, const double* direction) {
-    r.axis = Axis::direction;
-    for (int k = 0; k < 3; ++k) r.direction[k] = direction[k];
-    return r;
+// Sets the request's axis to a direction.
+inline void set_direction(TubeRequest& request, const double* direction) {
+    request.axis = Axis::direction;
+    for (int k = 0; k < 3; ++k) request.direction[k] = direction[k];
 }
 
 const Options kNoCallbacks = {};
@@ -78,7 +77,7 @@ inline const Options& jobs_of(const TubeRequest& request) {
 inline void notify(const Options& options, Phase phase, double fraction);  // >>jobs
 
 inline void notify(const TubeRequest& request, Phase phase, double fraction) {
-    if (request.progress && request.caller) notify(*request.caller, phase, fraction);
+    if (request.progress) notify(*request.progress, phase, fraction);
 }
 
 }  // namespace detail

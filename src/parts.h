@@ -232,7 +232,7 @@ inline bool parts_around_trunk(size_t count, const Parting& parting, const uint8
 }
 
 // The trunk's own automatic axis, chosen once for the labels as they stand: squaring the
-// cut asks for it, and meshing the trunk again while no label has changed since.
+// cut asks for it, and the trunk is meshed around it unless a label changed since.
 inline Status trunk_axis(const TubeInput& whole, PartsWork& w, Arena& arena) {
     if (w.trunk_known) return w.trunk_status;
     w.trunk = w.cut;
@@ -346,7 +346,7 @@ inline Status mesh_trunk(const TubeInput& trunk, const TubeRequest& along, const
 
 // The trunk into the output, around its own axis as the branches (a body whose legs hang
 // under it is meshed along the body) unless the caller laid out the layers; its frame and
-// layers are the whole's in the report. False (with outcome undone) if it fails.
+// layers are the whole's in the report. Where it fails, the outcome is undone.
 inline Status mesh_trunk_part(const TubeInput& whole, PartsWork& w, Arena& arena,
                               uint32_t* triangles, size_t capacity, size_t* count, Report& rep) {
     const Parting& parting = rep.parts.parting;

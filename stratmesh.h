@@ -1376,9 +1376,11 @@ stratmesh_status stratmesh_stream_close(stratmesh_stream* stream);
 //                         drop_outliers
 //   >>cloud               reading the cloud: invalid points refused or counted, outliers
 //                         left out, sums
-//   >>frame               the frame the layers are cut in: its axis, origin and scale
 //   >>jobs                the caller's callbacks: progress, and batches of jobs for the
 //                         runner
+//   >>request             what one tube is asked for: axis, layers, ends, caps, origin,
+//                         read once from Options
+//   >>frame               the frame the layers are cut in: its axis, origin and scale
 //   >>layer plan          cuts along the axis: explicit, equal, by height or automatic;
 //                         points grouped by layer
 //   >>unroll              a layer onto its annulus (cylinder and closed ends)
@@ -3680,7 +3682,6 @@ struct TubeInput {
     CloudReader reader;
     size_t count;
     CloudSums sums;
-    uint32_t cut_ends;  // ends that are cuts, never closed (Frame::cut_ends), besides open_ends
 };
 
 // Whether this build holds every feature the flags ask for (STRATMESH_SMALL_CODE leaves
@@ -3693,229 +3694,6 @@ inline bool flags_compiled(const Options& options) {
 
 const char* const kNotCompiledDetail =
     "the options ask for a feature this build leaves out (STRATMESH_SMALL_CODE)";
-
-}  // namespace detail
-}  // namespace stratmesh
-
-// >>frame ================================================================================
-// The frame the layers are cut in: its axis, origin and scale.
-//
-// The cloud is expressed in a frame whose third axis is the stacking axis and whose origin
-// is the centroid, so that clouds far from the origin (georeferenced scans) keep their
-// millimetres; a power of two brings its extent near 1.
-
-namespace stratmesh {
-namespace detail {
-
-// Coordinates in the reconstruction frame: (x, y) across the axis, h along it.
-struct Local {
-    double x, y, h;
-};
-
-struct Frame {
-    Vec3 origin, e1, e2, axis;  // (e1, e2, axis) is right-handed and orthonormal
-    // A power of two that brings the cloud's extent near 1, so that squared distances
-    // neither overflow (a cloud at 1e200) nor underflow (at 1e-200); being a power of two,
-    // it changes no rounding and the triangles do not depend on it.
-    double scale;
-    // Set when the cloud spans more than the largest double (coordinates of both signs
-    // near 1e308): p - origin would overflow, so halves are subtracted instead.
-    bool halved;
-    Vec3 half_origin;
-    // Layers are flipped on the surface (the surface_flips flag; see "flips on the surface"
-    // in >>layer triangulation).
-    bool surface_flips;
-    // The surface's ends (kLowPole, kHighPole) never taken for a closed one: both with the
-    // open_ends flag, the end of a branch at its cut (see mesh_parts); 0 without kClosedEnds.
-    uint32_t cut_ends;
-    // The valid points' lowest and highest coordinates (set by choose_frame with kFastLoops).
-    Vec3 low, high;
-    // The cloud's own extent over the frame's, which also covers the way to a given origin:
-    // 1 without origin_given.
-    double cloud_share;
-    // (p - origin) * scale, without overflow.
-    Vec3 offset(Vec3 p) const {
-        if (halved) return scaled(scaled(p, 0.5) - half_origin, 2 * scale);
-        return scaled(p - origin, scale);
-    }
-    Local local(Vec3 p) const {
-        Vec3 d = offset(p);
-        return {dot(d, e1), dot(d, e2), dot(d, axis)};
-    }
-    // local(p).h alone, the same bits.
-    double height(Vec3 p) const { return dot(offset(p), axis); }
-    // A frame height back as the user's coordinate along the axis, dot(point, axis).
-    double user_height(double h) const { return h / scale + dot(origin, axis); }
-};
-
-// The power of two 2^-e with 2^e just above `extent`, within [2^-1000, 2^1000].
-inline double scale_for_extent(double extent) {
-    if (!(extent > 0) || !is_finite(extent)) return 1;
-    int exponent = 0;
-    std::frexp(extent, &exponent);
-    if (exponent > 1000) exponent = 1000;
-    if (exponent < -1000) exponent = -1000;
-    return std::ldexp(1.0, -exponent);
-}
-
-// The principal direction of a symmetric 3x3 matrix by power iteration from its largest
-// column; a fixed number of steps keeps the cost bounded and the result deterministic.
-inline Vec3 principal_direction(const double m[3][3]) {
-    Vec3 cols[3] = {{m[0][0], m[1][0], m[2][0]}, {m[0][1], m[1][1], m[2][1]},
-                    {m[0][2], m[1][2], m[2][2]}};
-    Vec3 v = cols[0];
-    for (const Vec3& c : cols)
-        if (dot(c, c) > dot(v, v)) v = c;
-    if (!normalize(v)) return {0, 0, 1};
-    for (int step = 0; step < 100; ++step) {
-        Vec3 w = {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z,
-                  m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
-                  m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
-        if (!normalize(w)) break;
-        v = w;
-    }
-    // The sign of an eigenvector is arbitrary: point it along its largest component.
-    double big = v.x;
-    if (abs_value(v.y) > abs_value(big)) big = v.y;
-    if (abs_value(v.z) > abs_value(big)) big = v.z;
-    return big < 0 ? scaled(v, -1.0) : v;
-}
-
-// The frame of the points summed in `sums`: centroid origin, axis from the options (an
-// explicit one: Axis::automatic is resolved before, see choose_axis), e1/e2 completing it.
-// How far a given origin may lie from the cloud's bounding box, per coordinate, in
-// multiples of the box's largest side. Seen from farther, the whole cloud lies within
-// 2^-32 radians of one direction and its offsets from the origin keep fewer than 21 of
-// their 53 bits for the cloud's own shape: no unrolling around it means anything.
-const double kOriginReach = 0x1p32;
-
-// Whether `origin` lies within kOriginReach times the largest side of the box [low, high]
-// of it (halves, so that nothing overflows). A box of one point reaches everywhere.
-inline bool origin_in_reach(Vec3 origin, Vec3 low, Vec3 high) {
-    const Vec3 half_low = scaled(low, 0.5), half_high = scaled(high, 0.5);
-    const Vec3 half_origin = scaled(origin, 0.5);
-    const Vec3 side = half_high - half_low;
-    const Vec3 below = half_low - half_origin, above = half_origin - half_high;
-    const Vec3 way = {below.x > above.x ? below.x : above.x, below.y > above.y ? below.y : above.y,
-                      below.z > above.z ? below.z : above.z};
-    const double reach = largest_of(side);
-    return reach == 0 || largest_of(way) <= kOriginReach * reach;
-}
-
-// Why a given origin (origin_given) cannot serve as the frame's, or null if it can: it is
-// NaN or infinite, or lies beyond kOriginReach of the valid points summed in `sums`.
-inline const char* origin_refusal(const Options& options, const CloudSums& sums) {
-    if (!(options.flags & origin_given)) return nullptr;
-    const Vec3 given = {options.origin[0], options.origin[1], options.origin[2]};
-    if (!(is_finite(given.x) && is_finite(given.y) && is_finite(given.z)))
-        return "the given origin is NaN or infinite";
-    const Vec3 low = {sums.lowest[0], sums.lowest[1], sums.lowest[2]};
-    const Vec3 high = {sums.highest[0], sums.highest[1], sums.highest[2]};
-    if (sums.valid > 0 && !origin_in_reach(given, low, high))
-        return "the given origin lies farther from the cloud than 2^32 times the cloud's size: "
-               "no unrolling around it means anything (give a nearer origin, or none)";
-    return nullptr;
-}
-
-inline Status choose_frame(const CloudSums& sums, const Options& options, Frame& frame) {
-    const size_t valid = sums.valid;
-    const Vec3 sum = {sums.total[0], sums.total[1], sums.total[2]};
-    const Vec3 small_sum = {sums.small_total[0], sums.small_total[1], sums.small_total[2]};
-    const Vec3 low = {sums.lowest[0], sums.lowest[1], sums.lowest[2]};
-    const Vec3 high = {sums.highest[0], sums.highest[1], sums.highest[2]};
-    if (kFastLoops) {
-        frame.low = low;
-        frame.high = high;
-    }
-    if (!(is_finite(sum.x) && is_finite(sum.y) && is_finite(sum.z)))
-        frame.origin = scaled(scaled(small_sum, 1.0 / static_cast<double>(valid)), 0x1p40);
-    else
-        frame.origin = valid ? scaled(sum, 1.0 / static_cast<double>(valid)) : Vec3{0, 0, 0};
-    Vec3 size = valid ? high - low : Vec3{0, 0, 0};
-    Vec3 half_size = valid ? scaled(high, 0.5) - scaled(low, 0.5) : Vec3{0, 0, 0};
-    const double own_half_extent = largest_of(half_size);
-    if (options.flags & origin_given) {
-        if (origin_refusal(options, sums)) return Status::invalid_origin;
-        const Vec3 given = {options.origin[0], options.origin[1], options.origin[2]};
-        // The extent covers the way from the given origin to the cloud, so the frame's
-        // coordinates stay near 1 however far the origin is.
-        Vec3 way = scaled(frame.origin, 0.5) - scaled(given, 0.5);
-        way = {abs_value(way.x), abs_value(way.y), abs_value(way.z)};
-        half_size = {half_size.x + way.x, half_size.y + way.y, half_size.z + way.z};
-        size = {size.x + 2 * way.x, size.y + 2 * way.y, size.z + 2 * way.z};
-        frame.origin = given;
-    }
-    const double half_extent = largest_of(half_size);
-    frame.cloud_share = half_extent > 0 ? own_half_extent / half_extent : 1;
-    frame.halved = !(is_finite(size.x) && is_finite(size.y) && is_finite(size.z));
-    if (frame.halved) size = half_size;
-    frame.half_origin = scaled(frame.origin, 0.5);
-    double extent = size.x > size.y ? size.x : size.y;
-    if (size.z > extent) extent = size.z;
-    frame.scale = scale_for_extent(extent) * (frame.halved ? 0.5 : 1.0);
-    Vec3 axis = {0, 0, 1};
-    switch (options.axis) {
-    case Axis::x: axis = {1, 0, 0}; break;
-    case Axis::y: axis = {0, 1, 0}; break;
-    case Axis::z: axis = {0, 0, 1}; break;
-    case Axis::direction:
-        axis = {options.direction[0], options.direction[1], options.direction[2]};
-        if (!unit_direction(axis)) return Status::invalid_axis;
-        break;
-    default: return Status::invalid_axis;
-    }
-    // e1: the coordinate axis least aligned with the stacking axis, made orthogonal.
-    Vec3 helper = {1, 0, 0};
-    if (abs_value(axis.x) > abs_value(axis.y) || abs_value(axis.x) > abs_value(axis.z))
-        helper = abs_value(axis.y) < abs_value(axis.z) ? Vec3{0, 1, 0} : Vec3{0, 0, 1};
-    Vec3 e1 = cross(helper, axis);
-    if (!normalize(e1)) return Status::invalid_axis;
-    frame.axis = axis;
-    frame.surface_flips = kSurfaceFlips && (options.flags & surface_flips);
-    frame.cut_ends = kClosedEnds && (options.flags & open_ends) ? closed_bottom | closed_top : 0u;
-    frame.e1 = e1;
-    frame.e2 = cross(axis, e1);
-    return Status::ok;
-}
-
-// The lowest and highest frame height of the valid points.
-inline void height_range(const CloudReader& cloud, size_t count, const Frame& frame, double* lo,
-                         double* hi) {
-    for (size_t i = 0; i < count; ++i) {
-        if (!cloud.valid(i)) continue;
-        const double h = frame.height(cloud.point(i));
-        if (h < *lo) *lo = h;
-        if (h > *hi) *hi = h;
-    }
-}
-
-// height_range without a pass over the cloud, where the axis is a coordinate axis (and
-// the frame not halved): a height is then (p_k - origin_k) * scale plus zeros, exactly
-// that value, and rounding keeps the order, so the lowest and highest coordinates along
-// the axis give the same two heights, bit for bit. False otherwise.
-inline bool height_range_from_extremes(const Frame& frame, double* lo, double* hi) {
-    const double axis[3] = {frame.axis.x, frame.axis.y, frame.axis.z};
-    const double low[3] = {frame.low.x, frame.low.y, frame.low.z};
-    const double high[3] = {frame.high.x, frame.high.y, frame.high.z};
-    const double origin[3] = {frame.origin.x, frame.origin.y, frame.origin.z};
-    for (int k = 0; k < 3; ++k) {
-        if (frame.halved || axis[k] != 1 || axis[(k + 1) % 3] != 0 || axis[(k + 2) % 3] != 0)
-            continue;
-        *lo = (low[k] - origin[k]) * frame.scale;
-        *hi = (high[k] - origin[k]) * frame.scale;
-        return true;
-    }
-    return false;
-}
-
-STRATMESH_SMALL_NOINLINE inline void report_frame(const Frame& frame, Report& rep) {
-    rep.axis[0] = frame.axis.x;
-    rep.axis[1] = frame.axis.y;
-    rep.axis[2] = frame.axis.z;
-    rep.axis_origin[0] = frame.origin.x;
-    rep.axis_origin[1] = frame.origin.y;
-    rep.axis_origin[2] = frame.origin.z;
-}
 
 }  // namespace detail
 }  // namespace stratmesh
@@ -3987,6 +3765,321 @@ template <class Pass> static inline void run_pass(const Options& options, Pass& 
 }  // namespace detail
 }  // namespace stratmesh
 
+// >>request ==============================================================================
+// What one tube is asked for: axis, layers, ends, caps, origin, read once from Options.
+//
+// reconstruct() meshes several tubes where the cloud parts: the trunk, each branch, the
+// one tube they are weighed against, and the samples the automatic axis is chosen on. Each
+// has its own axis, layers, ends and caps; a TubeRequest says them, made once from the
+// caller's Options (tube_request()), and each step asks for its tube with a request of its
+// own. The caller's Options are only read: for the callbacks and the invalid points.
+
+namespace stratmesh {
+namespace detail {
+
+// The layers asked for, first match wins (see Options::cuts): the cuts, else `count`
+// equal layers, else layers of about `height`, else automatic.
+struct LayerRequest {
+    const double* cuts;
+    size_t cut_count;
+    uint32_t count;
+    double height;
+};
+
+// What reconstruct() does where the cloud parts into branches (see PartCounts).
+enum class PartsPolicy : uint32_t {
+    compare,   // the parts joined where whole and smaller than one tube, else the one tube
+    one_tube,  // one tube, without a search (the one_tube flag)
+    keep,      // the parts, joined where they can be (the keep_parts flag)
+};
+
+struct TubeRequest {
+    Axis axis;              // Axis::automatic until resolve_axis() chooses
+    double direction[3];    // with Axis::direction
+    LayerRequest layers;
+    uint32_t cut_ends;      // ClosedEnd bits: the ends that are cuts, never closed ones
+    bool caps;              // the boundary loops closed (close_ends)
+    bool surface_flips;
+    bool drop_outliers;     // the cloud is read without its outliers
+    const double* origin;   // the frame's reference point, or null for the centroid
+    PartsPolicy parts;
+    // The caller's Options: its job runner, or null for none (an axis trial).
+    const Options* caller;
+    // The Options whose progress callback is told, or null: none (a branch, whose progress
+    // would run backwards from part to part; an axis trial).
+    const Options* progress;
+};
+
+inline TubeRequest tube_request(const Options& options) {
+    const uint32_t f = options.flags;
+    const PartsPolicy parts = !kFindParts || (f & one_tube) ? PartsPolicy::one_tube
+                              : (f & keep_parts) ? PartsPolicy::keep
+                                                 : PartsPolicy::compare;
+    return {options.axis,
+            {options.direction[0], options.direction[1], options.direction[2]},
+            {options.cuts, options.cut_count, options.layer_count, options.layer_height},
+            kClosedEnds && (f & open_ends) ? closed_bottom | closed_top : 0u,
+            (f & close_ends) != 0,
+            kSurfaceFlips && (f & surface_flips),
+            kDropOutliers && (f & drop_outliers),
+            (f & origin_given) ? options.origin : nullptr,
+            parts,
+            &options,
+            &options};
+}
+
+// Sets the request's axis to a direction.
+inline void set_direction(TubeRequest& request, const double* direction) {
+    request.axis = Axis::direction;
+    for (int k = 0; k < 3; ++k) request.direction[k] = direction[k];
+}
+
+const Options kNoCallbacks = {};
+
+// The Options whose job runner a tube hands its jobs to (none in an axis trial).
+inline const Options& jobs_of(const TubeRequest& request) {
+    return request.caller ? *request.caller : kNoCallbacks;
+}
+
+// Phase progress, to the caller's callback where the request reports progress.
+inline void notify(const TubeRequest& request, Phase phase, double fraction) {
+    if (request.progress) notify(*request.progress, phase, fraction);
+}
+
+}  // namespace detail
+}  // namespace stratmesh
+
+// >>frame ================================================================================
+// The frame the layers are cut in: its axis, origin and scale.
+//
+// The cloud is expressed in a frame whose third axis is the stacking axis and whose origin
+// is the centroid, so that clouds far from the origin (georeferenced scans) keep their
+// millimetres; a power of two brings its extent near 1.
+
+namespace stratmesh {
+namespace detail {
+
+// Coordinates in the reconstruction frame: (x, y) across the axis, h along it.
+struct Local {
+    double x, y, h;
+};
+
+struct Frame {
+    Vec3 origin, e1, e2, axis;  // (e1, e2, axis) is right-handed and orthonormal
+    // A power of two that brings the cloud's extent near 1, so that squared distances
+    // neither overflow (a cloud at 1e200) nor underflow (at 1e-200); being a power of two,
+    // it changes no rounding and the triangles do not depend on it.
+    double scale;
+    // Set when the cloud spans more than the largest double (coordinates of both signs
+    // near 1e308): p - origin would overflow, so halves are subtracted instead.
+    bool halved;
+    Vec3 half_origin;
+    // Layers are flipped on the surface (the surface_flips flag; see "flips on the surface"
+    // in >>layer triangulation).
+    bool surface_flips;
+    // The surface's ends (kLowPole, kHighPole) never taken for a closed one
+    // (TubeRequest::cut_ends); 0 without kClosedEnds.
+    uint32_t cut_ends;
+    // The valid points' lowest and highest coordinates (set by choose_frame with kFastLoops).
+    Vec3 low, high;
+    // The cloud's own extent over the frame's, which also covers the way to a given origin:
+    // 1 without origin_given.
+    double cloud_share;
+    // (p - origin) * scale, without overflow.
+    Vec3 offset(Vec3 p) const {
+        if (halved) return scaled(scaled(p, 0.5) - half_origin, 2 * scale);
+        return scaled(p - origin, scale);
+    }
+    Local local(Vec3 p) const {
+        Vec3 d = offset(p);
+        return {dot(d, e1), dot(d, e2), dot(d, axis)};
+    }
+    // local(p).h alone, the same bits.
+    double height(Vec3 p) const { return dot(offset(p), axis); }
+    // A frame height back as the user's coordinate along the axis, dot(point, axis).
+    double user_height(double h) const { return h / scale + dot(origin, axis); }
+};
+
+// The power of two 2^-e with 2^e just above `extent`, within [2^-1000, 2^1000].
+STRATMESH_SMALL_NOINLINE inline double scale_for_extent(double extent) {
+    if (!(extent > 0) || !is_finite(extent)) return 1;
+    int exponent = 0;
+    std::frexp(extent, &exponent);
+    if (exponent > 1000) exponent = 1000;
+    if (exponent < -1000) exponent = -1000;
+    return std::ldexp(1.0, -exponent);
+}
+
+// The principal direction of a symmetric 3x3 matrix by power iteration from its largest
+// column; a fixed number of steps keeps the cost bounded and the result deterministic.
+inline Vec3 principal_direction(const double m[3][3]) {
+    Vec3 cols[3] = {{m[0][0], m[1][0], m[2][0]}, {m[0][1], m[1][1], m[2][1]},
+                    {m[0][2], m[1][2], m[2][2]}};
+    Vec3 v = cols[0];
+    for (const Vec3& c : cols)
+        if (dot(c, c) > dot(v, v)) v = c;
+    if (!normalize(v)) return {0, 0, 1};
+    for (int step = 0; step < 100; ++step) {
+        Vec3 w = {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z,
+                  m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
+                  m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
+        if (!normalize(w)) break;
+        v = w;
+    }
+    // The sign of an eigenvector is arbitrary: point it along its largest component.
+    double big = v.x;
+    if (abs_value(v.y) > abs_value(big)) big = v.y;
+    if (abs_value(v.z) > abs_value(big)) big = v.z;
+    return big < 0 ? scaled(v, -1.0) : v;
+}
+
+// The frame of the points summed in `sums`: centroid origin, axis from the options (an
+// explicit one: Axis::automatic is resolved before, see choose_axis), e1/e2 completing it.
+// How far a given origin may lie from the cloud's bounding box, per coordinate, in
+// multiples of the box's largest side. Seen from farther, the whole cloud lies within
+// 2^-32 radians of one direction and its offsets from the origin keep fewer than 21 of
+// their 53 bits for the cloud's own shape: no unrolling around it means anything.
+const double kOriginReach = 0x1p32;
+
+// Whether `origin` lies within kOriginReach times the largest side of the box [low, high]
+// of it (halves, so that nothing overflows). A box of one point reaches everywhere.
+inline bool origin_in_reach(Vec3 origin, Vec3 low, Vec3 high) {
+    const Vec3 half_low = scaled(low, 0.5), half_high = scaled(high, 0.5);
+    const Vec3 half_origin = scaled(origin, 0.5);
+    const Vec3 side = half_high - half_low;
+    const Vec3 below = half_low - half_origin, above = half_origin - half_high;
+    const Vec3 way = {below.x > above.x ? below.x : above.x, below.y > above.y ? below.y : above.y,
+                      below.z > above.z ? below.z : above.z};
+    const double reach = largest_of(side);
+    return reach == 0 || largest_of(way) <= kOriginReach * reach;
+}
+
+// Why a given origin cannot serve as the frame's, or null if it can (or none is given): it
+// is NaN or infinite, or lies beyond kOriginReach of the valid points summed in `sums`.
+inline const char* origin_refusal(const double* origin, const CloudSums& sums) {
+    if (!origin) return nullptr;
+    const Vec3 given = {origin[0], origin[1], origin[2]};
+    if (!(is_finite(given.x) && is_finite(given.y) && is_finite(given.z)))
+        return "the given origin is NaN or infinite";
+    const Vec3 low = {sums.lowest[0], sums.lowest[1], sums.lowest[2]};
+    const Vec3 high = {sums.highest[0], sums.highest[1], sums.highest[2]};
+    if (sums.valid > 0 && !origin_in_reach(given, low, high))
+        return "the given origin lies farther from the cloud than 2^32 times the cloud's size: "
+               "no unrolling around it means anything (give a nearer origin, or none)";
+    return nullptr;
+}
+
+inline const char* origin_refusal(const Options& options, const CloudSums& sums) {
+    return origin_refusal((options.flags & origin_given) ? options.origin : nullptr, sums);
+}
+
+inline Status choose_frame(const CloudSums& sums, const TubeRequest& request, Frame& frame) {
+    const size_t valid = sums.valid;
+    const Vec3 sum = {sums.total[0], sums.total[1], sums.total[2]};
+    const Vec3 small_sum = {sums.small_total[0], sums.small_total[1], sums.small_total[2]};
+    const Vec3 low = {sums.lowest[0], sums.lowest[1], sums.lowest[2]};
+    const Vec3 high = {sums.highest[0], sums.highest[1], sums.highest[2]};
+    if (kFastLoops) {
+        frame.low = low;
+        frame.high = high;
+    }
+    if (!(is_finite(sum.x) && is_finite(sum.y) && is_finite(sum.z)))
+        frame.origin = scaled(scaled(small_sum, 1.0 / static_cast<double>(valid)), 0x1p40);
+    else
+        frame.origin = valid ? scaled(sum, 1.0 / static_cast<double>(valid)) : Vec3{0, 0, 0};
+    Vec3 size = valid ? high - low : Vec3{0, 0, 0};
+    Vec3 half_size = valid ? scaled(high, 0.5) - scaled(low, 0.5) : Vec3{0, 0, 0};
+    const double own_half_extent = largest_of(half_size);
+    if (request.origin) {
+        if (origin_refusal(request.origin, sums)) return Status::invalid_origin;
+        const Vec3 given = {request.origin[0], request.origin[1], request.origin[2]};
+        // The extent covers the way from the given origin to the cloud, so the frame's
+        // coordinates stay near 1 however far the origin is.
+        Vec3 way = scaled(frame.origin, 0.5) - scaled(given, 0.5);
+        way = {abs_value(way.x), abs_value(way.y), abs_value(way.z)};
+        half_size = {half_size.x + way.x, half_size.y + way.y, half_size.z + way.z};
+        size = {size.x + 2 * way.x, size.y + 2 * way.y, size.z + 2 * way.z};
+        frame.origin = given;
+    }
+    const double half_extent = largest_of(half_size);
+    frame.cloud_share = half_extent > 0 ? own_half_extent / half_extent : 1;
+    frame.halved = !(is_finite(size.x) && is_finite(size.y) && is_finite(size.z));
+    if (frame.halved) size = half_size;
+    frame.half_origin = scaled(frame.origin, 0.5);
+    double extent = size.x > size.y ? size.x : size.y;
+    if (size.z > extent) extent = size.z;
+    frame.scale = scale_for_extent(extent) * (frame.halved ? 0.5 : 1.0);
+    Vec3 axis = {0, 0, 1};
+    switch (request.axis) {
+    case Axis::x: axis = {1, 0, 0}; break;
+    case Axis::y: axis = {0, 1, 0}; break;
+    case Axis::z: axis = {0, 0, 1}; break;
+    case Axis::direction:
+        axis = {request.direction[0], request.direction[1], request.direction[2]};
+        if (!unit_direction(axis)) return Status::invalid_axis;
+        break;
+    default: return Status::invalid_axis;
+    }
+    // e1: the coordinate axis least aligned with the stacking axis, made orthogonal.
+    Vec3 helper = {1, 0, 0};
+    if (abs_value(axis.x) > abs_value(axis.y) || abs_value(axis.x) > abs_value(axis.z))
+        helper = abs_value(axis.y) < abs_value(axis.z) ? Vec3{0, 1, 0} : Vec3{0, 0, 1};
+    Vec3 e1 = cross(helper, axis);
+    if (!normalize(e1)) return Status::invalid_axis;
+    frame.axis = axis;
+    frame.surface_flips = request.surface_flips;
+    frame.cut_ends = request.cut_ends;
+    frame.e1 = e1;
+    frame.e2 = cross(axis, e1);
+    return Status::ok;
+}
+
+inline Status choose_frame(const CloudSums& sums, const Options& options, Frame& frame) {
+    return choose_frame(sums, tube_request(options), frame);
+}
+
+// The lowest and highest frame height of the valid points.
+inline void height_range(const CloudReader& cloud, size_t count, const Frame& frame, double* lo,
+                         double* hi) {
+    for (size_t i = 0; i < count; ++i) {
+        if (!cloud.valid(i)) continue;
+        const double h = frame.height(cloud.point(i));
+        if (h < *lo) *lo = h;
+        if (h > *hi) *hi = h;
+    }
+}
+
+// height_range without a pass over the cloud, where the axis is a coordinate axis (and
+// the frame not halved): a height is then (p_k - origin_k) * scale plus zeros, exactly
+// that value, and rounding keeps the order, so the lowest and highest coordinates along
+// the axis give the same two heights, bit for bit. False otherwise.
+inline bool height_range_from_extremes(const Frame& frame, double* lo, double* hi) {
+    const double axis[3] = {frame.axis.x, frame.axis.y, frame.axis.z};
+    const double low[3] = {frame.low.x, frame.low.y, frame.low.z};
+    const double high[3] = {frame.high.x, frame.high.y, frame.high.z};
+    const double origin[3] = {frame.origin.x, frame.origin.y, frame.origin.z};
+    for (int k = 0; k < 3; ++k) {
+        if (frame.halved || axis[k] != 1 || axis[(k + 1) % 3] != 0 || axis[(k + 2) % 3] != 0)
+            continue;
+        *lo = (low[k] - origin[k]) * frame.scale;
+        *hi = (high[k] - origin[k]) * frame.scale;
+        return true;
+    }
+    return false;
+}
+
+STRATMESH_SMALL_NOINLINE inline void report_frame(const Frame& frame, Report& rep) {
+    rep.axis[0] = frame.axis.x;
+    rep.axis[1] = frame.axis.y;
+    rep.axis[2] = frame.axis.z;
+    rep.axis_origin[0] = frame.origin.x;
+    rep.axis_origin[1] = frame.origin.y;
+    rep.axis_origin[2] = frame.origin.z;
+}
+
+}  // namespace detail
+}  // namespace stratmesh
+
 // >>layer plan ===========================================================================
 // Cuts along the axis: explicit, equal, by height or automatic; points grouped by layer.
 //
@@ -4032,13 +4125,13 @@ static inline bool thick_enough(size_t points, double height, double radius) {
     return static_cast<double>(points) * height >= kMinLayerRows * kMinLayerRows * two_pi * radius;
 }
 
-// The number of layers the options can ask for, before empty layers are dropped.
-static inline size_t planned_layer_limit(size_t point_count, const Options& options) {
-    if (options.cuts && options.cut_count > 0) return options.cut_count + 1;
-    if (options.layer_count > 0)
-        return options.layer_count < point_count ? options.layer_count : (point_count > 0 ? point_count : 1);
+// The number of layers a request can ask for, before empty layers are dropped.
+static inline size_t planned_layer_limit(size_t point_count, const LayerRequest& layers) {
+    if (layers.cuts && layers.cut_count > 0) return layers.cut_count + 1;
+    if (layers.count > 0)
+        return layers.count < point_count ? layers.count : (point_count > 0 ? point_count : 1);
     // A target height: never more layers than points.
-    if (options.layer_height > 0) return point_count > 0 ? point_count : 1;
+    if (layers.height > 0) return point_count > 0 ? point_count : 1;
     return kMaxAutomaticLayers;
 }
 
@@ -4055,25 +4148,24 @@ static inline Status validate_layer_options(const Options& options) {
     return Status::ok;
 }
 
-static inline bool automatic_layers(const Options& options) {
-    return !(options.cuts && options.cut_count > 0) && options.layer_count == 0 &&
-           options.layer_height == 0;
+static inline bool automatic_layers(const LayerRequest& layers) {
+    return !(layers.cuts && layers.cut_count > 0) && layers.count == 0 && layers.height == 0;
 }
 
 // Fills plan.bounds (room for planned_layer_limit + 1 entries) for heights [lo, hi] from
-// the user's layer options (not automatic_layers): the cuts are coordinates along the axis
-// (Frame::user_height of frame heights), layer_height a length in the cloud's units.
-static inline void plan_layers(const Options& options, double lo, double hi, size_t point_count,
-                               const Frame& frame, LayerPlan& plan) {
+// the layers asked for (not automatic_layers): the cuts are coordinates along the axis
+// (Frame::user_height of frame heights), the height a length in the cloud's units.
+static inline void plan_layers(const LayerRequest& layers, double lo, double hi, size_t point_count,
+                        const Frame& frame, LayerPlan& plan) {
     const double cut_offset = dot(frame.origin, frame.axis);
     double* b = plan.bounds;
     uint32_t n = 0;
     b[n++] = lo;
-    if (options.cuts && options.cut_count > 0) {
+    if (layers.cuts && layers.cut_count > 0) {
         // The cuts inside (lo, hi], sorted, repeats dropped.
         size_t inside = 0;
-        for (size_t i = 0; i < options.cut_count; ++i) {
-            double c = (options.cuts[i] - cut_offset) * frame.scale;
+        for (size_t i = 0; i < layers.cut_count; ++i) {
+            double c = (layers.cuts[i] - cut_offset) * frame.scale;
             if (c > lo && c <= hi) b[1 + inside++] = c;
         }
         heap_sort(b + 1, inside);
@@ -4081,16 +4173,16 @@ static inline void plan_layers(const Options& options, double lo, double hi, siz
             if (b[1 + i] > b[n - 1]) b[n++] = b[1 + i];
     } else {
         double height = hi - lo;
-        double layers = 1;
-        if (options.layer_count > 0) {
-            layers = options.layer_count;
-        } else if (options.layer_height > 0) {
-            layers = std::ceil(height / (options.layer_height * frame.scale));
+        double planned = 1;
+        if (layers.count > 0) {
+            planned = layers.count;
+        } else if (layers.height > 0) {
+            planned = std::ceil(height / (layers.height * frame.scale));
         }
         double limit = static_cast<double>(point_count);
-        if (!(layers >= 1)) layers = 1;
-        if (layers > limit) layers = limit;
-        uint32_t count = static_cast<uint32_t>(layers);
+        if (!(planned >= 1)) planned = 1;
+        if (planned > limit) planned = limit;
+        uint32_t count = static_cast<uint32_t>(planned);
         for (uint32_t i = 1; i < count; ++i) {
             double c = lo + height * (static_cast<double>(i) / static_cast<double>(count));
             if (c > b[n - 1] && c < hi) b[n++] = c;
@@ -9347,13 +9439,13 @@ static inline void describe_layer(const Frame& frame, const Cylinder& cyl, doubl
 }
 
 // The workspace bound of mesh_tube() (with read_cloud()) for point_count points.
-static inline size_t tube_workspace_size(size_t point_count, const Options& options) {
+static inline size_t tube_workspace_size(size_t point_count, const TubeRequest& request) {
     if (point_count > kMaxPoints - 1) return 0;
     Arena arena = Arena::measuring();
     // drop_outliers, as find_outliers allocates: the bitmap stays, the grid comes and goes
     // before the rest is allocated.
     size_t outlier_bytes = 0;
-    if (kDropOutliers && (options.flags & drop_outliers)) {
+    if (kDropOutliers && request.drop_outliers) {
         Arena grid = Arena::measuring();
         grid.alloc<unsigned char>(point_count / 8 + 1);
         allocate_cell_scratch(grid, point_count);
@@ -9362,13 +9454,12 @@ static inline size_t tube_workspace_size(size_t point_count, const Options& opti
         arena.alloc<unsigned char>(point_count / 8 + 1);
     }
     ReconstructMemory m;
-    const size_t layer_limit = planned_layer_limit(point_count, options);
+    const size_t layer_limit = planned_layer_limit(point_count, request.layers);
     plan_reconstruct(m, point_count, layer_limit, arena);
-    size_t scratch = reconstruct_scratch_size(point_count,
-                                                      (options.flags & close_ends) != 0);
+    size_t scratch = reconstruct_scratch_size(point_count, request.caps);
     // With a runner, the layers done ahead (at most one per kMinLayerPoints points, plus the
     // last) stay while the groups are formed.
-    if (has_runner(options) &&
+    if (has_runner(jobs_of(request)) &&
         !plan_parallel_workspace(point_count, layer_limit, arena, &scratch))
         return 0;
     if (arena.failed || scratch == 0 || scratch > SIZE_MAX - arena.required_bytes()) return 0;
@@ -9435,16 +9526,15 @@ static inline size_t repeats_of_vertices(const CloudReader& reader, size_t count
 }
 
 // Plans the layers of a tube along the frame's axis and groups its points by layer.
-static inline Status plan_tube_layers(const TubeInput& in, const Options& options,
-                                      const Frame& frame, double lo, double hi, Arena& arena,
-                                      ReconstructMemory& m, LayerPlan& plan, Local** staged,
-                                      Report& rep) {
+static inline Status plan_tube_layers(const TubeInput& in, const TubeRequest& request, const Frame& frame,
+                               double lo, double hi, Arena& arena, ReconstructMemory& m,
+                               LayerPlan& plan, Local** staged, Report& rep) {
     const size_t valid = in.sums.valid;
-    const size_t layer_limit = planned_layer_limit(in.count, options);
+    const size_t layer_limit = planned_layer_limit(in.count, request.layers);
     if (!plan_reconstruct(m, in.count, layer_limit, arena)) return Status::out_of_memory;
-    notify(options, Phase::layers, 0);
+    notify(request, Phase::layers, 0);
     plan = {m.bounds, 0, (hi - lo) * kCutTolerance};
-    if (automatic_layers(options)) {
+    if (automatic_layers(request.layers)) {
         const size_t mark = arena.mark();
         const uint32_t bins = profile_bin_count(valid);
         ProfileBin* profile = nullptr;
@@ -9456,7 +9546,7 @@ static inline Status plan_tube_layers(const TubeInput& in, const Options& option
                               bins, plan);
         arena.rewind(mark);
     } else {
-        plan_layers(options, lo, hi, in.count, frame, plan);
+        plan_layers(request.layers, lo, hi, in.count, frame, plan);
     }
     rep.layers.planned_count = plan.count;
     // Without a runner, the grouped points are also staged in the workspace's end room when
@@ -9467,9 +9557,9 @@ static inline Status plan_tube_layers(const TubeInput& in, const Options& option
     const size_t mark = arena.mark();
     uint32_t* layer = arena.alloc<uint32_t>(in.count);
     if (arena.failed) return Status::out_of_memory;
-    if (kStagePoints && !has_runner(options))
+    if (kStagePoints && !has_runner(jobs_of(request)))
         *staged = static_cast<Local*>(arena.room_at_end(saturating_product(valid, sizeof(Local))));
-    if (!group_by_layer_in_jobs(options, in.reader, in.count, frame, plan, layer, m.layer_start,
+    if (!group_by_layer_in_jobs(jobs_of(request), in.reader, in.count, frame, plan, layer, m.layer_start,
                                 m.order, arena))
         group_by_layer(in.reader, in.count, frame, plan, layer, *staged, m.layer_start, m.order);
     arena.rewind(mark);
@@ -9478,18 +9568,17 @@ static inline Status plan_tube_layers(const TubeInput& in, const Options& option
 
 // Triangulates the planned layers one group after another, each stitched to the one below,
 // into `sink`; the layers used go to the report.
-static inline Status triangulate_tube(const TubeInput& in, const Options& options,
-                                      const Frame& frame, const LayerPlan& plan, Local* staged,
-                                      Arena& arena, ReconstructMemory& m, TriangleSink& sink,
-                                      Report& rep) {
-    notify(options, Phase::triangulate, 0);
+static inline Status triangulate_tube(const TubeInput& in, const TubeRequest& request, const Frame& frame,
+                               const LayerPlan& plan, Local* staged, Arena& arena,
+                               ReconstructMemory& m, TriangleSink& sink, Report& rep) {
+    notify(request, Phase::triangulate, 0);
     SurfaceChain& chain = m.chain;
     chain.frame = frame;
     chain.reader = in.reader;
     chain.output_id = nullptr;
     const LayerQueue queue = {m.order, staged, m.layer_start, plan.bounds, plan.count, true};
     ParallelLayers parallel;
-    rep.layers.parallel_count = start_parallel_layers(options, in.reader, frame, queue, arena, parallel);
+    rep.layers.parallel_count = start_parallel_layers(jobs_of(request), in.reader, frame, queue, arena, parallel);
     for (uint32_t first = 0; first < plan.count;) {
         GroupResult group;
         const Status status = add_group(chain, queue, first, arena, sink, group,
@@ -9502,7 +9591,7 @@ static inline Status triangulate_tube(const TubeInput& in, const Options& option
                            rep.layers.info[rep.layers.used_count]);
         ++rep.layers.used_count;
         first = group.last + 1;
-        notify(options, Phase::triangulate, static_cast<double>(first) / plan.count);
+        notify(request, Phase::triangulate, static_cast<double>(first) / plan.count);
     }
     rep.points.duplicate_count = chain.duplicates;
     if (rep.layers.used_count == 0) {
@@ -9510,7 +9599,7 @@ static inline Status triangulate_tube(const TubeInput& in, const Options& option
                      "it (try another axis)";
         return Status::not_columnar;
     }
-    notify(options, Phase::stitch, 1);
+    notify(request, Phase::stitch, 1);
     if (sink.count == 0) {
         rep.detail = "every point lies on the boundary of its layer: too few points to span a "
                      "surface";
@@ -9547,11 +9636,11 @@ static inline bool has_no_area(const CloudReader& reader, const Frame& frame, co
 }
 
 // Closes the tube's boundary loops with caps (close_ends) and fills the caps' report.
-static inline Status cap_tube(const TubeInput& in, const Options& options, const Frame& frame,
-                              Arena& arena, uint32_t* triangles, size_t capacity, size_t& count,
-                              size_t* triangle_count, Report& rep) {
-    notify(options, Phase::manifold, 0);
-    if (!(options.flags & close_ends)) return Status::ok;
+static inline Status cap_tube(const TubeInput& in, const TubeRequest& request, const Frame& frame,
+                       Arena& arena, uint32_t* triangles, size_t capacity, size_t& count,
+                       size_t* triangle_count, Report& rep) {
+    notify(request, Phase::manifold, 0);
+    if (!request.caps) return Status::ok;
     CapCounts caps = {0, 0, 0, 0};
     size_t needed = 0;
     const Status status = cap_boundary_loops(triangles, count, capacity, in.reader, in.count,
@@ -9571,13 +9660,12 @@ static inline Status cap_tube(const TubeInput& in, const Options& options, const
 // One tube through the kept points of `in`: the frame, the layers, their triangulation and
 // stitching, the caps. `rep` holds the counts of read_cloud; Report::points.unused_count
 // is left to the caller.
-static inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& arena,
-                               uint32_t* triangles, size_t triangle_capacity,
-                               size_t* triangle_count, Report& rep) {
+static inline Status mesh_tube(const TubeInput& in, const TubeRequest& request, Arena& arena,
+                        uint32_t* triangles, size_t triangle_capacity, size_t* triangle_count,
+                        Report& rep) {
     Frame frame;
-    Status status = choose_frame(in.sums, options, frame);
+    Status status = choose_frame(in.sums, request, frame);
     if (status != Status::ok) return status;
-    if (kClosedEnds) frame.cut_ends |= in.cut_ends;
     report_frame(frame, rep);
     if (in.sums.distinct < 3) {
         rep.detail = "fewer than 3 distinct valid points";
@@ -9593,10 +9681,10 @@ static inline Status mesh_tube(const TubeInput& in, const Options& options, Aren
     ReconstructMemory m;
     LayerPlan plan;
     Local* staged = nullptr;
-    status = plan_tube_layers(in, options, frame, lo, hi, arena, m, plan, &staged, rep);
+    status = plan_tube_layers(in, request, frame, lo, hi, arena, m, plan, &staged, rep);
     if (status != Status::ok) return status;
     TriangleSink sink = {triangles, triangle_capacity, 0, 0};
-    status = triangulate_tube(in, options, frame, plan, staged, arena, m, sink, rep);
+    status = triangulate_tube(in, request, frame, plan, staged, arena, m, sink, rep);
     if (status != Status::ok) return status;
     if (sink.count > triangle_capacity) {
         *triangle_count = sink.count;
@@ -9607,7 +9695,7 @@ static inline Status mesh_tube(const TubeInput& in, const Options& options, Aren
     if (kDegenerateCheck && has_no_area(in.reader, frame, triangles, sink.count))
         return Status::degenerate;
     size_t count = sink.count;
-    status = cap_tube(in, options, frame, arena, triangles, triangle_capacity, count,
+    status = cap_tube(in, request, frame, arena, triangles, triangle_capacity, count,
                       triangle_count, rep);
     if (status != Status::ok) return status;
     *triangle_count = count;
@@ -9620,7 +9708,7 @@ static inline Status mesh_tube(const TubeInput& in, const Options& options, Aren
     }
     report_chain(m.chain, in.sums.valid, rep);
     if (!rep.detail && rep.caps.open_count > 0) rep.detail = kLoopLeftOpenDetail;
-    notify(options, Phase::done, 1);
+    notify(request, Phase::done, 1);
     return Status::ok;
 }
 
@@ -10137,26 +10225,12 @@ inline uint32_t axis_candidates(const double* xyz, size_t count, Vec3* out) {
 
 // What a candidate's sample surface measures: its area, plus the area of a triangle per
 // sample point left out (a layer that cannot follow the surface drops points instead of
-// folding).
+// folding). *along (optional) receives the mean squared cosine between the triangles'
+// normals and the unit axis, weighted by their areas: 0 where the surface runs along the
+// axis, 1 where it lies across it.
 inline double sample_surface(const double* xyz, const uint32_t* tri, size_t count,
-                             size_t unused) {
-    double area = 0;
-    for (size_t t = 0; t < count; ++t) {
-        const double* a = xyz + 3 * tri[3 * t];
-        const double* b = xyz + 3 * tri[3 * t + 1];
-        const double* c = xyz + 3 * tri[3 * t + 2];
-        const Vec3 n = cross(Vec3{b[0] - a[0], b[1] - a[1], b[2] - a[2]},
-                             Vec3{c[0] - a[0], c[1] - a[1], c[2] - a[2]});
-        area += std::sqrt(dot(n, n)) / 2;
-    }
-    const double per_triangle = count > 0 ? area / static_cast<double>(count) : 0;
-    return area + 2 * per_triangle * static_cast<double>(unused);
-}
-
-// The mean squared cosine between the triangles' normals and the unit axis, weighted by
-// their areas: 0 where the surface runs along the axis, 1 where it lies across it.
-inline double normals_along(const double* xyz, const uint32_t* tri, size_t count, Vec3 axis) {
-    double along = 0, area = 0;
+                             size_t unused, Vec3 axis, double* along) {
+    double area = 0, along_sum = 0, normals = 0;
     for (size_t t = 0; t < count; ++t) {
         const double* a = xyz + 3 * tri[3 * t];
         const double* b = xyz + 3 * tri[3 * t + 1];
@@ -10164,42 +10238,49 @@ inline double normals_along(const double* xyz, const uint32_t* tri, size_t count
         const Vec3 n = cross(Vec3{b[0] - a[0], b[1] - a[1], b[2] - a[2]},
                              Vec3{c[0] - a[0], c[1] - a[1], c[2] - a[2]});
         const double length = std::sqrt(dot(n, n));
+        area += length / 2;
         if (length == 0) continue;
         const double cosine = dot(n, axis) / length;
-        along += cosine * cosine * length;
-        area += length;
+        along_sum += cosine * cosine * length;
+        normals += length;
     }
-    return area > 0 ? along / area : 1;
+    if (along) *along = normals > 0 ? along_sum / normals : 1;
+    const double per_triangle = count > 0 ? area / static_cast<double>(count) : 0;
+    return area + 2 * per_triangle * static_cast<double>(unused);
 }
 
-// Workspace for choose_axis() on a cloud of `valid` kept points, given the flags.
-inline size_t axis_workspace_size(size_t valid, const Options& options);
-
-// Meshes the sample along one candidate; DBL_MAX if it cannot.
-// *along (optional) receives the share of the sample surface's normals along the axis.
-inline double try_axis(const double* sample, size_t count, Vec3 axis, const Options& options,
-                       Arena& arena, double* along) {
-    Options trial = {};
+// What a candidate's sample is meshed as: one layer along `axis`, its ends cut where the
+// tube's are, nothing else asked for and no callback.
+inline TubeRequest trial_request(const TubeRequest& tube, Vec3 axis) {
+    TubeRequest trial = {};
     trial.axis = Axis::direction;
     trial.direction[0] = axis.x;
     trial.direction[1] = axis.y;
     trial.direction[2] = axis.z;
-    trial.flags = options.flags & open_ends;
-    trial.layer_count = 1;
+    trial.cut_ends = tube.cut_ends;
+    trial.layers.count = 1;
+    return trial;
+}
+
+// Meshes the sample along one candidate; DBL_MAX if it cannot.
+// *along (optional) receives the share of the sample surface's normals along the axis.
+inline double try_axis(const double* sample, size_t count, Vec3 axis, const TubeRequest& request,
+                       Arena& arena, double* along) {
+    const TubeRequest trial = trial_request(request, axis);
     const size_t mark = arena.mark();
     uint32_t* tri = arena.alloc<uint32_t>(6 * count);
     if (arena.failed) return DBL_MAX;
     const Cloud cloud = {sample, count, 0, Scalar::float64};
-    TubeInput in = {reader_of(cloud), count, {}, 0};
+    TubeInput in = {reader_of(cloud), count, {}};
     in.sums = sum_cloud(in.reader, count);
     Report rep = {};
     size_t triangles = 0;
     const Status status = mesh_tube(in, trial, arena, tri, 2 * count, &triangles, rep);
     arena.rewind(mark);
     if (status != Status::ok) return DBL_MAX;
-    if (along) *along = normals_along(sample, tri, triangles, axis);
-    return sample_surface(sample, tri, triangles, in.sums.valid - rep.points.used_count -
-                                                      rep.points.duplicate_count);
+    return sample_surface(sample, tri, triangles,
+                          in.sums.valid - rep.points.used_count - rep.points.duplicate_count,
+                          axis, along);
 }
 
 // Every k-th kept point of `in`, packed, at most `most` of them (and about that many), in
@@ -10232,7 +10313,8 @@ inline double* sample_points(const TubeInput& in, size_t most, Arena& arena, siz
 
 // The axis for Axis::automatic: the candidate whose sample surface is smallest (see above).
 // False if the workspace is too small.
-inline bool choose_axis(const TubeInput& in, const Options& options, Arena& arena, Vec3& axis) {
+inline bool choose_axis(const TubeInput& in, const TubeRequest& request, Arena& arena,
+                        Vec3& axis) {
     const size_t mark = arena.mark();
     size_t taken = 0;
     const double* shape = sample_points(in, kAxisShapeSample, arena, &taken);
@@ -10244,9 +10326,9 @@ inline bool choose_axis(const TubeInput& in, const Options& options, Arena& aren
     if (!sample) return false;
     axis = candidates[0];
     double along = 1;
-    double best = try_axis(sample, taken, candidates[0], options, arena, &along);
+    double best = try_axis(sample, taken, candidates[0], request, arena, &along);
     for (uint32_t k = 1; k < tries && !(along < kAlongSurface); ++k) {
-        const double score = try_axis(sample, taken, candidates[k], options, arena, nullptr);
+        const double score = try_axis(sample, taken, candidates[k], request, arena, nullptr);
         if (score < best) {
             best = score;
             axis = candidates[k];
@@ -10256,12 +10338,10 @@ inline bool choose_axis(const TubeInput& in, const Options& options, Arena& aren
     return !arena.failed;
 }
 
-inline size_t axis_workspace_size(size_t valid, const Options& options) {
+// Workspace for choose_axis() on a cloud of `valid` kept points.
+inline size_t axis_workspace_size(size_t valid, const TubeRequest& request) {
     const size_t count = valid < kAxisSample ? valid : kAxisSample;
-    Options trial = {};
-    trial.flags = options.flags & open_ends;
-    trial.layer_count = 1;
-    const size_t tube = tube_workspace_size(count, trial);
+    const size_t tube = tube_workspace_size(count, trial_request(request, Vec3{0, 0, 1}));
     if (tube == 0) return 0;
     const size_t shape = valid < kAxisShapeSample ? valid : kAxisShapeSample;
     Arena arena = Arena::measuring();
@@ -10270,28 +10350,26 @@ inline size_t axis_workspace_size(size_t valid, const Options& options) {
     return arena.failed ? 0 : arena.required_bytes() + tube;
 }
 
-// The options along the axis to use: Axis::automatic resolved by choose_axis().
-inline Status resolve_axis(const TubeInput& in, const Options& options, Arena& arena,
-                           Options& along, Report& rep) {
-    along = options;
-    if (options.axis != Axis::automatic) return Status::ok;
+// Axis::automatic in `request` resolved by choose_axis(); any other axis stays. *detail
+// receives the reason where it fails.
+inline Status resolve_axis(const TubeInput& in, Arena& arena, TubeRequest& request,
+                           const char** detail) {
+    if (request.axis != Axis::automatic) return Status::ok;
     if (!kAxisTrials) {
-        rep.detail = kNotCompiledDetail;
+        *detail = kNotCompiledDetail;
         return Status::not_compiled;
     }
     if (in.sums.distinct < 3) {  // no surface along any axis: mesh_tube says so
-        along.axis = Axis::z;
+        request.axis = Axis::z;
         return Status::ok;
     }
     Vec3 axis;
-    if (!choose_axis(in, options, arena, axis)) {
-        rep.detail = "the workspace is smaller than reconstruct_workspace_size()";
+    if (!choose_axis(in, request, arena, axis)) {
+        *detail = "the workspace is smaller than reconstruct_workspace_size()";
         return Status::out_of_memory;
     }
-    along.axis = Axis::direction;
-    along.direction[0] = axis.x;
-    along.direction[1] = axis.y;
-    along.direction[2] = axis.z;
+    const double direction[3] = {axis.x, axis.y, axis.z};
+    set_direction(request, direction);
     return Status::ok;
 }
 
@@ -10383,25 +10461,37 @@ inline void add_to_group(PointGroup& g, Vec3 p, int pass) {
     }
 }
 
-// The groups of why_no_area(): `group_of` numbers the runs of occupied bins from 1 (0:
-// empty); each point joins its bin's group, its box first, its moments after.
-inline uint32_t gather_groups(const TubeInput& in, const Binning& binning, uint32_t* group_of,
-                              PointGroup* groups) {
-    std::memset(group_of, 0, binning.bins * sizeof(uint32_t));
-    for (size_t i = 0; i < in.count; ++i)
-        if (in.reader.valid(i)) group_of[binning.of(in.reader.point(i))] = 1;
+// Numbers the runs of occupied bins (non-zero) from 1, empty bins 0; returns the runs.
+inline uint32_t number_runs(uint32_t* group_of, uint32_t bins) {
     uint32_t count = 0;
-    for (uint32_t b = 0; b < binning.bins; ++b) {
+    for (uint32_t b = 0; b < bins; ++b) {
         const bool occupied = group_of[b] != 0;
         if (occupied && (b == 0 || group_of[b - 1] == 0)) ++count;
         group_of[b] = occupied ? count : 0;
     }
-    std::memset(static_cast<void*>(groups), 0, count * sizeof(PointGroup));
-    for (int pass = 0; pass < 2; ++pass) {
+    return count;
+}
+
+// The groups of why_no_area(): the occupied bins first, numbered by run (number_runs()),
+// then each point joins its bin's group, its box first, its moments after. One loop over
+// the points serves the three passes.
+inline uint32_t gather_groups(const TubeInput& in, const Binning& binning, uint32_t* group_of,
+                              PointGroup* groups) {
+    std::memset(group_of, 0, binning.bins * sizeof(uint32_t));
+    uint32_t count = 0;
+    for (int pass = -1; pass < 2; ++pass) {
         for (size_t i = 0; i < in.count; ++i) {
             if (!in.reader.valid(i)) continue;
             const Vec3 p = in.reader.point(i);
-            add_to_group(groups[group_of[binning.of(p)] - 1], p, pass);
+            uint32_t& group = group_of[binning.of(p)];
+            if (pass < 0)
+                group = 1;
+            else
+                add_to_group(groups[group - 1], p, pass);
+        }
+        if (pass < 0) {
+            count = number_runs(group_of, binning.bins);
+            std::memset(static_cast<void*>(groups), 0, count * sizeof(PointGroup));
         }
         for (uint32_t k = 0; pass == 0 && k < count; ++k)
             groups[k].scale = scale_for_extent(largest_of(groups[k].high - groups[k].low));
@@ -10480,6 +10570,21 @@ inline Status explain_no_area(const TubeInput& in, Status status, Arena& arena, 
 
 #if !defined(STRATMESH_SMALL_CODE)
 namespace stratmesh {
+namespace detail {
+
+// Caps the boundary loops of the surface of `count` triangles (`in` reads the whole cloud)
+// in the frame along the request's axis, which is resolved.
+inline Status cap_surface(const TubeInput& in, const TubeRequest& request, Arena& arena,
+                          uint32_t* triangles, size_t capacity, size_t& count, CapCounts& caps,
+                          size_t* needed) {
+    Frame frame;
+    const Status status = choose_frame(in.sums, request, frame);
+    if (status != Status::ok) return status;
+    return cap_boundary_loops(triangles, count, capacity, in.reader, in.count, frame, arena,
+                              caps, needed);
+}
+
+}  // namespace detail
 
 size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count) {
     if (point_count > detail::kMaxPoints - 1) return 0;
@@ -10489,7 +10594,7 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count) {
     detail::allocate_cap_graph(graph, point_count, triangle_count, arena);
     detail::allocate_cap_loop(loop, point_count, arena);  // every point on a loop at most
     // Axis::automatic is resolved first, as reconstruct() resolves it.
-    const size_t axis = detail::axis_workspace_size(point_count, Options{});
+    const size_t axis = detail::axis_workspace_size(point_count, detail::tube_request(Options{}));
     if (arena.failed || axis == 0) return 0;
     return arena.required_bytes() > axis ? arena.required_bytes() : axis;
 }
@@ -10534,17 +10639,15 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
             checks.detail = "a triangle names a point outside the cloud, or an invalid one";
             return finish(Status::invalid_argument);
         }
-    detail::TubeInput in = {reader, cloud.count, sums, 0};
-    Options along;
-    status = detail::resolve_axis(in, options, arena, along, checks);
+    const detail::TubeInput in = {reader, cloud.count, sums};
+    detail::TubeRequest along = detail::tube_request(options);
+    status = detail::resolve_axis(in, arena, along, &checks.detail);
     if (status != Status::ok) return finish(status);
-    detail::Frame frame;
-    status = detail::choose_frame(sums, along, frame);
-    if (status == Status::invalid_origin) checks.detail = detail::origin_refusal(along, sums);
-    if (status != Status::ok) return finish(status);
-    status = detail::cap_boundary_loops(triangles, count, triangle_capacity, reader,
-                                        cloud.count, frame, arena, caps, &needed);
-    if (status == Status::out_of_memory)
+    status = detail::cap_surface(in, along, arena, triangles, triangle_capacity, count, caps,
+                                 &needed);
+    if (status == Status::invalid_origin)
+        checks.detail = detail::origin_refusal(along.origin, sums);
+    else if (status == Status::out_of_memory)
         checks.detail = "the workspace is smaller than cap_ends_workspace_size()";
     else if (status == Status::triangle_capacity)
         checks.detail = detail::kCapsTooLargeDetail;
@@ -10981,31 +11084,28 @@ inline Status out_of_workspace(Report& rep) {
 }  // namespace stratmesh
 
 namespace stratmesh {
+namespace detail {
 
-size_t find_parting_workspace_size(size_t point_count, const Options& options) {
-    if (point_count > detail::kMaxPoints - 1) return 0;
-    detail::Arena arena = detail::Arena::measuring();
-    if (options.flags & drop_outliers) arena.alloc<unsigned char>(point_count / 8 + 1);
+inline size_t parting_workspace_size(size_t point_count, const TubeRequest& request) {
+    if (point_count > kMaxPoints - 1) return 0;
+    Arena arena = Arena::measuring();
+    if (request.drop_outliers) arena.alloc<unsigned char>(point_count / 8 + 1);
     const size_t mark = arena.mark();
-    detail::allocate_cell_scratch(arena, point_count);  // the outliers' and the scale's grid
-    arena.alloc<detail::GridItem>(2 * detail::kScaleSample);
+    allocate_cell_scratch(arena, point_count);  // the outliers' and the scale's grid
+    arena.alloc<GridItem>(2 * kScaleSample);
     arena.rewind(mark);
     // Axis::automatic is resolved first, as reconstruct() resolves it.
-    arena.alloc<unsigned char>(detail::axis_workspace_size(point_count, options));
+    arena.alloc<unsigned char>(axis_workspace_size(point_count, request));
     arena.rewind(mark);
-    detail::PartingMemory m;
-    detail::allocate_parting(m, point_count, arena);
+    PartingMemory m;
+    allocate_parting(m, point_count, arena);
     return arena.failed ? 0 : arena.required_bytes();
 }
 
-}  // namespace stratmesh
-
-namespace stratmesh {
-namespace detail {
-
-// find_parting() with the fewest points a branch holds given: a sample of the cloud is
-// searched with fewer (see search_parting).
-inline Status find_parting_with(const Cloud& cloud, const Options& options, void* workspace,
+// find_parting() along the axis of `request` (its origin, outliers and invalid points as
+// it says) with the fewest points a branch holds given: a sample of the cloud is searched
+// with fewer (see search_parting).
+inline Status find_parting_with(const Cloud& cloud, const TubeRequest& request, void* workspace,
                                 size_t workspace_bytes, Parting* parting, uint8_t* branch_of,
                                 uint32_t smallest) {
     if (!parting) return Status::invalid_argument;
@@ -11030,15 +11130,15 @@ inline Status find_parting_with(const Cloud& cloud, const Options& options, void
     if (branch_of) std::memset(branch_of, kInTrunk, cloud.count);
     CloudReader reader = reader_of(cloud);
     CloudSums sums = sum_cloud(reader, cloud.count);
-    status = reject_invalid_points(reader, cloud.count, sums, options, rep);
+    status = reject_invalid_points(reader, cloud.count, sums, *request.caller, rep);
     if (status != Status::ok) return finish(status);
-    if (options.flags & drop_outliers) {
+    if (request.drop_outliers) {
         if (!find_outliers(reader, cloud.count, arena, rep)) return finish(out_of_workspace(rep));
         sums = sum_cloud(reader, cloud.count);
     }
-    const TubeInput in = {reader, cloud.count, sums, 0};
-    Options along;
-    status = resolve_axis(in, options, arena, along, rep);
+    const TubeInput in = {reader, cloud.count, sums};
+    TubeRequest along = request;
+    status = resolve_axis(in, arena, along, &rep.detail);
     if (status != Status::ok) return finish(status);
     Frame frame;
     status = choose_frame(sums, along, frame);
@@ -11120,10 +11220,14 @@ inline Status find_parting_with(const Cloud& cloud, const Options& options, void
 
 namespace stratmesh {
 
+size_t find_parting_workspace_size(size_t point_count, const Options& options) {
+    return detail::parting_workspace_size(point_count, detail::tube_request(options));
+}
+
 Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
                     size_t workspace_bytes, Parting* parting, uint8_t* branch_of) {
-    return detail::find_parting_with(cloud, options, workspace, workspace_bytes, parting,
-                                     branch_of, kSmallestBranch);
+    return detail::find_parting_with(cloud, detail::tube_request(options), workspace,
+                                     workspace_bytes, parting, branch_of, kSmallestBranch);
 }
 
 }  // namespace stratmesh
@@ -12104,9 +12208,11 @@ const double kAdoptionGaps = 2.0;
 
 const uint64_t kMostStrayChecks = uint64_t{1} << 26;
 
-inline void adopt_stray_points(const TubeInput& whole, double gap, uint8_t* labels) {
+// True if the trunk took a point.
+inline bool adopt_stray_points(const TubeInput& whole, double gap, uint8_t* labels) {
     const double reach = kAdoptionGaps * gap;
     uint64_t checks_left = kMostStrayChecks;
+    bool trunk_grew = false;
     // Passes until none is adopted: a point can be adopted through one adopted before it
     // (the sparse tip of a horn, point after point).
     for (bool adopted = true; adopted;) {
@@ -12114,7 +12220,7 @@ inline void adopt_stray_points(const TubeInput& whole, double gap, uint8_t* labe
         uint64_t strays = 0;
         for (size_t i = 0; i < whole.count; ++i)
             strays += labels[i] == kBeyondBranches && whole.reader.valid(i);
-        if (strays == 0 || strays > checks_left / whole.count) return;
+        if (strays == 0 || strays > checks_left / whole.count) return trunk_grew;
         checks_left -= strays * whole.count;
         for (size_t i = 0; i < whole.count; ++i) {
             if (labels[i] != kBeyondBranches || !whole.reader.valid(i)) continue;
@@ -12131,9 +12237,18 @@ inline void adopt_stray_points(const TubeInput& whole, double gap, uint8_t* labe
                 }
             }
             adopted = adopted || label != kBeyondBranches;
+            trunk_grew = trunk_grew || label == kInTrunk;
             labels[i] = label;
         }
     }
+    return trunk_grew;
+}
+
+// Whether every point is in a part (none is left beyond a cut in no branch).
+inline bool every_point_in_a_part(size_t count, const uint8_t* labels) {
+    for (size_t i = 0; i < count; ++i)
+        if (labels[i] == kBeyondBranches) return false;
+    return true;
 }
 
 // Where branches stand on a closed end of the trunk (its end layer at a side that parts
@@ -12166,15 +12281,7 @@ inline bool cuts_for_tall_ends(const PartsMemory& m, size_t n, const Parting& pa
     return true;
 }
 
-// A part's counts into the whole's report.
-inline void add_part_counts(const Report& part, Report& rep) {
-    rep.points.used_count += part.points.used_count;
-    rep.points.duplicate_count += part.points.duplicate_count;
-    rep.diagnostics.fold_count += part.diagnostics.fold_count;
-    rep.diagnostics.illegal_removed_count += part.diagnostics.illegal_removed_count;
-    rep.diagnostics.diagonal_swap_count += part.diagnostics.diagonal_swap_count;
-}
-
+// A part meshed into the record of the parts, and where meshed, its counts into the whole's.
 inline void record_part(Report& rep, uint8_t label, Status status, const TubeInput& in,
                         const Report& part, size_t triangles, size_t merged) {
     PartCounts& p = rep.parts;
@@ -12183,22 +12290,47 @@ inline void record_part(Report& rep, uint8_t label, Status status, const TubeInp
                                 status == Status::ok ? triangles : 0,
                                 part.diagnostics.fold_count, merged};
     ++p.part_count;
+    if (status != Status::ok) return;
+    rep.points.used_count += part.points.used_count;
+    rep.points.duplicate_count += part.points.duplicate_count;
+    rep.diagnostics.fold_count += part.diagnostics.fold_count;
+    rep.diagnostics.illegal_removed_count += part.diagnostics.illegal_removed_count;
+    rep.diagnostics.diagonal_swap_count += part.diagnostics.diagonal_swap_count;
 }
 
-// Finds where the cloud parts, on a sample first when it is large (see above); the labels
-// are filled where it parts. False if the workspace is too small.
-inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const Options& along,
+// ---- the steps ---------------------------------------------------------------------------
+//
+// reconstruct_default() reads top to bottom: search where the cloud parts, square the cut
+// to the trunk, adopt the stray points, mesh the one tube for its area, mesh the parts,
+// join them, then keep them or undo them. Each step asks for its tubes with a TubeRequest
+// of its own, made from the caller's (see >>request).
+
+// What the steps share: the memory, the request the parts are cut along (the caller's,
+// along the axis the cut is squared to), and the trunk's own axis once chosen for the
+// labels as they stand (`trunk_known`).
+struct PartsWork {
+    PartsMemory m;
+    TubeRequest cut;
+    bool trunk_known;
+    Status trunk_status;
+    TubeRequest trunk;
+};
+
+// Finds where the cloud parts along the request's axis (the frame's origin the centroid),
+// on a sample first when it is large (see above); the labels are filled where it parts.
+// False if the workspace is too small.
+inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const TubeRequest& along,
                            const PartsMemory& m, Arena& arena, Parting& parting) {
-    Options search = along;
-    search.flags &= skip_invalid_points | drop_outliers;
+    TubeRequest search = along;
+    search.origin = nullptr;
     if (whole.sums.valid > kPartingSample) {
         const size_t mark = arena.mark();
         size_t taken = 0;
         const double* sample = sample_points(whole, kPartingSample, arena, &taken);
         if (!sample) return false;
-        Options on_sample = search;
-        on_sample.flags &= ~static_cast<uint32_t>(skip_invalid_points | drop_outliers);
-        const size_t bytes = find_parting_workspace_size(taken, on_sample);
+        TubeRequest on_sample = search;  // the sample holds the kept points only
+        on_sample.drop_outliers = false;
+        const size_t bytes = parting_workspace_size(taken, on_sample);
         void* work = arena.alloc<unsigned char>(bytes);
         if (!work) return false;
         const Status status =
@@ -12209,13 +12341,37 @@ inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const Opt
             return true;
     }
     const size_t mark = arena.mark();
-    const size_t bytes = find_parting_workspace_size(cloud.count, search);
+    const size_t bytes = parting_workspace_size(cloud.count, search);
     void* work = arena.alloc<unsigned char>(bytes);
     if (!work) return false;
-    const Status status = find_parting(cloud, search, work, bytes, &parting, m.labels);
+    const Status status = find_parting_with(cloud, search, work, bytes, &parting, m.labels,
+                                            kSmallestBranch);
     arena.rewind(mark);
     if (status != Status::ok) parting.above_branch_count = parting.below_branch_count = 0;
     return true;
+}
+
+// Whether the cloud parts around a trunk: a trunk of fewer points than a branch is no
+// trunk, the cloud is apart all along (separate objects) and is meshed as one tube.
+inline bool parts_around_trunk(size_t count, const Parting& parting, const uint8_t* labels) {
+    if (parting.above_branch_count + parting.below_branch_count == 0) return false;
+    size_t trunk_points = 0;
+    for (size_t i = 0; i < count; ++i) trunk_points += labels[i] == kInTrunk;
+    return trunk_points >= kSmallestBranch;
+}
+
+// The trunk's own automatic axis, chosen once for the labels as they stand: squaring the
+// cut asks for it, and the trunk is meshed around it unless a label changed since.
+inline Status trunk_axis(const TubeInput& whole, PartsWork& w, Arena& arena) {
+    if (w.trunk_known) return w.trunk_status;
+    w.trunk = w.cut;
+    w.trunk.axis = Axis::automatic;
+    const char* ignored = nullptr;
+    const size_t mark = arena.mark();
+    w.trunk_status = resolve_axis(part_input(whole, w.m, kInTrunk), arena, w.trunk, &ignored);
+    arena.rewind(mark);
+    w.trunk_known = true;
+    return w.trunk_status;
 }
 
 // A fork scanned askew is cut obliquely, lower under one branch than under another, and a
@@ -12225,213 +12381,40 @@ inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const Opt
 // it), the parting is searched again along the mean of the two axes, up to kSquareCutRounds
 // times: an oblique cut leaves more of one branch in the trunk, which leans the trunk's
 // axis the other way, so the mean comes closer each round. A round is kept only if it
-// finds as many branches on each side; `along` then takes its axis. Not where the caller
-// gave cuts, which are positions along the axis. False if the workspace is too small.
+// finds as many branches on each side; the parts are then cut along its axis. Not where
+// the caller gave cuts, which are positions along the axis. False if the workspace is too
+// small.
 const double kSquareCutLeast = 0.99996;  // cos 0.5 degree
 
 const double kSquareCutMost = 0.866;     // cos 30 degrees
 
 const int kSquareCutRounds = 4;
 
-inline bool square_cut_to_trunk(const Cloud& cloud, const TubeInput& whole, const PartsMemory& m,
-                                Arena& arena, Options& along, Parting& parting) {
-    for (int round = 0; round < kSquareCutRounds && along.cut_count == 0; ++round) {
-        Options automatic = along, own;
-        automatic.axis = Axis::automatic;
-        Report ignored = {};
-        const size_t mark = arena.mark();
-        const Status status = resolve_axis(part_input(whole, m, kInTrunk), automatic, arena,
-                                           own, ignored);
-        arena.rewind(mark);
-        if (status != Status::ok || own.axis != Axis::direction) break;
+inline bool square_cut_to_trunk(const Cloud& cloud, const TubeInput& whole, PartsWork& w,
+                                Arena& arena, Parting& parting) {
+    for (int round = 0; round < kSquareCutRounds && w.cut.layers.cut_count == 0; ++round) {
+        if (trunk_axis(whole, w, arena) != Status::ok || w.trunk.axis != Axis::direction) break;
         const Vec3 cut = {parting.axis[0], parting.axis[1], parting.axis[2]};
-        Vec3 trunk = {own.direction[0], own.direction[1], own.direction[2]};
+        Vec3 trunk = {w.trunk.direction[0], w.trunk.direction[1], w.trunk.direction[2]};
         if (!normalize(trunk)) break;
         const double lean = dot(trunk, cut);
         if (!(std::fabs(lean) < kSquareCutLeast && std::fabs(lean) > kSquareCutMost)) break;
         const Vec3 toward = scaled(trunk, lean < 0 ? -1 : 1);  // the parting's way
-        Options squared = along;
-        squared.axis = Axis::direction;
-        squared.direction[0] = cut.x + toward.x;
-        squared.direction[1] = cut.y + toward.y;
-        squared.direction[2] = cut.z + toward.z;
+        const double mean[3] = {cut.x + toward.x, cut.y + toward.y, cut.z + toward.z};
+        TubeRequest squared = w.cut;
+        set_direction(squared, mean);
         Parting again = {};
-        if (!search_parting(cloud, whole, squared, m, arena, again)) return false;
+        if (!search_parting(cloud, whole, squared, w.m, arena, again)) return false;
         if (again.above_branch_count != parting.above_branch_count ||
             again.below_branch_count != parting.below_branch_count) {
-            if (!search_parting(cloud, whole, along, m, arena, parting)) return false;
-            break;  // the last round's labels are back
+            // The last round's labels back, and with them the trunk's axis chosen on them.
+            return search_parting(cloud, whole, w.cut, w.m, arena, parting);
         }
-        along = squared;
+        w.cut = squared;
+        w.trunk_known = false;
         parting = again;
     }
     return true;
-}
-
-// The trunk along the cloud's axis, its end layers under branches merged where they stand
-// on a closed end; its triangles start the output.
-inline Status mesh_trunk(const TubeInput& trunk, const Options& along, const Parting& parting,
-                         const PartsMemory& m, Arena& arena, uint32_t* triangles,
-                         size_t capacity, size_t* count, Report& part, size_t* merged) {
-    Options o = along;
-    o.flags &= ~static_cast<uint32_t>(close_ends);
-    part.layers.info = m.layers;
-    part.layers.info_capacity = m.layer_capacity;
-    const size_t mark = arena.mark();
-    Status status = mesh_tube(trunk, o, arena, triangles, capacity, count, part);
-    arena.rewind(mark);
-    size_t cut_count = 0;
-    *merged = 0;
-    if (status != Status::ok || part.layers.used_count > m.layer_capacity ||
-        !cuts_for_tall_ends(m, part.layers.used_count, parting, &cut_count, merged))
-        return status;
-    // Again along the same axis, through the layers' own cuts but those merged.
-    o.axis = Axis::direction;
-    for (int k = 0; k < 3; ++k) o.direction[k] = part.axis[k];
-    o.cuts = m.cuts;
-    o.cut_count = cut_count;
-    o.layer_count = cut_count == 0 ? 1 : 0;
-    o.layer_height = 0;
-    part = Report{};
-    part.layers.info = m.layers;
-    part.layers.info_capacity = m.layer_capacity;
-    status = mesh_tube(trunk, o, arena, triangles, capacity, count, part);
-    arena.rewind(mark);
-    return status;
-}
-
-// Meshes the parts into the output and joins them (then caps them, with close_ends).
-// Returns ok with rep.parts.outcome joined or kept_apart, or ok with outcome undone (the
-// output is then to be made again as one tube); other statuses are errors.
-inline Status mesh_parts(const Cloud& cloud, const TubeInput& whole, const Options& along,
-                         const PartsMemory& m, Arena& arena, uint32_t* triangles,
-                         size_t capacity, size_t* triangle_count, Report& rep) {
-    const Parting& parting = rep.parts.parting;
-    bool whole_split = true;
-    Report trunk_report = {};
-    const TubeInput trunk = part_input(whole, m, kInTrunk);
-    size_t count = 0, merged = 0;
-    Options trunk_options = along;
-    Status status = Status::ok;
-    // The trunk around its own axis, as the branches (a body whose legs hang under it is
-    // meshed along the body), unless the caller laid out the layers.
-    if (along.cut_count == 0 && along.layer_count == 0 && !(along.layer_height > 0)) {
-        Options automatic = along;
-        automatic.axis = Axis::automatic;
-        const size_t mark = arena.mark();
-        status = resolve_axis(trunk, automatic, arena, trunk_options, trunk_report);
-        arena.rewind(mark);
-        // Pointing the parting's way, so that the trunk's top is on the side above.
-        const double* d = trunk_options.direction;
-        if (trunk_options.axis == Axis::direction &&
-            d[0] * parting.axis[0] + d[1] * parting.axis[1] + d[2] * parting.axis[2] < 0)
-            for (int k = 0; k < 3; ++k) trunk_options.direction[k] = -d[k];
-    }
-    if (status == Status::ok)
-        status = mesh_trunk(trunk, trunk_options, parting, m, arena, triangles, capacity, &count,
-                            trunk_report, &merged);
-    record_part(rep, kInTrunk, status, trunk, trunk_report, count, merged);
-    if (status != Status::ok) {
-        rep.parts.outcome = PartsOutcome::undone;
-        return status == Status::out_of_memory ? status : Status::ok;
-    }
-    add_part_counts(trunk_report, rep);
-    for (int k = 0; k < 3; ++k) {
-        rep.axis[k] = trunk_report.axis[k];
-        rep.axis_origin[k] = trunk_report.axis_origin[k];
-    }
-    rep.layers.used_count = trunk_report.layers.used_count;
-    rep.layers.planned_count = trunk_report.layers.planned_count;
-    rep.layers.parallel_count = trunk_report.layers.parallel_count;
-    for (size_t k = 0; k < rep.layers.used_count && k < rep.layers.info_capacity &&
-                       k < m.layer_capacity; ++k)
-        rep.layers.info[k] = m.layers[k];
-    Options branch_options = along;
-    branch_options.axis = Axis::automatic;
-    branch_options.cuts = nullptr;
-    branch_options.cut_count = 0;
-    branch_options.layer_count = 0;
-    branch_options.layer_height = 0;
-    branch_options.progress = nullptr;
-    branch_options.flags &= ~static_cast<uint32_t>(origin_given | close_ends);
-    const uint32_t branches = parting.above_branch_count + parting.below_branch_count;
-    for (uint32_t b = 0; b < branches; ++b) {
-        const bool above = b < parting.above_branch_count;
-        const uint8_t label = static_cast<uint8_t>(
-            above ? kFirstAboveBranch + b : kFirstBelowBranch + (b - parting.above_branch_count));
-        const TubeInput branch = part_input(whole, m, label);
-        if (branch.sums.valid == 0) continue;  // the side above took its points
-        Report part = {};
-        Options own;
-        size_t added = 0;
-        const size_t mark = arena.mark();
-        status = resolve_axis(branch, branch_options, arena, own, part);
-        // The branch's end at the cut is a cut, not a closed end: its low end along its own
-        // axis if that runs away from the trunk.
-        const Vec3 trunk_axis = {parting.axis[0], parting.axis[1], parting.axis[2]};
-        const Vec3 own_axis = {own.direction[0], own.direction[1], own.direction[2]};
-        const bool away = (dot(own_axis, trunk_axis) > 0) == above;
-        TubeInput cut = branch;
-        cut.cut_ends = away ? kLowPole : kHighPole;
-        if (status == Status::ok)
-            status = mesh_tube(cut, own, arena, triangles + 3 * count, capacity - count,
-                               &added, part);
-        arena.rewind(mark);
-        record_part(rep, label, status, branch, part, added, 0);
-        if (status == Status::out_of_memory) return status;
-        if (status != Status::ok) {  // its points stay unused
-            whole_split = false;
-            if (!rep.detail) rep.detail = part.detail;
-            continue;
-        }
-        add_part_counts(part, rep);
-        count += added;
-    }
-    for (size_t i = 0; i < whole.count && whole_split; ++i)
-        whole_split = m.labels[i] != kBeyondBranches;
-    if (!whole_split && !rep.detail)
-        rep.detail = "points beyond a cut belong to no branch (a piece more than two gaps "
-                     "from every part)";
-    // The junctions.
-    JoinReport join = {};
-    const size_t join_bytes = join_branches_workspace_size(cloud.count, count);
-    const size_t mark = arena.mark();
-    void* work = arena.alloc<unsigned char>(join_bytes);
-    if (!work) return Status::out_of_memory;
-    Options joining = {};
-    joining.flags = along.flags & skip_invalid_points;
-    size_t joined = count;
-    status = join_branches(cloud, joining, parting, m.labels, work, join_bytes, triangles,
-                           capacity, &joined, &join);
-    arena.rewind(mark);
-    if (status == Status::ok) count = joined;
-    rep.parts.joined_side_count = join.joined_side_count;
-    rep.parts.apart_side_count = join.apart_side_count;
-    rep.parts.grafted_branch_count = join.grafted_branch_count;
-    rep.parts.junction_triangle_count = join.added_triangle_count;
-    rep.parts.removed_triangle_count = join.removed_triangle_count;
-    if (!rep.detail) rep.detail = join.detail;
-    whole_split = whole_split && status == Status::ok && join.apart_side_count == 0;
-    if (!whole_split && !(along.flags & keep_parts)) {
-        rep.parts.outcome = PartsOutcome::undone;
-        return Status::ok;
-    }
-    rep.parts.outcome = whole_split ? PartsOutcome::joined : PartsOutcome::kept_apart;
-    if (along.flags & close_ends) {
-        const size_t cap_bytes = cap_ends_workspace_size(cloud.count, count);
-        void* capping = arena.alloc<unsigned char>(cap_bytes);
-        if (!capping) return Status::out_of_memory;
-        Options capped = along;
-        capped.flags &= skip_invalid_points | origin_given;
-        Report caps = {};
-        status = cap_ends(cloud, capped, capping, cap_bytes, triangles, capacity, &count, &caps);
-        arena.rewind(mark);
-        if (status != Status::ok) return status;
-        rep.caps = caps.caps;
-    }
-    *triangle_count = count;
-    rep.triangle_count = count;
-    return Status::ok;
 }
 
 // The area of a surface whose triangles index the cloud.
@@ -12446,90 +12429,285 @@ inline double surface_area(const CloudReader& reader, const uint32_t* triangles,
     return area;
 }
 
-// reconstruct() with the search for branches: `in` is read and `along` has its axis. Where
-// the cloud parts, the parts joined are kept only if their surface is smaller than the one
-// tube's (unless keep_parts): a tube that wraps branches bridges the gaps between them
-// with webs, which add area, and so does a join that folds where the parting misread the
-// cloud (a neck's torn rim taken for two branches). The tube is meshed first for its area,
-// and again if it wins.
-inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in, const Options& along,
-                                  Arena& arena, uint32_t* triangles, size_t capacity,
-                                  size_t* triangle_count, Report& rep) {
+// The one tube's area, to weigh the parts against (DBL_MAX where it has none), where it
+// can decide: not where the parts are kept whatever their area, nor where a point in no
+// part undoes them whatever it. Its triangles are overwritten by the parts'.
+inline Status one_tube_area(const TubeInput& in, const TubeRequest& request, bool all_in_parts,
+                            Arena& arena, uint32_t* triangles, size_t capacity,
+                            const Report& before, double* area) {
+    *area = DBL_MAX;
+    if (request.parts == PartsPolicy::keep || !all_in_parts) return Status::ok;
+    Report tube = before;
+    size_t count = 0;
+    const size_t mark = arena.mark();
+    const Status status = mesh_tube(in, request, arena, triangles, capacity, &count, tube);
+    arena.rewind(mark);
+    if (status == Status::ok) *area = surface_area(in.reader, triangles, count);
+    return status == Status::out_of_memory ? status : Status::ok;
+}
+
+// The trunk along `along`, its end layers under branches merged where they stand on a
+// closed end; its triangles start the output.
+inline Status mesh_trunk(const TubeInput& trunk, const TubeRequest& along, const Parting& parting,
+                         const PartsMemory& m, Arena& arena, uint32_t* triangles,
+                         size_t capacity, size_t* count, Report& part, size_t* merged) {
+    part.layers.info = m.layers;
+    part.layers.info_capacity = m.layer_capacity;
+    const size_t mark = arena.mark();
+    Status status = mesh_tube(trunk, along, arena, triangles, capacity, count, part);
+    arena.rewind(mark);
+    size_t cut_count = 0;
+    *merged = 0;
+    if (status != Status::ok || part.layers.used_count > m.layer_capacity ||
+        !cuts_for_tall_ends(m, part.layers.used_count, parting, &cut_count, merged))
+        return status;
+    // Again along the same axis, through the layers' own cuts but those merged.
+    TubeRequest again = along;
+    set_direction(again, part.axis);
+    again.layers = {m.cuts, cut_count, cut_count == 0 ? 1u : 0u, 0};
+    part = Report{};
+    part.layers.info = m.layers;
+    part.layers.info_capacity = m.layer_capacity;
+    status = mesh_tube(trunk, again, arena, triangles, capacity, count, part);
+    arena.rewind(mark);
+    return status;
+}
+
+// The trunk into the output, around its own axis as the branches (a body whose legs hang
+// under it is meshed along the body) unless the caller laid out the layers; its frame and
+// layers are the whole's in the report. Where it fails, the outcome is undone.
+inline Status mesh_trunk_part(const TubeInput& whole, PartsWork& w, Arena& arena,
+                              uint32_t* triangles, size_t capacity, size_t* count, Report& rep) {
+    const Parting& parting = rep.parts.parting;
+    const TubeInput trunk = part_input(whole, w.m, kInTrunk);
+    const bool own_axis = automatic_layers(w.cut.layers);
+    Status status = own_axis ? trunk_axis(whole, w, arena) : Status::ok;
+    TubeRequest along = own_axis ? w.trunk : w.cut;
+    along.caps = false;  // the caps come once the parts are joined
+    // Pointing the parting's way, so that the trunk's top is on the side above.
+    const double* d = along.direction;
+    if (own_axis && along.axis == Axis::direction &&
+        d[0] * parting.axis[0] + d[1] * parting.axis[1] + d[2] * parting.axis[2] < 0)
+        for (int k = 0; k < 3; ++k) along.direction[k] = -d[k];
+    Report part = {};
+    size_t merged = 0;
+    if (status == Status::ok)
+        status = mesh_trunk(trunk, along, parting, w.m, arena, triangles, capacity, count, part,
+                            &merged);
+    record_part(rep, kInTrunk, status, trunk, part, *count, merged);
+    if (status != Status::ok) {
+        rep.parts.outcome = PartsOutcome::undone;
+        return status == Status::out_of_memory ? status : Status::ok;
+    }
+    for (int k = 0; k < 3; ++k) {
+        rep.axis[k] = part.axis[k];
+        rep.axis_origin[k] = part.axis_origin[k];
+    }
+    rep.layers.used_count = part.layers.used_count;
+    rep.layers.planned_count = part.layers.planned_count;
+    rep.layers.parallel_count = part.layers.parallel_count;
+    size_t kept = rep.layers.used_count < w.m.layer_capacity ? rep.layers.used_count
+                                                              : w.m.layer_capacity;
+    kept = kept < rep.layers.info_capacity ? kept : rep.layers.info_capacity;
+    if (kept > 0) std::memcpy(rep.layers.info, w.m.layers, kept * sizeof(LayerInfo));
+    return Status::ok;
+}
+
+// A branch's request: around its own automatic axis and layers, its frame's origin its own
+// centroid, no caps (they come once the parts are joined) and no progress (the caller's
+// would run backwards from part to part).
+inline TubeRequest branch_request(TubeRequest r) {
+    r.axis = Axis::automatic;
+    r.layers = LayerRequest{};
+    r.origin = nullptr;
+    r.caps = false;
+    r.progress = nullptr;
+    return r;
+}
+
+// Each branch into the output after the trunk's `*count` triangles, its end at the cut a
+// cut, not a closed end: its low end along its own axis if that runs away from the trunk.
+// *all_meshed is cleared where a branch fails (its points stay unused).
+inline Status mesh_branches(const TubeInput& whole, const PartsWork& w, Arena& arena,
+                            uint32_t* triangles, size_t capacity, size_t* count, bool* all_meshed,
+                            Report& rep) {
+    const Parting& parting = rep.parts.parting;
+    const TubeRequest branches = branch_request(w.cut);
+    const Vec3 parting_axis = {parting.axis[0], parting.axis[1], parting.axis[2]};
+    const uint32_t total = parting.above_branch_count + parting.below_branch_count;
+    for (uint32_t b = 0; b < total; ++b) {
+        const bool above = b < parting.above_branch_count;
+        const uint8_t label = static_cast<uint8_t>(
+            above ? kFirstAboveBranch + b : kFirstBelowBranch + (b - parting.above_branch_count));
+        const TubeInput branch = part_input(whole, w.m, label);
+        if (branch.sums.valid == 0) continue;  // the side above took its points
+        Report part = {};
+        TubeRequest own = branches;
+        size_t added = 0;
+        const size_t mark = arena.mark();
+        Status status = resolve_axis(branch, arena, own, &part.detail);
+        const Vec3 own_axis = {own.direction[0], own.direction[1], own.direction[2]};
+        own.cut_ends |= (dot(own_axis, parting_axis) > 0) == above ? kLowPole : kHighPole;
+        if (status == Status::ok)
+            status = mesh_tube(branch, own, arena, triangles + 3 * *count, capacity - *count,
+                               &added, part);
+        arena.rewind(mark);
+        record_part(rep, label, status, branch, part, added, 0);
+        if (status == Status::out_of_memory) return status;
+        if (status != Status::ok) {
+            *all_meshed = false;
+            if (!rep.detail) rep.detail = part.detail;
+            continue;
+        }
+        *count += added;
+    }
+    return Status::ok;
+}
+
+// Joins the parts meshed into the output (then caps them, as asked); `whole` tells whether
+// every part was meshed and every point is in one. Sets rep.parts.outcome: joined,
+// kept_apart, or undone (the output is then to be made again as one tube).
+inline Status join_parts(const Cloud& cloud, const PartsWork& w, bool whole, Arena& arena,
+                         uint32_t* triangles, size_t capacity, size_t count,
+                         size_t* triangle_count, Report& rep) {
+    JoinReport join = {};
+    const size_t bytes = join_branches_workspace_size(cloud.count, count);
+    const size_t mark = arena.mark();
+    void* work = arena.alloc<unsigned char>(bytes);
+    if (!work) return Status::out_of_memory;
+    size_t joined = count;
+    Status status = join_branches(cloud, *w.cut.caller, rep.parts.parting, w.m.labels, work,
+                                  bytes, triangles, capacity, &joined, &join);
+    arena.rewind(mark);
+    if (status == Status::ok) count = joined;
+    rep.parts.joined_side_count = join.joined_side_count;
+    rep.parts.apart_side_count = join.apart_side_count;
+    rep.parts.grafted_branch_count = join.grafted_branch_count;
+    rep.parts.junction_triangle_count = join.added_triangle_count;
+    rep.parts.removed_triangle_count = join.removed_triangle_count;
+    if (!rep.detail) rep.detail = join.detail;
+    whole = whole && status == Status::ok && join.apart_side_count == 0;
+    if (!whole && w.cut.parts != PartsPolicy::keep) {
+        rep.parts.outcome = PartsOutcome::undone;
+        return Status::ok;
+    }
+    rep.parts.outcome = whole ? PartsOutcome::joined : PartsOutcome::kept_apart;
+    if (w.cut.caps) {
+        // Around the axis the cut was made along, in the frame of the whole cloud.
+        const CloudReader reader = reader_of(cloud);
+        const TubeInput all = {reader, cloud.count, sum_cloud(reader, cloud.count)};
+        CapCounts caps = {0, 0, 0, 0};
+        size_t needed = 0;
+        status = cap_surface(all, w.cut, arena, triangles, capacity, count, caps, &needed);
+        arena.rewind(mark);
+        if (status != Status::ok) return status;
+        rep.caps.closed_count = caps.closed;
+        rep.caps.open_count = caps.left_open;
+        rep.caps.triangle_count = caps.triangles;
+        rep.caps.wall_flip_count = caps.wall_flips;
+    }
+    *triangle_count = count;
+    rep.triangle_count = count;
+    return Status::ok;
+}
+
+// Whether the parts are kept: joined and smaller than the one tube (a tube that wraps
+// branches bridges the gaps between them with webs, which add area, and so does a join
+// that folds where the parting misread the cloud, as a neck's torn rim taken for two
+// branches), or kept apart as asked. Otherwise the counts start again from `before`, the
+// parts' record stays.
+inline bool keep_or_undo(const TubeInput& in, const uint32_t* triangles, size_t count,
+                         double tube_area, const Report& before, Report& rep) {
+    const PartsOutcome outcome = rep.parts.outcome;
+    if (outcome == PartsOutcome::kept_apart ||
+        (outcome == PartsOutcome::joined && surface_area(in.reader, triangles, count) < tube_area))
+        return true;
+    PartCounts parts = rep.parts;
+    if (outcome != PartsOutcome::undone) {
+        parts.outcome = PartsOutcome::undone;
+        rep.detail = "the branches joined made a larger surface than one tube";
+    }
+    const char* detail = rep.detail;
+    rep = before;
+    rep.parts = parts;
+    rep.detail = detail;
+    return false;
+}
+
+// The steps where the cloud may part (see above); *kept tells whether the parts are the
+// output, else the one tube is to be meshed.
+inline Status mesh_apart(const Cloud& cloud, const TubeInput& in, const TubeRequest& request,
+                         Arena& arena, uint32_t* triangles, size_t capacity,
+                         size_t* triangle_count, Report& rep, bool* kept) {
+    PartsWork w = {};
+    w.cut = request;
+    Parting& parting = rep.parts.parting;
+    if (!allocate_parts(w.m, cloud.count, arena) ||
+        !search_parting(cloud, in, w.cut, w.m, arena, parting))
+        return Status::out_of_memory;
+    if (!parts_around_trunk(cloud.count, parting, w.m.labels)) return Status::ok;
+    if (!square_cut_to_trunk(cloud, in, w, arena, parting)) return Status::out_of_memory;
+    if (adopt_stray_points(in, parting.gap, w.m.labels)) w.trunk_known = false;
+    bool whole = every_point_in_a_part(in.count, w.m.labels);
+    const Report before = rep;
+    double tube_area = DBL_MAX;
+    Status status = one_tube_area(in, request, whole, arena, triangles, capacity, before,
+                                  &tube_area);
+    size_t count = 0;
+    if (status == Status::ok)
+        status = mesh_trunk_part(in, w, arena, triangles, capacity, &count, rep);
+    if (status != Status::ok) return status;
+    if (rep.parts.outcome != PartsOutcome::undone) {
+        status = mesh_branches(in, w, arena, triangles, capacity, &count, &whole, rep);
+        if (status != Status::ok) return status;
+        if (!whole && !rep.detail)
+            rep.detail = "points beyond a cut belong to no branch (a piece more than two gaps "
+                         "from every part)";
+        status = join_parts(cloud, w, whole, arena, triangles, capacity, count, triangle_count,
+                            rep);
+        if (status != Status::ok) return status;
+    }
+    *kept = keep_or_undo(in, triangles, *triangle_count, tube_area, before, rep);
+    return Status::ok;
+}
+
+// reconstruct() with the search for branches: `in` is read and the request's axis is
+// resolved. Where the cloud parts, the parts joined are kept only where whole and smaller
+// than the one tube's (see keep_or_undo()), else the one tube is.
+inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in,
+                                  const TubeRequest& request, Arena& arena,
+                                  uint32_t* triangles, size_t capacity, size_t* triangle_count,
+                                  Report& rep) {
     if (in.sums.distinct >= 3) {
         const size_t mark = arena.mark();
-        PartsMemory m;
-        if (!allocate_parts(m, cloud.count, arena)) return Status::out_of_memory;
-        if (!search_parting(cloud, in, along, m, arena, rep.parts.parting))
-            return Status::out_of_memory;
-        const Parting& p = rep.parts.parting;
-        // A trunk of fewer points than a branch is no trunk: the cloud is apart all along
-        // (separate objects), and is meshed as one tube.
-        size_t trunk_points = 0;
-        if (p.above_branch_count + p.below_branch_count > 0)
-            for (size_t i = 0; i < cloud.count; ++i) trunk_points += m.labels[i] == kInTrunk;
-        if (trunk_points >= kSmallestBranch) {
-            Options cut_along = along;
-            if (!square_cut_to_trunk(cloud, in, m, arena, cut_along, rep.parts.parting))
-                return Status::out_of_memory;
-            adopt_stray_points(in, p.gap, m.labels);
-            const Report before = rep;
-            double tube_area = DBL_MAX;
-            if (!(along.flags & keep_parts)) {
-                Report tube = before;
-                size_t count = 0;
-                const size_t tube_mark = arena.mark();
-                const Status status =
-                    mesh_tube(in, along, arena, triangles, capacity, &count, tube);
-                arena.rewind(tube_mark);
-                if (status == Status::out_of_memory) return status;
-                if (status == Status::ok) tube_area = surface_area(in.reader, triangles, count);
-            }
-            const Status status = mesh_parts(cloud, in, cut_along, m, arena, triangles,
-                                             capacity, triangle_count, rep);
-            if (status != Status::ok) return status;
-            if (rep.parts.outcome != PartsOutcome::undone &&
-                (rep.parts.outcome == PartsOutcome::kept_apart ||
-                 surface_area(in.reader, triangles, *triangle_count) < tube_area))
-                return status;
-            // Not kept: the counts start again, the parts' record stays.
-            PartCounts parts = rep.parts;
-            if (parts.outcome != PartsOutcome::undone) {
-                parts.outcome = PartsOutcome::undone;
-                rep.detail = "the branches joined made a larger surface than one tube";
-            }
-            const char* detail = rep.detail;
-            rep = before;
-            rep.parts = parts;
-            rep.detail = detail;
-        }
+        bool kept = false;
+        const Status status = mesh_apart(cloud, in, request, arena, triangles, capacity,
+                                         triangle_count, rep, &kept);
+        if (status != Status::ok || kept) return status;
         arena.rewind(mark);
     }
-    return mesh_tube(in, along, arena, triangles, capacity, triangle_count, rep);
+    return mesh_tube(in, request, arena, triangles, capacity, triangle_count, rep);
 }
 
 // The workspace reconstruct_default() takes on top of read_cloud()'s.
-inline size_t parts_workspace_size(size_t count, const Options& options) {
+inline size_t parts_workspace_size(size_t count, const TubeRequest& request) {
     Arena arena = Arena::measuring();
     PartsMemory m;
     allocate_parts(m, count, arena);
-    Options plain = options;  // a part's points are read through the mask
-    plain.flags &= ~static_cast<uint32_t>(drop_outliers | close_ends);
-    Options search = options;
-    search.flags &= skip_invalid_points | drop_outliers;
-    Options tube = options;  // the one tube meshed for its area while the parts' memory is held
-    tube.flags &= ~static_cast<uint32_t>(drop_outliers);
-    const size_t triangles = reconstruct_max_triangles(count, options);
+    // The one tube meshed for its area while the parts' memory is held, and the parts (their
+    // points read through the mask): the trunk's tube, without caps, takes no more.
+    TubeRequest tube = request;
+    tube.drop_outliers = false;
+    TubeRequest part = tube;
+    part.caps = false;
+    const size_t triangles = reconstruct_max_triangles(count, *request.caller);
     const size_t sample = count > kPartingSample
                               ? saturating_product(3 * sizeof(double), kPartingSample) + Arena::kAlign +
-                                    find_parting_workspace_size(kPartingSample, plain)
+                                    parting_workspace_size(kPartingSample, part)
                               : 0;
-    Options branch = plain;  // its own automatic axis and layers
-    branch.cuts = nullptr;
-    branch.cut_count = 0;
-    branch.layer_count = 0;
-    branch.layer_height = 0;
-    const size_t steps[] = {sample, find_parting_workspace_size(count, search),
-                            tube_workspace_size(count, plain), tube_workspace_size(count, tube),
+    const TubeRequest branch = branch_request(part);
+    const size_t steps[] = {sample, parting_workspace_size(count, request),
+                            tube_workspace_size(count, tube),
                             axis_workspace_size(count, branch),
                             tube_workspace_size(count, branch),
                             join_branches_workspace_size(count, triangles),
@@ -12578,22 +12756,22 @@ inline Status read_cloud(const Cloud& cloud, const Options& options, Arena& aren
     return Status::ok;
 }
 
-// Whether reconstruct() looks for branches with these options.
-inline bool searches_parts(const Options& options) {
-    return kFindParts && !(options.flags & one_tube);
+// Whether reconstruct() looks for branches.
+inline bool searches_parts(const TubeRequest& request) {
+    return kFindParts && request.parts != PartsPolicy::one_tube;
 }
 
-inline Status mesh_cloud(const Cloud& cloud, const TubeInput& in, const Options& along,
+inline Status mesh_cloud(const Cloud& cloud, const TubeInput& in, const TubeRequest& request,
                          Arena& arena, uint32_t* triangles, size_t capacity,
                          size_t* triangle_count, Report& rep) {
 #if !defined(STRATMESH_SMALL_CODE)
-    if (searches_parts(along))
-        return reconstruct_default(cloud, in, along, arena, triangles, capacity, triangle_count,
-                                   rep);
+    if (searches_parts(request))
+        return reconstruct_default(cloud, in, request, arena, triangles, capacity,
+                                   triangle_count, rep);
 #else
     (void)cloud;
 #endif
-    return mesh_tube(in, along, arena, triangles, capacity, triangle_count, rep);
+    return mesh_tube(in, request, arena, triangles, capacity, triangle_count, rep);
 }
 
 // reconstruct()'s body; `rep` arrives zeroed but for its caller's arrays.
@@ -12609,10 +12787,11 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     notify(options, Phase::validate, 0);
     Arena arena = Arena::over(workspace, workspace_bytes);
     TubeInput in = {};
-    Options along;
+    TubeRequest request = tube_request(options);
     status = read_cloud(cloud, options, arena, rep, in);
     const size_t read = arena.mark();  // the outliers' bitmap stays: the reader needs it
-    const char* far_origin = status == Status::ok ? origin_refusal(options, in.sums) : nullptr;
+    const char* far_origin =
+        status == Status::ok ? origin_refusal(request.origin, in.sums) : nullptr;
     if (far_origin) {
         rep.detail = far_origin;
         status = Status::invalid_origin;
@@ -12621,9 +12800,9 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     // and along it a layer would only seem not to surround its axis.
     if (status == Status::ok && kDegenerateCheck && in.sums.distinct >= 3 && on_a_line(in, arena))
         status = Status::degenerate;
-    if (status == Status::ok) status = resolve_axis(in, options, arena, along, rep);
+    if (status == Status::ok) status = resolve_axis(in, arena, request, &rep.detail);
     if (status == Status::ok)
-        status = mesh_cloud(cloud, in, along, arena, triangles, triangle_capacity,
+        status = mesh_cloud(cloud, in, request, arena, triangles, triangle_capacity,
                             triangle_count, rep);
     if (kMeasureWebs) arena.rewind(read);  // the surface is final: the scratch is free
     // A few far points or far clusters collapse the rest, so that no layer surrounds its
@@ -12651,12 +12830,14 @@ namespace stratmesh {
 size_t reconstruct_max_triangles(size_t point_count, const Options& options) {
     // A manifold surface through V vertices, open or closed, has at most 2V triangles; the
     // junctions of branches add at most four per branch beyond that.
-    const size_t junctions = detail::searches_parts(options) ? 8 * size_t{kMaxBranches} : 0;
+    const size_t junctions =
+        detail::searches_parts(detail::tube_request(options)) ? 8 * size_t{kMaxBranches} : 0;
     return point_count > (SIZE_MAX - junctions) / 2 ? 0 : 2 * point_count + junctions;
 }
 
 size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
-    size_t most = detail::tube_workspace_size(point_count, options);
+    const detail::TubeRequest request = detail::tube_request(options);
+    size_t most = detail::tube_workspace_size(point_count, request);
     if (most == 0) return 0;
     // The axis is chosen, and the parts meshed, once the outliers are known.
     detail::Arena arena = detail::Arena::measuring();
@@ -12665,9 +12846,10 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
     const size_t read = arena.required_bytes();
     size_t steps[detail::kMeasureWebs ? 3 : 2] = {};
     if (detail::kAxisTrials && options.axis == Axis::automatic)
-        steps[0] = detail::axis_workspace_size(point_count, options);
+        steps[0] = detail::axis_workspace_size(point_count, request);
 #if !defined(STRATMESH_SMALL_CODE)
-    if (detail::searches_parts(options)) steps[1] = detail::parts_workspace_size(point_count, options);
+    if (detail::searches_parts(request))
+        steps[1] = detail::parts_workspace_size(point_count, request);
 #endif
     // The webs are measured once the surface is final (far less than meshing it takes).
     if (detail::kMeasureWebs) {
@@ -12694,14 +12876,13 @@ Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
     // small build's stack frame stays within a short instruction's reach).
     LayerInfo* const layer_info = report ? report->layers.info : nullptr;
     const size_t layer_capacity = layer_info ? report->layers.info_capacity : 0;
-    const PartCounts parts = report ? report->parts : PartCounts{};
+    PartInfo* const part_info = report && detail::kFindParts ? report->parts.info : nullptr;
+    const size_t part_capacity = part_info ? report->parts.info_capacity : 0;
     std::memset(&rep, 0, sizeof rep);
     rep.layers.info = layer_info;
     rep.layers.info_capacity = layer_capacity;
-    if (detail::kFindParts) {
-        rep.parts.info = parts.info;
-        rep.parts.info_capacity = parts.info ? parts.info_capacity : 0;
-    }
+    rep.parts.info = part_info;
+    rep.parts.info_capacity = part_capacity;
     rep.points.in_count = cloud.count;
     if (triangle_count) *triangle_count = 0;
     Status status = detail::run_reconstruction(cloud, options, workspace, workspace_bytes,

@@ -120,26 +120,12 @@ inline uint32_t axis_candidates(const double* xyz, size_t count, Vec3* out) {
 
 // What a candidate's sample surface measures: its area, plus the area of a triangle per
 // sample point left out (a layer that cannot follow the surface drops points instead of
-// folding).
+// folding). *along (optional) receives the mean squared cosine between the triangles'
+// normals and the unit axis, weighted by their areas: 0 where the surface runs along the
+// axis, 1 where it lies across it.
 inline double sample_surface(const double* xyz, const uint32_t* tri, size_t count,
-                             size_t unused) {
-    double area = 0;
-    for (size_t t = 0; t < count; ++t) {
-        const double* a = xyz + 3 * tri[3 * t];
-        const double* b = xyz + 3 * tri[3 * t + 1];
-        const double* c = xyz + 3 * tri[3 * t + 2];
-        const Vec3 n = cross(Vec3{b[0] - a[0], b[1] - a[1], b[2] - a[2]},
-                             Vec3{c[0] - a[0], c[1] - a[1], c[2] - a[2]});
-        area += std::sqrt(dot(n, n)) / 2;
-    }
-    const double per_triangle = count > 0 ? area / static_cast<double>(count) : 0;
-    return area + 2 * per_triangle * static_cast<double>(unused);
-}
-
-// The mean squared cosine between the triangles' normals and the unit axis, weighted by
-// their areas: 0 where the surface runs along the axis, 1 where it lies across it.
-inline double normals_along(const double* xyz, const uint32_t* tri, size_t count, Vec3 axis) {
-    double along = 0, area = 0;
+                             size_t unused, Vec3 axis, double* along) {
+    double area = 0, along_sum = 0, normals = 0;
     for (size_t t = 0; t < count; ++t) {
         const double* a = xyz + 3 * tri[3 * t];
         const double* b = xyz + 3 * tri[3 * t + 1];
@@ -147,42 +133,49 @@ inline double normals_along(const double* xyz, const uint32_t* tri, size_t count
         const Vec3 n = cross(Vec3{b[0] - a[0], b[1] - a[1], b[2] - a[2]},
                              Vec3{c[0] - a[0], c[1] - a[1], c[2] - a[2]});
         const double length = std::sqrt(dot(n, n));
+        area += length / 2;
         if (length == 0) continue;
         const double cosine = dot(n, axis) / length;
-        along += cosine * cosine * length;
-        area += length;
+        along_sum += cosine * cosine * length;
+        normals += length;
     }
-    return area > 0 ? along / area : 1;
+    if (along) *along = normals > 0 ? along_sum / normals : 1;
+    const double per_triangle = count > 0 ? area / static_cast<double>(count) : 0;
+    return area + 2 * per_triangle * static_cast<double>(unused);
 }
 
-// Workspace for choose_axis() on a cloud of `valid` kept points, given the flags.
-inline size_t axis_workspace_size(size_t valid, const Options& options);
-
-// Meshes the sample along one candidate; DBL_MAX if it cannot.
-// *along (optional) receives the share of the sample surface's normals along the axis.
-inline double try_axis(const double* sample, size_t count, Vec3 axis, const Options& options,
-                       Arena& arena, double* along) {
-    Options trial = {};
+// What a candidate's sample is meshed as: one layer along `axis`, its ends cut where the
+// tube's are, nothing else asked for and no callback.
+inline TubeRequest trial_request(const TubeRequest& tube, Vec3 axis) {
+    TubeRequest trial = {};
     trial.axis = Axis::direction;
     trial.direction[0] = axis.x;
     trial.direction[1] = axis.y;
     trial.direction[2] = axis.z;
-    trial.flags = options.flags & open_ends;
-    trial.layer_count = 1;
+    trial.cut_ends = tube.cut_ends;
+    trial.layers.count = 1;
+    return trial;
+}
+
+// Meshes the sample along one candidate; DBL_MAX if it cannot.
+// *along (optional) receives the share of the sample surface's normals along the axis.
+inline double try_axis(const double* sample, size_t count, Vec3 axis, const TubeRequest& request,
+                       Arena& arena, double* along) {
+    const TubeRequest trial = trial_request(request, axis);
     const size_t mark = arena.mark();
     uint32_t* tri = arena.alloc<uint32_t>(6 * count);
     if (arena.failed) return DBL_MAX;
     const Cloud cloud = {sample, count, 0, Scalar::float64};
-    TubeInput in = {reader_of(cloud), count, {}, 0};
+    TubeInput in = {reader_of(cloud), count, {}};
     in.sums = sum_cloud(in.reader, count);
     Report rep = {};
     size_t triangles = 0;
     const Status status = mesh_tube(in, trial, arena, tri, 2 * count, &triangles, rep);
     arena.rewind(mark);
     if (status != Status::ok) return DBL_MAX;
-    if (along) *along = normals_along(sample, tri, triangles, axis);
-    return sample_surface(sample, tri, triangles, in.sums.valid - rep.points.used_count -
-                                                      rep.points.duplicate_count);
+    return sample_surface(sample, tri, triangles,
+                          in.sums.valid - rep.points.used_count - rep.points.duplicate_count,
+                          axis, along);
 }
 
 // Every k-th kept point of `in`, packed, at most `most` of them (and about that many), in
@@ -215,7 +208,8 @@ inline double* sample_points(const TubeInput& in, size_t most, Arena& arena, siz
 
 // The axis for Axis::automatic: the candidate whose sample surface is smallest (see above).
 // False if the workspace is too small.
-inline bool choose_axis(const TubeInput& in, const Options& options, Arena& arena, Vec3& axis) {
+inline bool choose_axis(const TubeInput& in, const TubeRequest& request, Arena& arena,
+                        Vec3& axis) {
     const size_t mark = arena.mark();
     size_t taken = 0;
     const double* shape = sample_points(in, kAxisShapeSample, arena, &taken);
@@ -227,9 +221,9 @@ inline bool choose_axis(const TubeInput& in, const Options& options, Arena& aren
     if (!sample) return false;
     axis = candidates[0];
     double along = 1;
-    double best = try_axis(sample, taken, candidates[0], options, arena, &along);
+    double best = try_axis(sample, taken, candidates[0], request, arena, &along);
     for (uint32_t k = 1; k < tries && !(along < kAlongSurface); ++k) {
-        const double score = try_axis(sample, taken, candidates[k], options, arena, nullptr);
+        const double score = try_axis(sample, taken, candidates[k], request, arena, nullptr);
         if (score < best) {
             best = score;
             axis = candidates[k];
@@ -239,12 +233,10 @@ inline bool choose_axis(const TubeInput& in, const Options& options, Arena& aren
     return !arena.failed;
 }
 
-inline size_t axis_workspace_size(size_t valid, const Options& options) {
+// Workspace for choose_axis() on a cloud of `valid` kept points.
+inline size_t axis_workspace_size(size_t valid, const TubeRequest& request) {
     const size_t count = valid < kAxisSample ? valid : kAxisSample;
-    Options trial = {};
-    trial.flags = options.flags & open_ends;
-    trial.layer_count = 1;
-    const size_t tube = tube_workspace_size(count, trial);
+    const size_t tube = tube_workspace_size(count, trial_request(request, Vec3{0, 0, 1}));
     if (tube == 0) return 0;
     const size_t shape = valid < kAxisShapeSample ? valid : kAxisShapeSample;
     Arena arena = Arena::measuring();
@@ -253,28 +245,26 @@ inline size_t axis_workspace_size(size_t valid, const Options& options) {
     return arena.failed ? 0 : arena.required_bytes() + tube;
 }
 
-// The options along the axis to use: Axis::automatic resolved by choose_axis().
-inline Status resolve_axis(const TubeInput& in, const Options& options, Arena& arena,
-                           Options& along, Report& rep) {
-    along = options;
-    if (options.axis != Axis::automatic) return Status::ok;
+// Axis::automatic in `request` resolved by choose_axis(); any other axis stays. *detail
+// receives the reason where it fails.
+inline Status resolve_axis(const TubeInput& in, Arena& arena, TubeRequest& request,
+                           const char** detail) {
+    if (request.axis != Axis::automatic) return Status::ok;
     if (!kAxisTrials) {
-        rep.detail = kNotCompiledDetail;
+        *detail = kNotCompiledDetail;
         return Status::not_compiled;
     }
     if (in.sums.distinct < 3) {  // no surface along any axis: mesh_tube says so
-        along.axis = Axis::z;
+        request.axis = Axis::z;
         return Status::ok;
     }
     Vec3 axis;
-    if (!choose_axis(in, options, arena, axis)) {
-        rep.detail = "the workspace is smaller than reconstruct_workspace_size()";
+    if (!choose_axis(in, request, arena, axis)) {
+        *detail = "the workspace is smaller than reconstruct_workspace_size()";
         return Status::out_of_memory;
     }
-    along.axis = Axis::direction;
-    along.direction[0] = axis.x;
-    along.direction[1] = axis.y;
-    along.direction[2] = axis.z;
+    const double direction[3] = {axis.x, axis.y, axis.z};
+    set_direction(request, direction);
     return Status::ok;
 }
 

@@ -6,6 +6,21 @@
 
 #if !defined(STRATMESH_SMALL_CODE)
 namespace stratmesh {
+namespace detail {
+
+// Caps the boundary loops of the surface of `count` triangles (`in` reads the whole cloud)
+// in the frame along the request's axis, which is resolved.
+inline Status cap_surface(const TubeInput& in, const TubeRequest& request, Arena& arena,
+                          uint32_t* triangles, size_t capacity, size_t& count, CapCounts& caps,
+                          size_t* needed) {
+    Frame frame;
+    const Status status = choose_frame(in.sums, request, frame);
+    if (status != Status::ok) return status;
+    return cap_boundary_loops(triangles, count, capacity, in.reader, in.count, frame, arena,
+                              caps, needed);
+}
+
+}  // namespace detail
 
 size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count) {
     if (point_count > detail::kMaxPoints - 1) return 0;
@@ -15,7 +30,7 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count) {
     detail::allocate_cap_graph(graph, point_count, triangle_count, arena);
     detail::allocate_cap_loop(loop, point_count, arena);  // every point on a loop at most
     // Axis::automatic is resolved first, as reconstruct() resolves it.
-    const size_t axis = detail::axis_workspace_size(point_count, Options{});
+    const size_t axis = detail::axis_workspace_size(point_count, detail::tube_request(Options{}));
     if (arena.failed || axis == 0) return 0;
     return arena.required_bytes() > axis ? arena.required_bytes() : axis;
 }
@@ -60,17 +75,15 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
             checks.detail = "a triangle names a point outside the cloud, or an invalid one";
             return finish(Status::invalid_argument);
         }
-    detail::TubeInput in = {reader, cloud.count, sums, 0};
-    Options along;
-    status = detail::resolve_axis(in, options, arena, along, checks);
+    const detail::TubeInput in = {reader, cloud.count, sums};
+    detail::TubeRequest along = detail::tube_request(options);
+    status = detail::resolve_axis(in, arena, along, &checks.detail);
     if (status != Status::ok) return finish(status);
-    detail::Frame frame;
-    status = detail::choose_frame(sums, along, frame);
-    if (status == Status::invalid_origin) checks.detail = detail::origin_refusal(along, sums);
-    if (status != Status::ok) return finish(status);
-    status = detail::cap_boundary_loops(triangles, count, triangle_capacity, reader,
-                                        cloud.count, frame, arena, caps, &needed);
-    if (status == Status::out_of_memory)
+    status = detail::cap_surface(in, along, arena, triangles, triangle_capacity, count, caps,
+                                 &needed);
+    if (status == Status::invalid_origin)
+        checks.detail = detail::origin_refusal(along.origin, sums);
+    else if (status == Status::out_of_memory)
         checks.detail = "the workspace is smaller than cap_ends_workspace_size()";
     else if (status == Status::triangle_capacity)
         checks.detail = detail::kCapsTooLargeDetail;

@@ -142,7 +142,6 @@ struct TubeInput {
     CloudReader reader;
     size_t count;
     CloudSums sums;
-    uint32_t cut_ends;  // ends that are cuts, never closed (Frame::cut_ends), besides open_ends
 };
 
 // Whether this build holds every feature the flags ask for (STRATMESH_SMALL_CODE leaves

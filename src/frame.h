@@ -26,8 +26,8 @@ struct Frame {
     // Layers are flipped on the surface (the surface_flips flag; see "flips on the surface"
     // in >>layer triangulation).
     bool surface_flips;
-    // The surface's ends (kLowPole, kHighPole) never taken for a closed one: both with the
-    // open_ends flag, the end of a branch at its cut (see mesh_parts); 0 without kClosedEnds.
+    // The surface's ends (kLowPole, kHighPole) never taken for a closed one
+    // (TubeRequest::cut_ends); 0 without kClosedEnds.
     uint32_t cut_ends;
     // The valid points' lowest and highest coordinates (set by choose_frame with kFastLoops).
     Vec3 low, high;
@@ -50,7 +50,7 @@ struct Frame {
 };
 
 // The power of two 2^-e with 2^e just above `extent`, within [2^-1000, 2^1000].
-inline double scale_for_extent(double extent) {
+STRATMESH_SMALL_NOINLINE inline double scale_for_extent(double extent) {
     if (!(extent > 0) || !is_finite(extent)) return 1;
     int exponent = 0;
     std::frexp(extent, &exponent);
@@ -103,11 +103,11 @@ inline bool origin_in_reach(Vec3 origin, Vec3 low, Vec3 high) {
     return reach == 0 || largest_of(way) <= kOriginReach * reach;
 }
 
-// Why a given origin (origin_given) cannot serve as the frame's, or null if it can: it is
-// NaN or infinite, or lies beyond kOriginReach of the valid points summed in `sums`.
-inline const char* origin_refusal(const Options& options, const CloudSums& sums) {
-    if (!(options.flags & origin_given)) return nullptr;
-    const Vec3 given = {options.origin[0], options.origin[1], options.origin[2]};
+// Why a given origin cannot serve as the frame's, or null if it can (or none is given): it
+// is NaN or infinite, or lies beyond kOriginReach of the valid points summed in `sums`.
+inline const char* origin_refusal(const double* origin, const CloudSums& sums) {
+    if (!origin) return nullptr;
+    const Vec3 given = {origin[0], origin[1], origin[2]};
     if (!(is_finite(given.x) && is_finite(given.y) && is_finite(given.z)))
         return "the given origin is NaN or infinite";
     const Vec3 low = {sums.lowest[0], sums.lowest[1], sums.lowest[2]};
@@ -118,7 +118,11 @@ inline const char* origin_refusal(const Options& options, const CloudSums& sums)
     return nullptr;
 }
 
-inline Status choose_frame(const CloudSums& sums, const Options& options, Frame& frame) {
+inline const char* origin_refusal(const Options& options, const CloudSums& sums) {
+    return origin_refusal((options.flags & origin_given) ? options.origin : nullptr, sums);
+}
+
+inline Status choose_frame(const CloudSums& sums, const TubeRequest& request, Frame& frame) {
     const size_t valid = sums.valid;
     const Vec3 sum = {sums.total[0], sums.total[1], sums.total[2]};
     const Vec3 small_sum = {sums.small_total[0], sums.small_total[1], sums.small_total[2]};
@@ -135,9 +139,9 @@ inline Status choose_frame(const CloudSums& sums, const Options& options, Frame&
     Vec3 size = valid ? high - low : Vec3{0, 0, 0};
     Vec3 half_size = valid ? scaled(high, 0.5) - scaled(low, 0.5) : Vec3{0, 0, 0};
     const double own_half_extent = largest_of(half_size);
-    if (options.flags & origin_given) {
-        if (origin_refusal(options, sums)) return Status::invalid_origin;
-        const Vec3 given = {options.origin[0], options.origin[1], options.origin[2]};
+    if (request.origin) {
+        if (origin_refusal(request.origin, sums)) return Status::invalid_origin;
+        const Vec3 given = {request.origin[0], request.origin[1], request.origin[2]};
         // The extent covers the way from the given origin to the cloud, so the frame's
         // coordinates stay near 1 however far the origin is.
         Vec3 way = scaled(frame.origin, 0.5) - scaled(given, 0.5);
@@ -155,12 +159,12 @@ inline Status choose_frame(const CloudSums& sums, const Options& options, Frame&
     if (size.z > extent) extent = size.z;
     frame.scale = scale_for_extent(extent) * (frame.halved ? 0.5 : 1.0);
     Vec3 axis = {0, 0, 1};
-    switch (options.axis) {
+    switch (request.axis) {
     case Axis::x: axis = {1, 0, 0}; break;
     case Axis::y: axis = {0, 1, 0}; break;
     case Axis::z: axis = {0, 0, 1}; break;
     case Axis::direction:
-        axis = {options.direction[0], options.direction[1], options.direction[2]};
+        axis = {request.direction[0], request.direction[1], request.direction[2]};
         if (!unit_direction(axis)) return Status::invalid_axis;
         break;
     default: return Status::invalid_axis;
@@ -172,11 +176,15 @@ inline Status choose_frame(const CloudSums& sums, const Options& options, Frame&
     Vec3 e1 = cross(helper, axis);
     if (!normalize(e1)) return Status::invalid_axis;
     frame.axis = axis;
-    frame.surface_flips = kSurfaceFlips && (options.flags & surface_flips);
-    frame.cut_ends = kClosedEnds && (options.flags & open_ends) ? closed_bottom | closed_top : 0u;
+    frame.surface_flips = request.surface_flips;
+    frame.cut_ends = request.cut_ends;
     frame.e1 = e1;
     frame.e2 = cross(axis, e1);
     return Status::ok;
+}
+
+inline Status choose_frame(const CloudSums& sums, const Options& options, Frame& frame) {
+    return choose_frame(sums, tube_request(options), frame);
 }
 
 // The lowest and highest frame height of the valid points.

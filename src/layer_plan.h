@@ -43,13 +43,13 @@ static inline bool thick_enough(size_t points, double height, double radius) {
     return static_cast<double>(points) * height >= kMinLayerRows * kMinLayerRows * two_pi * radius;
 }
 
-// The number of layers the options can ask for, before empty layers are dropped.
-static inline size_t planned_layer_limit(size_t point_count, const Options& options) {
-    if (options.cuts && options.cut_count > 0) return options.cut_count + 1;
-    if (options.layer_count > 0)
-        return options.layer_count < point_count ? options.layer_count : (point_count > 0 ? point_count : 1);
+// The number of layers a request can ask for, before empty layers are dropped.
+static inline size_t planned_layer_limit(size_t point_count, const LayerRequest& layers) {
+    if (layers.cuts && layers.cut_count > 0) return layers.cut_count + 1;
+    if (layers.count > 0)
+        return layers.count < point_count ? layers.count : (point_count > 0 ? point_count : 1);
     // A target height: never more layers than points.
-    if (options.layer_height > 0) return point_count > 0 ? point_count : 1;
+    if (layers.height > 0) return point_count > 0 ? point_count : 1;
     return kMaxAutomaticLayers;
 }
 
@@ -66,25 +66,24 @@ static inline Status validate_layer_options(const Options& options) {
     return Status::ok;
 }
 
-static inline bool automatic_layers(const Options& options) {
-    return !(options.cuts && options.cut_count > 0) && options.layer_count == 0 &&
-           options.layer_height == 0;
+static inline bool automatic_layers(const LayerRequest& layers) {
+    return !(layers.cuts && layers.cut_count > 0) && layers.count == 0 && layers.height == 0;
 }
 
 // Fills plan.bounds (room for planned_layer_limit + 1 entries) for heights [lo, hi] from
-// the user's layer options (not automatic_layers): the cuts are coordinates along the axis
-// (Frame::user_height of frame heights), layer_height a length in the cloud's units.
-static inline void plan_layers(const Options& options, double lo, double hi, size_t point_count,
-                               const Frame& frame, LayerPlan& plan) {
+// the layers asked for (not automatic_layers): the cuts are coordinates along the axis
+// (Frame::user_height of frame heights), the height a length in the cloud's units.
+static inline void plan_layers(const LayerRequest& layers, double lo, double hi, size_t point_count,
+                        const Frame& frame, LayerPlan& plan) {
     const double cut_offset = dot(frame.origin, frame.axis);
     double* b = plan.bounds;
     uint32_t n = 0;
     b[n++] = lo;
-    if (options.cuts && options.cut_count > 0) {
+    if (layers.cuts && layers.cut_count > 0) {
         // The cuts inside (lo, hi], sorted, repeats dropped.
         size_t inside = 0;
-        for (size_t i = 0; i < options.cut_count; ++i) {
-            double c = (options.cuts[i] - cut_offset) * frame.scale;
+        for (size_t i = 0; i < layers.cut_count; ++i) {
+            double c = (layers.cuts[i] - cut_offset) * frame.scale;
             if (c > lo && c <= hi) b[1 + inside++] = c;
         }
         heap_sort(b + 1, inside);
@@ -92,16 +91,16 @@ static inline void plan_layers(const Options& options, double lo, double hi, siz
             if (b[1 + i] > b[n - 1]) b[n++] = b[1 + i];
     } else {
         double height = hi - lo;
-        double layers = 1;
-        if (options.layer_count > 0) {
-            layers = options.layer_count;
-        } else if (options.layer_height > 0) {
-            layers = std::ceil(height / (options.layer_height * frame.scale));
+        double planned = 1;
+        if (layers.count > 0) {
+            planned = layers.count;
+        } else if (layers.height > 0) {
+            planned = std::ceil(height / (layers.height * frame.scale));
         }
         double limit = static_cast<double>(point_count);
-        if (!(layers >= 1)) layers = 1;
-        if (layers > limit) layers = limit;
-        uint32_t count = static_cast<uint32_t>(layers);
+        if (!(planned >= 1)) planned = 1;
+        if (planned > limit) planned = limit;
+        uint32_t count = static_cast<uint32_t>(planned);
         for (uint32_t i = 1; i < count; ++i) {
             double c = lo + height * (static_cast<double>(i) / static_cast<double>(count));
             if (c > b[n - 1] && c < hi) b[n++] = c;

@@ -83,25 +83,37 @@ inline void add_to_group(PointGroup& g, Vec3 p, int pass) {
     }
 }
 
-// The groups of why_no_area(): `group_of` numbers the runs of occupied bins from 1 (0:
-// empty); each point joins its bin's group, its box first, its moments after.
-inline uint32_t gather_groups(const TubeInput& in, const Binning& binning, uint32_t* group_of,
-                              PointGroup* groups) {
-    std::memset(group_of, 0, binning.bins * sizeof(uint32_t));
-    for (size_t i = 0; i < in.count; ++i)
-        if (in.reader.valid(i)) group_of[binning.of(in.reader.point(i))] = 1;
+// Numbers the runs of occupied bins (non-zero) from 1, empty bins 0; returns the runs.
+inline uint32_t number_runs(uint32_t* group_of, uint32_t bins) {
     uint32_t count = 0;
-    for (uint32_t b = 0; b < binning.bins; ++b) {
+    for (uint32_t b = 0; b < bins; ++b) {
         const bool occupied = group_of[b] != 0;
         if (occupied && (b == 0 || group_of[b - 1] == 0)) ++count;
         group_of[b] = occupied ? count : 0;
     }
-    std::memset(static_cast<void*>(groups), 0, count * sizeof(PointGroup));
-    for (int pass = 0; pass < 2; ++pass) {
+    return count;
+}
+
+// The groups of why_no_area(): the occupied bins first, numbered by run (number_runs()),
+// then each point joins its bin's group, its box first, its moments after. One loop over
+// the points serves the three passes.
+inline uint32_t gather_groups(const TubeInput& in, const Binning& binning, uint32_t* group_of,
+                              PointGroup* groups) {
+    std::memset(group_of, 0, binning.bins * sizeof(uint32_t));
+    uint32_t count = 0;
+    for (int pass = -1; pass < 2; ++pass) {
         for (size_t i = 0; i < in.count; ++i) {
             if (!in.reader.valid(i)) continue;
             const Vec3 p = in.reader.point(i);
-            add_to_group(groups[group_of[binning.of(p)] - 1], p, pass);
+            uint32_t& group = group_of[binning.of(p)];
+            if (pass < 0)
+                group = 1;
+            else
+                add_to_group(groups[group - 1], p, pass);
+        }
+        if (pass < 0) {
+            count = number_runs(group_of, binning.bins);
+            std::memset(static_cast<void*>(groups), 0, count * sizeof(PointGroup));
         }
         for (uint32_t k = 0; pass == 0 && k < count; ++k)
             groups[k].scale = scale_for_extent(largest_of(groups[k].high - groups[k].low));

@@ -422,31 +422,28 @@ inline Status out_of_workspace(Report& rep) {
 }  // namespace stratmesh
 
 namespace stratmesh {
+namespace detail {
 
-size_t find_parting_workspace_size(size_t point_count, const Options& options) {
-    if (point_count > detail::kMaxPoints - 1) return 0;
-    detail::Arena arena = detail::Arena::measuring();
-    if (options.flags & drop_outliers) arena.alloc<unsigned char>(point_count / 8 + 1);
+inline size_t parting_workspace_size(size_t point_count, const TubeRequest& request) {
+    if (point_count > kMaxPoints - 1) return 0;
+    Arena arena = Arena::measuring();
+    if (request.drop_outliers) arena.alloc<unsigned char>(point_count / 8 + 1);
     const size_t mark = arena.mark();
-    detail::allocate_cell_scratch(arena, point_count);  // the outliers' and the scale's grid
-    arena.alloc<detail::GridItem>(2 * detail::kScaleSample);
+    allocate_cell_scratch(arena, point_count);  // the outliers' and the scale's grid
+    arena.alloc<GridItem>(2 * kScaleSample);
     arena.rewind(mark);
     // Axis::automatic is resolved first, as reconstruct() resolves it.
-    arena.alloc<unsigned char>(detail::axis_workspace_size(point_count, options));
+    arena.alloc<unsigned char>(axis_workspace_size(point_count, request));
     arena.rewind(mark);
-    detail::PartingMemory m;
-    detail::allocate_parting(m, point_count, arena);
+    PartingMemory m;
+    allocate_parting(m, point_count, arena);
     return arena.failed ? 0 : arena.required_bytes();
 }
 
-}  // namespace stratmesh
-
-namespace stratmesh {
-namespace detail {
-
-// find_parting() with the fewest points a branch holds given: a sample of the cloud is
-// searched with fewer (see search_parting).
-inline Status find_parting_with(const Cloud& cloud, const Options& options, void* workspace,
+// find_parting() along the axis of `request` (its origin, outliers and invalid points as
+// it says) with the fewest points a branch holds given: a sample of the cloud is searched
+// with fewer (see search_parting).
+inline Status find_parting_with(const Cloud& cloud, const TubeRequest& request, void* workspace,
                                 size_t workspace_bytes, Parting* parting, uint8_t* branch_of,
                                 uint32_t smallest) {
     if (!parting) return Status::invalid_argument;
@@ -471,15 +468,15 @@ inline Status find_parting_with(const Cloud& cloud, const Options& options, void
     if (branch_of) std::memset(branch_of, kInTrunk, cloud.count);
     CloudReader reader = reader_of(cloud);
     CloudSums sums = sum_cloud(reader, cloud.count);
-    status = reject_invalid_points(reader, cloud.count, sums, options, rep);
+    status = reject_invalid_points(reader, cloud.count, sums, *request.caller, rep);
     if (status != Status::ok) return finish(status);
-    if (options.flags & drop_outliers) {
+    if (request.drop_outliers) {
         if (!find_outliers(reader, cloud.count, arena, rep)) return finish(out_of_workspace(rep));
         sums = sum_cloud(reader, cloud.count);
     }
-    const TubeInput in = {reader, cloud.count, sums, 0};
-    Options along;
-    status = resolve_axis(in, options, arena, along, rep);
+    const TubeInput in = {reader, cloud.count, sums};
+    TubeRequest along = request;
+    status = resolve_axis(in, arena, along, &rep.detail);
     if (status != Status::ok) return finish(status);
     Frame frame;
     status = choose_frame(sums, along, frame);
@@ -561,10 +558,14 @@ inline Status find_parting_with(const Cloud& cloud, const Options& options, void
 
 namespace stratmesh {
 
+size_t find_parting_workspace_size(size_t point_count, const Options& options) {
+    return detail::parting_workspace_size(point_count, detail::tube_request(options));
+}
+
 Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
                     size_t workspace_bytes, Parting* parting, uint8_t* branch_of) {
-    return detail::find_parting_with(cloud, options, workspace, workspace_bytes, parting,
-                                     branch_of, kSmallestBranch);
+    return detail::find_parting_with(cloud, detail::tube_request(options), workspace,
+                                     workspace_bytes, parting, branch_of, kSmallestBranch);
 }
 
 }  // namespace stratmesh

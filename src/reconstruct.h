@@ -28,22 +28,22 @@ inline Status read_cloud(const Cloud& cloud, const Options& options, Arena& aren
     return Status::ok;
 }
 
-// Whether reconstruct() looks for branches with these options.
-inline bool searches_parts(const Options& options) {
-    return kFindParts && !(options.flags & one_tube);
+// Whether reconstruct() looks for branches.
+inline bool searches_parts(const TubeRequest& request) {
+    return kFindParts && request.parts != PartsPolicy::one_tube;
 }
 
-inline Status mesh_cloud(const Cloud& cloud, const TubeInput& in, const Options& along,
+inline Status mesh_cloud(const Cloud& cloud, const TubeInput& in, const TubeRequest& request,
                          Arena& arena, uint32_t* triangles, size_t capacity,
                          size_t* triangle_count, Report& rep) {
 #if !defined(STRATMESH_SMALL_CODE)
-    if (searches_parts(along))
-        return reconstruct_default(cloud, in, along, arena, triangles, capacity, triangle_count,
-                                   rep);
+    if (searches_parts(request))
+        return reconstruct_default(cloud, in, request, arena, triangles, capacity,
+                                   triangle_count, rep);
 #else
     (void)cloud;
 #endif
-    return mesh_tube(in, along, arena, triangles, capacity, triangle_count, rep);
+    return mesh_tube(in, request, arena, triangles, capacity, triangle_count, rep);
 }
 
 // reconstruct()'s body; `rep` arrives zeroed but for its caller's arrays.
@@ -59,10 +59,11 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     notify(options, Phase::validate, 0);
     Arena arena = Arena::over(workspace, workspace_bytes);
     TubeInput in = {};
-    Options along;
+    TubeRequest request = tube_request(options);
     status = read_cloud(cloud, options, arena, rep, in);
     const size_t read = arena.mark();  // the outliers' bitmap stays: the reader needs it
-    const char* far_origin = status == Status::ok ? origin_refusal(options, in.sums) : nullptr;
+    const char* far_origin =
+        status == Status::ok ? origin_refusal(request.origin, in.sums) : nullptr;
     if (far_origin) {
         rep.detail = far_origin;
         status = Status::invalid_origin;
@@ -71,9 +72,9 @@ inline Status run_reconstruction(const Cloud& cloud, const Options& options, voi
     // and along it a layer would only seem not to surround its axis.
     if (status == Status::ok && kDegenerateCheck && in.sums.distinct >= 3 && on_a_line(in, arena))
         status = Status::degenerate;
-    if (status == Status::ok) status = resolve_axis(in, options, arena, along, rep);
+    if (status == Status::ok) status = resolve_axis(in, arena, request, &rep.detail);
     if (status == Status::ok)
-        status = mesh_cloud(cloud, in, along, arena, triangles, triangle_capacity,
+        status = mesh_cloud(cloud, in, request, arena, triangles, triangle_capacity,
                             triangle_count, rep);
     if (kMeasureWebs) arena.rewind(read);  // the surface is final: the scratch is free
     // A few far points or far clusters collapse the rest, so that no layer surrounds its
@@ -101,12 +102,14 @@ namespace stratmesh {
 size_t reconstruct_max_triangles(size_t point_count, const Options& options) {
     // A manifold surface through V vertices, open or closed, has at most 2V triangles; the
     // junctions of branches add at most four per branch beyond that.
-    const size_t junctions = detail::searches_parts(options) ? 8 * size_t{kMaxBranches} : 0;
+    const size_t junctions =
+        detail::searches_parts(detail::tube_request(options)) ? 8 * size_t{kMaxBranches} : 0;
     return point_count > (SIZE_MAX - junctions) / 2 ? 0 : 2 * point_count + junctions;
 }
 
 size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
-    size_t most = detail::tube_workspace_size(point_count, options);
+    const detail::TubeRequest request = detail::tube_request(options);
+    size_t most = detail::tube_workspace_size(point_count, request);
     if (most == 0) return 0;
     // The axis is chosen, and the parts meshed, once the outliers are known.
     detail::Arena arena = detail::Arena::measuring();
@@ -115,9 +118,10 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
     const size_t read = arena.required_bytes();
     size_t steps[detail::kMeasureWebs ? 3 : 2] = {};
     if (detail::kAxisTrials && options.axis == Axis::automatic)
-        steps[0] = detail::axis_workspace_size(point_count, options);
+        steps[0] = detail::axis_workspace_size(point_count, request);
 #if !defined(STRATMESH_SMALL_CODE)
-    if (detail::searches_parts(options)) steps[1] = detail::parts_workspace_size(point_count, options);
+    if (detail::searches_parts(request))
+        steps[1] = detail::parts_workspace_size(point_count, request);
 #endif
     // The webs are measured once the surface is final (far less than meshing it takes).
     if (detail::kMeasureWebs) {
@@ -144,14 +148,13 @@ Status reconstruct(const Cloud& cloud, const Options& options, void* workspace,
     // small build's stack frame stays within a short instruction's reach).
     LayerInfo* const layer_info = report ? report->layers.info : nullptr;
     const size_t layer_capacity = layer_info ? report->layers.info_capacity : 0;
-    const PartCounts parts = report ? report->parts : PartCounts{};
+    PartInfo* const part_info = report && detail::kFindParts ? report->parts.info : nullptr;
+    const size_t part_capacity = part_info ? report->parts.info_capacity : 0;
     std::memset(&rep, 0, sizeof rep);
     rep.layers.info = layer_info;
     rep.layers.info_capacity = layer_capacity;
-    if (detail::kFindParts) {
-        rep.parts.info = parts.info;
-        rep.parts.info_capacity = parts.info ? parts.info_capacity : 0;
-    }
+    rep.parts.info = part_info;
+    rep.parts.info_capacity = part_capacity;
     rep.points.in_count = cloud.count;
     if (triangle_count) *triangle_count = 0;
     Status status = detail::run_reconstruction(cloud, options, workspace, workspace_bytes,

@@ -48,13 +48,13 @@ static inline void describe_layer(const Frame& frame, const Cylinder& cyl, doubl
 }
 
 // The workspace bound of mesh_tube() (with read_cloud()) for point_count points.
-static inline size_t tube_workspace_size(size_t point_count, const Options& options) {
+static inline size_t tube_workspace_size(size_t point_count, const TubeRequest& request) {
     if (point_count > kMaxPoints - 1) return 0;
     Arena arena = Arena::measuring();
     // drop_outliers, as find_outliers allocates: the bitmap stays, the grid comes and goes
     // before the rest is allocated.
     size_t outlier_bytes = 0;
-    if (kDropOutliers && (options.flags & drop_outliers)) {
+    if (kDropOutliers && request.drop_outliers) {
         Arena grid = Arena::measuring();
         grid.alloc<unsigned char>(point_count / 8 + 1);
         allocate_cell_scratch(grid, point_count);
@@ -63,13 +63,12 @@ static inline size_t tube_workspace_size(size_t point_count, const Options& opti
         arena.alloc<unsigned char>(point_count / 8 + 1);
     }
     ReconstructMemory m;
-    const size_t layer_limit = planned_layer_limit(point_count, options);
+    const size_t layer_limit = planned_layer_limit(point_count, request.layers);
     plan_reconstruct(m, point_count, layer_limit, arena);
-    size_t scratch = reconstruct_scratch_size(point_count,
-                                                      (options.flags & close_ends) != 0);
+    size_t scratch = reconstruct_scratch_size(point_count, request.caps);
     // With a runner, the layers done ahead (at most one per kMinLayerPoints points, plus the
     // last) stay while the groups are formed.
-    if (has_runner(options) &&
+    if (has_runner(jobs_of(request)) &&
         !plan_parallel_workspace(point_count, layer_limit, arena, &scratch))
         return 0;
     if (arena.failed || scratch == 0 || scratch > SIZE_MAX - arena.required_bytes()) return 0;
@@ -136,16 +135,15 @@ static inline size_t repeats_of_vertices(const CloudReader& reader, size_t count
 }
 
 // Plans the layers of a tube along the frame's axis and groups its points by layer.
-static inline Status plan_tube_layers(const TubeInput& in, const Options& options,
-                                      const Frame& frame, double lo, double hi, Arena& arena,
-                                      ReconstructMemory& m, LayerPlan& plan, Local** staged,
-                                      Report& rep) {
+static inline Status plan_tube_layers(const TubeInput& in, const TubeRequest& request, const Frame& frame,
+                               double lo, double hi, Arena& arena, ReconstructMemory& m,
+                               LayerPlan& plan, Local** staged, Report& rep) {
     const size_t valid = in.sums.valid;
-    const size_t layer_limit = planned_layer_limit(in.count, options);
+    const size_t layer_limit = planned_layer_limit(in.count, request.layers);
     if (!plan_reconstruct(m, in.count, layer_limit, arena)) return Status::out_of_memory;
-    notify(options, Phase::layers, 0);
+    notify(request, Phase::layers, 0);
     plan = {m.bounds, 0, (hi - lo) * kCutTolerance};
-    if (automatic_layers(options)) {
+    if (automatic_layers(request.layers)) {
         const size_t mark = arena.mark();
         const uint32_t bins = profile_bin_count(valid);
         ProfileBin* profile = nullptr;
@@ -157,7 +155,7 @@ static inline Status plan_tube_layers(const TubeInput& in, const Options& option
                               bins, plan);
         arena.rewind(mark);
     } else {
-        plan_layers(options, lo, hi, in.count, frame, plan);
+        plan_layers(request.layers, lo, hi, in.count, frame, plan);
     }
     rep.layers.planned_count = plan.count;
     // Without a runner, the grouped points are also staged in the workspace's end room when
@@ -168,9 +166,9 @@ static inline Status plan_tube_layers(const TubeInput& in, const Options& option
     const size_t mark = arena.mark();
     uint32_t* layer = arena.alloc<uint32_t>(in.count);
     if (arena.failed) return Status::out_of_memory;
-    if (kStagePoints && !has_runner(options))
+    if (kStagePoints && !has_runner(jobs_of(request)))
         *staged = static_cast<Local*>(arena.room_at_end(saturating_product(valid, sizeof(Local))));
-    if (!group_by_layer_in_jobs(options, in.reader, in.count, frame, plan, layer, m.layer_start,
+    if (!group_by_layer_in_jobs(jobs_of(request), in.reader, in.count, frame, plan, layer, m.layer_start,
                                 m.order, arena))
         group_by_layer(in.reader, in.count, frame, plan, layer, *staged, m.layer_start, m.order);
     arena.rewind(mark);
@@ -179,18 +177,17 @@ static inline Status plan_tube_layers(const TubeInput& in, const Options& option
 
 // Triangulates the planned layers one group after another, each stitched to the one below,
 // into `sink`; the layers used go to the report.
-static inline Status triangulate_tube(const TubeInput& in, const Options& options,
-                                      const Frame& frame, const LayerPlan& plan, Local* staged,
-                                      Arena& arena, ReconstructMemory& m, TriangleSink& sink,
-                                      Report& rep) {
-    notify(options, Phase::triangulate, 0);
+static inline Status triangulate_tube(const TubeInput& in, const TubeRequest& request, const Frame& frame,
+                               const LayerPlan& plan, Local* staged, Arena& arena,
+                               ReconstructMemory& m, TriangleSink& sink, Report& rep) {
+    notify(request, Phase::triangulate, 0);
     SurfaceChain& chain = m.chain;
     chain.frame = frame;
     chain.reader = in.reader;
     chain.output_id = nullptr;
     const LayerQueue queue = {m.order, staged, m.layer_start, plan.bounds, plan.count, true};
     ParallelLayers parallel;
-    rep.layers.parallel_count = start_parallel_layers(options, in.reader, frame, queue, arena, parallel);
+    rep.layers.parallel_count = start_parallel_layers(jobs_of(request), in.reader, frame, queue, arena, parallel);
     for (uint32_t first = 0; first < plan.count;) {
         GroupResult group;
         const Status status = add_group(chain, queue, first, arena, sink, group,
@@ -203,7 +200,7 @@ static inline Status triangulate_tube(const TubeInput& in, const Options& option
                            rep.layers.info[rep.layers.used_count]);
         ++rep.layers.used_count;
         first = group.last + 1;
-        notify(options, Phase::triangulate, static_cast<double>(first) / plan.count);
+        notify(request, Phase::triangulate, static_cast<double>(first) / plan.count);
     }
     rep.points.duplicate_count = chain.duplicates;
     if (rep.layers.used_count == 0) {
@@ -211,7 +208,7 @@ static inline Status triangulate_tube(const TubeInput& in, const Options& option
                      "it (try another axis)";
         return Status::not_columnar;
     }
-    notify(options, Phase::stitch, 1);
+    notify(request, Phase::stitch, 1);
     if (sink.count == 0) {
         rep.detail = "every point lies on the boundary of its layer: too few points to span a "
                      "surface";
@@ -248,11 +245,11 @@ static inline bool has_no_area(const CloudReader& reader, const Frame& frame, co
 }
 
 // Closes the tube's boundary loops with caps (close_ends) and fills the caps' report.
-static inline Status cap_tube(const TubeInput& in, const Options& options, const Frame& frame,
-                              Arena& arena, uint32_t* triangles, size_t capacity, size_t& count,
-                              size_t* triangle_count, Report& rep) {
-    notify(options, Phase::manifold, 0);
-    if (!(options.flags & close_ends)) return Status::ok;
+static inline Status cap_tube(const TubeInput& in, const TubeRequest& request, const Frame& frame,
+                       Arena& arena, uint32_t* triangles, size_t capacity, size_t& count,
+                       size_t* triangle_count, Report& rep) {
+    notify(request, Phase::manifold, 0);
+    if (!request.caps) return Status::ok;
     CapCounts caps = {0, 0, 0, 0};
     size_t needed = 0;
     const Status status = cap_boundary_loops(triangles, count, capacity, in.reader, in.count,
@@ -272,13 +269,12 @@ static inline Status cap_tube(const TubeInput& in, const Options& options, const
 // One tube through the kept points of `in`: the frame, the layers, their triangulation and
 // stitching, the caps. `rep` holds the counts of read_cloud; Report::points.unused_count
 // is left to the caller.
-static inline Status mesh_tube(const TubeInput& in, const Options& options, Arena& arena,
-                               uint32_t* triangles, size_t triangle_capacity,
-                               size_t* triangle_count, Report& rep) {
+static inline Status mesh_tube(const TubeInput& in, const TubeRequest& request, Arena& arena,
+                        uint32_t* triangles, size_t triangle_capacity, size_t* triangle_count,
+                        Report& rep) {
     Frame frame;
-    Status status = choose_frame(in.sums, options, frame);
+    Status status = choose_frame(in.sums, request, frame);
     if (status != Status::ok) return status;
-    if (kClosedEnds) frame.cut_ends |= in.cut_ends;
     report_frame(frame, rep);
     if (in.sums.distinct < 3) {
         rep.detail = "fewer than 3 distinct valid points";
@@ -294,10 +290,10 @@ static inline Status mesh_tube(const TubeInput& in, const Options& options, Aren
     ReconstructMemory m;
     LayerPlan plan;
     Local* staged = nullptr;
-    status = plan_tube_layers(in, options, frame, lo, hi, arena, m, plan, &staged, rep);
+    status = plan_tube_layers(in, request, frame, lo, hi, arena, m, plan, &staged, rep);
     if (status != Status::ok) return status;
     TriangleSink sink = {triangles, triangle_capacity, 0, 0};
-    status = triangulate_tube(in, options, frame, plan, staged, arena, m, sink, rep);
+    status = triangulate_tube(in, request, frame, plan, staged, arena, m, sink, rep);
     if (status != Status::ok) return status;
     if (sink.count > triangle_capacity) {
         *triangle_count = sink.count;
@@ -308,7 +304,7 @@ static inline Status mesh_tube(const TubeInput& in, const Options& options, Aren
     if (kDegenerateCheck && has_no_area(in.reader, frame, triangles, sink.count))
         return Status::degenerate;
     size_t count = sink.count;
-    status = cap_tube(in, options, frame, arena, triangles, triangle_capacity, count,
+    status = cap_tube(in, request, frame, arena, triangles, triangle_capacity, count,
                       triangle_count, rep);
     if (status != Status::ok) return status;
     *triangle_count = count;
@@ -321,7 +317,7 @@ static inline Status mesh_tube(const TubeInput& in, const Options& options, Aren
     }
     report_chain(m.chain, in.sums.valid, rep);
     if (!rep.detail && rep.caps.open_count > 0) rep.detail = kLoopLeftOpenDetail;
-    notify(options, Phase::done, 1);
+    notify(request, Phase::done, 1);
     return Status::ok;
 }
 

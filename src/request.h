@@ -1,0 +1,83 @@
+// >>request ==============================================================================
+// What one tube is asked for: axis, layers, ends, caps, origin, read once from Options.
+//
+// reconstruct() meshes several tubes where the cloud parts: the trunk, each branch, the
+// one tube they are weighed against, and the samples the automatic axis is chosen on. Each
+// has its own axis, layers, ends and caps; a TubeRequest says them, made once from the
+// caller's Options (tube_request()), and each step asks for its tube with a request of its
+// own. The caller's Options are only read: for the callbacks and the invalid points.
+
+namespace stratmesh {
+namespace detail {
+
+// The layers asked for, first match wins (see Options::cuts): the cuts, else `count`
+// equal layers, else layers of about `height`, else automatic.
+struct LayerRequest {
+    const double* cuts;
+    size_t cut_count;
+    uint32_t count;
+    double height;
+};
+
+// What reconstruct() does where the cloud parts into branches (see PartCounts).
+enum class PartsPolicy : uint32_t {
+    compare,   // the parts joined where whole and smaller than one tube, else the one tube
+    one_tube,  // one tube, without a search (the one_tube flag)
+    keep,      // the parts, joined where they can be (the keep_parts flag)
+};
+
+struct TubeRequest {
+    Axis axis;              // Axis::automatic until resolve_axis() chooses
+    double direction[3];    // with Axis::direction
+    LayerRequest layers;
+    uint32_t cut_ends;      // ClosedEnd bits: the ends that are cuts, never closed ones
+    bool caps;              // the boundary loops closed (close_ends)
+    bool surface_flips;
+    bool drop_outliers;     // the cloud is read without its outliers
+    const double* origin;   // the frame's reference point, or null for the centroid
+    PartsPolicy parts;
+    // The caller's Options: its job runner, or null for none (an axis trial).
+    const Options* caller;
+    // The Options whose progress callback is told, or null: none (a branch, whose progress
+    // would run backwards from part to part; an axis trial).
+    const Options* progress;
+};
+
+inline TubeRequest tube_request(const Options& options) {
+    const uint32_t f = options.flags;
+    const PartsPolicy parts = !kFindParts || (f & one_tube) ? PartsPolicy::one_tube
+                              : (f & keep_parts) ? PartsPolicy::keep
+                                                 : PartsPolicy::compare;
+    return {options.axis,
+            {options.direction[0], options.direction[1], options.direction[2]},
+            {options.cuts, options.cut_count, options.layer_count, options.layer_height},
+            kClosedEnds && (f & open_ends) ? closed_bottom | closed_top : 0u,
+            (f & close_ends) != 0,
+            kSurfaceFlips && (f & surface_flips),
+            kDropOutliers && (f & drop_outliers),
+            (f & origin_given) ? options.origin : nullptr,
+            parts,
+            &options,
+            &options};
+}
+
+// Sets the request's axis to a direction.
+inline void set_direction(TubeRequest& request, const double* direction) {
+    request.axis = Axis::direction;
+    for (int k = 0; k < 3; ++k) request.direction[k] = direction[k];
+}
+
+const Options kNoCallbacks = {};
+
+// The Options whose job runner a tube hands its jobs to (none in an axis trial).
+inline const Options& jobs_of(const TubeRequest& request) {
+    return request.caller ? *request.caller : kNoCallbacks;
+}
+
+// Phase progress, to the caller's callback where the request reports progress.
+inline void notify(const TubeRequest& request, Phase phase, double fraction) {
+    if (request.progress) notify(*request.progress, phase, fraction);
+}
+
+}  // namespace detail
+}  // namespace stratmesh

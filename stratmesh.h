@@ -1574,11 +1574,11 @@ static const size_t kMaxPoints = 0xFFFFFFFEu;
 #endif
 
 #if defined(__GNUC__) || defined(__clang__)
-inline double abs_value(double x) { return __builtin_fabs(x); }
+static inline double abs_value(double x) { return __builtin_fabs(x); }
 #else
-inline double abs_value(double x) { return x < 0 ? -x : x; }
+static inline double abs_value(double x) { return x < 0 ? -x : x; }
 #endif
-inline bool is_finite(double x) { return x - x == 0; }
+static inline bool is_finite(double x) { return x - x == 0; }
 
 // Sorts ascending in place: heapsort, O(n log n) on any input (a million cuts, a huge fan)
 // with no recursion and no memory.
@@ -1605,7 +1605,7 @@ template <class T> void heap_sort(T* v, size_t count) {
     }
 }
 
-inline double read_double(const unsigned char* p) {
+static inline double read_double(const unsigned char* p) {
     double v;
     std::memcpy(&v, p, sizeof v);
     return v;
@@ -1704,29 +1704,29 @@ struct ByteRange {
     uintptr_t begin, end;
 };
 
-inline size_t saturating_product(size_t a, size_t b) {
+static inline size_t saturating_product(size_t a, size_t b) {
     return b != 0 && a > SIZE_MAX / b ? SIZE_MAX : a * b;
 }
 
-inline ByteRange byte_range(const void* p, size_t bytes) {
+static inline ByteRange byte_range(const void* p, size_t bytes) {
     uintptr_t begin = reinterpret_cast<uintptr_t>(p);
     if (!p) return {0, 0};
     return {begin, bytes > UINTPTR_MAX - begin ? UINTPTR_MAX : begin + bytes};
 }
 
 // Bytes covered by `count` records `stride` apart whose last one is `record_bytes` long.
-inline ByteRange strided_range(const void* p, size_t count, size_t stride, size_t record_bytes) {
+static inline ByteRange strided_range(const void* p, size_t count, size_t stride, size_t record_bytes) {
     if (count == 0) return {0, 0};
     size_t span = saturating_product(count - 1, stride);
     return byte_range(p, span > SIZE_MAX - record_bytes ? SIZE_MAX : span + record_bytes);
 }
 
-inline bool ranges_overlap(ByteRange a, ByteRange b) {
+static inline bool ranges_overlap(ByteRange a, ByteRange b) {
     return a.begin < a.end && b.begin < b.end && a.begin < b.end && b.begin < a.end;
 }
 
 // True if any two of the `count` ranges overlap.
-inline bool any_overlap(const ByteRange* ranges, size_t count) {
+static inline bool any_overlap(const ByteRange* ranges, size_t count) {
     for (size_t i = 0; i < count; ++i)
         for (size_t j = i + 1; j < count; ++j)
             if (ranges_overlap(ranges[i], ranges[j])) return true;
@@ -1763,7 +1763,7 @@ constexpr double kOrientBoundA = (3.0 + 16.0 * kEps) * kEps;
 constexpr double kIncircleBoundA = (10.0 + 96.0 * kEps) * kEps;
 
 // a + b = x + y exactly, with x = fl(a + b).
-inline void two_sum(double a, double b, double& x, double& y) {
+static inline void two_sum(double a, double b, double& x, double& y) {
     x = a + b;
     double bv = x - a;
     double av = x - bv;
@@ -1771,14 +1771,14 @@ inline void two_sum(double a, double b, double& x, double& y) {
 }
 
 // a - b = x + y exactly, with x = fl(a - b).
-inline void two_diff(double a, double b, double& x, double& y) {
+static inline void two_diff(double a, double b, double& x, double& y) {
     x = a - b;
     double bv = a - x;
     double av = x + bv;
     y = (a - av) + (bv - b);
 }
 
-inline void split(double a, double& hi, double& lo) {
+static inline void split(double a, double& hi, double& lo) {
     double c = kSplitter * a;
     double big = c - a;
     hi = c - big;
@@ -1786,7 +1786,7 @@ inline void split(double a, double& hi, double& lo) {
 }
 
 // a * b = x + y exactly, with x = fl(a * b) (Dekker's product, Veltkamp's split).
-inline void two_product(double a, double b, double& x, double& y) {
+static inline void two_product(double a, double b, double& x, double& y) {
     x = a * b;
     double ahi, alo, bhi, blo;
     split(a, ahi, alo);
@@ -1798,7 +1798,7 @@ inline void two_product(double a, double b, double& x, double& y) {
 }
 
 // (a1 + a0) - (b1 + b0) as a four-component expansion out[0..3], least significant first.
-inline void two_two_diff(double a1, double a0, double b1, double b0, double* out) {
+static inline void two_two_diff(double a1, double a0, double b1, double b0, double* out) {
     double i, j, z;
     two_diff(a0, b0, i, out[0]);
     two_sum(a1, i, j, z);
@@ -1807,7 +1807,7 @@ inline void two_two_diff(double a1, double a0, double b1, double b0, double* out
 }
 
 // ax*by - ay*bx as a four-component expansion.
-inline void cross_exact(double ax, double ay, double bx, double by, double* out) {
+static inline void cross_exact(double ax, double ay, double bx, double by, double* out) {
     double p1, p0, q1, q0;
     two_product(ax, by, p1, p0);
     two_product(ay, bx, q1, q0);
@@ -1816,7 +1816,7 @@ inline void cross_exact(double ax, double ay, double bx, double by, double* out)
 
 // h = e + f; returns the length of h with zero components removed (at least 1). h needs
 // room for elen + flen components and must not alias e or f.
-inline int expansion_sum(int elen, const double* e, int flen, const double* f, double* h) {
+static inline int expansion_sum(int elen, const double* e, int flen, const double* f, double* h) {
     int ei = 0, fi = 0, hi = 0;
     double q = 0, hh = 0;
     bool first = true;
@@ -1842,7 +1842,7 @@ inline int expansion_sum(int elen, const double* e, int flen, const double* f, d
 }
 
 // Removes the zero components of e in place; returns the new length (at least 1).
-inline int compress_zeros(int len, double* e) {
+static inline int compress_zeros(int len, double* e) {
     int kept = 0;
     for (int i = 0; i < len; ++i)
         if (e[i] != 0) e[kept++] = e[i];
@@ -1852,7 +1852,7 @@ inline int compress_zeros(int len, double* e) {
 
 // h = b * e; returns the length of h (at most 2 * elen) with zeros removed. h must not
 // alias e.
-inline int expansion_scale(int elen, const double* e, double b, double* h) {
+static inline int expansion_scale(int elen, const double* e, double b, double* h) {
     if (b == 0 || (elen == 1 && e[0] == 0)) {
         h[0] = 0;
         return 1;
@@ -1874,7 +1874,7 @@ inline int expansion_scale(int elen, const double* e, double b, double* h) {
 }
 
 // h = e * f; h and tmp each need room for 2 * elen * flen components, scaled for 2 * elen.
-inline int expansion_product(int elen, const double* e, int flen, const double* f, double* h,
+static inline int expansion_product(int elen, const double* e, int flen, const double* f, double* h,
                              double* tmp, double* scaled) {
     int len = expansion_scale(elen, e, f[0], h);
     for (int j = 1; j < flen; ++j) {
@@ -1885,19 +1885,19 @@ inline int expansion_product(int elen, const double* e, int flen, const double* 
     return len;
 }
 
-inline void expansion_negate(int len, double* e) {
+static inline void expansion_negate(int len, double* e) {
     for (int i = 0; i < len; ++i) e[i] = -e[i];
 }
 
 // The most significant non-zero component (0 if the expansion is zero).
-inline double expansion_top(int len, const double* e) {
+static inline double expansion_top(int len, const double* e) {
     for (int i = len - 1; i >= 0; --i)
         if (e[i] != 0) return e[i];
     return 0;
 }
 
 // orient2d from the raw coordinates: a x b + b x c + c x a, exactly.
-inline double orient2d_exact(const double* a, const double* b, const double* c) {
+static inline double orient2d_exact(const double* a, const double* b, const double* c) {
     double ab[4], bc[4], ca[4], s[8], t[12];
     cross_exact(a[0], a[1], b[0], b[1], ab);
     cross_exact(b[0], b[1], c[0], c[1], bc);
@@ -1914,7 +1914,7 @@ inline double orient2d_exact(const double* a, const double* b, const double* c) 
 // `values` are the coordinates and differences involved; `limit` the largest safe binary
 // exponent for the degree. Returns the factor, or 0 when no scaling is needed (or none
 // can help: magnitudes spread over more than the double range allows).
-inline double rescaling_factor(const double* values, int count, int limit) {
+static inline double rescaling_factor(const double* values, int count, int limit) {
     double largest = 0, smallest = DBL_MAX;
     for (int i = 0; i < count; ++i) {
         double v = abs_value(values[i]);
@@ -1942,7 +1942,7 @@ constexpr double kUnderflowGuard = 0x1p-1000;
 
 // Points the first `count` entries of `points` at scaled copies in `storage`, unless
 // factor is 0 (no scaling needed).
-inline void rescale_points(double factor, const double** points, double (*storage)[2],
+static inline void rescale_points(double factor, const double** points, double (*storage)[2],
                            int count) {
     if (factor == 0) return;
     for (int k = 0; k < count; ++k) {
@@ -1962,7 +1962,7 @@ inline void rescale_points(double factor, const double** points, double (*storag
 // the magnitudes and without underflow, so these stages need no rescaling.
 
 // floor(log2(|v|)) for a finite non-zero double.
-inline int top_bit_exponent(double v) {
+static inline int top_bit_exponent(double v) {
     uint64_t bits;
     std::memcpy(&bits, &v, sizeof bits);
     int biased = static_cast<int>((bits >> 52) & 0x7FF);
@@ -1975,7 +1975,7 @@ inline int top_bit_exponent(double v) {
 }
 
 // 2^e for -1022 <= e <= 1023.
-inline double power_of_two(int e) {
+static inline double power_of_two(int e) {
     uint64_t bits = static_cast<uint64_t>(e + 1023) << 52;
     double v;
     std::memcpy(&v, &bits, sizeof v);
@@ -1993,7 +1993,7 @@ struct Uint256 {
 
 // a * b exactly. Where the compiler has a 128-bit type this is one instruction on 64-bit
 // targets; elsewhere it is built from 32-bit halves. Both are exact, so results agree.
-inline Uint128 multiply_wide(uint64_t a, uint64_t b) {
+static inline Uint128 multiply_wide(uint64_t a, uint64_t b) {
     Uint128 r;
 #if defined(__SIZEOF_INT128__)
     __extension__ typedef unsigned __int128 uint128_type;
@@ -2012,7 +2012,7 @@ inline Uint128 multiply_wide(uint64_t a, uint64_t b) {
 }
 
 // a + b + carry; carry becomes the carry out (the carry in is 0 or 1).
-inline uint64_t add_with_carry(uint64_t a, uint64_t b, uint64_t& carry) {
+static inline uint64_t add_with_carry(uint64_t a, uint64_t b, uint64_t& carry) {
     uint64_t s = a + b;
     uint64_t out = s < a;
     uint64_t t = s + carry;
@@ -2022,7 +2022,7 @@ inline uint64_t add_with_carry(uint64_t a, uint64_t b, uint64_t& carry) {
 
 // sum += term or sum -= term, two's complement modulo 2^(64 N); term is zero-extended.
 template <size_t N, size_t M>
-inline void words_accumulate(uint64_t (&sum)[N], const uint64_t (&term)[M], bool subtract) {
+static inline void words_accumulate(uint64_t (&sum)[N], const uint64_t (&term)[M], bool subtract) {
     uint64_t flip = subtract ? ~uint64_t(0) : 0;
     uint64_t carry = subtract ? 1 : 0;
     for (size_t k = 0; k < N; ++k)
@@ -2031,7 +2031,7 @@ inline void words_accumulate(uint64_t (&sum)[N], const uint64_t (&term)[M], bool
 
 // Makes a two's complement number its magnitude; returns whether it was negative.
 template <size_t N>
-inline bool words_to_magnitude(uint64_t (&value)[N]) {
+static inline bool words_to_magnitude(uint64_t (&value)[N]) {
     if ((value[N - 1] >> 63) == 0) return false;
     uint64_t carry = 1;
     for (size_t k = 0; k < N; ++k) {
@@ -2042,7 +2042,7 @@ inline bool words_to_magnitude(uint64_t (&value)[N]) {
 }
 
 // a * b for a, b < 2^127 (the top word cannot overflow).
-inline Uint256 multiply_wide(const Uint128& a, const Uint128& b) {
+static inline Uint256 multiply_wide(const Uint128& a, const Uint128& b) {
     Uint128 p00 = multiply_wide(a.word[0], b.word[0]);
     Uint128 p01 = multiply_wide(a.word[0], b.word[1]);
     Uint128 p10 = multiply_wide(a.word[1], b.word[0]);
@@ -2071,7 +2071,7 @@ struct ScaledIntegers {
 // Scales `count` (at most 6) exact, hence finite, differences into integers; false when
 // they span more than 62 bits, or all lie below 2^-962 (the factor would leave the double
 // range; rare enough to leave to the expansions).
-inline bool to_integers(const double* values, int count, ScaledIntegers& out) {
+static inline bool to_integers(const double* values, int count, ScaledIntegers& out) {
     double largest = 0;
     for (int i = 0; i < count; ++i)
         if (abs_value(values[i]) > largest) largest = abs_value(values[i]);
@@ -2092,7 +2092,7 @@ inline bool to_integers(const double* values, int count, ScaledIntegers& out) {
 
 // u0 v1 - u1 v0 for four of the integers, given by index: its magnitude (below 2^125)
 // and whether it is negative.
-inline Uint128 integer_cross(const ScaledIntegers& z, int u0, int u1, int v0, int v1,
+static inline Uint128 integer_cross(const ScaledIntegers& z, int u0, int u1, int v0, int v1,
                              bool* negative) {
     Uint128 cross = {{0, 0}};
     Uint128 left = multiply_wide(z.magnitude[u0], z.magnitude[v1]);
@@ -2106,7 +2106,7 @@ inline Uint128 integer_cross(const ScaledIntegers& z, int u0, int u1, int v0, in
 // (-1)^negative * magnitude * 2^exponent as a double. Only the sign is exact: a non-zero
 // value is kept from rounding to zero or infinity.
 template <size_t N>
-inline double to_signed_double(const uint64_t (&magnitude)[N], bool negative, int exponent) {
+static inline double to_signed_double(const uint64_t (&magnitude)[N], bool negative, int exponent) {
     double value = 0;
     for (size_t k = N; k-- > 0;) value = value * 0x1p64 + static_cast<double>(magnitude[k]);
     if (value == 0) return 0;
@@ -2118,7 +2118,7 @@ inline double to_signed_double(const uint64_t (&magnitude)[N], bool negative, in
 
 // orient2d from exact differences u = a - c, v = b - c: u x v, or false when the integer
 // stage does not apply.
-inline bool orient2d_from_integer_differences(const double differences[4], double* det) {
+static inline bool orient2d_from_integer_differences(const double differences[4], double* det) {
     ScaledIntegers z;
     if (!to_integers(differences, 4, z)) return false;
     bool negative = false;
@@ -2130,7 +2130,7 @@ inline bool orient2d_from_integer_differences(const double differences[4], doubl
 // incircle from exact differences to d, rows (dx, dy): the 3x3 determinant of rows
 // (dx, dy, dx^2 + dy^2) expanded along the lifts, or false when the integer stage does
 // not apply.
-inline bool incircle_from_integer_differences(const double rows[3][2], double* det) {
+static inline bool incircle_from_integer_differences(const double rows[3][2], double* det) {
     ScaledIntegers z;
     if (!to_integers(&rows[0][0], 6, z)) return false;
     uint64_t sum[4] = {0, 0, 0, 0};
@@ -2153,7 +2153,7 @@ inline bool incircle_from_integer_differences(const double rows[3][2], double* d
 // integer stage, then with rescaling in expansions), then the raw coordinates are used
 // (with STRATMESH_SMALL_CODE at once, after the rescaling: kFastExactStages). Kept apart
 // from the filter so that the common, filtered call stays small.
-STRATMESH_NOINLINE inline double orient2d_beyond_filter(const double* a, const double* b,
+STRATMESH_NOINLINE static inline double orient2d_beyond_filter(const double* a, const double* b,
                                                          const double* c) {
     double differences[4], tails[4], det = 0;
     two_diff(a[0], c[0], differences[0], tails[0]);
@@ -2186,7 +2186,7 @@ STRATMESH_NOINLINE inline double orient2d_beyond_filter(const double* a, const d
 }
 
 // Sign-exact orient2d: the filter decides unless |det| is within the rounding error.
-inline double orient2d_robust(const double* a, const double* b, const double* c) {
+static inline double orient2d_robust(const double* a, const double* b, const double* c) {
     double acx = a[0] - c[0], bcx = b[0] - c[0];
     double acy = a[1] - c[1], bcy = b[1] - c[1];
     double left = acx * bcy;
@@ -2202,7 +2202,7 @@ const int kIncircleScratch = 1024;
 
 // incircle from the raw coordinates: the 4x4 determinant with rows (x, y, x^2 + y^2, 1),
 // expanded along the lift column. Needs kIncircleScratch doubles of scratch.
-inline double incircle_exact(const double* a, const double* b, const double* c,
+static inline double incircle_exact(const double* a, const double* b, const double* c,
                              const double* d, double* scratch) {
     const double* p[4] = {a, b, c, d};
     double* acc = scratch;         // 384
@@ -2247,7 +2247,7 @@ inline double incircle_exact(const double* a, const double* b, const double* c,
 // value. (Taking the expansion's two largest components instead is not enough: a
 // nonoverlapping expansion may hold a lone high bit followed by a component nearly as
 // large.)
-inline void to_double_double(const double* e, int len, double* hi, double* lo) {
+static inline void to_double_double(const double* e, int len, double* hi, double* lo) {
     double h = 0, l = 0;
     for (int k = 0; k < len; ++k) {
         double s, err;
@@ -2267,7 +2267,7 @@ inline void to_double_double(const double* e, int len, double* hi, double* lo) {
 // 64 eps^2 sum |L M| has the right sign. That settles near-cocircular points whose
 // determinant is not zero; exact zeros take the exact products. Needs 264 doubles of
 // scratch.
-inline double incircle_from_differences(const double rows[3][2], double* scratch) {
+static inline double incircle_from_differences(const double rows[3][2], double* scratch) {
     double lift[3][4], minor[3][4];
     int lift_len[3], minor_len[3];
     double hi = 0, lo = 0, magnitude = 0;
@@ -2314,7 +2314,7 @@ inline double incircle_from_differences(const double rows[3][2], double* scratch
 }
 
 // The differences of a, b, c to d, as rows; whether all six are exact.
-inline bool differences_to(const double* a, const double* b, const double* c, const double* d,
+static inline bool differences_to(const double* a, const double* b, const double* c, const double* d,
                            double rows[3][2]) {
     const double* p[3] = {a, b, c};
     bool exact = true;
@@ -2332,7 +2332,7 @@ inline bool differences_to(const double* a, const double* b, const double* c, co
 // (there is no underflow to avoid); then the differences after rescaling; then the raw
 // coordinates (with STRATMESH_SMALL_CODE only these: kFastExactStages). Kept apart from
 // the filter so that the common, filtered call stays small.
-STRATMESH_NOINLINE inline double incircle_beyond_filter(const double* a, const double* b,
+STRATMESH_NOINLINE static inline double incircle_beyond_filter(const double* a, const double* b,
                                                          const double* c, const double* d,
                                                          double* scratch) {
     double rows[3][2], det = 0;
@@ -2356,7 +2356,7 @@ STRATMESH_NOINLINE inline double incircle_beyond_filter(const double* a, const d
 }
 
 // Sign-exact incircle using `scratch` (kIncircleScratch doubles) when the filter fails.
-inline double incircle_robust(const double* a, const double* b, const double* c,
+static inline double incircle_robust(const double* a, const double* b, const double* c,
                               const double* d, double* scratch) {
     double adx = a[0] - d[0], bdx = b[0] - d[0], cdx = c[0] - d[0];
     double ady = a[1] - d[1], bdy = b[1] - d[1], cdy = c[1] - d[1];
@@ -2377,7 +2377,7 @@ inline double incircle_robust(const double* a, const double* b, const double* c,
 }
 
 // Lexicographic order on (x, y): the rank that sets each point's perturbation.
-inline bool lex_less(const double* p, const double* q) {
+static inline bool lex_less(const double* p, const double* q) {
     return p[0] < q[0] || (p[0] == q[0] && p[1] < q[1]);
 }
 
@@ -2387,7 +2387,7 @@ inline bool lex_less(const double* p, const double* q) {
 // orientation of the other three) is non-zero; d's cofactor is -orient(a, b, c) < 0, so
 // the loop always ends. Never returns 0 for four distinct points. The tie is settled out of
 // line (STRATMESH_FAST_NOINLINE), so that the filtered test inlines into its callers.
-STRATMESH_FAST_NOINLINE inline int incircle_tie(const double* a, const double* b,
+STRATMESH_FAST_NOINLINE static inline int incircle_tie(const double* a, const double* b,
                                                 const double* c, const double* d) {
     const double* p[4] = {a, b, c, d};
     // Sort the four points by decreasing lexicographic rank (insertion sort, 4 items).
@@ -2412,7 +2412,7 @@ STRATMESH_FAST_NOINLINE inline int incircle_tie(const double* a, const double* b
     return -1;
 }
 
-STRATMESH_SMALL_NOINLINE inline int incircle_perturbed(const double* a, const double* b,
+STRATMESH_SMALL_NOINLINE static inline int incircle_perturbed(const double* a, const double* b,
                                                        const double* c, const double* d,
                                                        double* scratch) {
     const double det = incircle_robust(a, b, c, d, scratch);
@@ -2483,7 +2483,7 @@ struct HilbertTable {
 
 constexpr HilbertTable kHilbertTable{};
 
-inline uint32_t hilbert_index(uint32_t x, uint32_t y) {
+static inline uint32_t hilbert_index(uint32_t x, uint32_t y) {
     // kHilbertBits is odd: a zero level is put on top, entered with x and y swapped so
     // that it leaves the identity transform (its digit is 0), and the 14 levels run in
     // seven steps.
@@ -2499,7 +2499,7 @@ inline uint32_t hilbert_index(uint32_t x, uint32_t y) {
     return d;
 }
 
-inline uint32_t quantize(double v, double lo, double scale) {
+static inline uint32_t quantize(double v, double lo, double scale) {
     const double top = static_cast<double>((1u << kHilbertBits) - 1);
     double q = (v - lo) * scale;
     if (!(q > 0)) return 0;
@@ -2507,7 +2507,7 @@ inline uint32_t quantize(double v, double lo, double scale) {
     return static_cast<uint32_t>(q);
 }
 
-inline uint32_t mix32(uint32_t h) {
+static inline uint32_t mix32(uint32_t h) {
     h ^= h >> 16;
     h *= 0x7FEB352Du;
     h ^= h >> 15;
@@ -2517,7 +2517,7 @@ inline uint32_t mix32(uint32_t h) {
 }
 
 // A hash of the point's coordinates (-0 and +0 hash alike).
-inline uint32_t coordinate_hash(double x, double y) {
+static inline uint32_t coordinate_hash(double x, double y) {
     uint64_t bx, by;
     x += 0.0;
     y += 0.0;
@@ -2530,7 +2530,7 @@ inline uint32_t coordinate_hash(double x, double y) {
 }
 
 // Stable LSD radix sort of `order` by `keys` (both count long), 8 bits a pass.
-inline void radix_sort(uint32_t* keys, uint32_t* order, uint32_t* keys_tmp,
+static inline void radix_sort(uint32_t* keys, uint32_t* order, uint32_t* keys_tmp,
                        uint32_t* order_tmp, size_t count) {
     for (uint32_t shift = 0; shift < 32; shift += 8) {
         size_t histogram[256];
@@ -2560,7 +2560,7 @@ struct BoundingBox2d {
 // The number of trailing zero bits of h, at most `limit` (< 32). The loop over the bits,
 // whose length is random, mispredicts its exit on about every other point; GCC and Clang
 // count them in an instruction or two (2.5% of delaunay_2d's time on 1e6 points).
-inline uint32_t trailing_zeros(uint32_t h, uint32_t limit) {
+static inline uint32_t trailing_zeros(uint32_t h, uint32_t limit) {
 #if defined(__GNUC__) || defined(__clang__)
     const uint32_t zeros = h ? static_cast<uint32_t>(__builtin_ctz(h)) : 32;
     return zeros < limit ? zeros : limit;
@@ -2573,7 +2573,7 @@ inline uint32_t trailing_zeros(uint32_t h, uint32_t limit) {
 
 // Fills order[0..count) with the indices of the points (x, y doubles, stride bytes apart)
 // in BRIO order over `box`; scratch from the arena.
-inline bool spatial_order(const unsigned char* xy, size_t stride, size_t count,
+static inline bool spatial_order(const unsigned char* xy, size_t stride, size_t count,
                           const BoundingBox2d& box, uint32_t* order, Arena& arena) {
     size_t mark = arena.mark();
     uint32_t* keys = arena.alloc<uint32_t>(count);
@@ -2635,9 +2635,9 @@ namespace detail {
 
 static const uint32_t kGhost = kNoIndex;
 
-inline uint32_t next_edge(uint32_t e) { return e % 3 == 2 ? e - 2 : e + 1; }
+static inline uint32_t next_edge(uint32_t e) { return e % 3 == 2 ? e - 2 : e + 1; }
 
-inline uint32_t prev_edge(uint32_t e) { return e % 3 == 0 ? e + 2 : e - 1; }
+static inline uint32_t prev_edge(uint32_t e) { return e % 3 == 0 ? e + 2 : e - 1; }
 
 struct Triangulation {
     const double* xy;     // 2 per vertex, vertices in insertion order
@@ -2670,7 +2670,7 @@ struct Triangulation {
 };
 
 // Memory for a triangulation of up to `count` points (the points themselves excluded).
-inline bool allocate_triangulation(Triangulation& tr, size_t count, Arena& arena) {
+static inline bool allocate_triangulation(Triangulation& tr, size_t count, Arena& arena) {
     size_t triangles = count >= 3 ? 2 * count - 2 : 4;
     tr.vertex = arena.alloc<uint32_t>(3 * triangles);
     tr.twin = arena.alloc<uint32_t>(3 * triangles);
@@ -2684,7 +2684,7 @@ inline bool allocate_triangulation(Triangulation& tr, size_t count, Arena& arena
 }
 
 // The first triangle (a, b, c), counter-clockwise, and its three ghosts.
-inline void start_triangulation(Triangulation& tr, uint32_t a, uint32_t b, uint32_t c) {
+static inline void start_triangulation(Triangulation& tr, uint32_t a, uint32_t b, uint32_t c) {
     tr.set_triangle(0, a, b, c);
     tr.set_triangle(1, b, a, kGhost);
     tr.set_triangle(2, c, b, kGhost);
@@ -2705,7 +2705,7 @@ enum class Location { inside, on_edge, on_vertex, outside, failed };
 // half-edge of the triangle; for on_edge, the half-edge p lies on; for on_vertex, a
 // half-edge starting at the vertex p coincides with; for outside, the hull half-edge of
 // the ghost triangle p is in (p strictly on its outer side).
-inline Location locate(const Triangulation& tr, const double* p, uint32_t& edge) {
+static inline Location locate(const Triangulation& tr, const double* p, uint32_t& edge) {
     uint32_t t = tr.hint;
     if (tr.is_ghost(t)) {
         for (uint32_t k = 0; k < 3; ++k) {
@@ -2758,7 +2758,7 @@ inline Location locate(const Triangulation& tr, const double* p, uint32_t& edge)
     return Location::failed;
 }
 
-inline bool push_edge(Triangulation& tr, uint32_t& top, uint32_t e) {
+static inline bool push_edge(Triangulation& tr, uint32_t& top, uint32_t e) {
     STRATMESH_ASSERT(top < tr.stack_capacity);
     if (top >= tr.stack_capacity) return false;
     tr.stack[top++] = e;
@@ -2766,7 +2766,7 @@ inline bool push_edge(Triangulation& tr, uint32_t& top, uint32_t e) {
 }
 
 // Splits the triangle of half-edge e = (a, b, c) into (a, b, p), (b, c, p), (c, a, p).
-inline void split_triangle(Triangulation& tr, uint32_t t, uint32_t p, uint32_t& top) {
+static inline void split_triangle(Triangulation& tr, uint32_t t, uint32_t p, uint32_t& top) {
     uint32_t a = tr.vertex[3 * t], b = tr.vertex[3 * t + 1], c = tr.vertex[3 * t + 2];
     uint32_t o1 = tr.twin[3 * t + 1], o2 = tr.twin[3 * t + 2];
     uint32_t t1 = tr.triangle_count, t2 = tr.triangle_count + 1;
@@ -2786,7 +2786,7 @@ inline void split_triangle(Triangulation& tr, uint32_t t, uint32_t p, uint32_t& 
 }
 
 // Splits the edge e = a->b (in triangle (a, b, c), twin in (b, a, d)) at p.
-inline void split_edge(Triangulation& tr, uint32_t e, uint32_t p, uint32_t& top) {
+static inline void split_edge(Triangulation& tr, uint32_t e, uint32_t p, uint32_t& top) {
     uint32_t f = tr.twin[e];
     uint32_t t = e / 3, u = f / 3;
     uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)], c = tr.vertex[prev_edge(e)];
@@ -2815,7 +2815,7 @@ inline void split_edge(Triangulation& tr, uint32_t e, uint32_t p, uint32_t& top)
 }
 
 // Whether edge e, in triangle (a, b, p) with p the point just inserted, must be flipped.
-inline bool must_flip(const Triangulation& tr, uint32_t e) {
+static inline bool must_flip(const Triangulation& tr, uint32_t e) {
     uint32_t f = tr.twin[e];
     uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)], p = tr.vertex[prev_edge(e)];
     uint32_t q = tr.vertex[prev_edge(f)];
@@ -2832,7 +2832,7 @@ inline bool must_flip(const Triangulation& tr, uint32_t e) {
 // Flips e = a->b of (a, b, p) with its twin in (b, a, q) into (p, a, q) and (q, b, p) (the
 // new triangles keep e's two triangle slots), and with kQueue queues the two edges that may
 // now fail the Delaunay test.
-template <bool kQueue> inline void flip_edge(Triangulation& tr, uint32_t e, uint32_t* top) {
+template <bool kQueue> static inline void flip_edge(Triangulation& tr, uint32_t e, uint32_t* top) {
     uint32_t f = tr.twin[e];
     uint32_t t = e / 3, u = f / 3;
     uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)], p = tr.vertex[prev_edge(e)];
@@ -2855,7 +2855,7 @@ template <bool kQueue> inline void flip_edge(Triangulation& tr, uint32_t e, uint
 
 // Inserts vertex p. Returns the vertex it duplicates, p itself if it was inserted, or
 // kNoIndex if an invariant failed.
-inline uint32_t insert_vertex(Triangulation& tr, uint32_t p) {
+static inline uint32_t insert_vertex(Triangulation& tr, uint32_t p) {
     uint32_t edge = 0;
     Location where = locate(tr, tr.point(p), edge);
     uint32_t top = 0;
@@ -2884,7 +2884,7 @@ struct DuplicateSink {
 
 // Builds the Delaunay triangulation of xy[0 .. count) (2 doubles per point, already in
 // insertion order), reporting duplicates to `sink`. Counts the vertices in *inserted.
-inline Status triangulate_points(Triangulation& tr, uint32_t count, DuplicateSink sink,
+static inline Status triangulate_points(Triangulation& tr, uint32_t count, DuplicateSink sink,
                                  uint32_t* inserted) {
     *inserted = 0;
     if (count < 3) return Status::too_few_points;
@@ -2940,7 +2940,7 @@ struct DuplicateMap {
     }
 };
 
-inline bool plan_delaunay_2d(Delaunay2dMemory& m, size_t count, Arena& arena,
+static inline bool plan_delaunay_2d(Delaunay2dMemory& m, size_t count, Arena& arena,
                              const unsigned char* xy, size_t stride,
                              const BoundingBox2d* box) {
     m.order = arena.alloc<uint32_t>(count);
@@ -2986,7 +2986,7 @@ namespace detail {
 // True if any two of the caller's buffers share a byte: checked before anything is
 // written. A count beyond the limit is refused as too_many_points instead, whatever its
 // span would cover.
-inline bool delaunay_buffers_overlap(const double* xy, size_t point_count, size_t stride_bytes,
+static inline bool delaunay_buffers_overlap(const double* xy, size_t point_count, size_t stride_bytes,
                                      void* workspace, size_t workspace_bytes,
                                      uint32_t* triangles, size_t triangle_capacity,
                                      Delaunay2dInfo* info, uint32_t* duplicate_of) {
@@ -3094,15 +3094,15 @@ struct Vec3 {
     double x, y, z;
 };
 
-inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+static inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 
-inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
-inline Vec3 cross(Vec3 a, Vec3 b) {
+static inline Vec3 cross(Vec3 a, Vec3 b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 
-inline Vec3 scaled(Vec3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+static inline Vec3 scaled(Vec3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
 
 struct CloudReader {
     const unsigned char* base;
@@ -3133,12 +3133,12 @@ struct CloudReader {
 
 // False unless v's squared length is a normal double (v's length between about 1.5e-154
 // and 1.3e154): a subnormal square has lost the bits that make the result unit.
-inline double largest_of(Vec3 v) {
+static inline double largest_of(Vec3 v) {
     const double xy = v.x > v.y ? v.x : v.y;
     return xy > v.z ? xy : v.z;
 }
 
-inline bool normalize(Vec3& v) {
+static inline bool normalize(Vec3& v) {
     const double square = dot(v, v);
     if (!(square >= DBL_MIN) || !is_finite(square)) return false;
     const double len = std::sqrt(square);
@@ -3150,7 +3150,7 @@ inline bool normalize(Vec3& v) {
 // that brings its largest component into [1, 2) (exact: a component that falls below the
 // smallest subnormal is negligible beside it), so that its square neither overflows nor
 // underflows. False for zero, NaN or infinite components.
-inline bool unit_direction(Vec3& v) {
+static inline bool unit_direction(Vec3& v) {
     if (!is_finite(v.x) || !is_finite(v.y) || !is_finite(v.z)) return false;
     const double largest = largest_of({abs_value(v.x), abs_value(v.y), abs_value(v.z)});
     if (largest == 0) return false;
@@ -3223,13 +3223,13 @@ struct GridItem {
 // A cell's coordinate along one axis, clamped to [0, kCellTop] (clamping keeps cells next
 // to each other next to each other, so no neighbour is missed; a clamped cell only holds
 // more points).
-inline uint64_t cell_coordinate(double offset, double side) {
+static inline uint64_t cell_coordinate(double offset, double side) {
     const double c = std::floor(offset / side);
     if (!(c > 0)) return 0;
     return c < static_cast<double>(kCellTop) ? static_cast<uint64_t>(c) : kCellTop;
 }
 
-inline uint64_t cell_key(uint64_t x, uint64_t y, uint64_t z) {
+static inline uint64_t cell_key(uint64_t x, uint64_t y, uint64_t z) {
     return (x << (2 * kCellBits)) | (y << kCellBits) | z;
 }
 
@@ -3242,7 +3242,7 @@ struct CellScratch {
 };
 
 // One allocation sequence for the call and for reconstruct_workspace_size().
-inline CellScratch allocate_cell_scratch(Arena& arena, size_t count) {
+static inline CellScratch allocate_cell_scratch(Arena& arena, size_t count) {
     CellScratch g;
     g.items = arena.alloc<GridItem>(count);
     g.spare = arena.alloc<GridItem>(count);
@@ -3254,7 +3254,7 @@ inline CellScratch allocate_cell_scratch(Arena& arena, size_t count) {
 // array: the pointers are swapped as the passes go). An LSD radix sort, a byte a pass,
 // skipping the bytes that every key shares: `any` and `every` are the keys' bitwise or
 // and and.
-inline void sort_items(GridItem*& items, GridItem*& spare, size_t n, uint64_t any, uint64_t every) {
+static inline void sort_items(GridItem*& items, GridItem*& spare, size_t n, uint64_t any, uint64_t every) {
     for (uint32_t shift = 0; shift < 64; shift += 8) {
         if ((((any ^ every) >> shift) & 0xFFu) == 0) continue;
         size_t histogram[256] = {};
@@ -3275,7 +3275,7 @@ inline void sort_items(GridItem*& items, GridItem*& spare, size_t n, uint64_t an
 // The valid points in g.items, sorted by their cell of side `side` from `low` and by index
 // within a cell; returns their count. Most key bytes are shared: a grid rarely spans more
 // than 2^8 cells an axis.
-inline size_t sort_into_cells(const CloudReader& reader, size_t count, Vec3 low, double side,
+static inline size_t sort_into_cells(const CloudReader& reader, size_t count, Vec3 low, double side,
                               CellScratch& g) {
     size_t n = 0;
     uint64_t any = 0, every = ~uint64_t{0};
@@ -3296,7 +3296,7 @@ inline size_t sort_into_cells(const CloudReader& reader, size_t count, Vec3 low,
 // The first item at or after `cell`, searched from items[from] outward (from < count):
 // the steps double until they pass it, then halve. The cells around a point's lie near it
 // in the array, so the search stays in memory the point's cell brought in.
-inline size_t first_in_cell(const GridItem* items, size_t count, uint64_t cell, size_t from) {
+static inline size_t first_in_cell(const GridItem* items, size_t count, uint64_t cell, size_t from) {
     size_t lo = from, hi = from;  // the answer lies in [lo, hi] once the steps pass it
     if (items[from].cell < cell) {
         for (size_t step = 1; hi < count && items[hi].cell < cell; step *= 2) {
@@ -3332,7 +3332,7 @@ struct CellBlock {
 // `member` is an item of `cell`. With `fingers` (18 valid positions, updated), each range
 // end is searched from where the same end was found last: a caller that goes through cells
 // in key order then finds each a few items on.
-inline CellBlock block_around(const GridItem* items, size_t count, size_t member,
+static inline CellBlock block_around(const GridItem* items, size_t count, size_t member,
                               size_t* fingers = nullptr) {
     const uint64_t cell = items[member].cell;
     CellBlock b;
@@ -3359,12 +3359,12 @@ inline CellBlock block_around(const GridItem* items, size_t count, size_t member
 
 // The samples of the scale measures are taken by a hash of the coordinates, about one
 // point in `step`, so that they do not depend on the order of the points.
-inline uint32_t sample_step(size_t count, size_t most) {
+static inline uint32_t sample_step(size_t count, size_t most) {
     const size_t step = count > most ? (count + most - 1) / most : 1;
     return step < UINT32_MAX ? static_cast<uint32_t>(step) : UINT32_MAX;
 }
 
-inline bool sampled_point(Vec3 p, uint32_t step) {
+static inline bool sampled_point(Vec3 p, uint32_t step) {
     double z = p.z + 0.0;
     uint64_t bz;
     std::memcpy(&bz, &z, sizeof bz);
@@ -3376,7 +3376,7 @@ inline bool sampled_point(Vec3 p, uint32_t step) {
 // The distance that nine points in ten do not exceed to their nearest distinct point, as
 // the top of its half-octave; 0 when more than a tenth find none within a cell. Measured
 // on about `most_sampled` points (see sample_step): a decile needs no more.
-inline double nearest_distance_decile(const CloudReader& reader, const CellScratch& g,
+static inline double nearest_distance_decile(const CloudReader& reader, const CellScratch& g,
                                       size_t count, double side, size_t most_sampled) {
     const GridItem* items = g.items;
     for (size_t i = 0; i < count; ++i) g.sorted[i] = reader.point(items[i].index);
@@ -3426,7 +3426,7 @@ struct CloudBox {
     size_t valid;
 };
 
-inline CloudBox box_of(const CloudReader& reader, size_t count) {
+static inline CloudBox box_of(const CloudReader& reader, size_t count) {
     CloudBox box = {{DBL_MAX, DBL_MAX, DBL_MAX}, {-DBL_MAX, -DBL_MAX, -DBL_MAX}, 0};
     for (size_t i = 0; i < count; ++i) {
         if (!reader.valid(i)) continue;
@@ -3446,7 +3446,7 @@ inline CloudBox box_of(const CloudReader& reader, size_t count) {
 // Where one cell of the grid (items sorted by cell) holds more than half the points: the
 // cell side that spreads its points as nearest_spacing spreads the whole cloud's first
 // (from its points' own box); 0 otherwise, or if they are all at one place.
-inline double crowded_cell_side(const CloudReader& reader, const GridItem* items, size_t n) {
+static inline double crowded_cell_side(const CloudReader& reader, const GridItem* items, size_t n) {
     for (size_t first = 0; first < n;) {
         size_t last = first;
         while (last < n && items[last].cell == items[first].cell) ++last;
@@ -3466,7 +3466,7 @@ inline double crowded_cell_side(const CloudReader& reader, const GridItem* items
     return 0;
 }
 
-inline double nearest_spacing(const CloudReader& reader, size_t count, const CloudBox& box,
+static inline double nearest_spacing(const CloudReader& reader, size_t count, const CloudBox& box,
                               CellScratch& g, size_t most_sampled) {
     const Vec3 half = scaled(box.high - box.low, 0.5);
     double side = 4 * std::sqrt(dot(half, half)) / std::sqrt(static_cast<double>(box.valid));
@@ -3493,7 +3493,7 @@ inline double nearest_spacing(const CloudReader& reader, size_t count, const Clo
 
 // Marks the outliers in `dropped` (zeroed, a bit per point) and returns how many; from
 // here on reader.valid() leaves them out. See "outliers" above.
-inline size_t drop_outliers_of(CloudReader& reader, size_t count, unsigned char* dropped,
+static inline size_t drop_outliers_of(CloudReader& reader, size_t count, unsigned char* dropped,
                                CellScratch& g) {
     reader.dropped = dropped;
     size_t total = 0;
@@ -3523,7 +3523,7 @@ inline size_t drop_outliers_of(CloudReader& reader, size_t count, unsigned char*
 
 // The drop_outliers step: the bitmap stays in `arena` for the whole call (reader.dropped),
 // the grid's scratch is given back. False if the workspace is too small.
-inline bool find_outliers(CloudReader& reader, size_t count, Arena& arena, Report& rep) {
+static inline bool find_outliers(CloudReader& reader, size_t count, Arena& arena, Report& rep) {
     unsigned char* dropped = arena.alloc<unsigned char>(count / 8 + 1);
     const size_t mark = arena.mark();
     CellScratch g = allocate_cell_scratch(arena, count);
@@ -3569,7 +3569,7 @@ struct DistinctPoints {
     }
 };
 
-inline CloudSums sum_cloud(const CloudReader& cloud, size_t count) {
+static inline CloudSums sum_cloud(const CloudReader& cloud, size_t count) {
     CloudSums s = {0, 0, {0, 0, 0}, {0, 0, 0}, {DBL_MAX, DBL_MAX, DBL_MAX},
                    {-DBL_MAX, -DBL_MAX, -DBL_MAX}};
     DistinctPoints distinct = {0, {}};
@@ -3591,7 +3591,7 @@ inline CloudSums sum_cloud(const CloudReader& cloud, size_t count) {
 }
 
 // The bytes the cloud's coordinates lie in.
-inline ByteRange cloud_bytes(const Cloud& cloud) {
+static inline ByteRange cloud_bytes(const Cloud& cloud) {
     const size_t point_bytes = 3 * (cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double));
     return strided_range(cloud.xyz, cloud.count, cloud.stride_bytes ? cloud.stride_bytes : point_bytes,
                          point_bytes);
@@ -3600,7 +3600,7 @@ inline ByteRange cloud_bytes(const Cloud& cloud) {
 // True if any two of the caller's buffers share a byte (the report and its layer array
 // included): checked before anything is written. A count beyond the limit is refused as
 // too_many_points instead.
-inline bool reconstruct_buffers_overlap(const Cloud& cloud, void* workspace,
+static inline bool reconstruct_buffers_overlap(const Cloud& cloud, void* workspace,
                                         size_t workspace_bytes, uint32_t* triangles,
                                         size_t triangle_capacity, size_t* triangle_count,
                                         const Report* report) {
@@ -3618,7 +3618,7 @@ inline bool reconstruct_buffers_overlap(const Cloud& cloud, void* workspace,
     return any_overlap(buffers, 7);
 }
 
-inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangles,
+static inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangles,
                                           size_t triangle_capacity, size_t* triangle_count,
                                           void* workspace, Report& rep) {
     rep.detail = "an argument is invalid: a null pointer with a non-zero count, a stride "
@@ -3640,7 +3640,7 @@ inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangle
 }
 
 // Reads a cloud that passed check_reconstruct_arguments.
-inline CloudReader reader_of(const Cloud& cloud) {
+static inline CloudReader reader_of(const Cloud& cloud) {
     size_t scalar = cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double);
     return {static_cast<const unsigned char*>(cloud.xyz),
             cloud.stride_bytes ? cloud.stride_bytes : 3 * scalar, cloud.scalar == Scalar::float32, nullptr};
@@ -3653,7 +3653,7 @@ const char* const kInvalidPointDetail =
 // Where a cloud of `count` points (`sums` is its sum_cloud) is refused with invalid_point:
 // at its first point with a NaN or infinite coordinate, unless the skip_invalid_points flag
 // is given. `count` if it is not refused.
-inline size_t refused_at(const CloudReader& reader, size_t count, const CloudSums& sums,
+static inline size_t refused_at(const CloudReader& reader, size_t count, const CloudSums& sums,
                          const Options& options) {
     if (sums.valid == count || (options.flags & skip_invalid_points)) return count;
     size_t first = 0;
@@ -3663,7 +3663,7 @@ inline size_t refused_at(const CloudReader& reader, size_t count, const CloudSum
 
 // Counts the points with a NaN or infinite coordinate in rep.points.rejected_count, or refuses the
 // cloud (see refused_at).
-inline Status reject_invalid_points(const CloudReader& reader, size_t count,
+static inline Status reject_invalid_points(const CloudReader& reader, size_t count,
                                     const CloudSums& sums, const Options& options, Report& rep) {
     const size_t first = refused_at(reader, count, sums, options);
     if (first < count) {
@@ -3686,7 +3686,7 @@ struct TubeInput {
 
 // Whether this build holds every feature the flags ask for (STRATMESH_SMALL_CODE leaves
 // some out).
-inline bool flags_compiled(const Options& options) {
+static inline bool flags_compiled(const Options& options) {
     const uint32_t f = options.flags;
     return (kDropOutliers || !(f & drop_outliers)) && (kSurfaceFlips || !(f & surface_flips)) &&
            (kClosedEnds || !(f & open_ends));
@@ -3810,7 +3810,7 @@ struct TubeRequest {
     const Options* progress;
 };
 
-inline TubeRequest tube_request(const Options& options) {
+static inline TubeRequest tube_request(const Options& options) {
     const uint32_t f = options.flags;
     const PartsPolicy parts = !kFindParts || (f & one_tube) ? PartsPolicy::one_tube
                               : (f & keep_parts) ? PartsPolicy::keep
@@ -3829,7 +3829,7 @@ inline TubeRequest tube_request(const Options& options) {
 }
 
 // Sets the request's axis to a direction.
-inline void set_direction(TubeRequest& request, const double* direction) {
+static inline void set_direction(TubeRequest& request, const double* direction) {
     request.axis = Axis::direction;
     for (int k = 0; k < 3; ++k) request.direction[k] = direction[k];
 }
@@ -3837,12 +3837,12 @@ inline void set_direction(TubeRequest& request, const double* direction) {
 const Options kNoCallbacks = {};
 
 // The Options whose job runner a tube hands its jobs to (none in an axis trial).
-inline const Options& jobs_of(const TubeRequest& request) {
+static inline const Options& jobs_of(const TubeRequest& request) {
     return request.caller ? *request.caller : kNoCallbacks;
 }
 
 // Phase progress, to the caller's callback where the request reports progress.
-inline void notify(const TubeRequest& request, Phase phase, double fraction) {
+static inline void notify(const TubeRequest& request, Phase phase, double fraction) {
     if (request.progress) notify(*request.progress, phase, fraction);
 }
 
@@ -3901,7 +3901,7 @@ struct Frame {
 };
 
 // The power of two 2^-e with 2^e just above `extent`, within [2^-1000, 2^1000].
-STRATMESH_SMALL_NOINLINE inline double scale_for_extent(double extent) {
+STRATMESH_SMALL_NOINLINE static inline double scale_for_extent(double extent) {
     if (!(extent > 0) || !is_finite(extent)) return 1;
     int exponent = 0;
     std::frexp(extent, &exponent);
@@ -3912,7 +3912,7 @@ STRATMESH_SMALL_NOINLINE inline double scale_for_extent(double extent) {
 
 // The principal direction of a symmetric 3x3 matrix by power iteration from its largest
 // column; a fixed number of steps keeps the cost bounded and the result deterministic.
-inline Vec3 principal_direction(const double m[3][3]) {
+static inline Vec3 principal_direction(const double m[3][3]) {
     Vec3 cols[3] = {{m[0][0], m[1][0], m[2][0]}, {m[0][1], m[1][1], m[2][1]},
                     {m[0][2], m[1][2], m[2][2]}};
     Vec3 v = cols[0];
@@ -3943,7 +3943,7 @@ const double kOriginReach = 0x1p32;
 
 // Whether `origin` lies within kOriginReach times the largest side of the box [low, high]
 // of it (halves, so that nothing overflows). A box of one point reaches everywhere.
-inline bool origin_in_reach(Vec3 origin, Vec3 low, Vec3 high) {
+static inline bool origin_in_reach(Vec3 origin, Vec3 low, Vec3 high) {
     const Vec3 half_low = scaled(low, 0.5), half_high = scaled(high, 0.5);
     const Vec3 half_origin = scaled(origin, 0.5);
     const Vec3 side = half_high - half_low;
@@ -3956,7 +3956,7 @@ inline bool origin_in_reach(Vec3 origin, Vec3 low, Vec3 high) {
 
 // Why a given origin cannot serve as the frame's, or null if it can (or none is given): it
 // is NaN or infinite, or lies beyond kOriginReach of the valid points summed in `sums`.
-inline const char* origin_refusal(const double* origin, const CloudSums& sums) {
+static inline const char* origin_refusal(const double* origin, const CloudSums& sums) {
     if (!origin) return nullptr;
     const Vec3 given = {origin[0], origin[1], origin[2]};
     if (!(is_finite(given.x) && is_finite(given.y) && is_finite(given.z)))
@@ -3969,11 +3969,11 @@ inline const char* origin_refusal(const double* origin, const CloudSums& sums) {
     return nullptr;
 }
 
-inline const char* origin_refusal(const Options& options, const CloudSums& sums) {
+static inline const char* origin_refusal(const Options& options, const CloudSums& sums) {
     return origin_refusal((options.flags & origin_given) ? options.origin : nullptr, sums);
 }
 
-inline Status choose_frame(const CloudSums& sums, const TubeRequest& request, Frame& frame) {
+static inline Status choose_frame(const CloudSums& sums, const TubeRequest& request, Frame& frame) {
     const size_t valid = sums.valid;
     const Vec3 sum = {sums.total[0], sums.total[1], sums.total[2]};
     const Vec3 small_sum = {sums.small_total[0], sums.small_total[1], sums.small_total[2]};
@@ -4034,12 +4034,12 @@ inline Status choose_frame(const CloudSums& sums, const TubeRequest& request, Fr
     return Status::ok;
 }
 
-inline Status choose_frame(const CloudSums& sums, const Options& options, Frame& frame) {
+static inline Status choose_frame(const CloudSums& sums, const Options& options, Frame& frame) {
     return choose_frame(sums, tube_request(options), frame);
 }
 
 // The lowest and highest frame height of the valid points.
-inline void height_range(const CloudReader& cloud, size_t count, const Frame& frame, double* lo,
+static inline void height_range(const CloudReader& cloud, size_t count, const Frame& frame, double* lo,
                          double* hi) {
     for (size_t i = 0; i < count; ++i) {
         if (!cloud.valid(i)) continue;
@@ -4053,7 +4053,7 @@ inline void height_range(const CloudReader& cloud, size_t count, const Frame& fr
 // the frame not halved): a height is then (p_k - origin_k) * scale plus zeros, exactly
 // that value, and rounding keeps the order, so the lowest and highest coordinates along
 // the axis give the same two heights, bit for bit. False otherwise.
-inline bool height_range_from_extremes(const Frame& frame, double* lo, double* hi) {
+static inline bool height_range_from_extremes(const Frame& frame, double* lo, double* hi) {
     const double axis[3] = {frame.axis.x, frame.axis.y, frame.axis.z};
     const double low[3] = {frame.low.x, frame.low.y, frame.low.z};
     const double high[3] = {frame.high.x, frame.high.y, frame.high.z};
@@ -4068,7 +4068,7 @@ inline bool height_range_from_extremes(const Frame& frame, double* lo, double* h
     return false;
 }
 
-STRATMESH_SMALL_NOINLINE inline void report_frame(const Frame& frame, Report& rep) {
+STRATMESH_SMALL_NOINLINE static inline void report_frame(const Frame& frame, Report& rep) {
     rep.axis[0] = frame.axis.x;
     rep.axis[1] = frame.axis.y;
     rep.axis[2] = frame.axis.z;
@@ -4565,7 +4565,7 @@ const uint32_t kSectors = 32;
 // ulp of glibc's exp over [-64, 64] (tests; one measured). The series to r^13 / 13! that
 // a reduction to |r| <= ln2 / 2 needs took a fifth of triangulate_layer's own time on a
 // tube.
-inline double exp_portable(double x) {
+static inline double exp_portable(double x) {
     if (!(x > -64)) x = -64;
     if (x > 64) x = 64;
     // ln2 / 32 in two parts, the first with 32 significant bits: k times it is exact.
@@ -4602,7 +4602,7 @@ inline double exp_portable(double x) {
 // A monotone stand-in for the polar angle of (dx, dy), in [0, 4): no trigonometry. The
 // quadrant picks one of three values by index, not by branch: points in no angular order
 // (a layer as the scanner wrote it) would mispredict half of the branches.
-STRATMESH_SMALL_NOINLINE inline double pseudo_angle(double dx, double dy) {
+STRATMESH_SMALL_NOINLINE static inline double pseudo_angle(double dx, double dy) {
     double sum = abs_value(dx) + abs_value(dy);
     double t = sum > 0 ? dy / sum : 0;  // in [-1, 1]
     if (!kFastLoops) return dx >= 0 ? (t < 0 ? 4 + t : t) : 2 - t;
@@ -4614,7 +4614,7 @@ STRATMESH_SMALL_NOINLINE inline double pseudo_angle(double dx, double dy) {
 // The polar angle of (dx, dy) in [0, 2 pi), with + - * / only (the same bits everywhere):
 // two argument reductions bring the tangent below tan(pi / 12), where the odd Taylor series
 // to x^21 is accurate to about 1e-15.
-inline double polar_angle(double dx, double dy) {
+static inline double polar_angle(double dx, double dy) {
     const double pi = 3.14159265358979323846;
     const double sqrt3 = 1.73205080756887729353;
     double ax = abs_value(dx), ay = abs_value(dy);
@@ -4657,7 +4657,7 @@ const double kSmallestDirection = 0x1p-60;
 // The annulus radius of a point of height h at distance r from the axis: e^{(h - h0) *
 // scale}, or beyond a pole the stereographic radius of its direction from the pole (see
 // "closed ends" above).
-inline double annulus_radius(const Cylinder& c, double h, double r) {
+static inline double annulus_radius(const Cylinder& c, double h, double r) {
     const bool low = kClosedEnds && (c.poles & kLowPole) && h < c.pole_low;
     const bool high = kClosedEnds && (c.poles & kHighPole) && h > c.pole_high;
     if (!low && !high) return exp_portable((h - c.h0) * c.scale);
@@ -4671,7 +4671,7 @@ inline double annulus_radius(const Cylinder& c, double h, double r) {
 
 // The point's place on the annulus: annulus_radius times its direction from the centre
 // (points on the centre line take direction e1).
-inline void roll(const Cylinder& c, const Local& p, double* out) {
+static inline void roll(const Cylinder& c, const Local& p, double* out) {
     double dx = p.x - c.cx, dy = p.y - c.cy;
     double r = std::sqrt(dx * dx + dy * dy);
     double rho = annulus_radius(c, p.h, r);
@@ -4691,16 +4691,16 @@ inline void roll(const Cylinder& c, const Local& p, double* out) {
 // neighbour then costs 1% of a tube's time instead of 10%.
 const size_t kGapSamplePoints = 1024;
 
-inline size_t gap_sample_stride(size_t count) { return count / kGapSamplePoints + 1; }
+static inline size_t gap_sample_stride(size_t count) { return count / kGapSamplePoints + 1; }
 
 // The sector of direction (dx, dy): kSectors of equal pseudo-angle, counter-clockwise.
-inline uint32_t sector_around(double dx, double dy) {
+static inline uint32_t sector_around(double dx, double dy) {
     const uint32_t s = static_cast<uint32_t>(pseudo_angle(dx, dy) * (kSectors / 4.0));
     return s < kSectors ? s : kSectors - 1;
 }
 
 template <class PointAt>
-inline uint32_t sectors_held(const PointAt& point_at, size_t count, double cx, double cy) {
+static inline uint32_t sectors_held(const PointAt& point_at, size_t count, double cx, double cy) {
     uint32_t held = 0;
     const size_t stride = gap_sample_stride(count);
     for (size_t i = 0; i < count; i += stride) {
@@ -4712,7 +4712,7 @@ inline uint32_t sectors_held(const PointAt& point_at, size_t count, double cx, d
 
 // The most sectors in a row, around the circle, missing from `held`: 0 for a ring, about
 // half of them for a half cylinder.
-inline uint32_t widest_gap(uint32_t held) {
+static inline uint32_t widest_gap(uint32_t held) {
     uint32_t widest = 0, run = 0;
     for (uint32_t k = 0; k < 2 * kSectors && widest < kSectors; ++k) {
         run = (held >> (k % kSectors)) & 1 ? 0 : run + 1;
@@ -4724,7 +4724,7 @@ inline uint32_t widest_gap(uint32_t held) {
 // Centre and radius of count points (frame coordinates; point_at(i) gives point i) for
 // heights [h0, h1].
 template <class PointAt>
-inline Cylinder fit_cylinder(const PointAt& point_at, size_t count, double h0, double h1) {
+static inline Cylinder fit_cylinder(const PointAt& point_at, size_t count, double h0, double h1) {
     double mx = 0, my = 0;
     for (size_t i = 0; i < count; ++i) {
         const Local& p = point_at(i);
@@ -4773,19 +4773,19 @@ inline Cylinder fit_cylinder(const PointAt& point_at, size_t count, double h0, d
 }
 
 // Triangle abc's normal, twice its area long.
-inline Vec3 normal_of(const Local& pa, const Local& pb, const Local& pc) {
+static inline Vec3 normal_of(const Local& pa, const Local& pb, const Local& pc) {
     return cross(Vec3{pb.x - pa.x, pb.y - pa.y, pb.h - pa.h},
                  Vec3{pc.x - pa.x, pc.y - pa.y, pc.h - pa.h});
 }
 
-inline double doubled_area(const Local& pa, const Local& pb, const Local& pc) {
+static inline double doubled_area(const Local& pa, const Local& pb, const Local& pc) {
     Vec3 n = normal_of(pa, pb, pc);
     return std::sqrt(dot(n, n));
 }
 
 // Whether triangle abc (counter-clockwise seen from outside) has its normal pointing
 // towards the cylinder's axis (beyond a pole: towards the pole): a fold.
-inline bool faces_axis(const Local& pa, const Local& pb, const Local& pc, const Cylinder& cyl) {
+static inline bool faces_axis(const Local& pa, const Local& pb, const Local& pc, const Cylinder& cyl) {
     Vec3 n = normal_of(pa, pb, pc);
     // From the axis (beyond a pole: the pole) to the centroid, three times over: only the
     // sign of its product with n counts, so no division.
@@ -4800,14 +4800,14 @@ inline bool faces_axis(const Local& pa, const Local& pb, const Local& pc, const 
 
 // Whether triangle t of a layer's triangulation is on the surface: neither a ghost nor at
 // vertex 0, the centre (nor peeled: see peel_loop).
-inline bool on_surface(const Triangulation& tr, uint32_t t) {
+static inline bool on_surface(const Triangulation& tr, uint32_t t) {
     const uint32_t* v = tr.vertex + 3 * t;
     return !tr.is_ghost(t) && v[0] != 0 && v[1] != 0 && v[2] != 0;
 }
 
 // Asks for the cache line holding p ahead of its use, where the compiler offers a way
 // (GCC, Clang): a hint, which changes nothing but the time.
-inline void prefetch(const void* p) {
+static inline void prefetch(const void* p) {
 #if defined(__GNUC__) || defined(__clang__)
     __builtin_prefetch(p);
 #else
@@ -4819,7 +4819,7 @@ inline void prefetch(const void* p) {
 // points[(v - 1) * stride]. Adds their doubled areas to *area if given. The triangles'
 // slots are not in the points' order: with kFastLoops the corners a few triangles ahead
 // are prefetched, as the loop otherwise waits on the cache for most of them.
-inline size_t count_folds(const Triangulation& tr, const Local* points, size_t stride,
+static inline size_t count_folds(const Triangulation& tr, const Local* points, size_t stride,
                           const Cylinder& cyl, double* area) {
     size_t folds = 0;
     const uint32_t ahead = 12;
@@ -4935,7 +4935,7 @@ const unsigned char kUnpeeled = 0x80;  // in those flags: the band puts the peel
 // Collects the link of the centre (vertex 0) counter-clockwise into loop, one entry per link
 // edge u -> w: the half-edge w -> u of the triangle beyond it. Flags its vertices
 // kOnBottomLoop. False if the centre touches the hull: the layer does not surround its axis.
-inline bool centre_link(const Triangulation& tr, uint32_t* loop, uint32_t* count,
+static inline bool centre_link(const Triangulation& tr, uint32_t* loop, uint32_t* count,
                         uint32_t* flags) {
     uint32_t start = kNoIndex;
     for (uint32_t e = 0; e < 3 * tr.triangle_count; ++e)
@@ -4961,7 +4961,7 @@ inline bool centre_link(const Triangulation& tr, uint32_t* loop, uint32_t* count
 // half-edge, in the triangle inside. Flags its vertices kOnTopLoop. A ghost (a, b, G) holds
 // G -> a, then a -> b; the twin of G -> a is a -> G in the ghost (z, a, G), whose next
 // half-edge is G -> z: the next ghost along the hull.
-inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* count, uint32_t* flags) {
+static inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* count, uint32_t* flags) {
     uint32_t start = 0;
     while (tr.vertex[start] != kGhost) ++start;
     uint32_t n = 0, e = start;
@@ -5023,7 +5023,7 @@ const uint32_t kFoldedEndPeelPasses = 64;
 const double kFoldedEndPeelSlope = 1e6;
 
 // Whether the triangle of loop entry g (see centre_link and hull_loop) is peeled.
-inline bool peels(const Triangulation& tr, const Local* points, const uint32_t* flags,
+static inline bool peels(const Triangulation& tr, const Local* points, const uint32_t* flags,
                   uint32_t g, bool top, double slope) {
     if (!on_surface(tr, g / 3)) return false;
     uint32_t from = tr.vertex[g], to = tr.vertex[next_edge(g)], x = tr.vertex[prev_edge(g)];
@@ -5048,7 +5048,7 @@ inline bool peels(const Triangulation& tr, const Local* points, const uint32_t* 
 // and returns its new length. A peeled triangle loses its first vertex to the centre, so
 // that it is no longer emitted. The pass reads the loop from the array's end, where it never
 // meets what it writes: both loops together hold each vertex at most once.
-inline uint32_t peel_loop(Triangulation& tr, const Local* points, uint32_t* flags, uint32_t* loop,
+static inline uint32_t peel_loop(Triangulation& tr, const Local* points, uint32_t* flags, uint32_t* loop,
                           uint32_t n, uint32_t capacity, bool top, double slope,
                           uint32_t passes) {
     for (uint32_t pass = 0; pass < passes; ++pass) {
@@ -5077,7 +5077,7 @@ inline uint32_t peel_loop(Triangulation& tr, const Local* points, uint32_t* flag
 
 // Turns loop entries into the layer-local indices of the loop's vertices, in loop order, and
 // sets each vertex's peeling pass in passes (0: on the centre's link or the hull).
-inline void name_loop(const Triangulation& tr, const uint32_t* order, const uint32_t* flags,
+static inline void name_loop(const Triangulation& tr, const uint32_t* order, const uint32_t* flags,
                       uint32_t* loop, uint32_t n, unsigned char* passes, bool top) {
     for (uint32_t i = 0; i < n; ++i) {
         const uint32_t v = tr.vertex[top ? loop[i] : next_edge(loop[i])];
@@ -5102,7 +5102,7 @@ struct LoadedLayer {
 
 // `staged` (optional): the same points in frame coordinates, in the arena's end room
 // (LayerQueue::staged), read in sequence instead of the cloud at random while intact.
-inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint32_t* ids,
+static inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint32_t* ids,
                        const Local* staged, size_t count, double h0, double h1, Arena& arena,
                        LoadedLayer& layer) {
     const bool intact = kStagePoints && staged && arena.untouched(staged);
@@ -5125,7 +5125,7 @@ inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint3
 
 // sectors_held by a loaded layer around its fitted centre (before the centre search moves
 // it).
-inline uint32_t layer_sectors(const LoadedLayer& layer) {
+static inline uint32_t layer_sectors(const LoadedLayer& layer) {
     const Local* points = layer.points;
     return sectors_held([points](size_t i) -> const Local& { return points[i]; }, layer.count,
                         layer.cyl.cx, layer.cyl.cy);
@@ -5169,7 +5169,7 @@ const double kEndSlab = 0.5;
 
 const double kAcrossEnd = 0.5;
 
-inline void find_closed_ends(LoadedLayer& layer, uint32_t ends) {
+static inline void find_closed_ends(LoadedLayer& layer, uint32_t ends) {
     layer.ends = ends;
     Cylinder& c = layer.cyl;
     const Local* points = layer.points;
@@ -5277,7 +5277,7 @@ const double kCentreStep = 0.3;
 // cyl's centre and triangulated, with the doubled area of its surface in *area; SIZE_MAX
 // where the centre does not lie inside the sample's hull (it does not surround that
 // centre). Its scratch is released.
-inline size_t sample_folds(const Local* points, size_t count, size_t stride,
+static inline size_t sample_folds(const Local* points, size_t count, size_t stride,
                            const Cylinder& cyl, Arena& arena, double* area) {
     *area = 0;
     size_t mark = arena.mark(), folds = SIZE_MAX;
@@ -5302,7 +5302,7 @@ inline size_t sample_folds(const Local* points, size_t count, size_t stride,
 }
 
 // Moves layer.cyl's centre where a sample of the layer folds least (see above).
-inline void choose_centre(LoadedLayer& layer, Arena& arena) {
+static inline void choose_centre(LoadedLayer& layer, Arena& arena) {
     const size_t stride = layer.count / kCentreSamplePoints + 1;
     const size_t count = (layer.count + stride - 1) / stride;
     const Cylinder fitted = layer.cyl;
@@ -5906,7 +5906,7 @@ namespace detail {
 
 // In-place sort of packed (key, value) pairs: insertion sort for the small fans of almost
 // every vertex, heap sort (O(n log n), no recursion) for large ones.
-inline void sort_pairs(uint64_t* items, size_t count) {
+static inline void sort_pairs(uint64_t* items, size_t count) {
     if (count <= 16) {
         for (size_t i = 1; i < count; ++i) {
             uint64_t item = items[i];
@@ -5932,7 +5932,7 @@ struct Fan {
 };
 
 // The sorted position of the entry leaving towards `neighbour`, or SIZE_MAX.
-inline size_t position_leaving_to(const Fan& fan, uint32_t neighbour) {
+static inline size_t position_leaving_to(const Fan& fan, uint32_t neighbour) {
     size_t lo = 0, hi = fan.size;
     while (lo < hi) {
         size_t mid = lo + (hi - lo) / 2;
@@ -5942,7 +5942,7 @@ inline size_t position_leaving_to(const Fan& fan, uint32_t neighbour) {
 }
 
 // Collects v's live triangles, sorted by leaving edge; marks dead those repeating one.
-inline size_t collect_fan(const uint32_t* tri, const uint32_t* incident, size_t begin,
+static inline size_t collect_fan(const uint32_t* tri, const uint32_t* incident, size_t begin,
                           size_t end, uint32_t v, unsigned char* dead, Fan& fan) {
     fan.size = 0;
     for (size_t k = begin; k < end; ++k) {
@@ -5971,7 +5971,7 @@ inline size_t collect_fan(const uint32_t* tri, const uint32_t* incident, size_t 
 
 // Labels the connected pieces of the fan (each triangle linked to the one leaving where
 // it arrives) and returns how many there are.
-inline uint32_t label_fan(Fan& fan) {
+static inline uint32_t label_fan(Fan& fan) {
     const uint32_t unlabeled = kNoIndex;
     for (size_t k = 0; k < fan.size; ++k) fan.label[k] = unlabeled;
     uint32_t pieces = 0;
@@ -5997,7 +5997,7 @@ inline uint32_t label_fan(Fan& fan) {
 }
 
 // Makes v's fan a single oriented piece; returns the number of triangles marked dead.
-inline size_t repair_fan(const uint32_t* tri, const uint32_t* incident, size_t begin,
+static inline size_t repair_fan(const uint32_t* tri, const uint32_t* incident, size_t begin,
                          size_t end, uint32_t v, unsigned char* dead, Fan& fan) {
     size_t removed = collect_fan(tri, incident, begin, end, v, dead, fan);
     uint32_t pieces = label_fan(fan);
@@ -6022,7 +6022,7 @@ inline size_t repair_fan(const uint32_t* tri, const uint32_t* incident, size_t b
 // piece: every corner has one and a walk from any corner comes back after all of them (a
 // cycle), or all but one have one and a walk from the corner nobody arrives at takes in all
 // of them (a chain).
-inline bool fan_is_one_piece(uint64_t* corners, size_t size) {
+static inline bool fan_is_one_piece(uint64_t* corners, size_t size) {
     if (size == 0) return true;
     sort_pairs(corners, size);
     auto leaving = [&](size_t i) { return static_cast<uint32_t>(corners[i] >> 32); };
@@ -6066,7 +6066,7 @@ inline bool fan_is_one_piece(uint64_t* corners, size_t size) {
 // Whether every vertex v with checked[v] != 0 passes fan_is_one_piece in tri[0 .. 3 count)
 // (indices below point_count): then the safety net would remove nothing at those vertices.
 // Lets finish_chunk skip the net where nothing can fail; the arena's failure answers false.
-inline bool fans_are_one_piece(const uint32_t* tri, size_t count, size_t point_count,
+static inline bool fans_are_one_piece(const uint32_t* tri, size_t count, size_t point_count,
                                const unsigned char* checked, Arena& arena) {
     size_t mark = arena.mark();
     uint32_t* offsets = arena.alloc<uint32_t>(point_count + 1);
@@ -6099,7 +6099,7 @@ inline bool fans_are_one_piece(const uint32_t* tri, size_t count, size_t point_c
 // layers in spatial order, so relabelled fans and their triangles sit close together in
 // memory whatever order the input points had; only the relabelling itself reads the input
 // indices at random.
-inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count, Arena& arena) {
+static inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count, Arena& arena) {
     size_t mark = arena.mark();
     uint32_t* original = arena.alloc<uint32_t>(point_count);  // label -> input index
     unsigned char* dead = arena.alloc<unsigned char>(count);
@@ -10140,7 +10140,7 @@ const uint32_t kMostAxisCandidates = 6;
 
 // The three principal directions of a symmetric 3x3 matrix, largest variance first: power
 // iteration, then again on the matrix without the first direction's share.
-inline void principal_directions(const double m[3][3], Vec3 out[3]) {
+static inline void principal_directions(const double m[3][3], Vec3 out[3]) {
     out[0] = principal_direction(m);
     const Vec3 v = out[0];
     const double mv[3] = {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z,
@@ -10163,7 +10163,7 @@ inline void principal_directions(const double m[3][3], Vec3 out[3]) {
 }
 
 // The scatter matrix of `count` points, packed, about their mean.
-inline void scatter_of(const double* xyz, size_t count, double m[3][3]) {
+static inline void scatter_of(const double* xyz, size_t count, double m[3][3]) {
     // Scaled by the power of two that brings the largest coordinate near 1 (exactly, so
     // directions and ratios keep their bits): squares of coordinates near either end of the
     // double range would overflow or vanish. A multiplication where the factor is a normal
@@ -10191,7 +10191,7 @@ inline void scatter_of(const double* xyz, size_t count, double m[3][3]) {
 }
 
 // The variance of the scatter matrix along the unit direction v.
-inline double variance_along(const double m[3][3], Vec3 v) {
+static inline double variance_along(const double m[3][3], Vec3 v) {
     const double c[3] = {v.x, v.y, v.z};
     double sum = 0;
     for (int r = 0; r < 3; ++r)
@@ -10206,7 +10206,7 @@ inline double variance_along(const double m[3][3], Vec3 v) {
 const double kLineVariance = 0x1p-40;
 
 // The candidates for the axis of a sample of `count` points, packed.
-inline uint32_t axis_candidates(const double* xyz, size_t count, Vec3* out) {
+static inline uint32_t axis_candidates(const double* xyz, size_t count, Vec3* out) {
     double m[3][3];
     scatter_of(xyz, count, m);
     Vec3 all[6];
@@ -10228,7 +10228,7 @@ inline uint32_t axis_candidates(const double* xyz, size_t count, Vec3* out) {
 // folding). *along (optional) receives the mean squared cosine between the triangles'
 // normals and the unit axis, weighted by their areas: 0 where the surface runs along the
 // axis, 1 where it lies across it.
-inline double sample_surface(const double* xyz, const uint32_t* tri, size_t count,
+static inline double sample_surface(const double* xyz, const uint32_t* tri, size_t count,
                              size_t unused, Vec3 axis, double* along) {
     double area = 0, along_sum = 0, normals = 0;
     for (size_t t = 0; t < count; ++t) {
@@ -10251,7 +10251,7 @@ inline double sample_surface(const double* xyz, const uint32_t* tri, size_t coun
 
 // What a candidate's sample is meshed as: one layer along `axis`, its ends cut where the
 // tube's are, nothing else asked for and no callback.
-inline TubeRequest trial_request(const TubeRequest& tube, Vec3 axis) {
+static inline TubeRequest trial_request(const TubeRequest& tube, Vec3 axis) {
     TubeRequest trial = {};
     trial.axis = Axis::direction;
     trial.direction[0] = axis.x;
@@ -10264,7 +10264,7 @@ inline TubeRequest trial_request(const TubeRequest& tube, Vec3 axis) {
 
 // Meshes the sample along one candidate; DBL_MAX if it cannot.
 // *along (optional) receives the share of the sample surface's normals along the axis.
-inline double try_axis(const double* sample, size_t count, Vec3 axis, const TubeRequest& request,
+static inline double try_axis(const double* sample, size_t count, Vec3 axis, const TubeRequest& request,
                        Arena& arena, double* along) {
     const TubeRequest trial = trial_request(request, axis);
     const size_t mark = arena.mark();
@@ -10286,7 +10286,7 @@ inline double try_axis(const double* sample, size_t count, Vec3 axis, const Tube
 // Every k-th kept point of `in`, packed, at most `most` of them (and about that many), in
 // `arena`; null if the workspace is too small. *taken receives their count. Where every
 // point is kept, the sample is read by index, without a pass over the cloud.
-inline double* sample_points(const TubeInput& in, size_t most, Arena& arena, size_t* taken) {
+static inline double* sample_points(const TubeInput& in, size_t most, Arena& arena, size_t* taken) {
     const size_t count = in.sums.valid < most ? in.sums.valid : most;
     double* sample = arena.alloc<double>(3 * count);
     *taken = 0;
@@ -10313,7 +10313,7 @@ inline double* sample_points(const TubeInput& in, size_t most, Arena& arena, siz
 
 // The axis for Axis::automatic: the candidate whose sample surface is smallest (see above).
 // False if the workspace is too small.
-inline bool choose_axis(const TubeInput& in, const TubeRequest& request, Arena& arena,
+static inline bool choose_axis(const TubeInput& in, const TubeRequest& request, Arena& arena,
                         Vec3& axis) {
     const size_t mark = arena.mark();
     size_t taken = 0;
@@ -10339,7 +10339,7 @@ inline bool choose_axis(const TubeInput& in, const TubeRequest& request, Arena& 
 }
 
 // Workspace for choose_axis() on a cloud of `valid` kept points.
-inline size_t axis_workspace_size(size_t valid, const TubeRequest& request) {
+static inline size_t axis_workspace_size(size_t valid, const TubeRequest& request) {
     const size_t count = valid < kAxisSample ? valid : kAxisSample;
     const size_t tube = tube_workspace_size(count, trial_request(request, Vec3{0, 0, 1}));
     if (tube == 0) return 0;
@@ -10352,7 +10352,7 @@ inline size_t axis_workspace_size(size_t valid, const TubeRequest& request) {
 
 // Axis::automatic in `request` resolved by choose_axis(); any other axis stays. *detail
 // receives the reason where it fails.
-inline Status resolve_axis(const TubeInput& in, Arena& arena, TubeRequest& request,
+static inline Status resolve_axis(const TubeInput& in, Arena& arena, TubeRequest& request,
                            const char** detail) {
     if (request.axis != Axis::automatic) return Status::ok;
     if (!kAxisTrials) {
@@ -10384,7 +10384,7 @@ namespace detail {
 
 // Whether the kept points of `in` lie on a line up to rounding (see kLineVariance), judged
 // on a sample. False also if the workspace is too small for the sample.
-inline bool on_a_line(const TubeInput& in, Arena& arena) {
+static inline bool on_a_line(const TubeInput& in, Arena& arena) {
     const size_t mark = arena.mark();
     size_t taken = 0;
     const double* sample = sample_points(in, kAxisSample, arena, &taken);
@@ -10417,10 +10417,10 @@ struct PointGroup {
     uint32_t count;
 };
 
-inline Vec3 half_offset(Vec3 p, Vec3 first) { return scaled(p, 0.5) - scaled(first, 0.5); }
+static inline Vec3 half_offset(Vec3 p, Vec3 first) { return scaled(p, 0.5) - scaled(first, 0.5); }
 
 // Whether a group spans a surface of its own: 3 points or more, off one line.
-inline bool spans_surface(const PointGroup& g) {
+static inline bool spans_surface(const PointGroup& g) {
     if (g.count < 3) return false;
     const double n = g.count;
     double m[3][3];
@@ -10430,7 +10430,7 @@ inline bool spans_surface(const PointGroup& g) {
     return along > 0 && m[0][0] + m[1][1] + m[2][2] - along > kLineVariance * along;
 }
 
-inline double coordinate(Vec3 p, int k) { return k == 0 ? p.x : k == 1 ? p.y : p.z; }
+static inline double coordinate(Vec3 p, int k) { return k == 0 ? p.x : k == 1 ? p.y : p.z; }
 
 // The points' positions along their bounding box's longest side, in up to kNoAreaBins bins.
 struct Binning {
@@ -10444,7 +10444,7 @@ struct Binning {
 };
 
 // Adds a point's half offset to its group's box (first pass) or moments (second pass).
-inline void add_to_group(PointGroup& g, Vec3 p, int pass) {
+static inline void add_to_group(PointGroup& g, Vec3 p, int pass) {
     if (pass == 0 && g.count++ == 0) g.first = p;
     const Vec3 h = half_offset(p, g.first);
     if (pass == 0) {
@@ -10462,7 +10462,7 @@ inline void add_to_group(PointGroup& g, Vec3 p, int pass) {
 }
 
 // Numbers the runs of occupied bins (non-zero) from 1, empty bins 0; returns the runs.
-inline uint32_t number_runs(uint32_t* group_of, uint32_t bins) {
+static inline uint32_t number_runs(uint32_t* group_of, uint32_t bins) {
     uint32_t count = 0;
     for (uint32_t b = 0; b < bins; ++b) {
         const bool occupied = group_of[b] != 0;
@@ -10475,7 +10475,7 @@ inline uint32_t number_runs(uint32_t* group_of, uint32_t bins) {
 // The groups of why_no_area(): the occupied bins first, numbered by run (number_runs()),
 // then each point joins its bin's group, its box first, its moments after. One loop over
 // the points serves the three passes.
-inline uint32_t gather_groups(const TubeInput& in, const Binning& binning, uint32_t* group_of,
+static inline uint32_t gather_groups(const TubeInput& in, const Binning& binning, uint32_t* group_of,
                               PointGroup* groups) {
     std::memset(group_of, 0, binning.bins * sizeof(uint32_t));
     uint32_t count = 0;
@@ -10505,7 +10505,7 @@ inline uint32_t gather_groups(const TubeInput& in, const Binning& binning, uint3
 // point beside the cloud (kCollapsedShare) and fewer than kOutlierNeighbours points lie
 // outside it: specks that drop_outliers leaves out; more: clusters far apart. Unexplained
 // otherwise, or when the workspace cannot hold the groups.
-inline NoArea why_no_area(const TubeInput& in, Arena& arena) {
+static inline NoArea why_no_area(const TubeInput& in, Arena& arena) {
     const Vec3 low = {in.sums.lowest[0], in.sums.lowest[1], in.sums.lowest[2]};
     const Vec3 high = {in.sums.highest[0], in.sums.highest[1], in.sums.highest[2]};
     const Vec3 half_side = scaled(high, 0.5) - scaled(low, 0.5);
@@ -10538,7 +10538,7 @@ inline NoArea why_no_area(const TubeInput& in, Arena& arena) {
 
 // The status and detail of a cloud refused as degenerate or not_columnar, where
 // why_no_area() tells a reason: the same status and detail where it tells none.
-inline Status explain_no_area(const TubeInput& in, Status status, Arena& arena, Report& rep) {
+static inline Status explain_no_area(const TubeInput& in, Status status, Arena& arena, Report& rep) {
     switch (why_no_area(in, arena)) {
     case NoArea::line:
         if (status != Status::degenerate) return status;
@@ -10574,7 +10574,7 @@ namespace detail {
 
 // Caps the boundary loops of the surface of `count` triangles (`in` reads the whole cloud)
 // in the frame along the request's axis, which is resolved.
-inline Status cap_surface(const TubeInput& in, const TubeRequest& request, Arena& arena,
+static inline Status cap_surface(const TubeInput& in, const TubeRequest& request, Arena& arena,
                           uint32_t* triangles, size_t capacity, size_t& count, CapCounts& caps,
                           size_t* needed) {
     Frame frame;
@@ -10709,7 +10709,7 @@ struct CachedBlock {
 
 // The size from which a piece of a side of `points` points counts: kSmallestBranch, and a
 // twentieth of the side.
-inline uint32_t counting_size(size_t points, uint32_t smallest) {
+static inline uint32_t counting_size(size_t points, uint32_t smallest) {
     const size_t twentieth = (points + 19) / 20;
     return twentieth > smallest ? static_cast<uint32_t>(twentieth) : smallest;
 }
@@ -10813,7 +10813,7 @@ struct BranchCandidate {
 // branches there; if so their sizes and roots go to `sizes` and `roots`, largest first, and
 // their count is returned (else 0). The points of orders [slab_start, added) are those
 // within two gaps of the cut.
-inline uint32_t branches_at(PartingSweep& s, uint32_t added, uint32_t slab_start, double cut,
+static inline uint32_t branches_at(PartingSweep& s, uint32_t added, uint32_t slab_start, double cut,
                             uint32_t* sizes, uint32_t* roots) {
     BranchCandidate found[kMaxBranches];
     uint32_t pieces = 0;
@@ -10909,7 +10909,7 @@ struct SideParting {
 // sweep where the cloud parts (the lowest above, the highest below). With `stop` (a cut
 // index, 0 for none), it stops once that cut is tried: the roots then name the pieces as
 // the union-find holds them, for labelling.
-inline SideParting sweep_for_parting(PartingSweep& s, const PartingSteps& p, bool from_top,
+static inline SideParting sweep_for_parting(PartingSweep& s, const PartingSteps& p, bool from_top,
                                      uint32_t stop) {
     s.sign = from_top ? 1 : -1;
     s.listed_count = 0;
@@ -10952,7 +10952,7 @@ inline SideParting sweep_for_parting(PartingSweep& s, const PartingSteps& p, boo
 // starts at the cut (within a gap of it) goes on the trunk across it: the top of a skull's
 // crown between two horns, where the cut lies just below it, too small to count as a bump
 // (the bust with horns of 50,000 points: 147 such points, which left the split undone).
-inline void label_branches(PartingSweep& s, const PartingSteps& p, bool from_top,
+static inline void label_branches(PartingSweep& s, const PartingSteps& p, bool from_top,
                            uint32_t cut_index, uint8_t first, uint8_t* branch_of) {
     const SideParting side = sweep_for_parting(s, p, from_top, cut_index);
     const double cut = s.sign * (p.lo + cut_index * p.step_height);
@@ -10975,7 +10975,7 @@ struct PartingMemory {
 };
 
 // Allocated after the scale is measured, whose grid is given back first.
-inline void allocate_parting(PartingMemory& m, size_t count, Arena& arena) {
+static inline void allocate_parting(PartingMemory& m, size_t count, Arena& arena) {
     m.items = arena.alloc<GridItem>(count);
     m.spare = arena.alloc<GridItem>(count);
     m.position = arena.alloc<Local>(count);
@@ -10994,7 +10994,7 @@ inline void allocate_parting(PartingMemory& m, size_t count, Arena& arena) {
 
 // The valid points in the frame, in cells of side `side` sorted by height, then across;
 // returns their count. `low` is their lowest frame coordinates.
-inline size_t grid_in_frame(const CloudReader& reader, size_t count, const Frame& frame,
+static inline size_t grid_in_frame(const CloudReader& reader, size_t count, const Frame& frame,
                             Local low, double side, PartingMemory& m) {
     size_t n = 0;
     uint64_t any = 0, every = ~uint64_t{0};
@@ -11015,7 +11015,7 @@ inline size_t grid_in_frame(const CloudReader& reader, size_t count, const Frame
 
 // The steps of the n points in grid order (a counting sort), every half gap from lo to hi,
 // fewer where that would make more steps than points.
-inline void split_into_steps(const Local* position, size_t n, double lo, double hi, double gap,
+static inline void split_into_steps(const Local* position, size_t n, double lo, double hi, double gap,
                              PartingSteps& p) {
     const double most = static_cast<double>(n);
     double steps = std::ceil((hi - lo) / (gap / kStepsPerGap));
@@ -11041,7 +11041,7 @@ inline void split_into_steps(const Local* position, size_t n, double lo, double 
 // find theirs; a point looks at kNearestCandidates points at most, its own cell first.
 // Exact where nearest_spacing is not: that one is rounded up to a half-octave, too coarse
 // for a threshold that tells a notch from a gap.
-inline double median_nearest_distance(const CloudReader& reader, size_t count, const CloudBox& box,
+static inline double median_nearest_distance(const CloudReader& reader, size_t count, const CloudBox& box,
                                       double decile, CellScratch& g, GridItem* sample,
                                       GridItem* sample_spare) {
     const size_t n = sort_into_cells(reader, count, box.low, decile, g);
@@ -11075,7 +11075,7 @@ inline double median_nearest_distance(const CloudReader& reader, size_t count, c
     return median < DBL_MAX ? std::sqrt(median) : 0;
 }
 
-inline Status out_of_workspace(Report& rep) {
+static inline Status out_of_workspace(Report& rep) {
     rep.detail = "the workspace is smaller than find_parting_workspace_size()";
     return Status::out_of_memory;
 }
@@ -11086,7 +11086,7 @@ inline Status out_of_workspace(Report& rep) {
 namespace stratmesh {
 namespace detail {
 
-inline size_t parting_workspace_size(size_t point_count, const TubeRequest& request) {
+static inline size_t parting_workspace_size(size_t point_count, const TubeRequest& request) {
     if (point_count > kMaxPoints - 1) return 0;
     Arena arena = Arena::measuring();
     if (request.drop_outliers) arena.alloc<unsigned char>(point_count / 8 + 1);
@@ -11105,7 +11105,7 @@ inline size_t parting_workspace_size(size_t point_count, const TubeRequest& requ
 // find_parting() along the axis of `request` (its origin, outliers and invalid points as
 // it says) with the fewest points a branch holds given: a sample of the cloud is searched
 // with fewer (see search_parting).
-inline Status find_parting_with(const Cloud& cloud, const TubeRequest& request, void* workspace,
+static inline Status find_parting_with(const Cloud& cloud, const TubeRequest& request, void* workspace,
                                 size_t workspace_bytes, Parting* parting, uint8_t* branch_of,
                                 uint32_t smallest) {
     if (!parting) return Status::invalid_argument;
@@ -12165,7 +12165,7 @@ const double kPoleLayerRadii = 4.0 / 3.0;
 
 // The trunk's layers, as many as a tube of `count` points can have (each holds at least
 // kMinLayerPoints but the last).
-inline size_t most_layers(size_t count) { return count / kMinLayerPoints + 2; }
+static inline size_t most_layers(size_t count) { return count / kMinLayerPoints + 2; }
 
 struct PartsMemory {
     uint8_t* labels;          // find_parting's branch_of for the whole cloud
@@ -12175,7 +12175,7 @@ struct PartsMemory {
     size_t layer_capacity;
 };
 
-inline bool allocate_parts(PartsMemory& m, size_t count, Arena& arena) {
+static inline bool allocate_parts(PartsMemory& m, size_t count, Arena& arena) {
     m.labels = arena.alloc<uint8_t>(count);
     m.mask = arena.alloc<unsigned char>(count / 8 + 1);
     m.layer_capacity = most_layers(count);
@@ -12185,7 +12185,7 @@ inline bool allocate_parts(PartsMemory& m, size_t count, Arena& arena) {
 }
 
 // The reader of the part labelled `label`: every other point left out with the outliers.
-inline TubeInput part_input(const TubeInput& whole, const PartsMemory& m, uint8_t label) {
+static inline TubeInput part_input(const TubeInput& whole, const PartsMemory& m, uint8_t label) {
     const size_t bytes = whole.count / 8 + 1;
     std::memset(m.mask, 0, bytes);
     for (size_t i = 0; i < whole.count; ++i)
@@ -12209,7 +12209,7 @@ const double kAdoptionGaps = 2.0;
 const uint64_t kMostStrayChecks = uint64_t{1} << 26;
 
 // True if the trunk took a point.
-inline bool adopt_stray_points(const TubeInput& whole, double gap, uint8_t* labels) {
+static inline bool adopt_stray_points(const TubeInput& whole, double gap, uint8_t* labels) {
     const double reach = kAdoptionGaps * gap;
     uint64_t checks_left = kMostStrayChecks;
     bool trunk_grew = false;
@@ -12245,7 +12245,7 @@ inline bool adopt_stray_points(const TubeInput& whole, double gap, uint8_t* labe
 }
 
 // Whether every point is in a part (none is left beyond a cut in no branch).
-inline bool every_point_in_a_part(size_t count, const uint8_t* labels) {
+static inline bool every_point_in_a_part(size_t count, const uint8_t* labels) {
     for (size_t i = 0; i < count; ++i)
         if (labels[i] == kBeyondBranches) return false;
     return true;
@@ -12255,7 +12255,7 @@ inline bool every_point_in_a_part(size_t count, const uint8_t* labels) {
 // is closed, as a skull's crown under horns), the cuts that merge that end layer with the
 // layers next to it until it is kPoleLayerRadii times the largest of their radii tall;
 // false where no end needs it. *merged counts the layers merged away.
-inline bool cuts_for_tall_ends(const PartsMemory& m, size_t n, const Parting& parting,
+static inline bool cuts_for_tall_ends(const PartsMemory& m, size_t n, const Parting& parting,
                                size_t* cut_count, size_t* merged) {
     if (n < 2) return false;
     const LayerInfo* layers = m.layers;
@@ -12282,7 +12282,7 @@ inline bool cuts_for_tall_ends(const PartsMemory& m, size_t n, const Parting& pa
 }
 
 // A part meshed into the record of the parts, and where meshed, its counts into the whole's.
-inline void record_part(Report& rep, uint8_t label, Status status, const TubeInput& in,
+static inline void record_part(Report& rep, uint8_t label, Status status, const TubeInput& in,
                         const Report& part, size_t triangles, size_t merged) {
     PartCounts& p = rep.parts;
     if (p.part_count < p.info_capacity)
@@ -12319,7 +12319,7 @@ struct PartsWork {
 // Finds where the cloud parts along the request's axis (the frame's origin the centroid),
 // on a sample first when it is large (see above); the labels are filled where it parts.
 // False if the workspace is too small.
-inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const TubeRequest& along,
+static inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const TubeRequest& along,
                            const PartsMemory& m, Arena& arena, Parting& parting) {
     TubeRequest search = along;
     search.origin = nullptr;
@@ -12353,7 +12353,7 @@ inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const Tub
 
 // Whether the cloud parts around a trunk: a trunk of fewer points than a branch is no
 // trunk, the cloud is apart all along (separate objects) and is meshed as one tube.
-inline bool parts_around_trunk(size_t count, const Parting& parting, const uint8_t* labels) {
+static inline bool parts_around_trunk(size_t count, const Parting& parting, const uint8_t* labels) {
     if (parting.above_branch_count + parting.below_branch_count == 0) return false;
     size_t trunk_points = 0;
     for (size_t i = 0; i < count; ++i) trunk_points += labels[i] == kInTrunk;
@@ -12362,7 +12362,7 @@ inline bool parts_around_trunk(size_t count, const Parting& parting, const uint8
 
 // The trunk's own automatic axis, chosen once for the labels as they stand: squaring the
 // cut asks for it, and the trunk is meshed around it unless a label changed since.
-inline Status trunk_axis(const TubeInput& whole, PartsWork& w, Arena& arena) {
+static inline Status trunk_axis(const TubeInput& whole, PartsWork& w, Arena& arena) {
     if (w.trunk_known) return w.trunk_status;
     w.trunk = w.cut;
     w.trunk.axis = Axis::automatic;
@@ -12390,7 +12390,7 @@ const double kSquareCutMost = 0.866;     // cos 30 degrees
 
 const int kSquareCutRounds = 4;
 
-inline bool square_cut_to_trunk(const Cloud& cloud, const TubeInput& whole, PartsWork& w,
+static inline bool square_cut_to_trunk(const Cloud& cloud, const TubeInput& whole, PartsWork& w,
                                 Arena& arena, Parting& parting) {
     for (int round = 0; round < kSquareCutRounds && w.cut.layers.cut_count == 0; ++round) {
         if (trunk_axis(whole, w, arena) != Status::ok || w.trunk.axis != Axis::direction) break;
@@ -12418,7 +12418,7 @@ inline bool square_cut_to_trunk(const Cloud& cloud, const TubeInput& whole, Part
 }
 
 // The area of a surface whose triangles index the cloud.
-inline double surface_area(const CloudReader& reader, const uint32_t* triangles, size_t count) {
+static inline double surface_area(const CloudReader& reader, const uint32_t* triangles, size_t count) {
     double area = 0;
     for (size_t t = 0; t < count; ++t) {
         const Vec3 a = reader.point(triangles[3 * t]);
@@ -12432,7 +12432,7 @@ inline double surface_area(const CloudReader& reader, const uint32_t* triangles,
 // The one tube's area, to weigh the parts against (DBL_MAX where it has none), where it
 // can decide: not where the parts are kept whatever their area, nor where a point in no
 // part undoes them whatever it. Its triangles are overwritten by the parts'.
-inline Status one_tube_area(const TubeInput& in, const TubeRequest& request, bool all_in_parts,
+static inline Status one_tube_area(const TubeInput& in, const TubeRequest& request, bool all_in_parts,
                             Arena& arena, uint32_t* triangles, size_t capacity,
                             const Report& before, double* area) {
     *area = DBL_MAX;
@@ -12448,7 +12448,7 @@ inline Status one_tube_area(const TubeInput& in, const TubeRequest& request, boo
 
 // The trunk along `along`, its end layers under branches merged where they stand on a
 // closed end; its triangles start the output.
-inline Status mesh_trunk(const TubeInput& trunk, const TubeRequest& along, const Parting& parting,
+static inline Status mesh_trunk(const TubeInput& trunk, const TubeRequest& along, const Parting& parting,
                          const PartsMemory& m, Arena& arena, uint32_t* triangles,
                          size_t capacity, size_t* count, Report& part, size_t* merged) {
     part.layers.info = m.layers;
@@ -12476,7 +12476,7 @@ inline Status mesh_trunk(const TubeInput& trunk, const TubeRequest& along, const
 // The trunk into the output, around its own axis as the branches (a body whose legs hang
 // under it is meshed along the body) unless the caller laid out the layers; its frame and
 // layers are the whole's in the report. Where it fails, the outcome is undone.
-inline Status mesh_trunk_part(const TubeInput& whole, PartsWork& w, Arena& arena,
+static inline Status mesh_trunk_part(const TubeInput& whole, PartsWork& w, Arena& arena,
                               uint32_t* triangles, size_t capacity, size_t* count, Report& rep) {
     const Parting& parting = rep.parts.parting;
     const TubeInput trunk = part_input(whole, w.m, kInTrunk);
@@ -12516,7 +12516,7 @@ inline Status mesh_trunk_part(const TubeInput& whole, PartsWork& w, Arena& arena
 // A branch's request: around its own automatic axis and layers, its frame's origin its own
 // centroid, no caps (they come once the parts are joined) and no progress (the caller's
 // would run backwards from part to part).
-inline TubeRequest branch_request(TubeRequest r) {
+static inline TubeRequest branch_request(TubeRequest r) {
     r.axis = Axis::automatic;
     r.layers = LayerRequest{};
     r.origin = nullptr;
@@ -12528,7 +12528,7 @@ inline TubeRequest branch_request(TubeRequest r) {
 // Each branch into the output after the trunk's `*count` triangles, its end at the cut a
 // cut, not a closed end: its low end along its own axis if that runs away from the trunk.
 // *all_meshed is cleared where a branch fails (its points stay unused).
-inline Status mesh_branches(const TubeInput& whole, const PartsWork& w, Arena& arena,
+static inline Status mesh_branches(const TubeInput& whole, const PartsWork& w, Arena& arena,
                             uint32_t* triangles, size_t capacity, size_t* count, bool* all_meshed,
                             Report& rep) {
     const Parting& parting = rep.parts.parting;
@@ -12567,7 +12567,7 @@ inline Status mesh_branches(const TubeInput& whole, const PartsWork& w, Arena& a
 // Joins the parts meshed into the output (then caps them, as asked); `whole` tells whether
 // every part was meshed and every point is in one. Sets rep.parts.outcome: joined,
 // kept_apart, or undone (the output is then to be made again as one tube).
-inline Status join_parts(const Cloud& cloud, const PartsWork& w, bool whole, Arena& arena,
+static inline Status join_parts(const Cloud& cloud, const PartsWork& w, bool whole, Arena& arena,
                          uint32_t* triangles, size_t capacity, size_t count,
                          size_t* triangle_count, Report& rep) {
     JoinReport join = {};
@@ -12616,7 +12616,7 @@ inline Status join_parts(const Cloud& cloud, const PartsWork& w, bool whole, Are
 // that folds where the parting misread the cloud, as a neck's torn rim taken for two
 // branches), or kept apart as asked. Otherwise the counts start again from `before`, the
 // parts' record stays.
-inline bool keep_or_undo(const TubeInput& in, const uint32_t* triangles, size_t count,
+static inline bool keep_or_undo(const TubeInput& in, const uint32_t* triangles, size_t count,
                          double tube_area, const Report& before, Report& rep) {
     const PartsOutcome outcome = rep.parts.outcome;
     if (outcome == PartsOutcome::kept_apart ||
@@ -12636,7 +12636,7 @@ inline bool keep_or_undo(const TubeInput& in, const uint32_t* triangles, size_t 
 
 // The steps where the cloud may part (see above); *kept tells whether the parts are the
 // output, else the one tube is to be meshed.
-inline Status mesh_apart(const Cloud& cloud, const TubeInput& in, const TubeRequest& request,
+static inline Status mesh_apart(const Cloud& cloud, const TubeInput& in, const TubeRequest& request,
                          Arena& arena, uint32_t* triangles, size_t capacity,
                          size_t* triangle_count, Report& rep, bool* kept) {
     PartsWork w = {};
@@ -12674,7 +12674,7 @@ inline Status mesh_apart(const Cloud& cloud, const TubeInput& in, const TubeRequ
 // reconstruct() with the search for branches: `in` is read and the request's axis is
 // resolved. Where the cloud parts, the parts joined are kept only where whole and smaller
 // than the one tube's (see keep_or_undo()), else the one tube is.
-inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in,
+static inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in,
                                   const TubeRequest& request, Arena& arena,
                                   uint32_t* triangles, size_t capacity, size_t* triangle_count,
                                   Report& rep) {
@@ -12690,7 +12690,7 @@ inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in,
 }
 
 // The workspace reconstruct_default() takes on top of read_cloud()'s.
-inline size_t parts_workspace_size(size_t count, const TubeRequest& request) {
+static inline size_t parts_workspace_size(size_t count, const TubeRequest& request) {
     Arena arena = Arena::measuring();
     PartsMemory m;
     allocate_parts(m, count, arena);
@@ -12735,7 +12735,7 @@ namespace detail {
 // Reads a cloud that passed check_reconstruct_arguments: refuses or counts its NaN and
 // infinite points, leaves out its outliers (drop_outliers; the bitmap stays in `arena`)
 // and sums what is kept.
-inline Status read_cloud(const Cloud& cloud, const Options& options, Arena& arena, Report& rep,
+static inline Status read_cloud(const Cloud& cloud, const Options& options, Arena& arena, Report& rep,
                          TubeInput& in) {
     in.reader = reader_of(cloud);
     in.count = cloud.count;
@@ -12757,11 +12757,11 @@ inline Status read_cloud(const Cloud& cloud, const Options& options, Arena& aren
 }
 
 // Whether reconstruct() looks for branches.
-inline bool searches_parts(const TubeRequest& request) {
+static inline bool searches_parts(const TubeRequest& request) {
     return kFindParts && request.parts != PartsPolicy::one_tube;
 }
 
-inline Status mesh_cloud(const Cloud& cloud, const TubeInput& in, const TubeRequest& request,
+static inline Status mesh_cloud(const Cloud& cloud, const TubeInput& in, const TubeRequest& request,
                          Arena& arena, uint32_t* triangles, size_t capacity,
                          size_t* triangle_count, Report& rep) {
 #if !defined(STRATMESH_SMALL_CODE)
@@ -12777,7 +12777,7 @@ inline Status mesh_cloud(const Cloud& cloud, const TubeInput& in, const TubeRequ
 // reconstruct()'s body; `rep` arrives zeroed but for its caller's arrays.
 // Report::points.unused_count is left to the caller, who derives it so the counts add up on
 // every path.
-inline Status run_reconstruction(const Cloud& cloud, const Options& options, void* workspace,
+static inline Status run_reconstruction(const Cloud& cloud, const Options& options, void* workspace,
                                  size_t workspace_bytes, uint32_t* triangles,
                                  size_t triangle_capacity, size_t* triangle_count,
                                  Report& rep) {

@@ -88,29 +88,29 @@ struct ByteRange {
     uintptr_t begin, end;
 };
 
-inline size_t saturating_product(size_t a, size_t b) {
+static inline size_t saturating_product(size_t a, size_t b) {
     return b != 0 && a > SIZE_MAX / b ? SIZE_MAX : a * b;
 }
 
-inline ByteRange byte_range(const void* p, size_t bytes) {
+static inline ByteRange byte_range(const void* p, size_t bytes) {
     uintptr_t begin = reinterpret_cast<uintptr_t>(p);
     if (!p) return {0, 0};
     return {begin, bytes > UINTPTR_MAX - begin ? UINTPTR_MAX : begin + bytes};
 }
 
 // Bytes covered by `count` records `stride` apart whose last one is `record_bytes` long.
-inline ByteRange strided_range(const void* p, size_t count, size_t stride, size_t record_bytes) {
+static inline ByteRange strided_range(const void* p, size_t count, size_t stride, size_t record_bytes) {
     if (count == 0) return {0, 0};
     size_t span = saturating_product(count - 1, stride);
     return byte_range(p, span > SIZE_MAX - record_bytes ? SIZE_MAX : span + record_bytes);
 }
 
-inline bool ranges_overlap(ByteRange a, ByteRange b) {
+static inline bool ranges_overlap(ByteRange a, ByteRange b) {
     return a.begin < a.end && b.begin < b.end && a.begin < b.end && b.begin < a.end;
 }
 
 // True if any two of the `count` ranges overlap.
-inline bool any_overlap(const ByteRange* ranges, size_t count) {
+static inline bool any_overlap(const ByteRange* ranges, size_t count) {
     for (size_t i = 0; i < count; ++i)
         for (size_t j = i + 1; j < count; ++j)
             if (ranges_overlap(ranges[i], ranges[j])) return true;

@@ -35,7 +35,7 @@ const uint32_t kMostAxisCandidates = 6;
 
 // The three principal directions of a symmetric 3x3 matrix, largest variance first: power
 // iteration, then again on the matrix without the first direction's share.
-inline void principal_directions(const double m[3][3], Vec3 out[3]) {
+static inline void principal_directions(const double m[3][3], Vec3 out[3]) {
     out[0] = principal_direction(m);
     const Vec3 v = out[0];
     const double mv[3] = {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z,
@@ -58,7 +58,7 @@ inline void principal_directions(const double m[3][3], Vec3 out[3]) {
 }
 
 // The scatter matrix of `count` points, packed, about their mean.
-inline void scatter_of(const double* xyz, size_t count, double m[3][3]) {
+static inline void scatter_of(const double* xyz, size_t count, double m[3][3]) {
     // Scaled by the power of two that brings the largest coordinate near 1 (exactly, so
     // directions and ratios keep their bits): squares of coordinates near either end of the
     // double range would overflow or vanish. A multiplication where the factor is a normal
@@ -86,7 +86,7 @@ inline void scatter_of(const double* xyz, size_t count, double m[3][3]) {
 }
 
 // The variance of the scatter matrix along the unit direction v.
-inline double variance_along(const double m[3][3], Vec3 v) {
+static inline double variance_along(const double m[3][3], Vec3 v) {
     const double c[3] = {v.x, v.y, v.z};
     double sum = 0;
     for (int r = 0; r < 3; ++r)
@@ -101,7 +101,7 @@ inline double variance_along(const double m[3][3], Vec3 v) {
 const double kLineVariance = 0x1p-40;
 
 // The candidates for the axis of a sample of `count` points, packed.
-inline uint32_t axis_candidates(const double* xyz, size_t count, Vec3* out) {
+static inline uint32_t axis_candidates(const double* xyz, size_t count, Vec3* out) {
     double m[3][3];
     scatter_of(xyz, count, m);
     Vec3 all[6];
@@ -123,7 +123,7 @@ inline uint32_t axis_candidates(const double* xyz, size_t count, Vec3* out) {
 // folding). *along (optional) receives the mean squared cosine between the triangles'
 // normals and the unit axis, weighted by their areas: 0 where the surface runs along the
 // axis, 1 where it lies across it.
-inline double sample_surface(const double* xyz, const uint32_t* tri, size_t count,
+static inline double sample_surface(const double* xyz, const uint32_t* tri, size_t count,
                              size_t unused, Vec3 axis, double* along) {
     double area = 0, along_sum = 0, normals = 0;
     for (size_t t = 0; t < count; ++t) {
@@ -146,7 +146,7 @@ inline double sample_surface(const double* xyz, const uint32_t* tri, size_t coun
 
 // What a candidate's sample is meshed as: one layer along `axis`, its ends cut where the
 // tube's are, nothing else asked for and no callback.
-inline TubeRequest trial_request(const TubeRequest& tube, Vec3 axis) {
+static inline TubeRequest trial_request(const TubeRequest& tube, Vec3 axis) {
     TubeRequest trial = {};
     trial.axis = Axis::direction;
     trial.direction[0] = axis.x;
@@ -159,7 +159,7 @@ inline TubeRequest trial_request(const TubeRequest& tube, Vec3 axis) {
 
 // Meshes the sample along one candidate; DBL_MAX if it cannot.
 // *along (optional) receives the share of the sample surface's normals along the axis.
-inline double try_axis(const double* sample, size_t count, Vec3 axis, const TubeRequest& request,
+static inline double try_axis(const double* sample, size_t count, Vec3 axis, const TubeRequest& request,
                        Arena& arena, double* along) {
     const TubeRequest trial = trial_request(request, axis);
     const size_t mark = arena.mark();
@@ -181,7 +181,7 @@ inline double try_axis(const double* sample, size_t count, Vec3 axis, const Tube
 // Every k-th kept point of `in`, packed, at most `most` of them (and about that many), in
 // `arena`; null if the workspace is too small. *taken receives their count. Where every
 // point is kept, the sample is read by index, without a pass over the cloud.
-inline double* sample_points(const TubeInput& in, size_t most, Arena& arena, size_t* taken) {
+static inline double* sample_points(const TubeInput& in, size_t most, Arena& arena, size_t* taken) {
     const size_t count = in.sums.valid < most ? in.sums.valid : most;
     double* sample = arena.alloc<double>(3 * count);
     *taken = 0;
@@ -208,7 +208,7 @@ inline double* sample_points(const TubeInput& in, size_t most, Arena& arena, siz
 
 // The axis for Axis::automatic: the candidate whose sample surface is smallest (see above).
 // False if the workspace is too small.
-inline bool choose_axis(const TubeInput& in, const TubeRequest& request, Arena& arena,
+static inline bool choose_axis(const TubeInput& in, const TubeRequest& request, Arena& arena,
                         Vec3& axis) {
     const size_t mark = arena.mark();
     size_t taken = 0;
@@ -234,7 +234,7 @@ inline bool choose_axis(const TubeInput& in, const TubeRequest& request, Arena& 
 }
 
 // Workspace for choose_axis() on a cloud of `valid` kept points.
-inline size_t axis_workspace_size(size_t valid, const TubeRequest& request) {
+static inline size_t axis_workspace_size(size_t valid, const TubeRequest& request) {
     const size_t count = valid < kAxisSample ? valid : kAxisSample;
     const size_t tube = tube_workspace_size(count, trial_request(request, Vec3{0, 0, 1}));
     if (tube == 0) return 0;
@@ -247,7 +247,7 @@ inline size_t axis_workspace_size(size_t valid, const TubeRequest& request) {
 
 // Axis::automatic in `request` resolved by choose_axis(); any other axis stays. *detail
 // receives the reason where it fails.
-inline Status resolve_axis(const TubeInput& in, Arena& arena, TubeRequest& request,
+static inline Status resolve_axis(const TubeInput& in, Arena& arena, TubeRequest& request,
                            const char** detail) {
     if (request.axis != Axis::automatic) return Status::ok;
     if (!kAxisTrials) {

@@ -10,7 +10,7 @@ namespace detail {
 
 // Caps the boundary loops of the surface of `count` triangles (`in` reads the whole cloud)
 // in the frame along the request's axis, which is resolved.
-inline Status cap_surface(const TubeInput& in, const TubeRequest& request, Arena& arena,
+static inline Status cap_surface(const TubeInput& in, const TubeRequest& request, Arena& arena,
                           uint32_t* triangles, size_t capacity, size_t& count, CapCounts& caps,
                           size_t* needed) {
     Frame frame;

@@ -29,7 +29,7 @@ struct DistinctPoints {
     }
 };
 
-inline CloudSums sum_cloud(const CloudReader& cloud, size_t count) {
+static inline CloudSums sum_cloud(const CloudReader& cloud, size_t count) {
     CloudSums s = {0, 0, {0, 0, 0}, {0, 0, 0}, {DBL_MAX, DBL_MAX, DBL_MAX},
                    {-DBL_MAX, -DBL_MAX, -DBL_MAX}};
     DistinctPoints distinct = {0, {}};
@@ -51,7 +51,7 @@ inline CloudSums sum_cloud(const CloudReader& cloud, size_t count) {
 }
 
 // The bytes the cloud's coordinates lie in.
-inline ByteRange cloud_bytes(const Cloud& cloud) {
+static inline ByteRange cloud_bytes(const Cloud& cloud) {
     const size_t point_bytes = 3 * (cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double));
     return strided_range(cloud.xyz, cloud.count, cloud.stride_bytes ? cloud.stride_bytes : point_bytes,
                          point_bytes);
@@ -60,7 +60,7 @@ inline ByteRange cloud_bytes(const Cloud& cloud) {
 // True if any two of the caller's buffers share a byte (the report and its layer array
 // included): checked before anything is written. A count beyond the limit is refused as
 // too_many_points instead.
-inline bool reconstruct_buffers_overlap(const Cloud& cloud, void* workspace,
+static inline bool reconstruct_buffers_overlap(const Cloud& cloud, void* workspace,
                                         size_t workspace_bytes, uint32_t* triangles,
                                         size_t triangle_capacity, size_t* triangle_count,
                                         const Report* report) {
@@ -78,7 +78,7 @@ inline bool reconstruct_buffers_overlap(const Cloud& cloud, void* workspace,
     return any_overlap(buffers, 7);
 }
 
-inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangles,
+static inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangles,
                                           size_t triangle_capacity, size_t* triangle_count,
                                           void* workspace, Report& rep) {
     rep.detail = "an argument is invalid: a null pointer with a non-zero count, a stride "
@@ -100,7 +100,7 @@ inline Status check_reconstruct_arguments(const Cloud& cloud, uint32_t* triangle
 }
 
 // Reads a cloud that passed check_reconstruct_arguments.
-inline CloudReader reader_of(const Cloud& cloud) {
+static inline CloudReader reader_of(const Cloud& cloud) {
     size_t scalar = cloud.scalar == Scalar::float32 ? sizeof(float) : sizeof(double);
     return {static_cast<const unsigned char*>(cloud.xyz),
             cloud.stride_bytes ? cloud.stride_bytes : 3 * scalar, cloud.scalar == Scalar::float32, nullptr};
@@ -113,7 +113,7 @@ const char* const kInvalidPointDetail =
 // Where a cloud of `count` points (`sums` is its sum_cloud) is refused with invalid_point:
 // at its first point with a NaN or infinite coordinate, unless the skip_invalid_points flag
 // is given. `count` if it is not refused.
-inline size_t refused_at(const CloudReader& reader, size_t count, const CloudSums& sums,
+static inline size_t refused_at(const CloudReader& reader, size_t count, const CloudSums& sums,
                          const Options& options) {
     if (sums.valid == count || (options.flags & skip_invalid_points)) return count;
     size_t first = 0;
@@ -123,7 +123,7 @@ inline size_t refused_at(const CloudReader& reader, size_t count, const CloudSum
 
 // Counts the points with a NaN or infinite coordinate in rep.points.rejected_count, or refuses the
 // cloud (see refused_at).
-inline Status reject_invalid_points(const CloudReader& reader, size_t count,
+static inline Status reject_invalid_points(const CloudReader& reader, size_t count,
                                     const CloudSums& sums, const Options& options, Report& rep) {
     const size_t first = refused_at(reader, count, sums, options);
     if (first < count) {
@@ -146,7 +146,7 @@ struct TubeInput {
 
 // Whether this build holds every feature the flags ask for (STRATMESH_SMALL_CODE leaves
 // some out).
-inline bool flags_compiled(const Options& options) {
+static inline bool flags_compiled(const Options& options) {
     const uint32_t f = options.flags;
     return (kDropOutliers || !(f & drop_outliers)) && (kSurfaceFlips || !(f & surface_flips)) &&
            (kClosedEnds || !(f & open_ends));

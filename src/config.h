@@ -150,11 +150,11 @@ static const size_t kMaxPoints = 0xFFFFFFFEu;
 #endif
 
 #if defined(__GNUC__) || defined(__clang__)
-inline double abs_value(double x) { return __builtin_fabs(x); }
+static inline double abs_value(double x) { return __builtin_fabs(x); }
 #else
-inline double abs_value(double x) { return x < 0 ? -x : x; }
+static inline double abs_value(double x) { return x < 0 ? -x : x; }
 #endif
-inline bool is_finite(double x) { return x - x == 0; }
+static inline bool is_finite(double x) { return x - x == 0; }
 
 // Sorts ascending in place: heapsort, O(n log n) on any input (a million cuts, a huge fan)
 // with no recursion and no memory.
@@ -181,7 +181,7 @@ template <class T> void heap_sort(T* v, size_t count) {
     }
 }
 
-inline double read_double(const unsigned char* p) {
+static inline double read_double(const unsigned char* p) {
     double v;
     std::memcpy(&v, p, sizeof v);
     return v;

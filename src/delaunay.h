@@ -20,9 +20,9 @@ namespace detail {
 
 static const uint32_t kGhost = kNoIndex;
 
-inline uint32_t next_edge(uint32_t e) { return e % 3 == 2 ? e - 2 : e + 1; }
+static inline uint32_t next_edge(uint32_t e) { return e % 3 == 2 ? e - 2 : e + 1; }
 
-inline uint32_t prev_edge(uint32_t e) { return e % 3 == 0 ? e + 2 : e - 1; }
+static inline uint32_t prev_edge(uint32_t e) { return e % 3 == 0 ? e + 2 : e - 1; }
 
 struct Triangulation {
     const double* xy;     // 2 per vertex, vertices in insertion order
@@ -55,7 +55,7 @@ struct Triangulation {
 };
 
 // Memory for a triangulation of up to `count` points (the points themselves excluded).
-inline bool allocate_triangulation(Triangulation& tr, size_t count, Arena& arena) {
+static inline bool allocate_triangulation(Triangulation& tr, size_t count, Arena& arena) {
     size_t triangles = count >= 3 ? 2 * count - 2 : 4;
     tr.vertex = arena.alloc<uint32_t>(3 * triangles);
     tr.twin = arena.alloc<uint32_t>(3 * triangles);
@@ -69,7 +69,7 @@ inline bool allocate_triangulation(Triangulation& tr, size_t count, Arena& arena
 }
 
 // The first triangle (a, b, c), counter-clockwise, and its three ghosts.
-inline void start_triangulation(Triangulation& tr, uint32_t a, uint32_t b, uint32_t c) {
+static inline void start_triangulation(Triangulation& tr, uint32_t a, uint32_t b, uint32_t c) {
     tr.set_triangle(0, a, b, c);
     tr.set_triangle(1, b, a, kGhost);
     tr.set_triangle(2, c, b, kGhost);
@@ -90,7 +90,7 @@ enum class Location { inside, on_edge, on_vertex, outside, failed };
 // half-edge of the triangle; for on_edge, the half-edge p lies on; for on_vertex, a
 // half-edge starting at the vertex p coincides with; for outside, the hull half-edge of
 // the ghost triangle p is in (p strictly on its outer side).
-inline Location locate(const Triangulation& tr, const double* p, uint32_t& edge) {
+static inline Location locate(const Triangulation& tr, const double* p, uint32_t& edge) {
     uint32_t t = tr.hint;
     if (tr.is_ghost(t)) {
         for (uint32_t k = 0; k < 3; ++k) {
@@ -143,7 +143,7 @@ inline Location locate(const Triangulation& tr, const double* p, uint32_t& edge)
     return Location::failed;
 }
 
-inline bool push_edge(Triangulation& tr, uint32_t& top, uint32_t e) {
+static inline bool push_edge(Triangulation& tr, uint32_t& top, uint32_t e) {
     STRATMESH_ASSERT(top < tr.stack_capacity);
     if (top >= tr.stack_capacity) return false;
     tr.stack[top++] = e;
@@ -151,7 +151,7 @@ inline bool push_edge(Triangulation& tr, uint32_t& top, uint32_t e) {
 }
 
 // Splits the triangle of half-edge e = (a, b, c) into (a, b, p), (b, c, p), (c, a, p).
-inline void split_triangle(Triangulation& tr, uint32_t t, uint32_t p, uint32_t& top) {
+static inline void split_triangle(Triangulation& tr, uint32_t t, uint32_t p, uint32_t& top) {
     uint32_t a = tr.vertex[3 * t], b = tr.vertex[3 * t + 1], c = tr.vertex[3 * t + 2];
     uint32_t o1 = tr.twin[3 * t + 1], o2 = tr.twin[3 * t + 2];
     uint32_t t1 = tr.triangle_count, t2 = tr.triangle_count + 1;
@@ -171,7 +171,7 @@ inline void split_triangle(Triangulation& tr, uint32_t t, uint32_t p, uint32_t& 
 }
 
 // Splits the edge e = a->b (in triangle (a, b, c), twin in (b, a, d)) at p.
-inline void split_edge(Triangulation& tr, uint32_t e, uint32_t p, uint32_t& top) {
+static inline void split_edge(Triangulation& tr, uint32_t e, uint32_t p, uint32_t& top) {
     uint32_t f = tr.twin[e];
     uint32_t t = e / 3, u = f / 3;
     uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)], c = tr.vertex[prev_edge(e)];
@@ -200,7 +200,7 @@ inline void split_edge(Triangulation& tr, uint32_t e, uint32_t p, uint32_t& top)
 }
 
 // Whether edge e, in triangle (a, b, p) with p the point just inserted, must be flipped.
-inline bool must_flip(const Triangulation& tr, uint32_t e) {
+static inline bool must_flip(const Triangulation& tr, uint32_t e) {
     uint32_t f = tr.twin[e];
     uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)], p = tr.vertex[prev_edge(e)];
     uint32_t q = tr.vertex[prev_edge(f)];
@@ -217,7 +217,7 @@ inline bool must_flip(const Triangulation& tr, uint32_t e) {
 // Flips e = a->b of (a, b, p) with its twin in (b, a, q) into (p, a, q) and (q, b, p) (the
 // new triangles keep e's two triangle slots), and with kQueue queues the two edges that may
 // now fail the Delaunay test.
-template <bool kQueue> inline void flip_edge(Triangulation& tr, uint32_t e, uint32_t* top) {
+template <bool kQueue> static inline void flip_edge(Triangulation& tr, uint32_t e, uint32_t* top) {
     uint32_t f = tr.twin[e];
     uint32_t t = e / 3, u = f / 3;
     uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)], p = tr.vertex[prev_edge(e)];
@@ -240,7 +240,7 @@ template <bool kQueue> inline void flip_edge(Triangulation& tr, uint32_t e, uint
 
 // Inserts vertex p. Returns the vertex it duplicates, p itself if it was inserted, or
 // kNoIndex if an invariant failed.
-inline uint32_t insert_vertex(Triangulation& tr, uint32_t p) {
+static inline uint32_t insert_vertex(Triangulation& tr, uint32_t p) {
     uint32_t edge = 0;
     Location where = locate(tr, tr.point(p), edge);
     uint32_t top = 0;
@@ -269,7 +269,7 @@ struct DuplicateSink {
 
 // Builds the Delaunay triangulation of xy[0 .. count) (2 doubles per point, already in
 // insertion order), reporting duplicates to `sink`. Counts the vertices in *inserted.
-inline Status triangulate_points(Triangulation& tr, uint32_t count, DuplicateSink sink,
+static inline Status triangulate_points(Triangulation& tr, uint32_t count, DuplicateSink sink,
                                  uint32_t* inserted) {
     *inserted = 0;
     if (count < 3) return Status::too_few_points;
@@ -325,7 +325,7 @@ struct DuplicateMap {
     }
 };
 
-inline bool plan_delaunay_2d(Delaunay2dMemory& m, size_t count, Arena& arena,
+static inline bool plan_delaunay_2d(Delaunay2dMemory& m, size_t count, Arena& arena,
                              const unsigned char* xy, size_t stride,
                              const BoundingBox2d* box) {
     m.order = arena.alloc<uint32_t>(count);
@@ -371,7 +371,7 @@ namespace detail {
 // True if any two of the caller's buffers share a byte: checked before anything is
 // written. A count beyond the limit is refused as too_many_points instead, whatever its
 // span would cover.
-inline bool delaunay_buffers_overlap(const double* xy, size_t point_count, size_t stride_bytes,
+static inline bool delaunay_buffers_overlap(const double* xy, size_t point_count, size_t stride_bytes,
                                      void* workspace, size_t workspace_bytes,
                                      uint32_t* triangles, size_t triangle_capacity,
                                      Delaunay2dInfo* info, uint32_t* duplicate_of) {

@@ -50,7 +50,7 @@ struct Frame {
 };
 
 // The power of two 2^-e with 2^e just above `extent`, within [2^-1000, 2^1000].
-STRATMESH_SMALL_NOINLINE inline double scale_for_extent(double extent) {
+STRATMESH_SMALL_NOINLINE static inline double scale_for_extent(double extent) {
     if (!(extent > 0) || !is_finite(extent)) return 1;
     int exponent = 0;
     std::frexp(extent, &exponent);
@@ -61,7 +61,7 @@ STRATMESH_SMALL_NOINLINE inline double scale_for_extent(double extent) {
 
 // The principal direction of a symmetric 3x3 matrix by power iteration from its largest
 // column; a fixed number of steps keeps the cost bounded and the result deterministic.
-inline Vec3 principal_direction(const double m[3][3]) {
+static inline Vec3 principal_direction(const double m[3][3]) {
     Vec3 cols[3] = {{m[0][0], m[1][0], m[2][0]}, {m[0][1], m[1][1], m[2][1]},
                     {m[0][2], m[1][2], m[2][2]}};
     Vec3 v = cols[0];
@@ -92,7 +92,7 @@ const double kOriginReach = 0x1p32;
 
 // Whether `origin` lies within kOriginReach times the largest side of the box [low, high]
 // of it (halves, so that nothing overflows). A box of one point reaches everywhere.
-inline bool origin_in_reach(Vec3 origin, Vec3 low, Vec3 high) {
+static inline bool origin_in_reach(Vec3 origin, Vec3 low, Vec3 high) {
     const Vec3 half_low = scaled(low, 0.5), half_high = scaled(high, 0.5);
     const Vec3 half_origin = scaled(origin, 0.5);
     const Vec3 side = half_high - half_low;
@@ -105,7 +105,7 @@ inline bool origin_in_reach(Vec3 origin, Vec3 low, Vec3 high) {
 
 // Why a given origin cannot serve as the frame's, or null if it can (or none is given): it
 // is NaN or infinite, or lies beyond kOriginReach of the valid points summed in `sums`.
-inline const char* origin_refusal(const double* origin, const CloudSums& sums) {
+static inline const char* origin_refusal(const double* origin, const CloudSums& sums) {
     if (!origin) return nullptr;
     const Vec3 given = {origin[0], origin[1], origin[2]};
     if (!(is_finite(given.x) && is_finite(given.y) && is_finite(given.z)))
@@ -118,11 +118,11 @@ inline const char* origin_refusal(const double* origin, const CloudSums& sums) {
     return nullptr;
 }
 
-inline const char* origin_refusal(const Options& options, const CloudSums& sums) {
+static inline const char* origin_refusal(const Options& options, const CloudSums& sums) {
     return origin_refusal((options.flags & origin_given) ? options.origin : nullptr, sums);
 }
 
-inline Status choose_frame(const CloudSums& sums, const TubeRequest& request, Frame& frame) {
+static inline Status choose_frame(const CloudSums& sums, const TubeRequest& request, Frame& frame) {
     const size_t valid = sums.valid;
     const Vec3 sum = {sums.total[0], sums.total[1], sums.total[2]};
     const Vec3 small_sum = {sums.small_total[0], sums.small_total[1], sums.small_total[2]};
@@ -183,12 +183,12 @@ inline Status choose_frame(const CloudSums& sums, const TubeRequest& request, Fr
     return Status::ok;
 }
 
-inline Status choose_frame(const CloudSums& sums, const Options& options, Frame& frame) {
+static inline Status choose_frame(const CloudSums& sums, const Options& options, Frame& frame) {
     return choose_frame(sums, tube_request(options), frame);
 }
 
 // The lowest and highest frame height of the valid points.
-inline void height_range(const CloudReader& cloud, size_t count, const Frame& frame, double* lo,
+static inline void height_range(const CloudReader& cloud, size_t count, const Frame& frame, double* lo,
                          double* hi) {
     for (size_t i = 0; i < count; ++i) {
         if (!cloud.valid(i)) continue;
@@ -202,7 +202,7 @@ inline void height_range(const CloudReader& cloud, size_t count, const Frame& fr
 // the frame not halved): a height is then (p_k - origin_k) * scale plus zeros, exactly
 // that value, and rounding keeps the order, so the lowest and highest coordinates along
 // the axis give the same two heights, bit for bit. False otherwise.
-inline bool height_range_from_extremes(const Frame& frame, double* lo, double* hi) {
+static inline bool height_range_from_extremes(const Frame& frame, double* lo, double* hi) {
     const double axis[3] = {frame.axis.x, frame.axis.y, frame.axis.z};
     const double low[3] = {frame.low.x, frame.low.y, frame.low.z};
     const double high[3] = {frame.high.x, frame.high.y, frame.high.z};
@@ -217,7 +217,7 @@ inline bool height_range_from_extremes(const Frame& frame, double* lo, double* h
     return false;
 }
 
-STRATMESH_SMALL_NOINLINE inline void report_frame(const Frame& frame, Report& rep) {
+STRATMESH_SMALL_NOINLINE static inline void report_frame(const Frame& frame, Report& rep) {
     rep.axis[0] = frame.axis.x;
     rep.axis[1] = frame.axis.y;
     rep.axis[2] = frame.axis.z;

@@ -63,7 +63,7 @@ const unsigned char kUnpeeled = 0x80;  // in those flags: the band puts the peel
 // Collects the link of the centre (vertex 0) counter-clockwise into loop, one entry per link
 // edge u -> w: the half-edge w -> u of the triangle beyond it. Flags its vertices
 // kOnBottomLoop. False if the centre touches the hull: the layer does not surround its axis.
-inline bool centre_link(const Triangulation& tr, uint32_t* loop, uint32_t* count,
+static inline bool centre_link(const Triangulation& tr, uint32_t* loop, uint32_t* count,
                         uint32_t* flags) {
     uint32_t start = kNoIndex;
     for (uint32_t e = 0; e < 3 * tr.triangle_count; ++e)
@@ -89,7 +89,7 @@ inline bool centre_link(const Triangulation& tr, uint32_t* loop, uint32_t* count
 // half-edge, in the triangle inside. Flags its vertices kOnTopLoop. A ghost (a, b, G) holds
 // G -> a, then a -> b; the twin of G -> a is a -> G in the ghost (z, a, G), whose next
 // half-edge is G -> z: the next ghost along the hull.
-inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* count, uint32_t* flags) {
+static inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* count, uint32_t* flags) {
     uint32_t start = 0;
     while (tr.vertex[start] != kGhost) ++start;
     uint32_t n = 0, e = start;
@@ -151,7 +151,7 @@ const uint32_t kFoldedEndPeelPasses = 64;
 const double kFoldedEndPeelSlope = 1e6;
 
 // Whether the triangle of loop entry g (see centre_link and hull_loop) is peeled.
-inline bool peels(const Triangulation& tr, const Local* points, const uint32_t* flags,
+static inline bool peels(const Triangulation& tr, const Local* points, const uint32_t* flags,
                   uint32_t g, bool top, double slope) {
     if (!on_surface(tr, g / 3)) return false;
     uint32_t from = tr.vertex[g], to = tr.vertex[next_edge(g)], x = tr.vertex[prev_edge(g)];
@@ -176,7 +176,7 @@ inline bool peels(const Triangulation& tr, const Local* points, const uint32_t* 
 // and returns its new length. A peeled triangle loses its first vertex to the centre, so
 // that it is no longer emitted. The pass reads the loop from the array's end, where it never
 // meets what it writes: both loops together hold each vertex at most once.
-inline uint32_t peel_loop(Triangulation& tr, const Local* points, uint32_t* flags, uint32_t* loop,
+static inline uint32_t peel_loop(Triangulation& tr, const Local* points, uint32_t* flags, uint32_t* loop,
                           uint32_t n, uint32_t capacity, bool top, double slope,
                           uint32_t passes) {
     for (uint32_t pass = 0; pass < passes; ++pass) {
@@ -205,7 +205,7 @@ inline uint32_t peel_loop(Triangulation& tr, const Local* points, uint32_t* flag
 
 // Turns loop entries into the layer-local indices of the loop's vertices, in loop order, and
 // sets each vertex's peeling pass in passes (0: on the centre's link or the hull).
-inline void name_loop(const Triangulation& tr, const uint32_t* order, const uint32_t* flags,
+static inline void name_loop(const Triangulation& tr, const uint32_t* order, const uint32_t* flags,
                       uint32_t* loop, uint32_t n, unsigned char* passes, bool top) {
     for (uint32_t i = 0; i < n; ++i) {
         const uint32_t v = tr.vertex[top ? loop[i] : next_edge(loop[i])];
@@ -230,7 +230,7 @@ struct LoadedLayer {
 
 // `staged` (optional): the same points in frame coordinates, in the arena's end room
 // (LayerQueue::staged), read in sequence instead of the cloud at random while intact.
-inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint32_t* ids,
+static inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint32_t* ids,
                        const Local* staged, size_t count, double h0, double h1, Arena& arena,
                        LoadedLayer& layer) {
     const bool intact = kStagePoints && staged && arena.untouched(staged);
@@ -253,7 +253,7 @@ inline bool load_layer(const CloudReader& cloud, const Frame& frame, const uint3
 
 // sectors_held by a loaded layer around its fitted centre (before the centre search moves
 // it).
-inline uint32_t layer_sectors(const LoadedLayer& layer) {
+static inline uint32_t layer_sectors(const LoadedLayer& layer) {
     const Local* points = layer.points;
     return sectors_held([points](size_t i) -> const Local& { return points[i]; }, layer.count,
                         layer.cyl.cx, layer.cyl.cy);
@@ -297,7 +297,7 @@ const double kEndSlab = 0.5;
 
 const double kAcrossEnd = 0.5;
 
-inline void find_closed_ends(LoadedLayer& layer, uint32_t ends) {
+static inline void find_closed_ends(LoadedLayer& layer, uint32_t ends) {
     layer.ends = ends;
     Cylinder& c = layer.cyl;
     const Local* points = layer.points;
@@ -405,7 +405,7 @@ const double kCentreStep = 0.3;
 // cyl's centre and triangulated, with the doubled area of its surface in *area; SIZE_MAX
 // where the centre does not lie inside the sample's hull (it does not surround that
 // centre). Its scratch is released.
-inline size_t sample_folds(const Local* points, size_t count, size_t stride,
+static inline size_t sample_folds(const Local* points, size_t count, size_t stride,
                            const Cylinder& cyl, Arena& arena, double* area) {
     *area = 0;
     size_t mark = arena.mark(), folds = SIZE_MAX;
@@ -430,7 +430,7 @@ inline size_t sample_folds(const Local* points, size_t count, size_t stride,
 }
 
 // Moves layer.cyl's centre where a sample of the layer folds least (see above).
-inline void choose_centre(LoadedLayer& layer, Arena& arena) {
+static inline void choose_centre(LoadedLayer& layer, Arena& arena) {
     const size_t stride = layer.count / kCentreSamplePoints + 1;
     const size_t count = (layer.count + stride - 1) / stride;
     const Cylinder fitted = layer.cyl;

@@ -35,7 +35,7 @@ namespace detail {
 
 // In-place sort of packed (key, value) pairs: insertion sort for the small fans of almost
 // every vertex, heap sort (O(n log n), no recursion) for large ones.
-inline void sort_pairs(uint64_t* items, size_t count) {
+static inline void sort_pairs(uint64_t* items, size_t count) {
     if (count <= 16) {
         for (size_t i = 1; i < count; ++i) {
             uint64_t item = items[i];
@@ -61,7 +61,7 @@ struct Fan {
 };
 
 // The sorted position of the entry leaving towards `neighbour`, or SIZE_MAX.
-inline size_t position_leaving_to(const Fan& fan, uint32_t neighbour) {
+static inline size_t position_leaving_to(const Fan& fan, uint32_t neighbour) {
     size_t lo = 0, hi = fan.size;
     while (lo < hi) {
         size_t mid = lo + (hi - lo) / 2;
@@ -71,7 +71,7 @@ inline size_t position_leaving_to(const Fan& fan, uint32_t neighbour) {
 }
 
 // Collects v's live triangles, sorted by leaving edge; marks dead those repeating one.
-inline size_t collect_fan(const uint32_t* tri, const uint32_t* incident, size_t begin,
+static inline size_t collect_fan(const uint32_t* tri, const uint32_t* incident, size_t begin,
                           size_t end, uint32_t v, unsigned char* dead, Fan& fan) {
     fan.size = 0;
     for (size_t k = begin; k < end; ++k) {
@@ -100,7 +100,7 @@ inline size_t collect_fan(const uint32_t* tri, const uint32_t* incident, size_t 
 
 // Labels the connected pieces of the fan (each triangle linked to the one leaving where
 // it arrives) and returns how many there are.
-inline uint32_t label_fan(Fan& fan) {
+static inline uint32_t label_fan(Fan& fan) {
     const uint32_t unlabeled = kNoIndex;
     for (size_t k = 0; k < fan.size; ++k) fan.label[k] = unlabeled;
     uint32_t pieces = 0;
@@ -126,7 +126,7 @@ inline uint32_t label_fan(Fan& fan) {
 }
 
 // Makes v's fan a single oriented piece; returns the number of triangles marked dead.
-inline size_t repair_fan(const uint32_t* tri, const uint32_t* incident, size_t begin,
+static inline size_t repair_fan(const uint32_t* tri, const uint32_t* incident, size_t begin,
                          size_t end, uint32_t v, unsigned char* dead, Fan& fan) {
     size_t removed = collect_fan(tri, incident, begin, end, v, dead, fan);
     uint32_t pieces = label_fan(fan);
@@ -151,7 +151,7 @@ inline size_t repair_fan(const uint32_t* tri, const uint32_t* incident, size_t b
 // piece: every corner has one and a walk from any corner comes back after all of them (a
 // cycle), or all but one have one and a walk from the corner nobody arrives at takes in all
 // of them (a chain).
-inline bool fan_is_one_piece(uint64_t* corners, size_t size) {
+static inline bool fan_is_one_piece(uint64_t* corners, size_t size) {
     if (size == 0) return true;
     sort_pairs(corners, size);
     auto leaving = [&](size_t i) { return static_cast<uint32_t>(corners[i] >> 32); };
@@ -195,7 +195,7 @@ inline bool fan_is_one_piece(uint64_t* corners, size_t size) {
 // Whether every vertex v with checked[v] != 0 passes fan_is_one_piece in tri[0 .. 3 count)
 // (indices below point_count): then the safety net would remove nothing at those vertices.
 // Lets finish_chunk skip the net where nothing can fail; the arena's failure answers false.
-inline bool fans_are_one_piece(const uint32_t* tri, size_t count, size_t point_count,
+static inline bool fans_are_one_piece(const uint32_t* tri, size_t count, size_t point_count,
                                const unsigned char* checked, Arena& arena) {
     size_t mark = arena.mark();
     uint32_t* offsets = arena.alloc<uint32_t>(point_count + 1);
@@ -228,7 +228,7 @@ inline bool fans_are_one_piece(const uint32_t* tri, size_t count, size_t point_c
 // layers in spatial order, so relabelled fans and their triangles sit close together in
 // memory whatever order the input points had; only the relabelling itself reads the input
 // indices at random.
-inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count, Arena& arena) {
+static inline size_t enforce_manifold(uint32_t* tri, size_t& count, size_t point_count, Arena& arena) {
     size_t mark = arena.mark();
     uint32_t* original = arena.alloc<uint32_t>(point_count);  // label -> input index
     unsigned char* dead = arena.alloc<unsigned char>(count);

@@ -6,7 +6,7 @@ namespace detail {
 
 // Whether the kept points of `in` lie on a line up to rounding (see kLineVariance), judged
 // on a sample. False also if the workspace is too small for the sample.
-inline bool on_a_line(const TubeInput& in, Arena& arena) {
+static inline bool on_a_line(const TubeInput& in, Arena& arena) {
     const size_t mark = arena.mark();
     size_t taken = 0;
     const double* sample = sample_points(in, kAxisSample, arena, &taken);
@@ -39,10 +39,10 @@ struct PointGroup {
     uint32_t count;
 };
 
-inline Vec3 half_offset(Vec3 p, Vec3 first) { return scaled(p, 0.5) - scaled(first, 0.5); }
+static inline Vec3 half_offset(Vec3 p, Vec3 first) { return scaled(p, 0.5) - scaled(first, 0.5); }
 
 // Whether a group spans a surface of its own: 3 points or more, off one line.
-inline bool spans_surface(const PointGroup& g) {
+static inline bool spans_surface(const PointGroup& g) {
     if (g.count < 3) return false;
     const double n = g.count;
     double m[3][3];
@@ -52,7 +52,7 @@ inline bool spans_surface(const PointGroup& g) {
     return along > 0 && m[0][0] + m[1][1] + m[2][2] - along > kLineVariance * along;
 }
 
-inline double coordinate(Vec3 p, int k) { return k == 0 ? p.x : k == 1 ? p.y : p.z; }
+static inline double coordinate(Vec3 p, int k) { return k == 0 ? p.x : k == 1 ? p.y : p.z; }
 
 // The points' positions along their bounding box's longest side, in up to kNoAreaBins bins.
 struct Binning {
@@ -66,7 +66,7 @@ struct Binning {
 };
 
 // Adds a point's half offset to its group's box (first pass) or moments (second pass).
-inline void add_to_group(PointGroup& g, Vec3 p, int pass) {
+static inline void add_to_group(PointGroup& g, Vec3 p, int pass) {
     if (pass == 0 && g.count++ == 0) g.first = p;
     const Vec3 h = half_offset(p, g.first);
     if (pass == 0) {
@@ -84,7 +84,7 @@ inline void add_to_group(PointGroup& g, Vec3 p, int pass) {
 }
 
 // Numbers the runs of occupied bins (non-zero) from 1, empty bins 0; returns the runs.
-inline uint32_t number_runs(uint32_t* group_of, uint32_t bins) {
+static inline uint32_t number_runs(uint32_t* group_of, uint32_t bins) {
     uint32_t count = 0;
     for (uint32_t b = 0; b < bins; ++b) {
         const bool occupied = group_of[b] != 0;
@@ -97,7 +97,7 @@ inline uint32_t number_runs(uint32_t* group_of, uint32_t bins) {
 // The groups of why_no_area(): the occupied bins first, numbered by run (number_runs()),
 // then each point joins its bin's group, its box first, its moments after. One loop over
 // the points serves the three passes.
-inline uint32_t gather_groups(const TubeInput& in, const Binning& binning, uint32_t* group_of,
+static inline uint32_t gather_groups(const TubeInput& in, const Binning& binning, uint32_t* group_of,
                               PointGroup* groups) {
     std::memset(group_of, 0, binning.bins * sizeof(uint32_t));
     uint32_t count = 0;
@@ -127,7 +127,7 @@ inline uint32_t gather_groups(const TubeInput& in, const Binning& binning, uint3
 // point beside the cloud (kCollapsedShare) and fewer than kOutlierNeighbours points lie
 // outside it: specks that drop_outliers leaves out; more: clusters far apart. Unexplained
 // otherwise, or when the workspace cannot hold the groups.
-inline NoArea why_no_area(const TubeInput& in, Arena& arena) {
+static inline NoArea why_no_area(const TubeInput& in, Arena& arena) {
     const Vec3 low = {in.sums.lowest[0], in.sums.lowest[1], in.sums.lowest[2]};
     const Vec3 high = {in.sums.highest[0], in.sums.highest[1], in.sums.highest[2]};
     const Vec3 half_side = scaled(high, 0.5) - scaled(low, 0.5);
@@ -160,7 +160,7 @@ inline NoArea why_no_area(const TubeInput& in, Arena& arena) {
 
 // The status and detail of a cloud refused as degenerate or not_columnar, where
 // why_no_area() tells a reason: the same status and detail where it tells none.
-inline Status explain_no_area(const TubeInput& in, Status status, Arena& arena, Report& rep) {
+static inline Status explain_no_area(const TubeInput& in, Status status, Arena& arena, Report& rep) {
     switch (why_no_area(in, arena)) {
     case NoArea::line:
         if (status != Status::degenerate) return status;

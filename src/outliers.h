@@ -58,13 +58,13 @@ struct GridItem {
 // A cell's coordinate along one axis, clamped to [0, kCellTop] (clamping keeps cells next
 // to each other next to each other, so no neighbour is missed; a clamped cell only holds
 // more points).
-inline uint64_t cell_coordinate(double offset, double side) {
+static inline uint64_t cell_coordinate(double offset, double side) {
     const double c = std::floor(offset / side);
     if (!(c > 0)) return 0;
     return c < static_cast<double>(kCellTop) ? static_cast<uint64_t>(c) : kCellTop;
 }
 
-inline uint64_t cell_key(uint64_t x, uint64_t y, uint64_t z) {
+static inline uint64_t cell_key(uint64_t x, uint64_t y, uint64_t z) {
     return (x << (2 * kCellBits)) | (y << kCellBits) | z;
 }
 
@@ -77,7 +77,7 @@ struct CellScratch {
 };
 
 // One allocation sequence for the call and for reconstruct_workspace_size().
-inline CellScratch allocate_cell_scratch(Arena& arena, size_t count) {
+static inline CellScratch allocate_cell_scratch(Arena& arena, size_t count) {
     CellScratch g;
     g.items = arena.alloc<GridItem>(count);
     g.spare = arena.alloc<GridItem>(count);
@@ -89,7 +89,7 @@ inline CellScratch allocate_cell_scratch(Arena& arena, size_t count) {
 // array: the pointers are swapped as the passes go). An LSD radix sort, a byte a pass,
 // skipping the bytes that every key shares: `any` and `every` are the keys' bitwise or
 // and and.
-inline void sort_items(GridItem*& items, GridItem*& spare, size_t n, uint64_t any, uint64_t every) {
+static inline void sort_items(GridItem*& items, GridItem*& spare, size_t n, uint64_t any, uint64_t every) {
     for (uint32_t shift = 0; shift < 64; shift += 8) {
         if ((((any ^ every) >> shift) & 0xFFu) == 0) continue;
         size_t histogram[256] = {};
@@ -110,7 +110,7 @@ inline void sort_items(GridItem*& items, GridItem*& spare, size_t n, uint64_t an
 // The valid points in g.items, sorted by their cell of side `side` from `low` and by index
 // within a cell; returns their count. Most key bytes are shared: a grid rarely spans more
 // than 2^8 cells an axis.
-inline size_t sort_into_cells(const CloudReader& reader, size_t count, Vec3 low, double side,
+static inline size_t sort_into_cells(const CloudReader& reader, size_t count, Vec3 low, double side,
                               CellScratch& g) {
     size_t n = 0;
     uint64_t any = 0, every = ~uint64_t{0};
@@ -131,7 +131,7 @@ inline size_t sort_into_cells(const CloudReader& reader, size_t count, Vec3 low,
 // The first item at or after `cell`, searched from items[from] outward (from < count):
 // the steps double until they pass it, then halve. The cells around a point's lie near it
 // in the array, so the search stays in memory the point's cell brought in.
-inline size_t first_in_cell(const GridItem* items, size_t count, uint64_t cell, size_t from) {
+static inline size_t first_in_cell(const GridItem* items, size_t count, uint64_t cell, size_t from) {
     size_t lo = from, hi = from;  // the answer lies in [lo, hi] once the steps pass it
     if (items[from].cell < cell) {
         for (size_t step = 1; hi < count && items[hi].cell < cell; step *= 2) {
@@ -167,7 +167,7 @@ struct CellBlock {
 // `member` is an item of `cell`. With `fingers` (18 valid positions, updated), each range
 // end is searched from where the same end was found last: a caller that goes through cells
 // in key order then finds each a few items on.
-inline CellBlock block_around(const GridItem* items, size_t count, size_t member,
+static inline CellBlock block_around(const GridItem* items, size_t count, size_t member,
                               size_t* fingers = nullptr) {
     const uint64_t cell = items[member].cell;
     CellBlock b;
@@ -194,12 +194,12 @@ inline CellBlock block_around(const GridItem* items, size_t count, size_t member
 
 // The samples of the scale measures are taken by a hash of the coordinates, about one
 // point in `step`, so that they do not depend on the order of the points.
-inline uint32_t sample_step(size_t count, size_t most) {
+static inline uint32_t sample_step(size_t count, size_t most) {
     const size_t step = count > most ? (count + most - 1) / most : 1;
     return step < UINT32_MAX ? static_cast<uint32_t>(step) : UINT32_MAX;
 }
 
-inline bool sampled_point(Vec3 p, uint32_t step) {
+static inline bool sampled_point(Vec3 p, uint32_t step) {
     double z = p.z + 0.0;
     uint64_t bz;
     std::memcpy(&bz, &z, sizeof bz);
@@ -211,7 +211,7 @@ inline bool sampled_point(Vec3 p, uint32_t step) {
 // The distance that nine points in ten do not exceed to their nearest distinct point, as
 // the top of its half-octave; 0 when more than a tenth find none within a cell. Measured
 // on about `most_sampled` points (see sample_step): a decile needs no more.
-inline double nearest_distance_decile(const CloudReader& reader, const CellScratch& g,
+static inline double nearest_distance_decile(const CloudReader& reader, const CellScratch& g,
                                       size_t count, double side, size_t most_sampled) {
     const GridItem* items = g.items;
     for (size_t i = 0; i < count; ++i) g.sorted[i] = reader.point(items[i].index);
@@ -261,7 +261,7 @@ struct CloudBox {
     size_t valid;
 };
 
-inline CloudBox box_of(const CloudReader& reader, size_t count) {
+static inline CloudBox box_of(const CloudReader& reader, size_t count) {
     CloudBox box = {{DBL_MAX, DBL_MAX, DBL_MAX}, {-DBL_MAX, -DBL_MAX, -DBL_MAX}, 0};
     for (size_t i = 0; i < count; ++i) {
         if (!reader.valid(i)) continue;
@@ -281,7 +281,7 @@ inline CloudBox box_of(const CloudReader& reader, size_t count) {
 // Where one cell of the grid (items sorted by cell) holds more than half the points: the
 // cell side that spreads its points as nearest_spacing spreads the whole cloud's first
 // (from its points' own box); 0 otherwise, or if they are all at one place.
-inline double crowded_cell_side(const CloudReader& reader, const GridItem* items, size_t n) {
+static inline double crowded_cell_side(const CloudReader& reader, const GridItem* items, size_t n) {
     for (size_t first = 0; first < n;) {
         size_t last = first;
         while (last < n && items[last].cell == items[first].cell) ++last;
@@ -301,7 +301,7 @@ inline double crowded_cell_side(const CloudReader& reader, const GridItem* items
     return 0;
 }
 
-inline double nearest_spacing(const CloudReader& reader, size_t count, const CloudBox& box,
+static inline double nearest_spacing(const CloudReader& reader, size_t count, const CloudBox& box,
                               CellScratch& g, size_t most_sampled) {
     const Vec3 half = scaled(box.high - box.low, 0.5);
     double side = 4 * std::sqrt(dot(half, half)) / std::sqrt(static_cast<double>(box.valid));
@@ -328,7 +328,7 @@ inline double nearest_spacing(const CloudReader& reader, size_t count, const Clo
 
 // Marks the outliers in `dropped` (zeroed, a bit per point) and returns how many; from
 // here on reader.valid() leaves them out. See "outliers" above.
-inline size_t drop_outliers_of(CloudReader& reader, size_t count, unsigned char* dropped,
+static inline size_t drop_outliers_of(CloudReader& reader, size_t count, unsigned char* dropped,
                                CellScratch& g) {
     reader.dropped = dropped;
     size_t total = 0;
@@ -358,7 +358,7 @@ inline size_t drop_outliers_of(CloudReader& reader, size_t count, unsigned char*
 
 // The drop_outliers step: the bitmap stays in `arena` for the whole call (reader.dropped),
 // the grid's scratch is given back. False if the workspace is too small.
-inline bool find_outliers(CloudReader& reader, size_t count, Arena& arena, Report& rep) {
+static inline bool find_outliers(CloudReader& reader, size_t count, Arena& arena, Report& rep) {
     unsigned char* dropped = arena.alloc<unsigned char>(count / 8 + 1);
     const size_t mark = arena.mark();
     CellScratch g = allocate_cell_scratch(arena, count);

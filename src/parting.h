@@ -47,7 +47,7 @@ struct CachedBlock {
 
 // The size from which a piece of a side of `points` points counts: kSmallestBranch, and a
 // twentieth of the side.
-inline uint32_t counting_size(size_t points, uint32_t smallest) {
+static inline uint32_t counting_size(size_t points, uint32_t smallest) {
     const size_t twentieth = (points + 19) / 20;
     return twentieth > smallest ? static_cast<uint32_t>(twentieth) : smallest;
 }
@@ -151,7 +151,7 @@ struct BranchCandidate {
 // branches there; if so their sizes and roots go to `sizes` and `roots`, largest first, and
 // their count is returned (else 0). The points of orders [slab_start, added) are those
 // within two gaps of the cut.
-inline uint32_t branches_at(PartingSweep& s, uint32_t added, uint32_t slab_start, double cut,
+static inline uint32_t branches_at(PartingSweep& s, uint32_t added, uint32_t slab_start, double cut,
                             uint32_t* sizes, uint32_t* roots) {
     BranchCandidate found[kMaxBranches];
     uint32_t pieces = 0;
@@ -247,7 +247,7 @@ struct SideParting {
 // sweep where the cloud parts (the lowest above, the highest below). With `stop` (a cut
 // index, 0 for none), it stops once that cut is tried: the roots then name the pieces as
 // the union-find holds them, for labelling.
-inline SideParting sweep_for_parting(PartingSweep& s, const PartingSteps& p, bool from_top,
+static inline SideParting sweep_for_parting(PartingSweep& s, const PartingSteps& p, bool from_top,
                                      uint32_t stop) {
     s.sign = from_top ? 1 : -1;
     s.listed_count = 0;
@@ -290,7 +290,7 @@ inline SideParting sweep_for_parting(PartingSweep& s, const PartingSteps& p, boo
 // starts at the cut (within a gap of it) goes on the trunk across it: the top of a skull's
 // crown between two horns, where the cut lies just below it, too small to count as a bump
 // (the bust with horns of 50,000 points: 147 such points, which left the split undone).
-inline void label_branches(PartingSweep& s, const PartingSteps& p, bool from_top,
+static inline void label_branches(PartingSweep& s, const PartingSteps& p, bool from_top,
                            uint32_t cut_index, uint8_t first, uint8_t* branch_of) {
     const SideParting side = sweep_for_parting(s, p, from_top, cut_index);
     const double cut = s.sign * (p.lo + cut_index * p.step_height);
@@ -313,7 +313,7 @@ struct PartingMemory {
 };
 
 // Allocated after the scale is measured, whose grid is given back first.
-inline void allocate_parting(PartingMemory& m, size_t count, Arena& arena) {
+static inline void allocate_parting(PartingMemory& m, size_t count, Arena& arena) {
     m.items = arena.alloc<GridItem>(count);
     m.spare = arena.alloc<GridItem>(count);
     m.position = arena.alloc<Local>(count);
@@ -332,7 +332,7 @@ inline void allocate_parting(PartingMemory& m, size_t count, Arena& arena) {
 
 // The valid points in the frame, in cells of side `side` sorted by height, then across;
 // returns their count. `low` is their lowest frame coordinates.
-inline size_t grid_in_frame(const CloudReader& reader, size_t count, const Frame& frame,
+static inline size_t grid_in_frame(const CloudReader& reader, size_t count, const Frame& frame,
                             Local low, double side, PartingMemory& m) {
     size_t n = 0;
     uint64_t any = 0, every = ~uint64_t{0};
@@ -353,7 +353,7 @@ inline size_t grid_in_frame(const CloudReader& reader, size_t count, const Frame
 
 // The steps of the n points in grid order (a counting sort), every half gap from lo to hi,
 // fewer where that would make more steps than points.
-inline void split_into_steps(const Local* position, size_t n, double lo, double hi, double gap,
+static inline void split_into_steps(const Local* position, size_t n, double lo, double hi, double gap,
                              PartingSteps& p) {
     const double most = static_cast<double>(n);
     double steps = std::ceil((hi - lo) / (gap / kStepsPerGap));
@@ -379,7 +379,7 @@ inline void split_into_steps(const Local* position, size_t n, double lo, double 
 // find theirs; a point looks at kNearestCandidates points at most, its own cell first.
 // Exact where nearest_spacing is not: that one is rounded up to a half-octave, too coarse
 // for a threshold that tells a notch from a gap.
-inline double median_nearest_distance(const CloudReader& reader, size_t count, const CloudBox& box,
+static inline double median_nearest_distance(const CloudReader& reader, size_t count, const CloudBox& box,
                                       double decile, CellScratch& g, GridItem* sample,
                                       GridItem* sample_spare) {
     const size_t n = sort_into_cells(reader, count, box.low, decile, g);
@@ -413,7 +413,7 @@ inline double median_nearest_distance(const CloudReader& reader, size_t count, c
     return median < DBL_MAX ? std::sqrt(median) : 0;
 }
 
-inline Status out_of_workspace(Report& rep) {
+static inline Status out_of_workspace(Report& rep) {
     rep.detail = "the workspace is smaller than find_parting_workspace_size()";
     return Status::out_of_memory;
 }
@@ -424,7 +424,7 @@ inline Status out_of_workspace(Report& rep) {
 namespace stratmesh {
 namespace detail {
 
-inline size_t parting_workspace_size(size_t point_count, const TubeRequest& request) {
+static inline size_t parting_workspace_size(size_t point_count, const TubeRequest& request) {
     if (point_count > kMaxPoints - 1) return 0;
     Arena arena = Arena::measuring();
     if (request.drop_outliers) arena.alloc<unsigned char>(point_count / 8 + 1);
@@ -443,7 +443,7 @@ inline size_t parting_workspace_size(size_t point_count, const TubeRequest& requ
 // find_parting() along the axis of `request` (its origin, outliers and invalid points as
 // it says) with the fewest points a branch holds given: a sample of the cloud is searched
 // with fewer (see search_parting).
-inline Status find_parting_with(const Cloud& cloud, const TubeRequest& request, void* workspace,
+static inline Status find_parting_with(const Cloud& cloud, const TubeRequest& request, void* workspace,
                                 size_t workspace_bytes, Parting* parting, uint8_t* branch_of,
                                 uint32_t smallest) {
     if (!parting) return Status::invalid_argument;

@@ -36,7 +36,7 @@ const double kPoleLayerRadii = 4.0 / 3.0;
 
 // The trunk's layers, as many as a tube of `count` points can have (each holds at least
 // kMinLayerPoints but the last).
-inline size_t most_layers(size_t count) { return count / kMinLayerPoints + 2; }
+static inline size_t most_layers(size_t count) { return count / kMinLayerPoints + 2; }
 
 struct PartsMemory {
     uint8_t* labels;          // find_parting's branch_of for the whole cloud
@@ -46,7 +46,7 @@ struct PartsMemory {
     size_t layer_capacity;
 };
 
-inline bool allocate_parts(PartsMemory& m, size_t count, Arena& arena) {
+static inline bool allocate_parts(PartsMemory& m, size_t count, Arena& arena) {
     m.labels = arena.alloc<uint8_t>(count);
     m.mask = arena.alloc<unsigned char>(count / 8 + 1);
     m.layer_capacity = most_layers(count);
@@ -56,7 +56,7 @@ inline bool allocate_parts(PartsMemory& m, size_t count, Arena& arena) {
 }
 
 // The reader of the part labelled `label`: every other point left out with the outliers.
-inline TubeInput part_input(const TubeInput& whole, const PartsMemory& m, uint8_t label) {
+static inline TubeInput part_input(const TubeInput& whole, const PartsMemory& m, uint8_t label) {
     const size_t bytes = whole.count / 8 + 1;
     std::memset(m.mask, 0, bytes);
     for (size_t i = 0; i < whole.count; ++i)
@@ -80,7 +80,7 @@ const double kAdoptionGaps = 2.0;
 const uint64_t kMostStrayChecks = uint64_t{1} << 26;
 
 // True if the trunk took a point.
-inline bool adopt_stray_points(const TubeInput& whole, double gap, uint8_t* labels) {
+static inline bool adopt_stray_points(const TubeInput& whole, double gap, uint8_t* labels) {
     const double reach = kAdoptionGaps * gap;
     uint64_t checks_left = kMostStrayChecks;
     bool trunk_grew = false;
@@ -116,7 +116,7 @@ inline bool adopt_stray_points(const TubeInput& whole, double gap, uint8_t* labe
 }
 
 // Whether every point is in a part (none is left beyond a cut in no branch).
-inline bool every_point_in_a_part(size_t count, const uint8_t* labels) {
+static inline bool every_point_in_a_part(size_t count, const uint8_t* labels) {
     for (size_t i = 0; i < count; ++i)
         if (labels[i] == kBeyondBranches) return false;
     return true;
@@ -126,7 +126,7 @@ inline bool every_point_in_a_part(size_t count, const uint8_t* labels) {
 // is closed, as a skull's crown under horns), the cuts that merge that end layer with the
 // layers next to it until it is kPoleLayerRadii times the largest of their radii tall;
 // false where no end needs it. *merged counts the layers merged away.
-inline bool cuts_for_tall_ends(const PartsMemory& m, size_t n, const Parting& parting,
+static inline bool cuts_for_tall_ends(const PartsMemory& m, size_t n, const Parting& parting,
                                size_t* cut_count, size_t* merged) {
     if (n < 2) return false;
     const LayerInfo* layers = m.layers;
@@ -153,7 +153,7 @@ inline bool cuts_for_tall_ends(const PartsMemory& m, size_t n, const Parting& pa
 }
 
 // A part meshed into the record of the parts, and where meshed, its counts into the whole's.
-inline void record_part(Report& rep, uint8_t label, Status status, const TubeInput& in,
+static inline void record_part(Report& rep, uint8_t label, Status status, const TubeInput& in,
                         const Report& part, size_t triangles, size_t merged) {
     PartCounts& p = rep.parts;
     if (p.part_count < p.info_capacity)
@@ -190,7 +190,7 @@ struct PartsWork {
 // Finds where the cloud parts along the request's axis (the frame's origin the centroid),
 // on a sample first when it is large (see above); the labels are filled where it parts.
 // False if the workspace is too small.
-inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const TubeRequest& along,
+static inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const TubeRequest& along,
                            const PartsMemory& m, Arena& arena, Parting& parting) {
     TubeRequest search = along;
     search.origin = nullptr;
@@ -224,7 +224,7 @@ inline bool search_parting(const Cloud& cloud, const TubeInput& whole, const Tub
 
 // Whether the cloud parts around a trunk: a trunk of fewer points than a branch is no
 // trunk, the cloud is apart all along (separate objects) and is meshed as one tube.
-inline bool parts_around_trunk(size_t count, const Parting& parting, const uint8_t* labels) {
+static inline bool parts_around_trunk(size_t count, const Parting& parting, const uint8_t* labels) {
     if (parting.above_branch_count + parting.below_branch_count == 0) return false;
     size_t trunk_points = 0;
     for (size_t i = 0; i < count; ++i) trunk_points += labels[i] == kInTrunk;
@@ -233,7 +233,7 @@ inline bool parts_around_trunk(size_t count, const Parting& parting, const uint8
 
 // The trunk's own automatic axis, chosen once for the labels as they stand: squaring the
 // cut asks for it, and the trunk is meshed around it unless a label changed since.
-inline Status trunk_axis(const TubeInput& whole, PartsWork& w, Arena& arena) {
+static inline Status trunk_axis(const TubeInput& whole, PartsWork& w, Arena& arena) {
     if (w.trunk_known) return w.trunk_status;
     w.trunk = w.cut;
     w.trunk.axis = Axis::automatic;
@@ -261,7 +261,7 @@ const double kSquareCutMost = 0.866;     // cos 30 degrees
 
 const int kSquareCutRounds = 4;
 
-inline bool square_cut_to_trunk(const Cloud& cloud, const TubeInput& whole, PartsWork& w,
+static inline bool square_cut_to_trunk(const Cloud& cloud, const TubeInput& whole, PartsWork& w,
                                 Arena& arena, Parting& parting) {
     for (int round = 0; round < kSquareCutRounds && w.cut.layers.cut_count == 0; ++round) {
         if (trunk_axis(whole, w, arena) != Status::ok || w.trunk.axis != Axis::direction) break;
@@ -289,7 +289,7 @@ inline bool square_cut_to_trunk(const Cloud& cloud, const TubeInput& whole, Part
 }
 
 // The area of a surface whose triangles index the cloud.
-inline double surface_area(const CloudReader& reader, const uint32_t* triangles, size_t count) {
+static inline double surface_area(const CloudReader& reader, const uint32_t* triangles, size_t count) {
     double area = 0;
     for (size_t t = 0; t < count; ++t) {
         const Vec3 a = reader.point(triangles[3 * t]);
@@ -303,7 +303,7 @@ inline double surface_area(const CloudReader& reader, const uint32_t* triangles,
 // The one tube's area, to weigh the parts against (DBL_MAX where it has none), where it
 // can decide: not where the parts are kept whatever their area, nor where a point in no
 // part undoes them whatever it. Its triangles are overwritten by the parts'.
-inline Status one_tube_area(const TubeInput& in, const TubeRequest& request, bool all_in_parts,
+static inline Status one_tube_area(const TubeInput& in, const TubeRequest& request, bool all_in_parts,
                             Arena& arena, uint32_t* triangles, size_t capacity,
                             const Report& before, double* area) {
     *area = DBL_MAX;
@@ -319,7 +319,7 @@ inline Status one_tube_area(const TubeInput& in, const TubeRequest& request, boo
 
 // The trunk along `along`, its end layers under branches merged where they stand on a
 // closed end; its triangles start the output.
-inline Status mesh_trunk(const TubeInput& trunk, const TubeRequest& along, const Parting& parting,
+static inline Status mesh_trunk(const TubeInput& trunk, const TubeRequest& along, const Parting& parting,
                          const PartsMemory& m, Arena& arena, uint32_t* triangles,
                          size_t capacity, size_t* count, Report& part, size_t* merged) {
     part.layers.info = m.layers;
@@ -347,7 +347,7 @@ inline Status mesh_trunk(const TubeInput& trunk, const TubeRequest& along, const
 // The trunk into the output, around its own axis as the branches (a body whose legs hang
 // under it is meshed along the body) unless the caller laid out the layers; its frame and
 // layers are the whole's in the report. Where it fails, the outcome is undone.
-inline Status mesh_trunk_part(const TubeInput& whole, PartsWork& w, Arena& arena,
+static inline Status mesh_trunk_part(const TubeInput& whole, PartsWork& w, Arena& arena,
                               uint32_t* triangles, size_t capacity, size_t* count, Report& rep) {
     const Parting& parting = rep.parts.parting;
     const TubeInput trunk = part_input(whole, w.m, kInTrunk);
@@ -387,7 +387,7 @@ inline Status mesh_trunk_part(const TubeInput& whole, PartsWork& w, Arena& arena
 // A branch's request: around its own automatic axis and layers, its frame's origin its own
 // centroid, no caps (they come once the parts are joined) and no progress (the caller's
 // would run backwards from part to part).
-inline TubeRequest branch_request(TubeRequest r) {
+static inline TubeRequest branch_request(TubeRequest r) {
     r.axis = Axis::automatic;
     r.layers = LayerRequest{};
     r.origin = nullptr;
@@ -399,7 +399,7 @@ inline TubeRequest branch_request(TubeRequest r) {
 // Each branch into the output after the trunk's `*count` triangles, its end at the cut a
 // cut, not a closed end: its low end along its own axis if that runs away from the trunk.
 // *all_meshed is cleared where a branch fails (its points stay unused).
-inline Status mesh_branches(const TubeInput& whole, const PartsWork& w, Arena& arena,
+static inline Status mesh_branches(const TubeInput& whole, const PartsWork& w, Arena& arena,
                             uint32_t* triangles, size_t capacity, size_t* count, bool* all_meshed,
                             Report& rep) {
     const Parting& parting = rep.parts.parting;
@@ -438,7 +438,7 @@ inline Status mesh_branches(const TubeInput& whole, const PartsWork& w, Arena& a
 // Joins the parts meshed into the output (then caps them, as asked); `whole` tells whether
 // every part was meshed and every point is in one. Sets rep.parts.outcome: joined,
 // kept_apart, or undone (the output is then to be made again as one tube).
-inline Status join_parts(const Cloud& cloud, const PartsWork& w, bool whole, Arena& arena,
+static inline Status join_parts(const Cloud& cloud, const PartsWork& w, bool whole, Arena& arena,
                          uint32_t* triangles, size_t capacity, size_t count,
                          size_t* triangle_count, Report& rep) {
     JoinReport join = {};
@@ -487,7 +487,7 @@ inline Status join_parts(const Cloud& cloud, const PartsWork& w, bool whole, Are
 // that folds where the parting misread the cloud, as a neck's torn rim taken for two
 // branches), or kept apart as asked. Otherwise the counts start again from `before`, the
 // parts' record stays.
-inline bool keep_or_undo(const TubeInput& in, const uint32_t* triangles, size_t count,
+static inline bool keep_or_undo(const TubeInput& in, const uint32_t* triangles, size_t count,
                          double tube_area, const Report& before, Report& rep) {
     const PartsOutcome outcome = rep.parts.outcome;
     if (outcome == PartsOutcome::kept_apart ||
@@ -507,7 +507,7 @@ inline bool keep_or_undo(const TubeInput& in, const uint32_t* triangles, size_t 
 
 // The steps where the cloud may part (see above); *kept tells whether the parts are the
 // output, else the one tube is to be meshed.
-inline Status mesh_apart(const Cloud& cloud, const TubeInput& in, const TubeRequest& request,
+static inline Status mesh_apart(const Cloud& cloud, const TubeInput& in, const TubeRequest& request,
                          Arena& arena, uint32_t* triangles, size_t capacity,
                          size_t* triangle_count, Report& rep, bool* kept) {
     PartsWork w = {};
@@ -545,7 +545,7 @@ inline Status mesh_apart(const Cloud& cloud, const TubeInput& in, const TubeRequ
 // reconstruct() with the search for branches: `in` is read and the request's axis is
 // resolved. Where the cloud parts, the parts joined are kept only where whole and smaller
 // than the one tube's (see keep_or_undo()), else the one tube is.
-inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in,
+static inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in,
                                   const TubeRequest& request, Arena& arena,
                                   uint32_t* triangles, size_t capacity, size_t* triangle_count,
                                   Report& rep) {
@@ -561,7 +561,7 @@ inline Status reconstruct_default(const Cloud& cloud, const TubeInput& in,
 }
 
 // The workspace reconstruct_default() takes on top of read_cloud()'s.
-inline size_t parts_workspace_size(size_t count, const TubeRequest& request) {
+static inline size_t parts_workspace_size(size_t count, const TubeRequest& request) {
     Arena arena = Arena::measuring();
     PartsMemory m;
     allocate_parts(m, count, arena);

@@ -11,15 +11,15 @@ struct Vec3 {
     double x, y, z;
 };
 
-inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+static inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 
-inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
-inline Vec3 cross(Vec3 a, Vec3 b) {
+static inline Vec3 cross(Vec3 a, Vec3 b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 
-inline Vec3 scaled(Vec3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+static inline Vec3 scaled(Vec3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
 
 struct CloudReader {
     const unsigned char* base;
@@ -50,12 +50,12 @@ struct CloudReader {
 
 // False unless v's squared length is a normal double (v's length between about 1.5e-154
 // and 1.3e154): a subnormal square has lost the bits that make the result unit.
-inline double largest_of(Vec3 v) {
+static inline double largest_of(Vec3 v) {
     const double xy = v.x > v.y ? v.x : v.y;
     return xy > v.z ? xy : v.z;
 }
 
-inline bool normalize(Vec3& v) {
+static inline bool normalize(Vec3& v) {
     const double square = dot(v, v);
     if (!(square >= DBL_MIN) || !is_finite(square)) return false;
     const double len = std::sqrt(square);
@@ -67,7 +67,7 @@ inline bool normalize(Vec3& v) {
 // that brings its largest component into [1, 2) (exact: a component that falls below the
 // smallest subnormal is negligible beside it), so that its square neither overflows nor
 // underflows. False for zero, NaN or infinite components.
-inline bool unit_direction(Vec3& v) {
+static inline bool unit_direction(Vec3& v) {
     if (!is_finite(v.x) || !is_finite(v.y) || !is_finite(v.z)) return false;
     const double largest = largest_of({abs_value(v.x), abs_value(v.y), abs_value(v.z)});
     if (largest == 0) return false;

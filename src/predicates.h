@@ -25,7 +25,7 @@ constexpr double kOrientBoundA = (3.0 + 16.0 * kEps) * kEps;
 constexpr double kIncircleBoundA = (10.0 + 96.0 * kEps) * kEps;
 
 // a + b = x + y exactly, with x = fl(a + b).
-inline void two_sum(double a, double b, double& x, double& y) {
+static inline void two_sum(double a, double b, double& x, double& y) {
     x = a + b;
     double bv = x - a;
     double av = x - bv;
@@ -33,14 +33,14 @@ inline void two_sum(double a, double b, double& x, double& y) {
 }
 
 // a - b = x + y exactly, with x = fl(a - b).
-inline void two_diff(double a, double b, double& x, double& y) {
+static inline void two_diff(double a, double b, double& x, double& y) {
     x = a - b;
     double bv = a - x;
     double av = x + bv;
     y = (a - av) + (bv - b);
 }
 
-inline void split(double a, double& hi, double& lo) {
+static inline void split(double a, double& hi, double& lo) {
     double c = kSplitter * a;
     double big = c - a;
     hi = c - big;
@@ -48,7 +48,7 @@ inline void split(double a, double& hi, double& lo) {
 }
 
 // a * b = x + y exactly, with x = fl(a * b) (Dekker's product, Veltkamp's split).
-inline void two_product(double a, double b, double& x, double& y) {
+static inline void two_product(double a, double b, double& x, double& y) {
     x = a * b;
     double ahi, alo, bhi, blo;
     split(a, ahi, alo);
@@ -60,7 +60,7 @@ inline void two_product(double a, double b, double& x, double& y) {
 }
 
 // (a1 + a0) - (b1 + b0) as a four-component expansion out[0..3], least significant first.
-inline void two_two_diff(double a1, double a0, double b1, double b0, double* out) {
+static inline void two_two_diff(double a1, double a0, double b1, double b0, double* out) {
     double i, j, z;
     two_diff(a0, b0, i, out[0]);
     two_sum(a1, i, j, z);
@@ -69,7 +69,7 @@ inline void two_two_diff(double a1, double a0, double b1, double b0, double* out
 }
 
 // ax*by - ay*bx as a four-component expansion.
-inline void cross_exact(double ax, double ay, double bx, double by, double* out) {
+static inline void cross_exact(double ax, double ay, double bx, double by, double* out) {
     double p1, p0, q1, q0;
     two_product(ax, by, p1, p0);
     two_product(ay, bx, q1, q0);
@@ -78,7 +78,7 @@ inline void cross_exact(double ax, double ay, double bx, double by, double* out)
 
 // h = e + f; returns the length of h with zero components removed (at least 1). h needs
 // room for elen + flen components and must not alias e or f.
-inline int expansion_sum(int elen, const double* e, int flen, const double* f, double* h) {
+static inline int expansion_sum(int elen, const double* e, int flen, const double* f, double* h) {
     int ei = 0, fi = 0, hi = 0;
     double q = 0, hh = 0;
     bool first = true;
@@ -104,7 +104,7 @@ inline int expansion_sum(int elen, const double* e, int flen, const double* f, d
 }
 
 // Removes the zero components of e in place; returns the new length (at least 1).
-inline int compress_zeros(int len, double* e) {
+static inline int compress_zeros(int len, double* e) {
     int kept = 0;
     for (int i = 0; i < len; ++i)
         if (e[i] != 0) e[kept++] = e[i];
@@ -114,7 +114,7 @@ inline int compress_zeros(int len, double* e) {
 
 // h = b * e; returns the length of h (at most 2 * elen) with zeros removed. h must not
 // alias e.
-inline int expansion_scale(int elen, const double* e, double b, double* h) {
+static inline int expansion_scale(int elen, const double* e, double b, double* h) {
     if (b == 0 || (elen == 1 && e[0] == 0)) {
         h[0] = 0;
         return 1;
@@ -136,7 +136,7 @@ inline int expansion_scale(int elen, const double* e, double b, double* h) {
 }
 
 // h = e * f; h and tmp each need room for 2 * elen * flen components, scaled for 2 * elen.
-inline int expansion_product(int elen, const double* e, int flen, const double* f, double* h,
+static inline int expansion_product(int elen, const double* e, int flen, const double* f, double* h,
                              double* tmp, double* scaled) {
     int len = expansion_scale(elen, e, f[0], h);
     for (int j = 1; j < flen; ++j) {
@@ -147,19 +147,19 @@ inline int expansion_product(int elen, const double* e, int flen, const double* 
     return len;
 }
 
-inline void expansion_negate(int len, double* e) {
+static inline void expansion_negate(int len, double* e) {
     for (int i = 0; i < len; ++i) e[i] = -e[i];
 }
 
 // The most significant non-zero component (0 if the expansion is zero).
-inline double expansion_top(int len, const double* e) {
+static inline double expansion_top(int len, const double* e) {
     for (int i = len - 1; i >= 0; --i)
         if (e[i] != 0) return e[i];
     return 0;
 }
 
 // orient2d from the raw coordinates: a x b + b x c + c x a, exactly.
-inline double orient2d_exact(const double* a, const double* b, const double* c) {
+static inline double orient2d_exact(const double* a, const double* b, const double* c) {
     double ab[4], bc[4], ca[4], s[8], t[12];
     cross_exact(a[0], a[1], b[0], b[1], ab);
     cross_exact(b[0], b[1], c[0], c[1], bc);
@@ -176,7 +176,7 @@ inline double orient2d_exact(const double* a, const double* b, const double* c) 
 // `values` are the coordinates and differences involved; `limit` the largest safe binary
 // exponent for the degree. Returns the factor, or 0 when no scaling is needed (or none
 // can help: magnitudes spread over more than the double range allows).
-inline double rescaling_factor(const double* values, int count, int limit) {
+static inline double rescaling_factor(const double* values, int count, int limit) {
     double largest = 0, smallest = DBL_MAX;
     for (int i = 0; i < count; ++i) {
         double v = abs_value(values[i]);
@@ -204,7 +204,7 @@ constexpr double kUnderflowGuard = 0x1p-1000;
 
 // Points the first `count` entries of `points` at scaled copies in `storage`, unless
 // factor is 0 (no scaling needed).
-inline void rescale_points(double factor, const double** points, double (*storage)[2],
+static inline void rescale_points(double factor, const double** points, double (*storage)[2],
                            int count) {
     if (factor == 0) return;
     for (int k = 0; k < count; ++k) {
@@ -224,7 +224,7 @@ inline void rescale_points(double factor, const double** points, double (*storag
 // the magnitudes and without underflow, so these stages need no rescaling.
 
 // floor(log2(|v|)) for a finite non-zero double.
-inline int top_bit_exponent(double v) {
+static inline int top_bit_exponent(double v) {
     uint64_t bits;
     std::memcpy(&bits, &v, sizeof bits);
     int biased = static_cast<int>((bits >> 52) & 0x7FF);
@@ -237,7 +237,7 @@ inline int top_bit_exponent(double v) {
 }
 
 // 2^e for -1022 <= e <= 1023.
-inline double power_of_two(int e) {
+static inline double power_of_two(int e) {
     uint64_t bits = static_cast<uint64_t>(e + 1023) << 52;
     double v;
     std::memcpy(&v, &bits, sizeof v);
@@ -255,7 +255,7 @@ struct Uint256 {
 
 // a * b exactly. Where the compiler has a 128-bit type this is one instruction on 64-bit
 // targets; elsewhere it is built from 32-bit halves. Both are exact, so results agree.
-inline Uint128 multiply_wide(uint64_t a, uint64_t b) {
+static inline Uint128 multiply_wide(uint64_t a, uint64_t b) {
     Uint128 r;
 #if defined(__SIZEOF_INT128__)
     __extension__ typedef unsigned __int128 uint128_type;
@@ -274,7 +274,7 @@ inline Uint128 multiply_wide(uint64_t a, uint64_t b) {
 }
 
 // a + b + carry; carry becomes the carry out (the carry in is 0 or 1).
-inline uint64_t add_with_carry(uint64_t a, uint64_t b, uint64_t& carry) {
+static inline uint64_t add_with_carry(uint64_t a, uint64_t b, uint64_t& carry) {
     uint64_t s = a + b;
     uint64_t out = s < a;
     uint64_t t = s + carry;
@@ -284,7 +284,7 @@ inline uint64_t add_with_carry(uint64_t a, uint64_t b, uint64_t& carry) {
 
 // sum += term or sum -= term, two's complement modulo 2^(64 N); term is zero-extended.
 template <size_t N, size_t M>
-inline void words_accumulate(uint64_t (&sum)[N], const uint64_t (&term)[M], bool subtract) {
+static inline void words_accumulate(uint64_t (&sum)[N], const uint64_t (&term)[M], bool subtract) {
     uint64_t flip = subtract ? ~uint64_t(0) : 0;
     uint64_t carry = subtract ? 1 : 0;
     for (size_t k = 0; k < N; ++k)
@@ -293,7 +293,7 @@ inline void words_accumulate(uint64_t (&sum)[N], const uint64_t (&term)[M], bool
 
 // Makes a two's complement number its magnitude; returns whether it was negative.
 template <size_t N>
-inline bool words_to_magnitude(uint64_t (&value)[N]) {
+static inline bool words_to_magnitude(uint64_t (&value)[N]) {
     if ((value[N - 1] >> 63) == 0) return false;
     uint64_t carry = 1;
     for (size_t k = 0; k < N; ++k) {
@@ -304,7 +304,7 @@ inline bool words_to_magnitude(uint64_t (&value)[N]) {
 }
 
 // a * b for a, b < 2^127 (the top word cannot overflow).
-inline Uint256 multiply_wide(const Uint128& a, const Uint128& b) {
+static inline Uint256 multiply_wide(const Uint128& a, const Uint128& b) {
     Uint128 p00 = multiply_wide(a.word[0], b.word[0]);
     Uint128 p01 = multiply_wide(a.word[0], b.word[1]);
     Uint128 p10 = multiply_wide(a.word[1], b.word[0]);
@@ -333,7 +333,7 @@ struct ScaledIntegers {
 // Scales `count` (at most 6) exact, hence finite, differences into integers; false when
 // they span more than 62 bits, or all lie below 2^-962 (the factor would leave the double
 // range; rare enough to leave to the expansions).
-inline bool to_integers(const double* values, int count, ScaledIntegers& out) {
+static inline bool to_integers(const double* values, int count, ScaledIntegers& out) {
     double largest = 0;
     for (int i = 0; i < count; ++i)
         if (abs_value(values[i]) > largest) largest = abs_value(values[i]);
@@ -354,7 +354,7 @@ inline bool to_integers(const double* values, int count, ScaledIntegers& out) {
 
 // u0 v1 - u1 v0 for four of the integers, given by index: its magnitude (below 2^125)
 // and whether it is negative.
-inline Uint128 integer_cross(const ScaledIntegers& z, int u0, int u1, int v0, int v1,
+static inline Uint128 integer_cross(const ScaledIntegers& z, int u0, int u1, int v0, int v1,
                              bool* negative) {
     Uint128 cross = {{0, 0}};
     Uint128 left = multiply_wide(z.magnitude[u0], z.magnitude[v1]);
@@ -368,7 +368,7 @@ inline Uint128 integer_cross(const ScaledIntegers& z, int u0, int u1, int v0, in
 // (-1)^negative * magnitude * 2^exponent as a double. Only the sign is exact: a non-zero
 // value is kept from rounding to zero or infinity.
 template <size_t N>
-inline double to_signed_double(const uint64_t (&magnitude)[N], bool negative, int exponent) {
+static inline double to_signed_double(const uint64_t (&magnitude)[N], bool negative, int exponent) {
     double value = 0;
     for (size_t k = N; k-- > 0;) value = value * 0x1p64 + static_cast<double>(magnitude[k]);
     if (value == 0) return 0;
@@ -380,7 +380,7 @@ inline double to_signed_double(const uint64_t (&magnitude)[N], bool negative, in
 
 // orient2d from exact differences u = a - c, v = b - c: u x v, or false when the integer
 // stage does not apply.
-inline bool orient2d_from_integer_differences(const double differences[4], double* det) {
+static inline bool orient2d_from_integer_differences(const double differences[4], double* det) {
     ScaledIntegers z;
     if (!to_integers(differences, 4, z)) return false;
     bool negative = false;
@@ -392,7 +392,7 @@ inline bool orient2d_from_integer_differences(const double differences[4], doubl
 // incircle from exact differences to d, rows (dx, dy): the 3x3 determinant of rows
 // (dx, dy, dx^2 + dy^2) expanded along the lifts, or false when the integer stage does
 // not apply.
-inline bool incircle_from_integer_differences(const double rows[3][2], double* det) {
+static inline bool incircle_from_integer_differences(const double rows[3][2], double* det) {
     ScaledIntegers z;
     if (!to_integers(&rows[0][0], 6, z)) return false;
     uint64_t sum[4] = {0, 0, 0, 0};
@@ -415,7 +415,7 @@ inline bool incircle_from_integer_differences(const double rows[3][2], double* d
 // integer stage, then with rescaling in expansions), then the raw coordinates are used
 // (with STRATMESH_SMALL_CODE at once, after the rescaling: kFastExactStages). Kept apart
 // from the filter so that the common, filtered call stays small.
-STRATMESH_NOINLINE inline double orient2d_beyond_filter(const double* a, const double* b,
+STRATMESH_NOINLINE static inline double orient2d_beyond_filter(const double* a, const double* b,
                                                          const double* c) {
     double differences[4], tails[4], det = 0;
     two_diff(a[0], c[0], differences[0], tails[0]);
@@ -448,7 +448,7 @@ STRATMESH_NOINLINE inline double orient2d_beyond_filter(const double* a, const d
 }
 
 // Sign-exact orient2d: the filter decides unless |det| is within the rounding error.
-inline double orient2d_robust(const double* a, const double* b, const double* c) {
+static inline double orient2d_robust(const double* a, const double* b, const double* c) {
     double acx = a[0] - c[0], bcx = b[0] - c[0];
     double acy = a[1] - c[1], bcy = b[1] - c[1];
     double left = acx * bcy;
@@ -464,7 +464,7 @@ const int kIncircleScratch = 1024;
 
 // incircle from the raw coordinates: the 4x4 determinant with rows (x, y, x^2 + y^2, 1),
 // expanded along the lift column. Needs kIncircleScratch doubles of scratch.
-inline double incircle_exact(const double* a, const double* b, const double* c,
+static inline double incircle_exact(const double* a, const double* b, const double* c,
                              const double* d, double* scratch) {
     const double* p[4] = {a, b, c, d};
     double* acc = scratch;         // 384
@@ -509,7 +509,7 @@ inline double incircle_exact(const double* a, const double* b, const double* c,
 // value. (Taking the expansion's two largest components instead is not enough: a
 // nonoverlapping expansion may hold a lone high bit followed by a component nearly as
 // large.)
-inline void to_double_double(const double* e, int len, double* hi, double* lo) {
+static inline void to_double_double(const double* e, int len, double* hi, double* lo) {
     double h = 0, l = 0;
     for (int k = 0; k < len; ++k) {
         double s, err;
@@ -529,7 +529,7 @@ inline void to_double_double(const double* e, int len, double* hi, double* lo) {
 // 64 eps^2 sum |L M| has the right sign. That settles near-cocircular points whose
 // determinant is not zero; exact zeros take the exact products. Needs 264 doubles of
 // scratch.
-inline double incircle_from_differences(const double rows[3][2], double* scratch) {
+static inline double incircle_from_differences(const double rows[3][2], double* scratch) {
     double lift[3][4], minor[3][4];
     int lift_len[3], minor_len[3];
     double hi = 0, lo = 0, magnitude = 0;
@@ -576,7 +576,7 @@ inline double incircle_from_differences(const double rows[3][2], double* scratch
 }
 
 // The differences of a, b, c to d, as rows; whether all six are exact.
-inline bool differences_to(const double* a, const double* b, const double* c, const double* d,
+static inline bool differences_to(const double* a, const double* b, const double* c, const double* d,
                            double rows[3][2]) {
     const double* p[3] = {a, b, c};
     bool exact = true;
@@ -594,7 +594,7 @@ inline bool differences_to(const double* a, const double* b, const double* c, co
 // (there is no underflow to avoid); then the differences after rescaling; then the raw
 // coordinates (with STRATMESH_SMALL_CODE only these: kFastExactStages). Kept apart from
 // the filter so that the common, filtered call stays small.
-STRATMESH_NOINLINE inline double incircle_beyond_filter(const double* a, const double* b,
+STRATMESH_NOINLINE static inline double incircle_beyond_filter(const double* a, const double* b,
                                                          const double* c, const double* d,
                                                          double* scratch) {
     double rows[3][2], det = 0;
@@ -618,7 +618,7 @@ STRATMESH_NOINLINE inline double incircle_beyond_filter(const double* a, const d
 }
 
 // Sign-exact incircle using `scratch` (kIncircleScratch doubles) when the filter fails.
-inline double incircle_robust(const double* a, const double* b, const double* c,
+static inline double incircle_robust(const double* a, const double* b, const double* c,
                               const double* d, double* scratch) {
     double adx = a[0] - d[0], bdx = b[0] - d[0], cdx = c[0] - d[0];
     double ady = a[1] - d[1], bdy = b[1] - d[1], cdy = c[1] - d[1];
@@ -639,7 +639,7 @@ inline double incircle_robust(const double* a, const double* b, const double* c,
 }
 
 // Lexicographic order on (x, y): the rank that sets each point's perturbation.
-inline bool lex_less(const double* p, const double* q) {
+static inline bool lex_less(const double* p, const double* q) {
     return p[0] < q[0] || (p[0] == q[0] && p[1] < q[1]);
 }
 
@@ -649,7 +649,7 @@ inline bool lex_less(const double* p, const double* q) {
 // orientation of the other three) is non-zero; d's cofactor is -orient(a, b, c) < 0, so
 // the loop always ends. Never returns 0 for four distinct points. The tie is settled out of
 // line (STRATMESH_FAST_NOINLINE), so that the filtered test inlines into its callers.
-STRATMESH_FAST_NOINLINE inline int incircle_tie(const double* a, const double* b,
+STRATMESH_FAST_NOINLINE static inline int incircle_tie(const double* a, const double* b,
                                                 const double* c, const double* d) {
     const double* p[4] = {a, b, c, d};
     // Sort the four points by decreasing lexicographic rank (insertion sort, 4 items).
@@ -674,7 +674,7 @@ STRATMESH_FAST_NOINLINE inline int incircle_tie(const double* a, const double* b
     return -1;
 }
 
-STRATMESH_SMALL_NOINLINE inline int incircle_perturbed(const double* a, const double* b,
+STRATMESH_SMALL_NOINLINE static inline int incircle_perturbed(const double* a, const double* b,
                                                        const double* c, const double* d,
                                                        double* scratch) {
     const double det = incircle_robust(a, b, c, d, scratch);

@@ -7,7 +7,7 @@ namespace detail {
 // Reads a cloud that passed check_reconstruct_arguments: refuses or counts its NaN and
 // infinite points, leaves out its outliers (drop_outliers; the bitmap stays in `arena`)
 // and sums what is kept.
-inline Status read_cloud(const Cloud& cloud, const Options& options, Arena& arena, Report& rep,
+static inline Status read_cloud(const Cloud& cloud, const Options& options, Arena& arena, Report& rep,
                          TubeInput& in) {
     in.reader = reader_of(cloud);
     in.count = cloud.count;
@@ -29,11 +29,11 @@ inline Status read_cloud(const Cloud& cloud, const Options& options, Arena& aren
 }
 
 // Whether reconstruct() looks for branches.
-inline bool searches_parts(const TubeRequest& request) {
+static inline bool searches_parts(const TubeRequest& request) {
     return kFindParts && request.parts != PartsPolicy::one_tube;
 }
 
-inline Status mesh_cloud(const Cloud& cloud, const TubeInput& in, const TubeRequest& request,
+static inline Status mesh_cloud(const Cloud& cloud, const TubeInput& in, const TubeRequest& request,
                          Arena& arena, uint32_t* triangles, size_t capacity,
                          size_t* triangle_count, Report& rep) {
 #if !defined(STRATMESH_SMALL_CODE)
@@ -49,7 +49,7 @@ inline Status mesh_cloud(const Cloud& cloud, const TubeInput& in, const TubeRequ
 // reconstruct()'s body; `rep` arrives zeroed but for its caller's arrays.
 // Report::points.unused_count is left to the caller, who derives it so the counts add up on
 // every path.
-inline Status run_reconstruction(const Cloud& cloud, const Options& options, void* workspace,
+static inline Status run_reconstruction(const Cloud& cloud, const Options& options, void* workspace,
                                  size_t workspace_bytes, uint32_t* triangles,
                                  size_t triangle_capacity, size_t* triangle_count,
                                  Report& rep) {

@@ -43,7 +43,7 @@ struct TubeRequest {
     const Options* progress;
 };
 
-inline TubeRequest tube_request(const Options& options) {
+static inline TubeRequest tube_request(const Options& options) {
     const uint32_t f = options.flags;
     const PartsPolicy parts = !kFindParts || (f & one_tube) ? PartsPolicy::one_tube
                               : (f & keep_parts) ? PartsPolicy::keep
@@ -62,7 +62,7 @@ inline TubeRequest tube_request(const Options& options) {
 }
 
 // Sets the request's axis to a direction.
-inline void set_direction(TubeRequest& request, const double* direction) {
+static inline void set_direction(TubeRequest& request, const double* direction) {
     request.axis = Axis::direction;
     for (int k = 0; k < 3; ++k) request.direction[k] = direction[k];
 }
@@ -70,12 +70,12 @@ inline void set_direction(TubeRequest& request, const double* direction) {
 const Options kNoCallbacks = {};
 
 // The Options whose job runner a tube hands its jobs to (none in an axis trial).
-inline const Options& jobs_of(const TubeRequest& request) {
+static inline const Options& jobs_of(const TubeRequest& request) {
     return request.caller ? *request.caller : kNoCallbacks;
 }
 
 // Phase progress, to the caller's callback where the request reports progress.
-inline void notify(const TubeRequest& request, Phase phase, double fraction) {
+static inline void notify(const TubeRequest& request, Phase phase, double fraction) {
     if (request.progress) notify(*request.progress, phase, fraction);
 }
 

@@ -44,7 +44,7 @@ struct HilbertTable {
 
 constexpr HilbertTable kHilbertTable{};
 
-inline uint32_t hilbert_index(uint32_t x, uint32_t y) {
+static inline uint32_t hilbert_index(uint32_t x, uint32_t y) {
     // kHilbertBits is odd: a zero level is put on top, entered with x and y swapped so
     // that it leaves the identity transform (its digit is 0), and the 14 levels run in
     // seven steps.
@@ -60,7 +60,7 @@ inline uint32_t hilbert_index(uint32_t x, uint32_t y) {
     return d;
 }
 
-inline uint32_t quantize(double v, double lo, double scale) {
+static inline uint32_t quantize(double v, double lo, double scale) {
     const double top = static_cast<double>((1u << kHilbertBits) - 1);
     double q = (v - lo) * scale;
     if (!(q > 0)) return 0;
@@ -68,7 +68,7 @@ inline uint32_t quantize(double v, double lo, double scale) {
     return static_cast<uint32_t>(q);
 }
 
-inline uint32_t mix32(uint32_t h) {
+static inline uint32_t mix32(uint32_t h) {
     h ^= h >> 16;
     h *= 0x7FEB352Du;
     h ^= h >> 15;
@@ -78,7 +78,7 @@ inline uint32_t mix32(uint32_t h) {
 }
 
 // A hash of the point's coordinates (-0 and +0 hash alike).
-inline uint32_t coordinate_hash(double x, double y) {
+static inline uint32_t coordinate_hash(double x, double y) {
     uint64_t bx, by;
     x += 0.0;
     y += 0.0;
@@ -91,7 +91,7 @@ inline uint32_t coordinate_hash(double x, double y) {
 }
 
 // Stable LSD radix sort of `order` by `keys` (both count long), 8 bits a pass.
-inline void radix_sort(uint32_t* keys, uint32_t* order, uint32_t* keys_tmp,
+static inline void radix_sort(uint32_t* keys, uint32_t* order, uint32_t* keys_tmp,
                        uint32_t* order_tmp, size_t count) {
     for (uint32_t shift = 0; shift < 32; shift += 8) {
         size_t histogram[256];
@@ -121,7 +121,7 @@ struct BoundingBox2d {
 // The number of trailing zero bits of h, at most `limit` (< 32). The loop over the bits,
 // whose length is random, mispredicts its exit on about every other point; GCC and Clang
 // count them in an instruction or two (2.5% of delaunay_2d's time on 1e6 points).
-inline uint32_t trailing_zeros(uint32_t h, uint32_t limit) {
+static inline uint32_t trailing_zeros(uint32_t h, uint32_t limit) {
 #if defined(__GNUC__) || defined(__clang__)
     const uint32_t zeros = h ? static_cast<uint32_t>(__builtin_ctz(h)) : 32;
     return zeros < limit ? zeros : limit;
@@ -134,7 +134,7 @@ inline uint32_t trailing_zeros(uint32_t h, uint32_t limit) {
 
 // Fills order[0..count) with the indices of the points (x, y doubles, stride bytes apart)
 // in BRIO order over `box`; scratch from the arena.
-inline bool spatial_order(const unsigned char* xy, size_t stride, size_t count,
+static inline bool spatial_order(const unsigned char* xy, size_t stride, size_t count,
                           const BoundingBox2d& box, uint32_t* order, Arena& arena) {
     size_t mark = arena.mark();
     uint32_t* keys = arena.alloc<uint32_t>(count);

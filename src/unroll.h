@@ -48,7 +48,7 @@ const uint32_t kSectors = 32;
 // ulp of glibc's exp over [-64, 64] (tests; one measured). The series to r^13 / 13! that
 // a reduction to |r| <= ln2 / 2 needs took a fifth of triangulate_layer's own time on a
 // tube.
-inline double exp_portable(double x) {
+static inline double exp_portable(double x) {
     if (!(x > -64)) x = -64;
     if (x > 64) x = 64;
     // ln2 / 32 in two parts, the first with 32 significant bits: k times it is exact.
@@ -85,7 +85,7 @@ inline double exp_portable(double x) {
 // A monotone stand-in for the polar angle of (dx, dy), in [0, 4): no trigonometry. The
 // quadrant picks one of three values by index, not by branch: points in no angular order
 // (a layer as the scanner wrote it) would mispredict half of the branches.
-STRATMESH_SMALL_NOINLINE inline double pseudo_angle(double dx, double dy) {
+STRATMESH_SMALL_NOINLINE static inline double pseudo_angle(double dx, double dy) {
     double sum = abs_value(dx) + abs_value(dy);
     double t = sum > 0 ? dy / sum : 0;  // in [-1, 1]
     if (!kFastLoops) return dx >= 0 ? (t < 0 ? 4 + t : t) : 2 - t;
@@ -97,7 +97,7 @@ STRATMESH_SMALL_NOINLINE inline double pseudo_angle(double dx, double dy) {
 // The polar angle of (dx, dy) in [0, 2 pi), with + - * / only (the same bits everywhere):
 // two argument reductions bring the tangent below tan(pi / 12), where the odd Taylor series
 // to x^21 is accurate to about 1e-15.
-inline double polar_angle(double dx, double dy) {
+static inline double polar_angle(double dx, double dy) {
     const double pi = 3.14159265358979323846;
     const double sqrt3 = 1.73205080756887729353;
     double ax = abs_value(dx), ay = abs_value(dy);
@@ -140,7 +140,7 @@ const double kSmallestDirection = 0x1p-60;
 // The annulus radius of a point of height h at distance r from the axis: e^{(h - h0) *
 // scale}, or beyond a pole the stereographic radius of its direction from the pole (see
 // "closed ends" above).
-inline double annulus_radius(const Cylinder& c, double h, double r) {
+static inline double annulus_radius(const Cylinder& c, double h, double r) {
     const bool low = kClosedEnds && (c.poles & kLowPole) && h < c.pole_low;
     const bool high = kClosedEnds && (c.poles & kHighPole) && h > c.pole_high;
     if (!low && !high) return exp_portable((h - c.h0) * c.scale);
@@ -154,7 +154,7 @@ inline double annulus_radius(const Cylinder& c, double h, double r) {
 
 // The point's place on the annulus: annulus_radius times its direction from the centre
 // (points on the centre line take direction e1).
-inline void roll(const Cylinder& c, const Local& p, double* out) {
+static inline void roll(const Cylinder& c, const Local& p, double* out) {
     double dx = p.x - c.cx, dy = p.y - c.cy;
     double r = std::sqrt(dx * dx + dy * dy);
     double rho = annulus_radius(c, p.h, r);
@@ -174,16 +174,16 @@ inline void roll(const Cylinder& c, const Local& p, double* out) {
 // neighbour then costs 1% of a tube's time instead of 10%.
 const size_t kGapSamplePoints = 1024;
 
-inline size_t gap_sample_stride(size_t count) { return count / kGapSamplePoints + 1; }
+static inline size_t gap_sample_stride(size_t count) { return count / kGapSamplePoints + 1; }
 
 // The sector of direction (dx, dy): kSectors of equal pseudo-angle, counter-clockwise.
-inline uint32_t sector_around(double dx, double dy) {
+static inline uint32_t sector_around(double dx, double dy) {
     const uint32_t s = static_cast<uint32_t>(pseudo_angle(dx, dy) * (kSectors / 4.0));
     return s < kSectors ? s : kSectors - 1;
 }
 
 template <class PointAt>
-inline uint32_t sectors_held(const PointAt& point_at, size_t count, double cx, double cy) {
+static inline uint32_t sectors_held(const PointAt& point_at, size_t count, double cx, double cy) {
     uint32_t held = 0;
     const size_t stride = gap_sample_stride(count);
     for (size_t i = 0; i < count; i += stride) {
@@ -195,7 +195,7 @@ inline uint32_t sectors_held(const PointAt& point_at, size_t count, double cx, d
 
 // The most sectors in a row, around the circle, missing from `held`: 0 for a ring, about
 // half of them for a half cylinder.
-inline uint32_t widest_gap(uint32_t held) {
+static inline uint32_t widest_gap(uint32_t held) {
     uint32_t widest = 0, run = 0;
     for (uint32_t k = 0; k < 2 * kSectors && widest < kSectors; ++k) {
         run = (held >> (k % kSectors)) & 1 ? 0 : run + 1;
@@ -207,7 +207,7 @@ inline uint32_t widest_gap(uint32_t held) {
 // Centre and radius of count points (frame coordinates; point_at(i) gives point i) for
 // heights [h0, h1].
 template <class PointAt>
-inline Cylinder fit_cylinder(const PointAt& point_at, size_t count, double h0, double h1) {
+static inline Cylinder fit_cylinder(const PointAt& point_at, size_t count, double h0, double h1) {
     double mx = 0, my = 0;
     for (size_t i = 0; i < count; ++i) {
         const Local& p = point_at(i);
@@ -256,19 +256,19 @@ inline Cylinder fit_cylinder(const PointAt& point_at, size_t count, double h0, d
 }
 
 // Triangle abc's normal, twice its area long.
-inline Vec3 normal_of(const Local& pa, const Local& pb, const Local& pc) {
+static inline Vec3 normal_of(const Local& pa, const Local& pb, const Local& pc) {
     return cross(Vec3{pb.x - pa.x, pb.y - pa.y, pb.h - pa.h},
                  Vec3{pc.x - pa.x, pc.y - pa.y, pc.h - pa.h});
 }
 
-inline double doubled_area(const Local& pa, const Local& pb, const Local& pc) {
+static inline double doubled_area(const Local& pa, const Local& pb, const Local& pc) {
     Vec3 n = normal_of(pa, pb, pc);
     return std::sqrt(dot(n, n));
 }
 
 // Whether triangle abc (counter-clockwise seen from outside) has its normal pointing
 // towards the cylinder's axis (beyond a pole: towards the pole): a fold.
-inline bool faces_axis(const Local& pa, const Local& pb, const Local& pc, const Cylinder& cyl) {
+static inline bool faces_axis(const Local& pa, const Local& pb, const Local& pc, const Cylinder& cyl) {
     Vec3 n = normal_of(pa, pb, pc);
     // From the axis (beyond a pole: the pole) to the centroid, three times over: only the
     // sign of its product with n counts, so no division.
@@ -283,14 +283,14 @@ inline bool faces_axis(const Local& pa, const Local& pb, const Local& pc, const 
 
 // Whether triangle t of a layer's triangulation is on the surface: neither a ghost nor at
 // vertex 0, the centre (nor peeled: see peel_loop).
-inline bool on_surface(const Triangulation& tr, uint32_t t) {
+static inline bool on_surface(const Triangulation& tr, uint32_t t) {
     const uint32_t* v = tr.vertex + 3 * t;
     return !tr.is_ghost(t) && v[0] != 0 && v[1] != 0 && v[2] != 0;
 }
 
 // Asks for the cache line holding p ahead of its use, where the compiler offers a way
 // (GCC, Clang): a hint, which changes nothing but the time.
-inline void prefetch(const void* p) {
+static inline void prefetch(const void* p) {
 #if defined(__GNUC__) || defined(__clang__)
     __builtin_prefetch(p);
 #else
@@ -302,7 +302,7 @@ inline void prefetch(const void* p) {
 // points[(v - 1) * stride]. Adds their doubled areas to *area if given. The triangles'
 // slots are not in the points' order: with kFastLoops the corners a few triangles ahead
 // are prefetched, as the loop otherwise waits on the cache for most of them.
-inline size_t count_folds(const Triangulation& tr, const Local* points, size_t stride,
+static inline size_t count_folds(const Triangulation& tr, const Local* points, size_t stride,
                           const Cylinder& cyl, double* area) {
     size_t folds = 0;
     const uint32_t ahead = 12;

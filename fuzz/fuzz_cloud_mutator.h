@@ -64,7 +64,7 @@ inline size_t write_input(SplitInput& s, uint8_t* out, size_t max_size, uint32_t
     write_cloud(s.spec, bytes);
     const size_t rest = std::min(s.rest.size(), max_size - bytes.size());
     bytes.insert(bytes.end(), s.rest.begin(), s.rest.begin() + static_cast<std::ptrdiff_t>(rest));
-    std::memcpy(out, bytes.data(), bytes.size());
+    std::copy(bytes.begin(), bytes.end(), out);
     return bytes.size();
 }
 

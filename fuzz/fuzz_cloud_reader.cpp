@@ -21,6 +21,7 @@
 
 #include "cloud_io.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <iterator>
@@ -268,7 +269,7 @@ extern "C" size_t LLVMFuzzerCustomMutator(uint8_t* data, size_t size, size_t max
         for (int attempt = 0; attempt < 4; ++attempt) {
             if (!mutate_structure(text, random)) continue;
             if (text.size() > max_size) break;
-            std::memcpy(data, text.data(), text.size());
+            std::copy(text.begin(), text.end(), data);
             return text.size();
         }
     }

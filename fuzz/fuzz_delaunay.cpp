@@ -11,6 +11,7 @@
 #include "stratmesh.h"
 #include "support/delaunay_check.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -182,7 +183,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                                                   tris2.data(), max_tris, &info2, dup2.data());
     STRATMESH_FUZZ_CHECK(s2 == s, "second run: different status");
     STRATMESH_FUZZ_CHECK(std::memcmp(&info, &info2, sizeof info) == 0, "second run: different info");
-    STRATMESH_FUZZ_CHECK(std::memcmp(tris.data(), tris2.data(), 3 * info.triangle_count * sizeof(uint32_t)) == 0,
+    STRATMESH_FUZZ_CHECK(std::equal(tris.begin(), tris.begin() + static_cast<std::ptrdiff_t>(3 * info.triangle_count), tris2.begin()),
                          "second run: different triangles");
     STRATMESH_FUZZ_CHECK(dup == dup2, "second run: different duplicate_of");
 

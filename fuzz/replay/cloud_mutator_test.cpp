@@ -42,7 +42,8 @@ void expect_reads_as(const std::vector<uint8_t>& bytes, const SplitInput& meant,
                got.spec.grid_exponent == meant.spec.grid_exponent && got.spec.grid_range == meant.spec.grid_range,
            "another header", where);
     expect(got.spec.xyz.size() == meant.spec.xyz.size() &&
-               std::memcmp(got.spec.xyz.data(), meant.spec.xyz.data(), got.spec.xyz.size() * sizeof(double)) == 0,
+               std::equal(got.spec.xyz.begin(), got.spec.xyz.end(), meant.spec.xyz.begin(),
+                          [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }),
            "other points", where);
     expect(got.rest.size() <= meant.rest.size() && std::equal(got.rest.begin(), got.rest.end(), meant.rest.begin()),
            "the bytes after the cloud changed", where);

@@ -36,9 +36,10 @@ struct GraftEdge {
 
 struct JoinMemory {
     CapLoop loops;  // only ids and starts
-    CapGraph graph;  // until the loops are traced; the grafts' arrays then take its memory
+    CapGraph graph;  // the caller's surface: its loops traced, then the gaps' edges looked up
     uint32_t* hole_next;     // per point: its successor on a planned hole, kNoIndex if free,
-                             // kHeldVertex where no hole may pass (the trunk's boundary)
+                             // kHeldVertex where no hole may pass (the trunk's boundary); in
+                             // the memory of graph.boundary_next, all traced by then
     uint32_t* holes;         // the planned holes' loops, one after another
     unsigned char* removed;  // per triangle, the caller's then the filled: 1 where a
                              // planned hole takes it out
@@ -48,26 +49,23 @@ struct JoinMemory {
     GraftEdge* edges;        // 3 per triangle of `under`, sorted
     uint64_t* queue;         // hole edges to grow across, (from << 32) | to
     size_t under_capacity;
-    size_t room;  // the arena's mark after the loops
 };
 
 const uint32_t kHeldVertex = kNoIndex - 1;
 
 // The arena sequence of the call, shared with join_branches_workspace_size(): the loops,
 // then the graph after them, then (allocate_grafts) once the loops are traced, the grafts'
-// arrays in the graph's room.
+// arrays after the graph, which the gap fill reads (see fill_gap).
 inline bool allocate_join(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
     m.loops.ids = arena.alloc<uint32_t>(point_count);  // every point on a loop at most
     m.loops.starts = arena.alloc<unsigned char>(point_count);
-    m.room = arena.mark();
     allocate_cap_graph(m.graph, point_count, triangle_count, arena);
     return !arena.failed;
 }
 
 inline bool allocate_grafts(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
-    arena.rewind(m.room);
     m.under_capacity = triangle_count < kGraftMaxTriangles ? triangle_count : kGraftMaxTriangles;
-    m.hole_next = arena.alloc<uint32_t>(point_count);
+    m.hole_next = m.graph.boundary_next;
     m.holes = arena.alloc<uint32_t>(point_count);
     m.removed = arena.alloc<unsigned char>(triangle_count + kMostFilled);
     m.filled = arena.alloc<uint32_t>(3 * kMostFilled);
@@ -380,31 +378,14 @@ struct Graft {
     size_t triangles() const { return static_cast<size_t>(hole.length) + branch.length; }
 };
 
-// How many times the loop winds around (cx, cy) across the axis, counter-clockwise positive
-// (the sum of its turns, rounded).
-inline long winding_around(const TracedLoop& loop, const SideView& view, double cx, double cy) {
-    double sum = 0;
-    Local p = view.at(loop.ids[loop.length - 1]);
-    for (uint32_t i = 0; i < loop.length; ++i) {
+// How many times the loop winds around (x, y) across the axis, counter-clockwise positive.
+inline long loop_winding(const TracedLoop& loop, const SideView& view, double x, double y) {
+    const double p[2] = {x, y};
+    auto corner = [&](uint32_t i) {
         const Local q = view.at(loop.ids[i]);
-        const double ax = p.x - cx, ay = p.y - cy, bx = q.x - cx, by = q.y - cy;
-        sum += std::atan2(ax * by - ay * bx, ax * bx + ay * by);
-        p = q;
-    }
-    return std::lround(sum / 6.28318530717958647693);
-}
-
-// Whether (x, y) lies inside the loop across the axis (even-odd rule).
-inline bool inside_loop(const TracedLoop& loop, const SideView& view, double x, double y) {
-    bool inside = false;
-    Local p = view.at(loop.ids[loop.length - 1]);
-    for (uint32_t i = 0; i < loop.length; ++i) {
-        const Local q = view.at(loop.ids[i]);
-        if ((q.y > y) != (p.y > y) && x < q.x + (y - q.y) * (p.x - q.x) / (p.y - q.y))
-            inside = !inside;
-        p = q;
-    }
-    return inside;
+        return Point2{{q.x, q.y}};
+    };
+    return winding_number(corner, loop.length, p);
 }
 
 // The trunk's triangles a graft reads: the caller's, `count` of them, then those that
@@ -496,66 +477,54 @@ inline TracedLoop gap_beside(const JoinMemory& m, size_t entries, size_t found,
     return best;
 }
 
+// A gap's ears: no diagonal that is an edge of the caller's surface (the graph's, whose
+// edges between boundary vertices are all there: the gap's corners are such); each ear a
+// triangle of m.filled.
+class GapEars final : public EarRules {
+public:
+    GapEars(const uint32_t* ids, JoinMemory& m) : ids_(ids), m_(m) {}
+
+private:
+    bool forbidden(uint32_t a, uint32_t b) const override {
+        return m_.graph.has_edge(ids_[a], ids_[b]);
+    }
+
+    void take(uint32_t p, uint32_t v, uint32_t n) override {
+        uint32_t* out = m_.filled + 3 * m_.filled_count++;
+        out[0] = ids_[p];
+        out[1] = ids_[v];
+        out[2] = ids_[n];
+    }
+
+    const uint32_t* ids_;
+    JoinMemory& m_;
+};
+
 // Closes the gap `loop` (in cap order) with triangles in m.filled, by ears clipped in the
-// view, and frees its vertices for the holes; false (nothing added) where the loop does not
-// turn counter-clockwise in the view (the way the triangles facing a branch turn), an ear
-// would repeat an edge of the surface, or none is left to clip (a loop that crosses itself
-// across the axis).
-inline bool fill_gap(const uint32_t* tri, size_t count, const TracedLoop& loop,
-                     const SideView& view, JoinMemory& m) {
+// view, each from the first corner left, and frees its vertices for the holes; false
+// (nothing added) where the loop is no simple polygon turning counter-clockwise in the view
+// (the way the triangles facing a branch turn) or no ear is left whose diagonal is not an
+// edge of the surface. count: the caller's triangles, which m.removed numbers first.
+inline bool fill_gap(size_t count, const TracedLoop& loop, const SideView& view, JoinMemory& m) {
     const uint32_t n = loop.length;
     if (m.filled_count + (n - 2) > kMostFilled) return false;
-    uint32_t ring[kGapLoopMost];
-    double area = 0;
+    double xy[2 * kGapLoopMost];
     for (uint32_t i = 0; i < n; ++i) {
-        ring[i] = loop.ids[i];
-        const Local p = view.at(loop.ids[i]), q = view.at(loop.ids[(i + 1) % n]);
-        area += p.x * q.y - q.x * p.y;
+        const Local p = view.at(loop.ids[i]);
+        xy[2 * i] = p.x;
+        xy[2 * i + 1] = p.y;
     }
-    if (!(area > 0)) return false;
-    auto is_edge = [&](uint32_t a, uint32_t b) {
-        for (size_t t = 0; t < count; ++t) {
-            const uint32_t* c = tri + 3 * t;
-            for (int e = 0; e < 3; ++e)
-                if ((c[e] == a && c[(e + 1) % 3] == b) || (c[e] == b && c[(e + 1) % 3] == a))
-                    return true;
-        }
-        return false;
-    };
-    auto turn = [&](const Local& a, const Local& b, const Local& c) {
-        return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-    };
+    uint64_t sweep[kGapLoopMost];
+    if (!polygon_is_simple(xy, n, sweep) || !(simple_polygon_turn(xy, n) > 0)) return false;
+    uint32_t prev[kGapLoopMost], next[kGapLoopMost], reflex[kGapLoopMost];
+    unsigned char flags[kGapLoopMost];
     const size_t first = m.filled_count;
-    for (uint32_t left = n; left > 3;) {
-        uint32_t ear = left;
-        for (uint32_t i = 0; i < left && ear == left; ++i) {
-            const uint32_t a = ring[(i + left - 1) % left], b = ring[i], c = ring[(i + 1) % left];
-            const Local pa = view.at(a), pb = view.at(b), pc = view.at(c);
-            if (!(turn(pa, pb, pc) > 0)) continue;
-            bool empty = true;
-            for (uint32_t k = 0; k < left && empty; ++k) {
-                const uint32_t v = ring[k];
-                if (v == a || v == b || v == c) continue;
-                const Local pv = view.at(v);
-                empty = !(turn(pa, pb, pv) >= 0 && turn(pb, pc, pv) >= 0 && turn(pc, pa, pv) >= 0);
-            }
-            if (empty && !is_edge(a, c)) ear = i;
-        }
-        if (ear == left) {
-            m.filled_count = first;
-            return false;
-        }
-        uint32_t* out = m.filled + 3 * m.filled_count++;
-        out[0] = ring[(ear + left - 1) % left];
-        out[1] = ring[ear];
-        out[2] = ring[(ear + 1) % left];
-        for (uint32_t k = ear; k + 1 < left; ++k) ring[k] = ring[k + 1];
-        --left;
+    GapEars ears(loop.ids, m);
+    EarClipper clipper(xy, n, {prev, next, reflex, flags});
+    if (!clipper.clip(0, EarWalk::from_first, ears)) {
+        m.filled_count = first;
+        return false;
     }
-    uint32_t* out = m.filled + 3 * m.filled_count++;
-    out[0] = ring[0];
-    out[1] = ring[1];
-    out[2] = ring[2];
     for (size_t f = first; f < m.filled_count; ++f) m.removed[count + f] = 0;
     for (uint32_t i = 0; i < n; ++i) m.hole_next[loop.ids[i]] = kNoIndex;
     return true;
@@ -580,7 +549,7 @@ inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_
     height /= loop.length;
     // In cap order a branch's loop turns clockwise seen from the branch (its cap would face
     // away from it), once around its centre.
-    if (winding_around(loop, view, cx, cy) != -1) {
+    if (loop_winding(loop, view, cx, cy) != -1) {
         detail = "a branch's loop does not go once around its centre, seen along the axis";
         return false;
     }
@@ -613,7 +582,8 @@ inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_
             if ((gx - cx) * (gx - cx) + (gy - cy) * (gy - cy) > reach) continue;
             const Vec3 normal = cross({b.x - a.x, b.y - a.y, b.h - a.h}, {d.x - a.x, d.y - a.y, d.h - a.h});
             if (!(normal.z > kGraftFacing * std::sqrt(dot(normal, normal)))) continue;
-            if (!inside_loop(loop, view, gx, gy)) continue;
+            // Odd: inside by the even-odd rule.
+            if (loop_winding(loop, view, gx, gy) % 2 == 0) continue;
             if (found == m.under_capacity) {
                 detail = "more of the trunk's triangles lie under a branch's loop than a graft "
                          "takes (kGraftMaxTriangles)";
@@ -655,7 +625,7 @@ inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_
         hole[0] = first[0];
         for (uint32_t i = 1; i < length; ++i) hole[i] = next[hole[i - 1]];
         graft.hole = {hole, length};
-        if (winding_around(graft.hole, view, cx, cy) == 1) return true;
+        if (loop_winding(graft.hole, view, cx, cy) == 1) return true;
         for (uint32_t i = 0; i < length; ++i) next[hole[i]] = kNoIndex;
         for (size_t k = 0; k < found; ++k) m.removed[m.under[k]] = 0;
         detail = "the hole under a branch's loop does not go once around the branch's centre";
@@ -672,7 +642,7 @@ inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_
         const TracedLoop beside = gap_beside(m, entries, found, branch_of, view, cx, cy,
                                              kGapReach * std::sqrt(reach), low, high);
         const size_t filled_before = m.filled_count;
-        if (beside.ids && fill_gap(tri, count, beside, view, m)) {
+        if (beside.ids && fill_gap(count, beside, view, m)) {
             planned = plan_hole();
             if (!planned) {
                 m.filled_count = filled_before;

@@ -1,5 +1,5 @@
 // >>polygon ==============================================================================
-// Simple polygons on the exact predicates: crossing edges, ear clipping.
+// Simple polygons on the exact predicates: crossing edges, winding, ear clipping.
 
 namespace stratmesh {
 namespace detail {
@@ -114,6 +114,32 @@ inline double simple_polygon_turn(const double* xy, uint32_t length) {
         if (lex_less(at(i), at(lowest))) lowest = i;
     return orient2d_robust(at(lowest == 0 ? length - 1 : lowest - 1), at(lowest),
                            at(lowest + 1 == length ? 0 : lowest + 1));
+}
+
+// A corner of a polygon whose corners are computed as they are read.
+struct Point2 {
+    double xy[2];
+};
+
+// How many times the closed polygon of corners point(0), ..., point(length - 1) winds around
+// p, counter-clockwise positive: an edge that crosses the line through p along x (half-open:
+// from at or below p to above it, or back) counts +1 going up with p on its left, -1 going
+// down with p on its right, by orient2d. Odd where the even-odd rule has p inside; for p on
+// the polygon, the count of a region beside it.
+template <class PointAt>
+long winding_number(PointAt point, uint32_t length, const double* p) {
+    long winding = 0;
+    Point2 a = point(length - 1);
+    for (uint32_t i = 0; i < length; ++i) {
+        const Point2 b = point(i);
+        if (a.xy[1] <= p[1]) {
+            if (b.xy[1] > p[1] && orient2d_robust(a.xy, b.xy, p) > 0) ++winding;
+        } else if (b.xy[1] <= p[1] && orient2d_robust(a.xy, b.xy, p) < 0) {
+            --winding;
+        }
+        a = b;
+    }
+    return winding;
 }
 
 // ---- ear clipping

@@ -1,5 +1,5 @@
-// The polygon module the caps and their pockets share: ear clipping, simplicity, on the
-// exact predicates. This suite compiles the implementation
+// The polygon module the caps, their pockets and the grafts' gap fill share: ear clipping,
+// winding, simplicity, on the exact predicates. This suite compiles the implementation
 // itself, to reach them.
 #define STRATMESH_IMPLEMENTATION
 #include "stratmesh.h"
@@ -175,6 +175,36 @@ TEST_CASE("polygon: the ears the clipper takes, and where it gives up, are those
     }
     CHECK(compared > 1000);
     CHECK(failed > 100);
+}
+
+TEST_CASE("polygon: winding numbers by the exact predicate") {
+    // A regular pentagram, {5/2}: twice around its centre, once around a point of a tip, not
+    // around a point outside; turned clockwise, the opposite.
+    std::vector<double> pentagram;
+    for (int i = 0; i < 5; ++i) {
+        const double angle = 6.283185307179586 * (2 * i) / 5 + 0.1;
+        pentagram.push_back(std::cos(angle));
+        pentagram.push_back(std::sin(angle));
+    }
+    for (double sense : {1.0, -1.0}) {
+        auto corner = [&](uint32_t i) {
+            const uint32_t k = sense > 0 ? i : 4 - i;
+            return detail::Point2{{pentagram[2 * k], pentagram[2 * k + 1]}};
+        };
+        const double centre[2] = {0, 0}, tip[2] = {0.9 * std::cos(0.1), 0.9 * std::sin(0.1)},
+                     outside[2] = {1.5, 0};
+        CHECK(detail::winding_number(corner, 5, centre) == static_cast<long>(2 * sense));
+        CHECK(detail::winding_number(corner, 5, tip) == static_cast<long>(sense));
+        CHECK(detail::winding_number(corner, 5, outside) == 0);
+    }
+    // One unit in the last place either side of a nearly flat edge, (1, a) to (3, 3 a): a
+    // straight corner at (1, a) on the way from (0, 0).
+    const double a = 0x1p-40;
+    const double flat[8] = {0, 0, 1, a, 3, 3 * a, 0, 1};
+    auto corner = [&](uint32_t i) { return detail::Point2{{flat[2 * i], flat[2 * i + 1]}}; };
+    const double above[2] = {2, std::nextafter(2 * a, 1.0)}, below[2] = {2, std::nextafter(2 * a, 0.0)};
+    CHECK(detail::winding_number(corner, 4, above) == 1);
+    CHECK(detail::winding_number(corner, 4, below) == 0);
 }
 
 TEST_CASE("polygon: simplicity and the turn of a simple polygon") {

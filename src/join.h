@@ -36,10 +36,12 @@ struct GraftEdge {
 
 struct JoinMemory {
     CapLoop loops;  // only ids and starts
-    CapGraph graph;  // the caller's surface: its loops traced, then the gaps' edges looked up
+    uint32_t* gap_joins;  // per entry of loops.ids on a loop of at most kGapLoopMost: bit j
+                          // set where its vertex and the loop's j-th are joined by an edge of
+                          // the caller's surface (the diagonals a gap fill may not make)
+    CapGraph graph;  // until the loops are traced; the grafts' arrays then take its memory
     uint32_t* hole_next;     // per point: its successor on a planned hole, kNoIndex if free,
-                             // kHeldVertex where no hole may pass (the trunk's boundary); in
-                             // the memory of graph.boundary_next, all traced by then
+                             // kHeldVertex where no hole may pass (the trunk's boundary)
     uint32_t* holes;         // the planned holes' loops, one after another
     unsigned char* removed;  // per triangle, the caller's then the filled: 1 where a
                              // planned hole takes it out
@@ -49,23 +51,27 @@ struct JoinMemory {
     GraftEdge* edges;        // 3 per triangle of `under`, sorted
     uint64_t* queue;         // hole edges to grow across, (from << 32) | to
     size_t under_capacity;
+    size_t room;  // the arena's mark after the loops
 };
 
 const uint32_t kHeldVertex = kNoIndex - 1;
 
 // The arena sequence of the call, shared with join_branches_workspace_size(): the loops,
-// then the graph after them, then (allocate_grafts) once the loops are traced, the grafts'
-// arrays after the graph, which the gap fill reads (see fill_gap).
+// then the graph after them, then (allocate_grafts) once the loops are traced and the gaps'
+// joins noted, the grafts' arrays in the graph's room.
 inline bool allocate_join(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
     m.loops.ids = arena.alloc<uint32_t>(point_count);  // every point on a loop at most
     m.loops.starts = arena.alloc<unsigned char>(point_count);
+    m.gap_joins = arena.alloc<uint32_t>(point_count);
+    m.room = arena.mark();
     allocate_cap_graph(m.graph, point_count, triangle_count, arena);
     return !arena.failed;
 }
 
 inline bool allocate_grafts(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
+    arena.rewind(m.room);
     m.under_capacity = triangle_count < kGraftMaxTriangles ? triangle_count : kGraftMaxTriangles;
-    m.hole_next = m.graph.boundary_next;
+    m.hole_next = arena.alloc<uint32_t>(point_count);
     m.holes = arena.alloc<uint32_t>(point_count);
     m.removed = arena.alloc<unsigned char>(triangle_count + kMostFilled);
     m.filled = arena.alloc<uint32_t>(3 * kMostFilled);
@@ -499,17 +505,35 @@ inline TracedLoop gap_beside(const JoinMemory& m, size_t entries, size_t found,
     return best;
 }
 
-// A gap's ears: no diagonal that is an edge of the caller's surface (the graph's, whose
-// edges between boundary vertices are all there: the gap's corners are such); each ear a
-// triangle of m.filled.
+static_assert(kGapLoopMost <= 32, "a gap's joins are bits of 32");
+
+// Notes in m.gap_joins, from the graph, which vertices of each loop small enough to be a
+// gap are joined by an edge of the caller's surface: the graph keeps the edges between
+// boundary vertices, and its memory goes to the grafts.
+inline void note_gap_joins(JoinMemory& m, size_t entries) {
+    for (size_t start = 0; start < entries;) {
+        size_t end = start + 1;
+        while (end < entries && m.loops.starts[end] == 0) ++end;
+        const uint32_t* ids = m.loops.ids + start;
+        for (size_t i = 0; end - start <= kGapLoopMost && i < end - start; ++i) {
+            uint32_t joins = 0;
+            for (size_t j = 0; j < end - start; ++j)
+                if (m.graph.has_edge(ids[i], ids[j])) joins |= uint32_t{1} << j;
+            m.gap_joins[start + i] = joins;
+        }
+        start = end;
+    }
+}
+
+// A gap's ears: no diagonal that is an edge of the caller's surface (see note_gap_joins);
+// each ear a triangle of m.filled.
 class GapEars final : public EarRules {
 public:
-    GapEars(const uint32_t* ids, JoinMemory& m) : ids_(ids), m_(m) {}
+    GapEars(const uint32_t* ids, const uint32_t* joins, JoinMemory& m)
+        : ids_(ids), joins_(joins), m_(m) {}
 
 private:
-    bool forbidden(uint32_t a, uint32_t b) const override {
-        return m_.graph.has_edge(ids_[a], ids_[b]);
-    }
+    bool forbidden(uint32_t a, uint32_t b) const override { return ((joins_[a] >> b) & 1) != 0; }
 
     void take(uint32_t p, uint32_t v, uint32_t n) override {
         uint32_t* out = m_.filled + 3 * m_.filled_count++;
@@ -519,6 +543,7 @@ private:
     }
 
     const uint32_t* ids_;
+    const uint32_t* joins_;
     JoinMemory& m_;
 };
 
@@ -541,7 +566,7 @@ inline bool fill_gap(size_t count, const TracedLoop& loop, const SideView& view,
     uint32_t prev[kGapLoopMost], next[kGapLoopMost], reflex[kGapLoopMost];
     unsigned char flags[kGapLoopMost];
     const size_t first = m.filled_count;
-    GapEars ears(loop.ids, m);
+    GapEars ears(loop.ids, m.gap_joins + (loop.ids - m.loops.ids), m);
     EarClipper clipper(xy, n, {prev, next, reflex, flags});
     if (!clipper.clip(0, EarWalk::from_first, ears)) {
         m.filled_count = first;
@@ -954,6 +979,7 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
     build_cap_graph(triangles, given, cloud.count, m.graph);
     size_t entries = 0;
     trace_boundary_loops(m.graph, cloud.count, m.loops, &entries);
+    note_gap_joins(m, entries);
     if (!allocate_grafts(m, cloud.count, given, arena)) {
         checks.detail = "the workspace is smaller than join_branches_workspace_size()";
         return finish(Status::out_of_memory);

@@ -1,22 +1,23 @@
 // >>caps =================================================================================
 // Closing a boundary loop: pockets, lowered caps, fins.
 //
-// With the close_ends flag, each boundary loop of the final surface is closed by a cap made
-// of triangles over the loop's own vertices. The loop is triangulated in its projection
-// across the axis: first checked to be a simple polygon (a sweep over its edges sorted by x,
-// exact orient2d), then ear clipping, then flips of the cap's diagonals. A triangulation of
-// a simple polygon lifts to a surface that is a graph over it, so the cap's triangles cannot
-// cross one another; but they can cross the wall where it leans over the cap near a ragged
-// loop (a bust's shoulders, the noisy end of a scan). So the flips make the bottom cap as
-// low as the loop allows and the top cap as high: a diagonal is flipped when the other one,
-// with every vertex at its height along the axis, lies more than kCapHeightTie below it
-// (above, on the top cap): the lower or upper envelope of the loop, where the quadrilaterals
-// allow. On ties (a planar loop, a CT contour) the Delaunay criterion decides, so planar
-// caps are the constrained Delaunay triangulation (ear clipping alone leaves slivers).
-// Delaunay caps alone cross a wall leaning over a ragged loop several times as often. The
-// flips are bounded (kCapFlipsPerCorner per loop vertex): any triangulation of the polygon is
-// valid, so stopping early only leaves a cap less low. STRATMESH_SMALL_CODE leaves the
-// heights out: Delaunay caps.
+// With the close_ends flag, each boundary loop of the final surface is closed by a cap
+// made of triangles over the loop's own vertices. The loop is triangulated in its
+// projection across the axis: first checked to be a simple polygon (a sweep over its edges
+// sorted by x, exact orient2d), then ear clipping (see the polygon section), then flips of
+// the cap's diagonals. A triangulation of a simple polygon lifts to a surface that is a
+// graph over it, so the cap's triangles cannot cross one another; but they can cross the
+// wall where it leans over the cap near a ragged loop (a bust's shoulders, the noisy end
+// of a scan). So the flips make the bottom cap as low as the loop allows and the top cap
+// as high: a diagonal is flipped when the other one, with every vertex at its height along
+// the axis, lies more than kCapHeightTie below it (above, on the top cap): the lower or
+// upper envelope of the loop, where the quadrilaterals allow. On ties (a planar loop, a CT
+// contour) the Delaunay criterion decides, so planar caps are the constrained Delaunay
+// triangulation (ear clipping alone leaves slivers). Delaunay caps alone cross a wall
+// leaning over a ragged loop several times as often. The flips are bounded
+// (kCapFlipsPerCorner per loop vertex): any triangulation of the polygon is valid, so
+// stopping early only leaves a cap less low. STRATMESH_SMALL_CODE leaves the heights out:
+// Delaunay caps.
 //
 // Each cap triangle runs the loop's edges against the surface's direction, so the closed
 // surface stays consistently oriented (the bottom cap faces -axis, the top one +axis). A
@@ -57,6 +58,9 @@ inline double depth_below_plane(const double* a, const double* b, const double* 
 
 const uint32_t kCapFlipsPerCorner = 64;
 
+// A cap triangle's flag while flipping: on the stack of those to check.
+const unsigned char kQueued = 4;
+
 // Ear clipping is greedy: where the surface holds some of a loop's diagonals (its
 // triangles with three corners on the loop), the ears taken first can leave a remainder
 // whose every ear would repeat one, where another order would not (the bundled bust's
@@ -68,7 +72,7 @@ const uint32_t kCapFlipsPerCorner = 64;
 // vertices, whose diagonals must not be edges of the surface; lower: the cap is a bottom
 // one (it faces -axis), to be made as low as the loop allows (a top one as high). Returns
 // false if no ear is left (every one would repeat an edge of the surface).
-class CapTriangulation {
+class CapTriangulation final : public EarRules {
 public:
     CapTriangulation(CapLoop& c, const uint32_t* ids, uint32_t length, const CapGraph& g,
                      bool lower)
@@ -97,44 +101,10 @@ public:
     }
 
     bool clip_ears(uint32_t start) {
-        uint32_t reflex_count = 0;
-        for (uint32_t i = 0; i < length_; ++i) {
-            c_.prev[i] = i == 0 ? length_ - 1 : i - 1;
-            c_.next[i] = i + 1 == length_ ? 0 : i + 1;
-            c_.owner[i] = kNoIndex;
-            c_.flags[i] = 0;
-        }
-        for (uint32_t i = 0; i < length_; ++i) {
-            if (convex(i)) continue;
-            c_.flags[i] = kReflex;
-            c_.reflex[reflex_count++] = i;
-        }
-        uint32_t remaining = length_, v = start, misses = 0;
+        std::memset(c_.owner, 0xFF, sizeof(uint32_t) * length_);  // all kNoIndex
         triangles_ = 0;
-        while (remaining > 3) {
-            if (!is_ear(v, reflex_count)) {
-                v = c_.next[v];
-                if (++misses > remaining) return false;
-                continue;
-            }
-            uint32_t p = c_.prev[v], n = c_.next[v];
-            uint32_t t = add_triangle(p, v, n);
-            c_.owner[p] = 3 * t + 2;  // the new polygon edge p -> n has t beyond it
-            c_.next[p] = n;
-            c_.prev[n] = p;
-            c_.flags[v] = kRemoved;
-            // Clipping only narrows the corners at p and n: a reflex one may turn convex.
-            settle_corner(p);
-            settle_corner(n);
-            --remaining;
-            misses = 0;
-            v = p;
-        }
-        if (!convex(v)) return false;
-        uint32_t p = c_.prev[v], n = c_.next[v];
-        uint32_t t = add_triangle(p, v, n);
-        link(3 * t + 2, c_.owner[n]);
-        return true;
+        EarClipper clipper(c_.xy, length_, {c_.prev, c_.next, c_.reflex, c_.flags});
+        return clipper.clip(start, EarWalk::from_previous, *this);
     }
 
     // Flips until no diagonal would be lower (higher, on a top cap) flipped, nor, where the
@@ -183,7 +153,7 @@ public:
                 best = 0;
                 // i - j must be a diagonal (the loop edge m - 1 -> 0 closes the whole).
                 if ((j != m - 1 || i != 0) &&
-                    (joined(i, j) || !diagonal_inside(i, j)))
+                    (joined(i, j) || !diagonal_inside(c_.xy, m, i, j)))
                     continue;
                 for (uint32_t k = i + 1; k < j && best == 0; ++k)
                     if (closes(i, k) && closes(k, j)) best = static_cast<uint8_t>(k - i);
@@ -216,35 +186,6 @@ public:
         return true;
     }
 
-    // Whether i - j (positions on the loop) runs inside the polygon: within the corners at
-    // both ends and clear of every loop edge that does not end at i or j.
-    bool diagonal_inside(uint32_t i, uint32_t j) const {
-        auto within_corner = [this](uint32_t a, uint32_t b) {
-            const double* pa = point(a);
-            const double* pb = point(b);
-            const double* before = point(a == 0 ? length_ - 1 : a - 1);
-            const double* after = point(a + 1 == length_ ? 0 : a + 1);
-            if (orient2d_robust(before, pa, after) > 0)
-                return orient2d_robust(pa, pb, before) > 0 && orient2d_robust(pb, pa, after) > 0;
-            return !(orient2d_robust(pa, pb, after) >= 0 && orient2d_robust(pb, pa, before) >= 0);
-        };
-        if (!within_corner(i, j) || !within_corner(j, i)) return false;
-        const double* pi = point(i);
-        const double* pj = point(j);
-        for (uint32_t a = 0; a < length_; ++a) {
-            const uint32_t b = a + 1 == length_ ? 0 : a + 1;
-            if (a == i || a == j || b == i || b == j) continue;
-            const double oa = orient2d_robust(pi, pj, point(a));
-            const double ob = orient2d_robust(pi, pj, point(b));
-            if ((oa > 0 && ob > 0) || (oa < 0 && ob < 0)) continue;
-            const double oi = orient2d_robust(point(a), point(b), pi);
-            const double oj = orient2d_robust(point(a), point(b), pj);
-            if ((oi > 0 && oj > 0) || (oi < 0 && oj < 0)) continue;
-            return false;  // the segments cross or touch
-        }
-        return true;
-    }
-
     uint32_t triangles() const { return triangles_; }
 
 private:
@@ -255,51 +196,28 @@ private:
         return g_.has_edge(ids_[a], ids_[b]) && waived_fin(a, b) == kNoIndex;
     }
 
-    bool convex(uint32_t i) const {
-        return orient2d_robust(point(c_.prev[i]), point(i), point(c_.next[i])) > 0;
-    }
+    // The clipping's rules: no diagonal that is an edge of the surface staying there; each
+    // ear a cap triangle, its edges p -> v and v -> n linked to the triangles beyond. Its
+    // edge n -> p is the polygon's new edge p -> n, with t beyond it, but for the last ear,
+    // whose n -> p is an edge of the polygon already.
+    bool forbidden(uint32_t a, uint32_t b) const override { return joined(a, b); }
 
-    void settle_corner(uint32_t i) {
-        if ((c_.flags[i] & kReflex) && convex(i)) c_.flags[i] = 0;
-    }
-
-    void queue(uint32_t t, uint32_t& depth) {
-        if (c_.flags[t] & kQueued) return;
-        c_.flags[t] = kQueued;
-        c_.stack[depth++] = t;
-    }
-
-    // Strictly convex, a diagonal that is no edge of the surface, and no other corner in
-    // the closed triangle. Only non-convex corners need testing (in a simple polygon, a
-    // triangle holding a corner holds a reflex one); those turned convex leave the list.
-    bool is_ear(uint32_t v, uint32_t& reflex_count) {
-        if (c_.flags[v] & kReflex) return false;
-        uint32_t p = c_.prev[v], n = c_.next[v];
-        if (joined(p, n)) return false;
-        bool empty = true;
-        uint32_t kept = 0;
-        for (uint32_t k = 0; k < reflex_count; ++k) {
-            uint32_t r = c_.reflex[k];
-            if (c_.flags[r] != kReflex) continue;
-            c_.reflex[kept++] = r;
-            if (empty && r != p && r != n && in_closed_triangle(point(p), point(v), point(n), point(r)))
-                empty = false;
-        }
-        reflex_count = kept;
-        return empty;
-    }
-
-    // Adds triangle (p, v, n) and links its edges p -> v and v -> n to the triangles beyond.
-    uint32_t add_triangle(uint32_t p, uint32_t v, uint32_t n) {
-        uint32_t t = triangles_++;
+    void take(uint32_t p, uint32_t v, uint32_t n) override {
+        const uint32_t t = triangles_++;
         uint32_t* corner = c_.corners + 3 * static_cast<size_t>(t);
         corner[0] = p;
         corner[1] = v;
         corner[2] = n;
         link(3 * t, c_.owner[p]);
         link(3 * t + 1, c_.owner[v]);
-        c_.across[3 * static_cast<size_t>(t) + 2] = kNoIndex;
-        return t;
+        link(3 * t + 2, t + 3 == length_ ? c_.owner[n] : kNoIndex);
+        c_.owner[p] = 3 * t + 2;
+    }
+
+    void queue(uint32_t t, uint32_t& depth) {
+        if (c_.flags[t] & kQueued) return;
+        c_.flags[t] = kQueued;
+        c_.stack[depth++] = t;
     }
 
     void link(uint32_t edge, uint32_t other) {
@@ -554,45 +472,47 @@ inline bool unroll_loop(const CloudReader& cloud, const Frame& frame, const uint
     return true;
 }
 
-// Closes the pocket [from, to] of positions (to may be `length`: the first position again)
-// by ear clipping in the annulus picture, where it turns counter-clockwise; appends its
-// triangles at tri[3 * count] as the cap writes its own (in loop order). False, with count
-// unchanged, where no ear is left whose diagonal is not already an edge of the surface.
-inline bool close_pocket(uint32_t* tri, size_t& count, const CapGraph& g, const uint32_t* ids,
-                         uint32_t length, const double* xy, uint32_t from, uint32_t to,
-                         uint32_t* prev, uint32_t* next) {
-    const uint32_t n = to - from + 1;
-    auto point = [&](uint32_t k) { return xy + 2 * ((from + k) % length); };
-    for (uint32_t k = 0; k < n; ++k) {
-        prev[k] = k == 0 ? n - 1 : k - 1;
-        next[k] = k + 1 == n ? 0 : k + 1;
-    }
-    size_t added = count;
-    uint32_t v = 1, remaining = n, misses = 0;
-    while (remaining > 2) {
-        const uint32_t a = prev[v], b = next[v];
-        bool ear = orient2d_robust(point(a), point(v), point(b)) > 0 &&
-                   (remaining == 3 || !g.has_edge(ids[(from + a) % length], ids[(from + b) % length]));
-        for (uint32_t k = next[b]; ear && k != a; k = next[k])
-            ear = !(orient2d_robust(point(a), point(v), point(k)) >= 0 &&
-                    orient2d_robust(point(v), point(b), point(k)) >= 0 &&
-                    orient2d_robust(point(b), point(a), point(k)) >= 0);
-        if (!ear) {
-            v = b;
-            if (++misses > remaining) return false;
-            continue;
-        }
-        tri[3 * added] = ids[(from + a) % length];
-        tri[3 * added + 1] = ids[(from + v) % length];
-        tri[3 * added + 2] = ids[(from + b) % length];
+// A pocket's ears: its corners are the loop's positions from `from` on (mod length); no
+// diagonal that is an edge of the surface; each ear appended at tri[3 added] as the cap
+// writes its own triangles (in loop order).
+class PocketEars final : public EarRules {
+public:
+    PocketEars(uint32_t* tri, size_t count, const CapGraph& g, const uint32_t* ids,
+               uint32_t length, uint32_t from)
+        : added(count), tri_(tri), g_(g), ids_(ids), length_(length), from_(from) {}
+
+    size_t added;
+
+private:
+    uint32_t id(uint32_t corner) const { return ids_[(from_ + corner) % length_]; }
+
+    bool forbidden(uint32_t a, uint32_t b) const override { return g_.has_edge(id(a), id(b)); }
+
+    void take(uint32_t p, uint32_t v, uint32_t n) override {
+        tri_[3 * added] = id(p);
+        tri_[3 * added + 1] = id(v);
+        tri_[3 * added + 2] = id(n);
         ++added;
-        next[a] = b;
-        prev[b] = a;
-        v = a;
-        --remaining;
-        misses = 0;
     }
-    count = added;
+
+    uint32_t* tri_;
+    const CapGraph& g_;
+    const uint32_t* ids_;
+    uint32_t length_, from_;
+};
+
+// Closes the pocket of the `corners` positions from `from` on (the last may be the first
+// position again), whose points in the annulus picture are run[0 .. 2 corners), by ear
+// clipping from its second corner on (it turns counter-clockwise there); appends its
+// triangles at tri[3 * count]. False, with count unchanged, where no ear is left whose
+// diagonal is not already an edge of the surface.
+inline bool close_pocket(uint32_t* tri, size_t& count, const CapGraph& g, const uint32_t* ids,
+                         uint32_t length, const double* run, uint32_t from, uint32_t corners,
+                         const EarRing& ring) {
+    PocketEars ears(tri, count, g, ids, length, from);
+    EarClipper clipper(run, corners, ring);
+    if (!clipper.clip(1, EarWalk::from_previous, ears)) return false;
+    count = ears.added;
     return true;
 }
 
@@ -624,7 +544,7 @@ inline uint32_t fill_pockets(uint32_t* tri, size_t& count, const CapGraph& g, Ca
     // The convex hull of the clockwise loop from its first position (on the hull, being the
     // farthest out) round to it again: a Graham scan in the loop's order.
     // The first position closes the hull again: scanned last, but not stored twice.
-    uint32_t* hull = c.reflex;
+    uint32_t* hull = c.stack;
     uint32_t hull_count = 0;
     for (uint32_t j = 0; j <= length; ++j) {
         const double* pj = xy + 2 * (j % length);
@@ -634,22 +554,32 @@ inline uint32_t fill_pockets(uint32_t* tri, size_t& count, const CapGraph& g, Ca
         if (j < length) hull[hull_count++] = j;
     }
     if (hull_count < 3) return length;  // the cap needs three corners at least
-    unsigned char* gone = c.flags;
-    std::memset(gone, 0, length);
+    // The positions a closed pocket takes leave the cap's loop: ids is compacted as the
+    // pockets go, behind them (the last pocket reads position 0 again, which stays).
+    const EarRing ring = {c.prev, c.next, c.reflex, c.flags};
+    uint32_t kept = 0;
     for (uint32_t k = 0; k < hull_count; ++k) {
         const uint32_t from = hull[k], to = k + 1 < hull_count ? hull[k + 1] : length;
         const double* pa = xy + 2 * from;
         const double* pb = xy + 2 * (to % length);
         const double span = std::atan2(abs_value(pa[0] * pb[1] - pa[1] * pb[0]),
                                        pa[0] * pb[0] + pa[1] * pb[1]);
-        if (to - from < 2 || !(span < kPocketTurn) || g.has_edge(ids[from], ids[to % length]) ||
-            !close_pocket(tri, count, g, ids, length, xy, from, to, c.prev, c.next))
-            continue;
-        for (uint32_t j = from + 1; j < to; ++j) gone[j] = 1;
+        bool closed = false;
+        if (to - from >= 2 && span < kPocketTurn && !g.has_edge(ids[from], ids[to % length])) {
+            // The last pocket runs past the loop's end: its points are moved to the front
+            // of xy, which nothing reads again, to be a run as the others are.
+            if (to == length) {
+                const double first[2] = {xy[0], xy[1]};
+                std::memmove(xy, xy + 2 * from, sizeof(double) * 2 * (length - from));
+                xy[2 * (length - from)] = first[0];
+                xy[2 * (length - from) + 1] = first[1];
+            }
+            closed = close_pocket(tri, count, g, ids, length, to == length ? xy : xy + 2 * from,
+                                  from, to - from + 1, ring);
+        }
+        ids[kept++] = ids[from];
+        for (uint32_t j = from + 1; !closed && j < to; ++j) ids[kept++] = ids[j];
     }
-    uint32_t kept = 0;
-    for (uint32_t i = 0; i < length; ++i)
-        if (!gone[i]) ids[kept++] = ids[i];
     return kept;
 }
 
@@ -702,14 +632,7 @@ inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
             for (uint32_t i = 0; i < length; ++i)
                 project(ids[i], c.xy + 2 * static_cast<size_t>(i), &height);
             if (!polygon_is_simple(c.xy, length, c.sweep)) break;
-            // The lexicographically lowest corner is convex: it gives the turning direction.
-            uint32_t lowest = 0;
-            for (uint32_t i = 1; i < length; ++i)
-                if (lex_less(c.xy + 2 * static_cast<size_t>(i), c.xy + 2 * static_cast<size_t>(lowest)))
-                    lowest = i;
-            turn = orient2d_robust(c.xy + 2 * static_cast<size_t>(lowest == 0 ? length - 1 : lowest - 1),
-                                   c.xy + 2 * static_cast<size_t>(lowest),
-                                   c.xy + 2 * static_cast<size_t>(lowest + 1 == length ? 0 : lowest + 1));
+            turn = simple_polygon_turn(c.xy, length);
             if (!pockets || turn == 0) break;
             const size_t before = count;
             length = fill_pockets(tri, count, g, c, cloud, frame, ids, length, turn < 0);

@@ -36,6 +36,9 @@ struct GraftEdge {
 
 struct JoinMemory {
     CapLoop loops;  // only ids and starts
+    uint32_t* gap_joins;  // per entry of loops.ids on a loop of at most kGapLoopMost: bit j
+                          // set where its vertex and the loop's j-th are joined by an edge of
+                          // the caller's surface (the diagonals a gap fill may not make)
     CapGraph graph;  // until the loops are traced; the grafts' arrays then take its memory
     uint32_t* hole_next;     // per point: its successor on a planned hole, kNoIndex if free,
                              // kHeldVertex where no hole may pass (the trunk's boundary)
@@ -54,11 +57,12 @@ struct JoinMemory {
 const uint32_t kHeldVertex = kNoIndex - 1;
 
 // The arena sequence of the call, shared with join_branches_workspace_size(): the loops,
-// then the graph after them, then (allocate_grafts) once the loops are traced, the grafts'
-// arrays in the graph's room.
+// then the graph after them, then (allocate_grafts) once the loops are traced and the gaps'
+// joins noted, the grafts' arrays in the graph's room.
 inline bool allocate_join(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
     m.loops.ids = arena.alloc<uint32_t>(point_count);  // every point on a loop at most
     m.loops.starts = arena.alloc<unsigned char>(point_count);
+    m.gap_joins = arena.alloc<uint32_t>(point_count);
     m.room = arena.mark();
     allocate_cap_graph(m.graph, point_count, triangle_count, arena);
     return !arena.failed;
@@ -171,24 +175,15 @@ inline void find_side_loops(const CapLoop& loops, size_t entries, const uint8_t*
     }
 }
 
-// Plans the rim junction of a side with `branches` branches, from its loops, with its cut
-// and gap as heights of the view: false (detail set) if it cannot be joined so.
-inline bool plan_junction(const SideLoops& loops, uint32_t branches, double cut, double gap,
-                          const SideView& view, SideJunction& side, const char*& detail) {
-    const double trunk_height = loops.trunk_height;
-    const double* branch_height = loops.branch_height;
-    const TracedLoop* found = loops.branch;
-    side.trunk = loops.trunk;
-    // Loops farther than kJoinReach gaps from the cut are not the junction's: a trunk
-    // closed at the cut keeps only its far loop, a branch closed there only its tip's.
-    auto near_cut = [&](double height) { return std::fabs(height - cut) <= kJoinReach * gap; };
-    if (!side.trunk.ids || !near_cut(trunk_height)) {
-        detail = "the trunk has no boundary loop near the cut to join a side's branches to "
-                 "(a trunk closed there: the branches stand on a closed end)";
-        return false;
-    }
-    // The trunk's centre, and the sense its loop turns in (+1 counter-clockwise).
-    const TracedLoop& trunk = side.trunk;
+// The trunk's loop seen across the axis: its centre, its mean radius, and the sense it
+// turns in (+1 counter-clockwise).
+struct TrunkCentre {
+    double cx, cy, radius, sense;
+
+    double angle(double x, double y) const { return std::atan2(sense * (y - cy), x - cx); }
+};
+
+inline TrunkCentre trunk_centre(const TracedLoop& trunk, const SideView& view) {
     double cx = 0, cy = 0, area = 0;
     for (uint32_t i = 0; i < trunk.length; ++i) {
         const Local p = view.at(trunk.ids[i]);
@@ -199,61 +194,64 @@ inline bool plan_junction(const SideLoops& loops, uint32_t branches, double cut,
     }
     cx /= trunk.length;
     cy /= trunk.length;
-    double trunk_radius = 0;
+    double radius = 0;
     for (uint32_t i = 0; i < trunk.length; ++i) {
         const Local p = view.at(trunk.ids[i]);
-        trunk_radius += std::sqrt((p.x - cx) * (p.x - cx) + (p.y - cy) * (p.y - cy));
+        radius += std::sqrt((p.x - cx) * (p.x - cx) + (p.y - cy) * (p.y - cy));
     }
-    trunk_radius /= trunk.length;
-    const double sense = area < 0 ? -1 : 1;
-    side.sense = sense;
-    auto angle = [&](double x, double y) { return std::atan2(sense * (y - cy), x - cx); };
-    double branch_angle[kMaxBranches];
-    side.branches = 0;
-    for (uint32_t b = 0; b < branches; ++b) {
-        if (!found[b].ids || !near_cut(branch_height[b])) continue;
-        const TracedLoop& loop = found[b];
-        double bx = 0, by = 0, nearest = DBL_MAX;
-        uint32_t opening = 0;
-        for (uint32_t i = 0; i < loop.length; ++i) {
-            const Local p = view.at(loop.ids[i]);
-            bx += p.x;
-            by += p.y;
-            const double d = (p.x - cx) * (p.x - cx) + (p.y - cy) * (p.y - cy);
-            if (d < nearest) {
-                nearest = d;
-                opening = i;
-            }
+    radius /= trunk.length;
+    return {cx, cy, radius, area < 0 ? -1.0 : 1.0};
+}
+
+// Adds the branch's loop to the side's, in the order of their angles around the trunk's
+// centre (kept in branch_angle): its centre, and where it opens, its vertex nearest the
+// trunk's centre. False (detail set) where its centre is not within the trunk's loop.
+inline bool add_rim_branch(const TracedLoop& loop, const SideView& view,
+                           const TrunkCentre& trunk, SideJunction& side, double* branch_angle,
+                           const char*& detail) {
+    double bx = 0, by = 0, nearest = DBL_MAX;
+    uint32_t opening = 0;
+    for (uint32_t i = 0; i < loop.length; ++i) {
+        const Local p = view.at(loop.ids[i]);
+        bx += p.x;
+        by += p.y;
+        const double d = (p.x - trunk.cx) * (p.x - trunk.cx) + (p.y - trunk.cy) * (p.y - trunk.cy);
+        if (d < nearest) {
+            nearest = d;
+            opening = i;
         }
-        bx /= loop.length;
-        by /= loop.length;
-        if ((bx - cx) * (bx - cx) + (by - cy) * (by - cy) >= trunk_radius * trunk_radius) {
-            detail = "a branch's loop is not within the trunk's loop nearest it, across the axis "
-                     "(a branch standing on a closed end, not on a rim around the branches)";
-            return false;
-        }
-        // Inserted in the order of their angles around the trunk's centre.
-        const double a = angle(bx, by);
-        uint32_t k = side.branches++;
-        for (; k > 0 && branch_angle[k - 1] > a; --k) {
-            branch_angle[k] = branch_angle[k - 1];
-            side.branch[k] = side.branch[k - 1];
-            side.opening[k] = side.opening[k - 1];
-            side.centre[k][0] = side.centre[k - 1][0];
-            side.centre[k][1] = side.centre[k - 1][1];
-        }
-        branch_angle[k] = a;
-        side.branch[k] = loop;
-        side.opening[k] = opening;
-        side.centre[k][0] = bx;
-        side.centre[k][1] = by;
     }
-    if (side.branches < 2) {
-        detail = "fewer than two of a side's branches have a boundary loop of their own";
+    bx /= loop.length;
+    by /= loop.length;
+    if ((bx - trunk.cx) * (bx - trunk.cx) + (by - trunk.cy) * (by - trunk.cy) >=
+        trunk.radius * trunk.radius) {
+        detail = "a branch's loop is not within the trunk's loop nearest it, across the axis "
+                 "(a branch standing on a closed end, not on a rim around the branches)";
         return false;
     }
-    // The gap after branch i: the trunk's vertex nearest in angle to the middle between
-    // branch i and the next one.
+    const double a = trunk.angle(bx, by);
+    uint32_t k = side.branches++;
+    for (; k > 0 && branch_angle[k - 1] > a; --k) {
+        branch_angle[k] = branch_angle[k - 1];
+        side.branch[k] = side.branch[k - 1];
+        side.opening[k] = side.opening[k - 1];
+        side.centre[k][0] = side.centre[k - 1][0];
+        side.centre[k][1] = side.centre[k - 1][1];
+    }
+    branch_angle[k] = a;
+    side.branch[k] = loop;
+    side.opening[k] = opening;
+    side.centre[k][0] = bx;
+    side.centre[k][1] = by;
+    return true;
+}
+
+// The gap after each branch i: the trunk's vertex nearest in angle to the middle between
+// branch i and the next one. False (detail set) where the gaps do not follow one another
+// along the trunk's loop as the branches do.
+inline bool place_rim_gaps(const SideView& view, const TrunkCentre& centre,
+                           const double* branch_angle, SideJunction& side, const char*& detail) {
+    const TracedLoop& trunk = side.trunk;
     const double two_pi = 6.28318530717958647693;
     for (uint32_t i = 0; i < side.branches; ++i) {
         const uint32_t next = (i + 1) % side.branches;
@@ -263,14 +261,13 @@ inline bool plan_junction(const SideLoops& loops, uint32_t branches, double cut,
         double nearest = DBL_MAX;
         for (uint32_t j = 0; j < trunk.length; ++j) {
             const Local p = view.at(trunk.ids[j]);
-            const double off = std::fabs(std::remainder(angle(p.x, p.y) - middle, two_pi));
+            const double off = std::fabs(std::remainder(centre.angle(p.x, p.y) - middle, two_pi));
             if (off < nearest) {
                 nearest = off;
                 side.gap[i] = j;
             }
         }
     }
-    // The gaps must follow one another along the trunk's loop as the branches do.
     const uint32_t last = side.gap[side.branches - 1];
     uint32_t before = 0;
     for (uint32_t i = 0; i + 1 < side.branches; ++i) {
@@ -282,6 +279,35 @@ inline bool plan_junction(const SideLoops& loops, uint32_t branches, double cut,
         before = along;
     }
     return true;
+}
+
+// Plans the rim junction of a side with `branches` branches, from its loops, with its cut
+// and gap as heights of the view: false (detail set) if it cannot be joined so.
+inline bool plan_junction(const SideLoops& loops, uint32_t branches, double cut, double gap,
+                          const SideView& view, SideJunction& side, const char*& detail) {
+    side.trunk = loops.trunk;
+    // Loops farther than kJoinReach gaps from the cut are not the junction's: a trunk
+    // closed at the cut keeps only its far loop, a branch closed there only its tip's.
+    auto near_cut = [&](double height) { return std::fabs(height - cut) <= kJoinReach * gap; };
+    if (!side.trunk.ids || !near_cut(loops.trunk_height)) {
+        detail = "the trunk has no boundary loop near the cut to join a side's branches to "
+                 "(a trunk closed there: the branches stand on a closed end)";
+        return false;
+    }
+    const TrunkCentre centre = trunk_centre(side.trunk, view);
+    side.sense = centre.sense;
+    double branch_angle[kMaxBranches];
+    side.branches = 0;
+    for (uint32_t b = 0; b < branches; ++b) {
+        if (!loops.branch[b].ids || !near_cut(loops.branch_height[b])) continue;
+        if (!add_rim_branch(loops.branch[b], view, centre, side, branch_angle, detail))
+            return false;
+    }
+    if (side.branches < 2) {
+        detail = "fewer than two of a side's branches have a boundary loop of their own";
+        return false;
+    }
+    return place_rim_gaps(view, centre, branch_angle, side, detail);
 }
 
 // Angles around a centre across the axis, from the direction of a reference point, in
@@ -380,31 +406,14 @@ struct Graft {
     size_t triangles() const { return static_cast<size_t>(hole.length) + branch.length; }
 };
 
-// How many times the loop winds around (cx, cy) across the axis, counter-clockwise positive
-// (the sum of its turns, rounded).
-inline long winding_around(const TracedLoop& loop, const SideView& view, double cx, double cy) {
-    double sum = 0;
-    Local p = view.at(loop.ids[loop.length - 1]);
-    for (uint32_t i = 0; i < loop.length; ++i) {
+// How many times the loop winds around (x, y) across the axis, counter-clockwise positive.
+inline long loop_winding(const TracedLoop& loop, const SideView& view, double x, double y) {
+    const double p[2] = {x, y};
+    auto corner = [&](uint32_t i) {
         const Local q = view.at(loop.ids[i]);
-        const double ax = p.x - cx, ay = p.y - cy, bx = q.x - cx, by = q.y - cy;
-        sum += std::atan2(ax * by - ay * bx, ax * bx + ay * by);
-        p = q;
-    }
-    return std::lround(sum / 6.28318530717958647693);
-}
-
-// Whether (x, y) lies inside the loop across the axis (even-odd rule).
-inline bool inside_loop(const TracedLoop& loop, const SideView& view, double x, double y) {
-    bool inside = false;
-    Local p = view.at(loop.ids[loop.length - 1]);
-    for (uint32_t i = 0; i < loop.length; ++i) {
-        const Local q = view.at(loop.ids[i]);
-        if ((q.y > y) != (p.y > y) && x < q.x + (y - q.y) * (p.x - q.x) / (p.y - q.y))
-            inside = !inside;
-        p = q;
-    }
-    return inside;
+        return Point2{{q.x, q.y}};
+    };
+    return winding_number(corner, loop.length, p);
 }
 
 // The trunk's triangles a graft reads: the caller's, `count` of them, then those that
@@ -496,78 +505,88 @@ inline TracedLoop gap_beside(const JoinMemory& m, size_t entries, size_t found,
     return best;
 }
 
+static_assert(kGapLoopMost <= 32, "a gap's joins are bits of 32");
+
+// Notes in m.gap_joins, from the graph, which vertices of each loop small enough to be a
+// gap are joined by an edge of the caller's surface: the graph keeps the edges between
+// boundary vertices, and its memory goes to the grafts.
+inline void note_gap_joins(JoinMemory& m, size_t entries) {
+    for (size_t start = 0; start < entries;) {
+        size_t end = start + 1;
+        while (end < entries && m.loops.starts[end] == 0) ++end;
+        const uint32_t* ids = m.loops.ids + start;
+        for (size_t i = 0; end - start <= kGapLoopMost && i < end - start; ++i) {
+            uint32_t joins = 0;
+            for (size_t j = 0; j < end - start; ++j)
+                if (m.graph.has_edge(ids[i], ids[j])) joins |= uint32_t{1} << j;
+            m.gap_joins[start + i] = joins;
+        }
+        start = end;
+    }
+}
+
+// A gap's ears: no diagonal that is an edge of the caller's surface (see note_gap_joins);
+// each ear a triangle of m.filled.
+class GapEars final : public EarRules {
+public:
+    GapEars(const uint32_t* ids, const uint32_t* joins, JoinMemory& m)
+        : ids_(ids), joins_(joins), m_(m) {}
+
+private:
+    bool forbidden(uint32_t a, uint32_t b) const override { return ((joins_[a] >> b) & 1) != 0; }
+
+    void take(uint32_t p, uint32_t v, uint32_t n) override {
+        uint32_t* out = m_.filled + 3 * m_.filled_count++;
+        out[0] = ids_[p];
+        out[1] = ids_[v];
+        out[2] = ids_[n];
+    }
+
+    const uint32_t* ids_;
+    const uint32_t* joins_;
+    JoinMemory& m_;
+};
+
 // Closes the gap `loop` (in cap order) with triangles in m.filled, by ears clipped in the
-// view, and frees its vertices for the holes; false (nothing added) where the loop does not
-// turn counter-clockwise in the view (the way the triangles facing a branch turn), an ear
-// would repeat an edge of the surface, or none is left to clip (a loop that crosses itself
-// across the axis).
-inline bool fill_gap(const uint32_t* tri, size_t count, const TracedLoop& loop,
-                     const SideView& view, JoinMemory& m) {
+// view, each from the first corner left, and frees its vertices for the holes; false
+// (nothing added) where the loop is no simple polygon turning counter-clockwise in the view
+// (the way the triangles facing a branch turn) or no ear is left whose diagonal is not an
+// edge of the surface. count: the caller's triangles, which m.removed numbers first.
+inline bool fill_gap(size_t count, const TracedLoop& loop, const SideView& view, JoinMemory& m) {
     const uint32_t n = loop.length;
     if (m.filled_count + (n - 2) > kMostFilled) return false;
-    uint32_t ring[kGapLoopMost];
-    double area = 0;
+    double xy[2 * kGapLoopMost];
     for (uint32_t i = 0; i < n; ++i) {
-        ring[i] = loop.ids[i];
-        const Local p = view.at(loop.ids[i]), q = view.at(loop.ids[(i + 1) % n]);
-        area += p.x * q.y - q.x * p.y;
+        const Local p = view.at(loop.ids[i]);
+        xy[2 * i] = p.x;
+        xy[2 * i + 1] = p.y;
     }
-    if (!(area > 0)) return false;
-    auto is_edge = [&](uint32_t a, uint32_t b) {
-        for (size_t t = 0; t < count; ++t) {
-            const uint32_t* c = tri + 3 * t;
-            for (int e = 0; e < 3; ++e)
-                if ((c[e] == a && c[(e + 1) % 3] == b) || (c[e] == b && c[(e + 1) % 3] == a))
-                    return true;
-        }
-        return false;
-    };
-    auto turn = [&](const Local& a, const Local& b, const Local& c) {
-        return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-    };
+    uint64_t sweep[kGapLoopMost];
+    if (!polygon_is_simple(xy, n, sweep) || !(simple_polygon_turn(xy, n) > 0)) return false;
+    uint32_t prev[kGapLoopMost], next[kGapLoopMost], reflex[kGapLoopMost];
+    unsigned char flags[kGapLoopMost];
     const size_t first = m.filled_count;
-    for (uint32_t left = n; left > 3;) {
-        uint32_t ear = left;
-        for (uint32_t i = 0; i < left && ear == left; ++i) {
-            const uint32_t a = ring[(i + left - 1) % left], b = ring[i], c = ring[(i + 1) % left];
-            const Local pa = view.at(a), pb = view.at(b), pc = view.at(c);
-            if (!(turn(pa, pb, pc) > 0)) continue;
-            bool empty = true;
-            for (uint32_t k = 0; k < left && empty; ++k) {
-                const uint32_t v = ring[k];
-                if (v == a || v == b || v == c) continue;
-                const Local pv = view.at(v);
-                empty = !(turn(pa, pb, pv) >= 0 && turn(pb, pc, pv) >= 0 && turn(pc, pa, pv) >= 0);
-            }
-            if (empty && !is_edge(a, c)) ear = i;
-        }
-        if (ear == left) {
-            m.filled_count = first;
-            return false;
-        }
-        uint32_t* out = m.filled + 3 * m.filled_count++;
-        out[0] = ring[(ear + left - 1) % left];
-        out[1] = ring[ear];
-        out[2] = ring[(ear + 1) % left];
-        for (uint32_t k = ear; k + 1 < left; ++k) ring[k] = ring[k + 1];
-        --left;
+    GapEars ears(loop.ids, m.gap_joins + (loop.ids - m.loops.ids), m);
+    EarClipper clipper(xy, n, {prev, next, reflex, flags});
+    if (!clipper.clip(0, EarWalk::from_first, ears)) {
+        m.filled_count = first;
+        return false;
     }
-    uint32_t* out = m.filled + 3 * m.filled_count++;
-    out[0] = ring[0];
-    out[1] = ring[1];
-    out[2] = ring[2];
     for (size_t f = first; f < m.filled_count; ++f) m.removed[count + f] = 0;
     for (uint32_t i = 0; i < n; ++i) m.hole_next[loop.ids[i]] = kNoIndex;
     return true;
 }
 
-// Plans the graft of the branch whose loop (nearest the cut) is `loop`, taking the hole's
-// triangles out in m.removed and its vertices in m.hole_next, its loop appended to m.holes
-// at holes_used; false (nothing taken, detail set) if it cannot be grafted. tri: the
-// caller's `count` triangles; entries: the count of m.loops' ids.
-inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_of,
-                       const TracedLoop& loop, double gap, const SideView& view, JoinMemory& m,
-                       size_t entries, size_t& holes_used, Graft& graft, const char*& detail) {
+// Where a branch's loop stands in the view: its centre across the axis, the square of its
+// reach from there, and the heights a trunk triangle's centroid under it may have.
+struct GraftSite {
+    double cx, cy, reach, low, high;
+};
+
+// The site of the branch's loop, within kJoinReach gaps below its mean height and one gap
+// above; false (detail set) where the loop does not go once around its centre.
+inline bool graft_site(const TracedLoop& loop, double gap, const SideView& view,
+                       GraftSite& site, const char*& detail) {
     double cx = 0, cy = 0, height = 0;
     for (uint32_t i = 0; i < loop.length; ++i) {
         const Local p = view.at(loop.ids[i]);
@@ -580,7 +599,7 @@ inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_
     height /= loop.length;
     // In cap order a branch's loop turns clockwise seen from the branch (its cap would face
     // away from it), once around its centre.
-    if (winding_around(loop, view, cx, cy) != -1) {
+    if (loop_winding(loop, view, cx, cy) != -1) {
         detail = "a branch's loop does not go once around its centre, seen along the axis";
         return false;
     }
@@ -590,103 +609,142 @@ inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_
         const double d = (p.x - cx) * (p.x - cx) + (p.y - cy) * (p.y - cy);
         if (d > reach) reach = d;
     }
-    const double low = height - kJoinReach * gap, high = height + gap;
-    uint32_t* next = m.hole_next;
-    uint32_t* hole = m.holes + holes_used;
-    size_t found = 0, taken = 0;
-    uint32_t length = 0;
-    bool missed_centre = false;
-    // The trunk's triangles under the loop, and the disc grown from the one nearest its
-    // centre whose vertices are free; false (detail set, nothing taken) where it fails.
-    auto plan_hole = [&]() {
-        found = 0;
-        for (size_t t = 0; t < count + m.filled_count; ++t) {
-            const uint32_t* c = trunk_corners(tri, count, m, t);
-            if (m.removed[t] || c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;
-            if (branch_of[c[0]] != kInTrunk || branch_of[c[1]] != kInTrunk ||
-                branch_of[c[2]] != kInTrunk)
-                continue;
-            const Local a = view.at(c[0]), b = view.at(c[1]), d = view.at(c[2]);
-            const double gx = (a.x + b.x + d.x) / 3, gy = (a.y + b.y + d.y) / 3;
-            const double gh = (a.h + b.h + d.h) / 3;
-            if (gh < low || gh > high) continue;
-            if ((gx - cx) * (gx - cx) + (gy - cy) * (gy - cy) > reach) continue;
-            const Vec3 normal = cross({b.x - a.x, b.y - a.y, b.h - a.h}, {d.x - a.x, d.y - a.y, d.h - a.h});
-            if (!(normal.z > kGraftFacing * std::sqrt(dot(normal, normal)))) continue;
-            if (!inside_loop(loop, view, gx, gy)) continue;
-            if (found == m.under_capacity) {
-                detail = "more of the trunk's triangles lie under a branch's loop than a graft "
-                         "takes (kGraftMaxTriangles)";
-                return false;
-            }
-            m.under[found++] = static_cast<uint32_t>(t);
-        }
-        size_t seed = found;
-        double nearest = DBL_MAX;
-        for (size_t k = 0; k < found; ++k) {
-            const uint32_t* c = trunk_corners(tri, count, m, m.under[k]);
-            if (next[c[0]] != kNoIndex || next[c[1]] != kNoIndex || next[c[2]] != kNoIndex)
-                continue;
-            const Local a = view.at(c[0]), b = view.at(c[1]), d = view.at(c[2]);
-            const double gx = (a.x + b.x + d.x) / 3 - cx, gy = (a.y + b.y + d.y) / 3 - cy;
-            if (gx * gx + gy * gy < nearest) {
-                nearest = gx * gx + gy * gy;
-                seed = k;
-            }
-        }
-        if (seed == found) {
-            detail = "no triangle of the trunk under a branch's loop faces it (and is free to take)";
+    site = {cx, cy, reach, height - kJoinReach * gap, height + gap};
+    return true;
+}
+
+// Collects in m.under[0 .. found) the trunk's triangles under the branch's loop that face
+// it (see "grafts" above) and no planned hole takes; false (detail set) if there are more
+// than m.under holds.
+inline bool find_under(const uint32_t* tri, size_t count, const uint8_t* branch_of,
+                       const TracedLoop& loop, const SideView& view, const GraftSite& site,
+                       JoinMemory& m, size_t& found, const char*& detail) {
+    found = 0;
+    for (size_t t = 0; t < count + m.filled_count; ++t) {
+        const uint32_t* c = trunk_corners(tri, count, m, t);
+        if (m.removed[t] || c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) continue;
+        if (branch_of[c[0]] != kInTrunk || branch_of[c[1]] != kInTrunk ||
+            branch_of[c[2]] != kInTrunk)
+            continue;
+        const Local a = view.at(c[0]), b = view.at(c[1]), d = view.at(c[2]);
+        const double gx = (a.x + b.x + d.x) / 3, gy = (a.y + b.y + d.y) / 3;
+        const double gh = (a.h + b.h + d.h) / 3;
+        if (gh < site.low || gh > site.high) continue;
+        if ((gx - site.cx) * (gx - site.cx) + (gy - site.cy) * (gy - site.cy) > site.reach) continue;
+        const Vec3 normal = cross({b.x - a.x, b.y - a.y, b.h - a.h}, {d.x - a.x, d.y - a.y, d.h - a.h});
+        if (!(normal.z > kGraftFacing * std::sqrt(dot(normal, normal)))) continue;
+        // Odd: inside by the even-odd rule.
+        if (loop_winding(loop, view, gx, gy) % 2 == 0) continue;
+        if (found == m.under_capacity) {
+            detail = "more of the trunk's triangles lie under a branch's loop than a graft "
+                     "takes (kGraftMaxTriangles)";
             return false;
         }
-        for (size_t k = 0; k < found; ++k)
-            for (size_t e = 0; e < 3; ++e) {
-                const uint32_t* c = trunk_corners(tri, count, m, m.under[k]);
-                m.edges[3 * k + e] = {c[e], c[(e + 1) % 3], static_cast<uint32_t>(k)};
-            }
-        heap_sort(m.edges, 3 * found);
-        const uint32_t* first = trunk_corners(tri, count, m, m.under[seed]);
-        for (size_t e = 0; e < 3; ++e) {
-            next[first[e]] = first[(e + 1) % 3];
-            m.queue[e] = (uint64_t{first[e]} << 32) | first[(e + 1) % 3];
+        m.under[found++] = static_cast<uint32_t>(t);
+    }
+    return true;
+}
+
+// The position in m.under[0 .. found) of the triangle nearest the site's centre whose
+// corners no hole holds; found if there is none.
+inline size_t hole_seed(const uint32_t* tri, size_t count, const JoinMemory& m, size_t found,
+                        const SideView& view, const GraftSite& site) {
+    size_t seed = found;
+    double nearest = DBL_MAX;
+    for (size_t k = 0; k < found; ++k) {
+        const uint32_t* c = trunk_corners(tri, count, m, m.under[k]);
+        if (m.hole_next[c[0]] != kNoIndex || m.hole_next[c[1]] != kNoIndex ||
+            m.hole_next[c[2]] != kNoIndex)
+            continue;
+        const Local a = view.at(c[0]), b = view.at(c[1]), d = view.at(c[2]);
+        const double gx = (a.x + b.x + d.x) / 3 - site.cx, gy = (a.y + b.y + d.y) / 3 - site.cy;
+        if (gx * gx + gy * gy < nearest) {
+            nearest = gx * gx + gy * gy;
+            seed = k;
         }
-        m.removed[m.under[seed]] = 1;
-        taken = 1 + grow_hole(tri, count, m, found, 3);
-        length = static_cast<uint32_t>(taken + 2);
-        hole[0] = first[0];
-        for (uint32_t i = 1; i < length; ++i) hole[i] = next[hole[i - 1]];
-        graft.hole = {hole, length};
-        if (winding_around(graft.hole, view, cx, cy) == 1) return true;
-        for (uint32_t i = 0; i < length; ++i) next[hole[i]] = kNoIndex;
-        for (size_t k = 0; k < found; ++k) m.removed[m.under[k]] = 0;
-        detail = "the hole under a branch's loop does not go once around the branch's centre";
-        missed_centre = true;
-        return false;
-    };
-    bool planned = plan_hole();
+    }
+    return seed;
+}
+
+enum class HolePlan { cut, refused, missed_centre };
+
+// Plans the hole under the branch's loop: the disc grown from the seed across the
+// triangles under it, its loop written at `hole` and kept in graft.hole, its triangles in
+// graft.removed. Refused (detail set, nothing taken) where no triangle is there to take;
+// missed_centre where the disc does not go once around the site's centre. found: the
+// triangles under the loop, for gap_beside.
+inline HolePlan plan_hole(const uint32_t* tri, size_t count, const uint8_t* branch_of,
+                          const TracedLoop& loop, const SideView& view, const GraftSite& site,
+                          JoinMemory& m, uint32_t* hole, size_t& found, Graft& graft,
+                          const char*& detail) {
+    if (!find_under(tri, count, branch_of, loop, view, site, m, found, detail))
+        return HolePlan::refused;
+    const size_t seed = hole_seed(tri, count, m, found, view, site);
+    if (seed == found) {
+        detail = "no triangle of the trunk under a branch's loop faces it (and is free to take)";
+        return HolePlan::refused;
+    }
+    for (size_t k = 0; k < found; ++k)
+        for (size_t e = 0; e < 3; ++e) {
+            const uint32_t* c = trunk_corners(tri, count, m, m.under[k]);
+            m.edges[3 * k + e] = {c[e], c[(e + 1) % 3], static_cast<uint32_t>(k)};
+        }
+    heap_sort(m.edges, 3 * found);
+    uint32_t* next = m.hole_next;
+    const uint32_t* first = trunk_corners(tri, count, m, m.under[seed]);
+    for (size_t e = 0; e < 3; ++e) {
+        next[first[e]] = first[(e + 1) % 3];
+        m.queue[e] = (uint64_t{first[e]} << 32) | first[(e + 1) % 3];
+    }
+    m.removed[m.under[seed]] = 1;
+    graft.removed = 1 + grow_hole(tri, count, m, found, 3);
+    const uint32_t length = static_cast<uint32_t>(graft.removed + 2);
+    hole[0] = first[0];
+    for (uint32_t i = 1; i < length; ++i) hole[i] = next[hole[i - 1]];
+    graft.hole = {hole, length};
+    if (loop_winding(graft.hole, view, site.cx, site.cy) == 1) return HolePlan::cut;
+    for (uint32_t i = 0; i < length; ++i) next[hole[i]] = kNoIndex;
+    for (size_t k = 0; k < found; ++k) m.removed[m.under[k]] = 0;
+    detail = "the hole under a branch's loop does not go once around the branch's centre";
+    return HolePlan::missed_centre;
+}
+
+// Plans the graft of the branch whose loop (nearest the cut) is `loop`, taking the hole's
+// triangles out in m.removed and its vertices in m.hole_next, its loop appended to m.holes
+// at holes_used; false (nothing taken, detail set) if it cannot be grafted. tri: the
+// caller's `count` triangles; entries: the count of m.loops' ids.
+inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_of,
+                       const TracedLoop& loop, double gap, const SideView& view, JoinMemory& m,
+                       size_t entries, size_t& holes_used, Graft& graft, const char*& detail) {
+    GraftSite site;
+    if (!graft_site(loop, gap, view, site, detail)) return false;
+    uint32_t* hole = m.holes + holes_used;
+    size_t found = 0;
+    HolePlan plan = plan_hole(tri, count, branch_of, loop, view, site, m, hole, found, graft, detail);
     // A disc with no vertex inside never takes a triangle with a corner it may not take.
     // Where such a corner is on a small gap in the trunk's end beside the stump (an end
     // meshed across a fork's open top keeps some among its long triangles) and that
     // triangle covers the branch's centre, the hole misses the centre: the gap is closed
     // and the hole planned again, free to take that triangle now.
-    if (!planned && missed_centre) {
-        const TracedLoop beside = gap_beside(m, entries, found, branch_of, view, cx, cy,
-                                             kGapReach * std::sqrt(reach), low, high);
+    if (plan == HolePlan::missed_centre) {
+        const TracedLoop beside =
+            gap_beside(m, entries, found, branch_of, view, site.cx, site.cy,
+                       kGapReach * std::sqrt(site.reach), site.low, site.high);
         const size_t filled_before = m.filled_count;
-        if (beside.ids && fill_gap(tri, count, beside, view, m)) {
-            planned = plan_hole();
-            if (!planned) {
+        if (beside.ids && fill_gap(count, beside, view, m)) {
+            plan = plan_hole(tri, count, branch_of, loop, view, site, m, hole, found, graft, detail);
+            if (plan != HolePlan::cut) {
                 m.filled_count = filled_before;
-                for (uint32_t i = 0; i < beside.length; ++i) next[beside.ids[i]] = kHeldVertex;
+                for (uint32_t i = 0; i < beside.length; ++i) m.hole_next[beside.ids[i]] = kHeldVertex;
             }
         }
     }
-    if (!planned) return false;
-    holes_used += length;
+    if (plan != HolePlan::cut) return false;
+    holes_used += graft.hole.length;
     graft.branch = loop;
-    graft.centre[0] = cx;
-    graft.centre[1] = cy;
+    graft.centre[0] = site.cx;
+    graft.centre[1] = site.cy;
     graft.side = view.sign;
-    graft.removed = taken;
     return true;
 }
 
@@ -720,6 +778,135 @@ inline void write_graft(const Graft& graft, const SideView& view, uint32_t* out)
             ++l;
         }
     }
+}
+
+// The caller's input as join_branches() plans from it: the surface's triangles in the
+// cloud's indices, the labels, the frame along the parting's axis, the traced loops'
+// entries (in JoinMemory::loops).
+struct JoinInput {
+    const CloudReader& reader;
+    const Frame& frame;
+    const Parting& parting;
+    const uint32_t* triangles;
+    size_t given;
+    const uint8_t* branch_of;
+    size_t entries;
+};
+
+// What join_branches() plans before it writes: each side's rim junction, or the grafts of
+// its branches; the triangles they need in all.
+struct JoinPlan {
+    SideJunction junction[2];
+    bool rim[2] = {false, false};
+    Graft grafts[2 * kMaxBranches];
+    uint32_t graft_count = 0;
+    size_t holes_used = 0, removed = 0, needed = 0;
+    const uint32_t* taken = nullptr;  // the trunk loop a side's rim joined: not the other's
+};
+
+// Plans side k (0 above the cut, 1 below) with `branches` branches: its rim junction where
+// a trunk loop goes around them, else a graft for each branch where it stands; counts the
+// side into r.
+inline void plan_side(int k, uint32_t branches, const JoinInput& in, JoinMemory& m,
+                      JoinPlan& plan, JoinReport& r) {
+    const SideView view = {in.reader, in.frame, k == 0 ? 1.0 : -1.0};
+    const uint8_t first = static_cast<uint8_t>(k == 0 ? kFirstAboveBranch : kFirstBelowBranch);
+    const double cut = (k == 0 ? in.parting.above : in.parting.below) -
+                       dot(in.frame.origin, in.frame.axis);
+    const double gap = in.parting.gap * in.frame.scale;
+    SideLoops loops;
+    find_side_loops(m.loops, in.entries, in.branch_of, first, branches, view, plan.taken, loops);
+    const char* rim_why = nullptr;  // superseded by the grafts' reasons
+    plan.rim[k] = plan_junction(loops, branches, view.sign * cut * in.frame.scale, gap, view,
+                                plan.junction[k], rim_why);
+    if (plan.rim[k]) {
+        plan.taken = plan.junction[k].trunk.ids;
+        plan.needed += plan.junction[k].triangles();
+        ++r.joined_side_count;
+        return;
+    }
+    // No rim goes around the branches: each is grafted where it stands on the trunk.
+    uint32_t grafted = 0;
+    for (uint32_t b = 0; b < branches; ++b) {
+        const char* graft_why = nullptr;
+        Graft& graft = plan.grafts[plan.graft_count];
+        if (!loops.branch[b].ids) {
+            graft_why = "a branch has no boundary loop of its own to join";
+        } else if (plan_graft(in.triangles, in.given, in.branch_of, loops.branch[b], gap, view,
+                              m, in.entries, plan.holes_used, graft, graft_why)) {
+            plan.needed += graft.triangles();
+            plan.removed += graft.removed;
+            ++plan.graft_count;
+            ++grafted;
+            continue;
+        }
+        if (!r.detail) r.detail = graft_why;
+    }
+    r.grafted_branch_count += grafted;
+    if (grafted == branches)
+        ++r.joined_side_count;
+    else
+        ++r.apart_side_count;
+}
+
+// Writes the plan over the caller's triangles: those the holes take out gone, then the
+// gaps' triangles, the rims' and the grafts'; counts into r; returns the triangles in all.
+inline size_t write_join(const JoinInput& in, const JoinMemory& m, const JoinPlan& plan,
+                         uint32_t* triangles, JoinReport& r) {
+    size_t kept = 0;
+    for (size_t t = 0; t < in.given; ++t) {
+        if (m.removed[t]) continue;
+        if (kept != t)
+            for (size_t e = 0; e < 3; ++e) triangles[3 * kept + e] = triangles[3 * t + e];
+        ++kept;
+    }
+    r.removed_triangle_count = in.given - kept;
+    uint32_t* out = triangles + 3 * kept;
+    for (size_t f = 0; f < m.filled_count; ++f) {
+        if (m.removed[in.given + f]) continue;
+        for (size_t e = 0; e < 3; ++e) out[e] = m.filled[3 * f + e];
+        out += 3;
+        ++r.added_triangle_count;
+    }
+    for (int k = 0; k < 2; ++k) {
+        if (!plan.rim[k]) continue;
+        const SideView view = {in.reader, in.frame, k == 0 ? 1.0 : -1.0};
+        write_junction(plan.junction[k], view, out);
+        out += 3 * plan.junction[k].triangles();
+        r.added_triangle_count += plan.junction[k].triangles();
+    }
+    for (uint32_t g = 0; g < plan.graft_count; ++g) {
+        const SideView view = {in.reader, in.frame, plan.grafts[g].side};
+        write_graft(plan.grafts[g], view, out);
+        out += 3 * plan.grafts[g].triangles();
+        r.added_triangle_count += plan.grafts[g].triangles();
+    }
+    return kept + r.added_triangle_count;
+}
+
+// join_branches()'s checks of the points and the triangles: ok, or a status with
+// checks.detail set.
+inline Status check_join_input(const CloudReader& reader, size_t point_count,
+                               const CloudSums& sums, const Options& options,
+                               const uint32_t* triangles, size_t given, Report& checks) {
+    const Status status = reject_invalid_points(reader, point_count, sums, options, checks);
+    if (status != Status::ok) return status;
+    for (size_t k = 0; k < 3 * given; ++k)
+        if (triangles[k] >= point_count || !reader.valid(triangles[k])) {
+            checks.detail = "a triangle names a point outside the cloud, or an invalid one";
+            return Status::invalid_argument;
+        }
+    return Status::ok;
+}
+
+// The frame join_branches() sees the sides in: along the parting's axis.
+inline Status join_frame(const CloudSums& sums, const Options& options, const Parting& parting,
+                         Frame& frame) {
+    Options along = options;
+    along.axis = Axis::direction;
+    along.flags &= ~static_cast<uint32_t>(origin_given);
+    for (int k = 0; k < 3; ++k) along.direction[k] = parting.axis[k];
+    return choose_frame(sums, along, frame);
 }
 
 }  // namespace detail
@@ -776,19 +963,10 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
     }
     const CloudReader reader = reader_of(cloud);
     const CloudSums sums = sum_cloud(reader, cloud.count);
-    status = reject_invalid_points(reader, cloud.count, sums, options, checks);
+    status = check_join_input(reader, cloud.count, sums, options, triangles, given, checks);
     if (status != Status::ok) return finish(status);
-    for (size_t k = 0; k < 3 * given; ++k)
-        if (triangles[k] >= cloud.count || !reader.valid(triangles[k])) {
-            checks.detail = "a triangle names a point outside the cloud, or an invalid one";
-            return finish(Status::invalid_argument);
-        }
-    Options along = options;
-    along.axis = Axis::direction;
-    along.flags &= ~static_cast<uint32_t>(origin_given);
-    for (int k = 0; k < 3; ++k) along.direction[k] = parting.axis[k];
     Frame frame;
-    status = choose_frame(sums, along, frame);
+    status = join_frame(sums, options, parting, frame);
     if (status != Status::ok) return finish(status);
     const uint32_t sides[2] = {parting.above_branch_count < kMaxBranches ? parting.above_branch_count : kMaxBranches,
                                parting.below_branch_count < kMaxBranches ? parting.below_branch_count : kMaxBranches};
@@ -801,6 +979,7 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
     build_cap_graph(triangles, given, cloud.count, m.graph);
     size_t entries = 0;
     trace_boundary_loops(m.graph, cloud.count, m.loops, &entries);
+    note_gap_joins(m, entries);
     if (!allocate_grafts(m, cloud.count, given, arena)) {
         checks.detail = "the workspace is smaller than join_branches_workspace_size()";
         return finish(Status::out_of_memory);
@@ -808,82 +987,14 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
     std::memset(m.hole_next, 0xFF, sizeof(uint32_t) * cloud.count);
     for (size_t i = 0; i < entries; ++i) m.hole_next[m.loops.ids[i]] = kHeldVertex;
     std::memset(m.removed, 0, given);
-    SideJunction plan[2];
-    bool rim[2] = {false, false};
-    Graft grafts[2 * kMaxBranches];
-    uint32_t graft_count = 0;
-    size_t holes_used = 0, removed = 0;
-    const uint32_t* taken = nullptr;
-    for (int k = 0; k < 2; ++k) {
-        if (sides[k] == 0) continue;
-        const SideView view = {reader, frame, k == 0 ? 1.0 : -1.0};
-        const uint8_t first = static_cast<uint8_t>(k == 0 ? kFirstAboveBranch : kFirstBelowBranch);
-        const double cut = (k == 0 ? parting.above : parting.below) - dot(frame.origin, frame.axis);
-        const double gap = parting.gap * frame.scale;
-        SideLoops loops;
-        find_side_loops(m.loops, entries, branch_of, first, sides[k], view, taken, loops);
-        const char* rim_why = nullptr;  // superseded by the grafts' reasons
-        rim[k] = plan_junction(loops, sides[k], view.sign * cut * frame.scale, gap, view,
-                               plan[k], rim_why);
-        if (rim[k]) {
-            taken = plan[k].trunk.ids;
-            needed += plan[k].triangles();
-            ++r.joined_side_count;
-            continue;
-        }
-        // No rim goes around the branches: each is grafted where it stands on the trunk.
-        uint32_t grafted = 0;
-        for (uint32_t b = 0; b < sides[k]; ++b) {
-            const char* graft_why = nullptr;
-            if (!loops.branch[b].ids) {
-                graft_why = "a branch has no boundary loop of its own to join";
-            } else if (plan_graft(triangles, given, branch_of, loops.branch[b], gap, view, m,
-                                  entries, holes_used, grafts[graft_count], graft_why)) {
-                needed += grafts[graft_count].triangles();
-                removed += grafts[graft_count].removed;
-                ++graft_count;
-                ++grafted;
-                continue;
-            }
-            if (!r.detail) r.detail = graft_why;
-        }
-        r.grafted_branch_count += grafted;
-        if (grafted == sides[k])
-            ++r.joined_side_count;
-        else
-            ++r.apart_side_count;
-    }
-    needed = needed + m.filled_count - removed;
+    const JoinInput in = {reader, frame, parting, triangles, given, branch_of, entries};
+    JoinPlan plan;
+    plan.needed = given;
+    for (int k = 0; k < 2; ++k)
+        if (sides[k] != 0) plan_side(k, sides[k], in, m, plan, r);
+    needed = plan.needed + m.filled_count - plan.removed;
     if (needed > triangle_capacity) return finish(Status::triangle_capacity);
-    size_t kept = 0;
-    for (size_t t = 0; t < given; ++t) {
-        if (m.removed[t]) continue;
-        if (kept != t)
-            for (size_t e = 0; e < 3; ++e) triangles[3 * kept + e] = triangles[3 * t + e];
-        ++kept;
-    }
-    r.removed_triangle_count = given - kept;
-    uint32_t* out = triangles + 3 * kept;
-    for (size_t f = 0; f < m.filled_count; ++f) {
-        if (m.removed[given + f]) continue;
-        for (size_t e = 0; e < 3; ++e) out[e] = m.filled[3 * f + e];
-        out += 3;
-        ++r.added_triangle_count;
-    }
-    for (int k = 0; k < 2; ++k) {
-        if (!rim[k]) continue;
-        const SideView view = {reader, frame, k == 0 ? 1.0 : -1.0};
-        write_junction(plan[k], view, out);
-        out += 3 * plan[k].triangles();
-        r.added_triangle_count += plan[k].triangles();
-    }
-    for (uint32_t g = 0; g < graft_count; ++g) {
-        const SideView view = {reader, frame, grafts[g].side};
-        write_graft(grafts[g], view, out);
-        out += 3 * grafts[g].triangles();
-        r.added_triangle_count += grafts[g].triangles();
-    }
-    *triangle_count = kept + r.added_triangle_count;
+    *triangle_count = write_join(in, m, plan, triangles, r);
     return finish(Status::ok);
 }
 

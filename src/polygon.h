@@ -1,5 +1,5 @@
 // >>polygon ==============================================================================
-// Simple polygons on the exact predicates: crossing edges, containment.
+// Simple polygons on the exact predicates: crossing edges, winding, ear clipping.
 
 namespace stratmesh {
 namespace detail {
@@ -73,6 +73,193 @@ inline bool in_closed_triangle(const double* a, const double* b, const double* c
     return orient2d_robust(a, b, p) >= 0 && orient2d_robust(b, c, p) >= 0 &&
            orient2d_robust(c, a, p) >= 0;
 }
+
+// Whether corners i and j of the simple counter-clockwise polygon xy[0 .. length) see each
+// other through it: the segment leaves both corners into the polygon and meets no edge that
+// does not end at i or j (touching one counts as meeting it).
+inline bool diagonal_inside(const double* xy, uint32_t length, uint32_t i, uint32_t j) {
+    auto point = [xy](uint32_t k) { return xy + 2 * static_cast<size_t>(k); };
+    auto within_corner = [&](uint32_t a, uint32_t b) {
+        const double* pa = point(a);
+        const double* pb = point(b);
+        const double* before = point(a == 0 ? length - 1 : a - 1);
+        const double* after = point(a + 1 == length ? 0 : a + 1);
+        if (orient2d_robust(before, pa, after) > 0)
+            return orient2d_robust(pa, pb, before) > 0 && orient2d_robust(pb, pa, after) > 0;
+        return !(orient2d_robust(pa, pb, after) >= 0 && orient2d_robust(pb, pa, before) >= 0);
+    };
+    if (!within_corner(i, j) || !within_corner(j, i)) return false;
+    const double* pi = point(i);
+    const double* pj = point(j);
+    for (uint32_t a = 0; a < length; ++a) {
+        const uint32_t b = a + 1 == length ? 0 : a + 1;
+        if (a == i || a == j || b == i || b == j) continue;
+        const double oa = orient2d_robust(pi, pj, point(a));
+        const double ob = orient2d_robust(pi, pj, point(b));
+        if ((oa > 0 && ob > 0) || (oa < 0 && ob < 0)) continue;
+        const double oi = orient2d_robust(point(a), point(b), pi);
+        const double oj = orient2d_robust(point(a), point(b), pj);
+        if ((oi > 0 && oj > 0) || (oi < 0 && oj < 0)) continue;
+        return false;
+    }
+    return true;
+}
+
+// The turning direction of the simple polygon xy[0 .. length): orient2d at its
+// lexicographically lowest corner, which is strictly convex; positive counter-clockwise.
+inline double simple_polygon_turn(const double* xy, uint32_t length) {
+    auto at = [xy](uint32_t i) { return xy + 2 * static_cast<size_t>(i); };
+    uint32_t lowest = 0;
+    for (uint32_t i = 1; i < length; ++i)
+        if (lex_less(at(i), at(lowest))) lowest = i;
+    return orient2d_robust(at(lowest == 0 ? length - 1 : lowest - 1), at(lowest),
+                           at(lowest + 1 == length ? 0 : lowest + 1));
+}
+
+// A corner of a polygon whose corners are computed as they are read.
+struct Point2 {
+    double xy[2];
+};
+
+// How many times the closed polygon of corners point(0), ..., point(length - 1) winds around
+// p, counter-clockwise positive: an edge that crosses the line through p along x (half-open:
+// from at or below p to above it, or back) counts +1 going up with p on its left, -1 going
+// down with p on its right, by orient2d. Odd where the even-odd rule has p inside; for p on
+// the polygon, the count of a region beside it.
+template <class PointAt>
+long winding_number(PointAt point, uint32_t length, const double* p) {
+    long winding = 0;
+    Point2 a = point(length - 1);
+    for (uint32_t i = 0; i < length; ++i) {
+        const Point2 b = point(i);
+        if (a.xy[1] <= p[1]) {
+            if (b.xy[1] > p[1] && orient2d_robust(a.xy, b.xy, p) > 0) ++winding;
+        } else if (b.xy[1] <= p[1] && orient2d_robust(a.xy, b.xy, p) < 0) {
+            --winding;
+        }
+        a = b;
+    }
+    return winding;
+}
+
+// ---- ear clipping
+//
+// The caps, their pockets and the small gaps a graft closes are all triangulated by
+// clipping ears off a simple counter-clockwise polygon: a strictly convex corner whose
+// closed triangle holds no other corner, and whose diagonal the caller allows (the
+// callers forbid those already edges of the surface: the edge would join three
+// triangles). Only corners that are not strictly convex need testing for containment (in
+// a simple polygon, a triangle holding a corner holds one of those); clipping only narrows
+// the corners beside an ear, so the list of them only shrinks. The walk goes on from the
+// corner before each ear, or, where the caller asks, from the first corner left; it gives
+// up once every corner left has failed in a row.
+
+// The clipping's arrays, an entry per corner.
+struct EarRing {
+    uint32_t* prev;        // the neighbours in the polygon left to clip
+    uint32_t* next;
+    uint32_t* reflex;      // corners not strictly convex when last looked at
+    unsigned char* flags;  // kReflex while in `reflex` and not strictly convex
+};
+
+const unsigned char kReflex = 1;
+
+// What a caller of EarClipper decides: which diagonals may not be made, and what becomes of
+// each ear.
+class EarRules {
+public:
+    // Whether the diagonal between corners a and b may not be made.
+    virtual bool forbidden(uint32_t a, uint32_t b) const = 0;
+    // The ear (p, v, n), counter-clockwise: one of length - 2, the last of them the three
+    // corners left at the end.
+    virtual void take(uint32_t p, uint32_t v, uint32_t n) = 0;
+
+protected:
+    ~EarRules() = default;
+};
+
+// Where the walk goes on after an ear: from the corner before it, or from the first
+// corner left (in the corners' order).
+enum class EarWalk { from_previous, from_first };
+
+class EarClipper {
+public:
+    // The polygon: corner i at xy[2 i], xy[2 i + 1], for i < length.
+    EarClipper(const double* xy, uint32_t length, const EarRing& ring)
+        : xy_(xy), length_(length), ring_(ring) {}
+
+    // Clips the polygon from corner `start`, handing every ear to rules.take; false, after
+    // the ears taken so far, where every corner left fails.
+    bool clip(uint32_t start, EarWalk walk, EarRules& rules) {
+        const uint32_t length = length_;
+        reflex_count_ = 0;
+        for (uint32_t i = 0; i < length; ++i) {
+            ring_.prev[i] = i == 0 ? length - 1 : i - 1;
+            ring_.next[i] = i + 1 == length ? 0 : i + 1;
+            ring_.flags[i] = convex(i) ? 0 : kReflex;
+            if (ring_.flags[i]) ring_.reflex[reflex_count_++] = i;
+        }
+        uint32_t remaining = length, v = start, first = 0, misses = 0;
+        while (remaining > 3) {
+            if (!is_ear(v, rules)) {
+                v = ring_.next[v];
+                if (++misses > remaining) return false;
+                continue;
+            }
+            const uint32_t p = ring_.prev[v], n = ring_.next[v];
+            rules.take(p, v, n);
+            ring_.next[p] = n;
+            ring_.prev[n] = p;
+            settle(p);
+            settle(n);
+            if (v == first) first = n;
+            --remaining;
+            misses = 0;
+            v = walk == EarWalk::from_first ? first : p;
+        }
+        // The last triangle, from the first corner left where the walk starts there.
+        if (walk == EarWalk::from_first) v = ring_.next[first];
+        if (!convex(v)) return false;
+        rules.take(ring_.prev[v], v, ring_.next[v]);
+        return true;
+    }
+
+private:
+    const double* point(uint32_t i) const { return xy_ + 2 * static_cast<size_t>(i); }
+
+    bool convex(uint32_t i) const {
+        return orient2d_robust(point(ring_.prev[i]), point(i), point(ring_.next[i])) > 0;
+    }
+
+    void settle(uint32_t i) {
+        if ((ring_.flags[i] & kReflex) && convex(i)) ring_.flags[i] = 0;
+    }
+
+    // Strictly convex, a diagonal the rules allow, and no other corner in the closed
+    // triangle; the reflex list drops the corners clipped or turned convex on the way.
+    bool is_ear(uint32_t v, const EarRules& rules) {
+        if (ring_.flags[v] & kReflex) return false;
+        const uint32_t p = ring_.prev[v], n = ring_.next[v];
+        if (rules.forbidden(p, n)) return false;
+        bool empty = true;
+        uint32_t kept = 0;
+        for (uint32_t k = 0; k < reflex_count_; ++k) {
+            const uint32_t r = ring_.reflex[k];
+            if (ring_.flags[r] != kReflex) continue;
+            ring_.reflex[kept++] = r;
+            if (empty && r != p && r != n &&
+                in_closed_triangle(point(p), point(v), point(n), point(r)))
+                empty = false;
+        }
+        reflex_count_ = kept;
+        return empty;
+    }
+
+    const double* xy_;
+    uint32_t length_;
+    EarRing ring_;
+    uint32_t reflex_count_ = 0;
+};
 
 }  // namespace detail
 }  // namespace stratmesh

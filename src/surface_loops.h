@@ -55,14 +55,13 @@ struct CapLoop {
                               // polygon edge p -> next[p], or kNoIndex on the loop itself
     uint32_t* corners;        // per cap triangle: 3 positions, counter-clockwise
     uint32_t* across;         // per cap triangle edge k (corner k to k + 1): the edge beyond
-    uint32_t* stack;          // cap triangles whose edges are to be checked
+    uint32_t* stack;          // cap triangles whose edges are to be checked (before the
+                              // cap, the positions on its pockets' hull)
     uint8_t* search;          // per pair of positions i < j: the cap search's choice, k - i
                               // (allocated, and read, only where kCapSearchCorners > 0)
 };
 
 const unsigned char kLoopStart = 1, kLoopBroken = 2;
-
-const unsigned char kRemoved = 1, kReflex = 2, kQueued = 4;
 
 const unsigned char kFinSeen = 1, kFinFlippable = 2, kFinWaived = 4, kFinUsed = 8;
 

@@ -103,7 +103,7 @@ struct JoinReport {
 };
 
 // Bytes of workspace join_branches() needs for a surface of triangle_count triangles over
-// point_count points: 5 bytes a point, plus the larger of 12 a point and 12 a triangle (the
+// point_count points: 9 bytes a point, plus the larger of 12 a point and 12 a triangle (the
 // loops' tracing) and 8 a point, 1 a triangle, 56 for each triangle up to 65,536 and 15,600
 // for the gaps' closings (the grafts); 0 if that is beyond what this platform can address.
 size_t join_branches_workspace_size(size_t point_count, size_t triangle_count);

@@ -7420,7 +7420,7 @@ struct CapGraph {
 // the index. Coarser than x, the key still never orders an edge before one whose smaller x
 // is below its own, so the sweep meets every pair whose x ranges overlap (and a few more,
 // which the exact test settles).
-inline uint32_t sweep_key(double x) {
+static inline uint32_t sweep_key(double x) {
     x += 0.0;
     uint64_t bits;
     std::memcpy(&bits, &x, sizeof bits);
@@ -7458,7 +7458,7 @@ const unsigned char kFinSeen = 1, kFinFlippable = 2, kFinWaived = 4, kFinUsed = 
 
 // The allocation sequences of the cap phase: the call runs them with its real sizes,
 // reconstruct_workspace_size with the largest possible ones, so the two cannot disagree.
-inline bool allocate_cap_graph(CapGraph& g, size_t point_count, size_t triangle_count,
+static inline bool allocate_cap_graph(CapGraph& g, size_t point_count, size_t triangle_count,
                                Arena& arena) {
     g.offsets = arena.alloc<size_t>(point_count + 1);
     g.targets = arena.alloc<uint32_t>(3 * triangle_count);
@@ -7466,7 +7466,7 @@ inline bool allocate_cap_graph(CapGraph& g, size_t point_count, size_t triangle_
     return !arena.failed;
 }
 
-inline bool allocate_cap_loop(CapLoop& c, size_t length, Arena& arena) {
+static inline bool allocate_cap_loop(CapLoop& c, size_t length, Arena& arena) {
     c.ids = arena.alloc<uint32_t>(length);
     c.starts = arena.alloc<unsigned char>(length);
     c.xy = arena.alloc<double>(2 * length);
@@ -7496,7 +7496,7 @@ inline bool allocate_cap_loop(CapLoop& c, size_t length, Arena& arena) {
 // Fills the graph from the triangles; returns the number of boundary vertices. Only edges
 // between boundary vertices are kept (the diagonals of a cap join boundary vertices), so
 // on a tube the graph is small and built in three streaming passes.
-inline size_t build_cap_graph(const uint32_t* tri, size_t count, size_t point_count,
+static inline size_t build_cap_graph(const uint32_t* tri, size_t count, size_t point_count,
                               CapGraph& g) {
     // Around an inner vertex the triangles leave towards the same vertices they arrive
     // from; around a boundary vertex (one fan, a chain) the two sets differ by the far
@@ -7557,7 +7557,7 @@ inline size_t build_cap_graph(const uint32_t* tri, size_t count, size_t point_co
 // Chains the boundary edges into loops, stored one after another in cap order (the
 // boundary reversed); a chain that does not come back to its start is marked broken.
 // Returns the cap triangles all the unbroken loops would need.
-inline size_t trace_boundary_loops(CapGraph& g, size_t point_count, CapLoop& c,
+static inline size_t trace_boundary_loops(CapGraph& g, size_t point_count, CapLoop& c,
                                    size_t* loop_entries) {
     size_t filled = 0, triangles = 0;
     for (size_t v = 0; v < point_count; ++v) {
@@ -7594,10 +7594,10 @@ inline size_t trace_boundary_loops(CapGraph& g, size_t point_count, CapLoop& c,
 namespace stratmesh {
 namespace detail {
 
-inline bool same_point(const double* a, const double* b) { return a[0] == b[0] && a[1] == b[1]; }
+static inline bool same_point(const double* a, const double* b) { return a[0] == b[0] && a[1] == b[1]; }
 
 // For p collinear with a and b: whether it lies on the closed segment ab.
-inline bool on_segment(const double* a, const double* b, const double* p) {
+static inline bool on_segment(const double* a, const double* b, const double* p) {
     for (int k = 0; k < 2; ++k) {
         double low = a[k] < b[k] ? a[k] : b[k], high = a[k] < b[k] ? b[k] : a[k];
         if (p[k] < low || p[k] > high) return false;
@@ -7606,10 +7606,10 @@ inline bool on_segment(const double* a, const double* b, const double* p) {
 }
 
 // -1, 0 or 1 as x is below, at or above y: the sign of x - y, without rounding.
-inline int compare(double x, double y) { return (x > y) - (x < y); }
+static inline int compare(double x, double y) { return (x > y) - (x < y); }
 
 // Whether the closed segments pq and rs share a point.
-inline bool segments_meet(const double* p, const double* q, const double* r, const double* s) {
+static inline bool segments_meet(const double* p, const double* q, const double* r, const double* s) {
     double d1 = orient2d_robust(r, s, p), d2 = orient2d_robust(r, s, q);
     double d3 = orient2d_robust(p, q, r), d4 = orient2d_robust(p, q, s);
     if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0)))
@@ -7621,7 +7621,7 @@ inline bool segments_meet(const double* p, const double* q, const double* r, con
 // Whether the closed polygon xy[0 .. length) is simple: no repeated point, no edge folding
 // back onto the next, no two other edges meeting. Edges are swept in order of their
 // smaller x; each is tested against those whose x range reaches into its own.
-inline bool polygon_is_simple(const double* xy, uint32_t length, uint64_t* sweep) {
+static inline bool polygon_is_simple(const double* xy, uint32_t length, uint64_t* sweep) {
     if (length < 3) return false;
     auto at = [&](uint32_t i) { return xy + 2 * static_cast<size_t>(i); };
     for (uint32_t i = 0; i < length; ++i) {
@@ -7659,7 +7659,7 @@ inline bool polygon_is_simple(const double* xy, uint32_t length, uint64_t* sweep
 }
 
 // Whether p lies in the closed triangle abc (counter-clockwise).
-inline bool in_closed_triangle(const double* a, const double* b, const double* c, const double* p) {
+static inline bool in_closed_triangle(const double* a, const double* b, const double* c, const double* p) {
     return orient2d_robust(a, b, p) >= 0 && orient2d_robust(b, c, p) >= 0 &&
            orient2d_robust(c, a, p) >= 0;
 }
@@ -7667,7 +7667,7 @@ inline bool in_closed_triangle(const double* a, const double* b, const double* c
 // Whether corners i and j of the simple counter-clockwise polygon xy[0 .. length) see each
 // other through it: the segment leaves both corners into the polygon and meets no edge that
 // does not end at i or j (touching one counts as meeting it).
-inline bool diagonal_inside(const double* xy, uint32_t length, uint32_t i, uint32_t j) {
+static inline bool diagonal_inside(const double* xy, uint32_t length, uint32_t i, uint32_t j) {
     auto point = [xy](uint32_t k) { return xy + 2 * static_cast<size_t>(k); };
     auto within_corner = [&](uint32_t a, uint32_t b) {
         const double* pa = point(a);
@@ -7697,7 +7697,7 @@ inline bool diagonal_inside(const double* xy, uint32_t length, uint32_t i, uint3
 
 // The turning direction of the simple polygon xy[0 .. length): orient2d at its
 // lexicographically lowest corner, which is strictly convex; positive counter-clockwise.
-inline double simple_polygon_turn(const double* xy, uint32_t length) {
+static inline double simple_polygon_turn(const double* xy, uint32_t length) {
     auto at = [xy](uint32_t i) { return xy + 2 * static_cast<size_t>(i); };
     uint32_t lowest = 0;
     for (uint32_t i = 1; i < length; ++i)
@@ -7901,7 +7901,7 @@ const double kCapHeightTie = 0x1p-40;
 // How far d lies below the plane through a, b and w (counter-clockwise across the axis),
 // each at its height (heights: a's, b's, w's, d's): the plane's height at d's place, the
 // heights weighted by the triangles d makes with the opposite edges, less d's own.
-inline double depth_below_plane(const double* a, const double* b, const double* w,
+static inline double depth_below_plane(const double* a, const double* b, const double* w,
                                 const double* d, const double* heights) {
     auto orient = [d](const double* p, const double* q) {
         return (p[0] - d[0]) * (q[1] - d[1]) - (p[1] - d[1]) * (q[0] - d[0]);
@@ -8159,18 +8159,18 @@ const char* const kLoopLeftOpenDetail =
 // The per point key of a loop's fin chords: at the chord's first corner (position i - 1),
 // the fin's position i, for the fins with a flag in `wanted`. `key` is all kNoIndex outside
 // these calls: clear_fin_chords puts it back.
-inline void key_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length,
+static inline void key_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length,
                            const unsigned char* fins, unsigned char wanted) {
     for (uint32_t i = 0; i < length; ++i)
         if (fins[i] & wanted) key[ids[i == 0 ? length - 1 : i - 1]] = i;
 }
 
-inline void clear_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length) {
+static inline void clear_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length) {
     for (uint32_t i = 0; i < length; ++i) key[ids[i]] = kNoIndex;
 }
 
 // The fin position whose chord is a - b (either way round), or kNoIndex.
-inline uint32_t keyed_fin(const uint32_t* key, const uint32_t* ids, uint32_t length,
+static inline uint32_t keyed_fin(const uint32_t* key, const uint32_t* ids, uint32_t length,
                           uint32_t a, uint32_t b) {
     for (int side = 0; side < 2; ++side) {
         const uint32_t i = key[side == 0 ? a : b];
@@ -8180,7 +8180,7 @@ inline uint32_t keyed_fin(const uint32_t* key, const uint32_t* ids, uint32_t len
 }
 
 // Whether (u, x, m) and (x, v, m) face the way (u, v, m) and (v, u, x) do together.
-inline bool fin_flip_keeps_facing(const CloudReader& cloud, const Frame& frame, uint32_t u,
+static inline bool fin_flip_keeps_facing(const CloudReader& cloud, const Frame& frame, uint32_t u,
                                   uint32_t v, uint32_t m, uint32_t x) {
     const Vec3 pu = frame.offset(cloud.point(u)), pv = frame.offset(cloud.point(v));
     const Vec3 pm = frame.offset(cloud.point(m)), px = frame.offset(cloud.point(x));
@@ -8191,7 +8191,7 @@ inline bool fin_flip_keeps_facing(const CloudReader& cloud, const Frame& frame, 
 
 // Marks kFinWaived the fins of the loop ids[0 .. length) that may be flipped (above),
 // scanning the wall tri[0 .. 3 wall); returns how many.
-inline uint32_t mark_flippable_fins(const uint32_t* tri, size_t wall, const CloudReader& cloud,
+static inline uint32_t mark_flippable_fins(const uint32_t* tri, size_t wall, const CloudReader& cloud,
                                     const Frame& frame, const CapGraph& g, uint32_t* key,
                                     const uint32_t* ids, uint32_t length, unsigned char* fins) {
     if (length <= 4) return 0;  // a chord two corners apart either way: no single fin
@@ -8226,7 +8226,7 @@ inline uint32_t mark_flippable_fins(const uint32_t* tri, size_t wall, const Clou
 
 // Flips the wall's edge under each fin marked kFinUsed; returns how many it flipped. slots:
 // two size_t per position (in the memory of the loop's projection, free once its cap is made).
-inline size_t flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const uint32_t* ids,
+static inline size_t flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const uint32_t* ids,
                              uint32_t length, const unsigned char* fins, double* slots) {
     auto slot = [slots](uint32_t i, uint32_t which) { return slots + 2 * static_cast<size_t>(i) + which; };
     static_assert(sizeof(size_t) <= sizeof(double), "a slot holds a triangle index");
@@ -8287,7 +8287,7 @@ const double kPocketTurn = 3.14159265358979323846 / 8;
 // axis, at a radius exp((h - h_first) / r) for the height h (-h for a bottom loop) and the
 // loop's mean radius r, mirrored so that the loop turns clockwise. False if it does not
 // run once around its centroid monotonically.
-inline bool unroll_loop(const CloudReader& cloud, const Frame& frame, const uint32_t* ids,
+static inline bool unroll_loop(const CloudReader& cloud, const Frame& frame, const uint32_t* ids,
                         uint32_t length, bool lower, double* xy) {
     double cx = 0, cy = 0, radius = 0;
     for (uint32_t i = 0; i < length; ++i) {
@@ -8362,7 +8362,7 @@ private:
 // clipping from its second corner on (it turns counter-clockwise there); appends its
 // triangles at tri[3 * count]. False, with count unchanged, where no ear is left whose
 // diagonal is not already an edge of the surface.
-inline bool close_pocket(uint32_t* tri, size_t& count, const CapGraph& g, const uint32_t* ids,
+static inline bool close_pocket(uint32_t* tri, size_t& count, const CapGraph& g, const uint32_t* ids,
                          uint32_t length, const double* run, uint32_t from, uint32_t corners,
                          const EarRing& ring) {
     PocketEars ears(tri, count, g, ids, length, from);
@@ -8376,7 +8376,7 @@ inline bool close_pocket(uint32_t* tri, size_t& count, const CapGraph& g, const 
 // highest position (its lowest, for a bottom loop) comes first, and keeps in ids, in order,
 // the positions left for the cap; returns their number. The cap loop's arrays serve as
 // scratch.
-inline uint32_t fill_pockets(uint32_t* tri, size_t& count, const CapGraph& g, CapLoop& c,
+static inline uint32_t fill_pockets(uint32_t* tri, size_t& count, const CapGraph& g, CapLoop& c,
                              const CloudReader& cloud, const Frame& frame, uint32_t* ids,
                              uint32_t length, bool lower) {
     uint32_t top = 0;
@@ -8444,7 +8444,7 @@ inline uint32_t fill_pockets(uint32_t* tri, size_t& count, const CapGraph& g, Ca
 // each loop is projected across the frame's axis. Returns ok; out_of_memory; or
 // triangle_capacity with *needed the triangles every cap closing would take, and nothing
 // written.
-inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
+static inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
                                  const CloudReader& cloud, size_t point_count,
                                  const Frame& frame, Arena& arena, CapCounts& caps,
                                  size_t* needed) {
@@ -11404,7 +11404,7 @@ const uint32_t kHeldVertex = kNoIndex - 1;
 // The arena sequence of the call, shared with join_branches_workspace_size(): the loops,
 // then the graph after them, then (allocate_grafts) once the loops are traced and the gaps'
 // joins noted, the grafts' arrays in the graph's room.
-inline bool allocate_join(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
+static inline bool allocate_join(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
     m.loops.ids = arena.alloc<uint32_t>(point_count);  // every point on a loop at most
     m.loops.starts = arena.alloc<unsigned char>(point_count);
     m.gap_joins = arena.alloc<uint32_t>(point_count);
@@ -11413,7 +11413,7 @@ inline bool allocate_join(JoinMemory& m, size_t point_count, size_t triangle_cou
     return !arena.failed;
 }
 
-inline bool allocate_grafts(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
+static inline bool allocate_grafts(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
     arena.rewind(m.room);
     m.under_capacity = triangle_count < kGraftMaxTriangles ? triangle_count : kGraftMaxTriangles;
     m.hole_next = arena.alloc<uint32_t>(point_count);
@@ -11464,14 +11464,14 @@ struct SideView {
     }
 };
 
-inline double loop_mean_height(const TracedLoop& loop, const SideView& view) {
+static inline double loop_mean_height(const TracedLoop& loop, const SideView& view) {
     double sum = 0;
     for (uint32_t i = 0; i < loop.length; ++i) sum += view.at(loop.ids[i]).h;
     return sum / loop.length;
 }
 
 // The label every point of the loop has, or kBeyondBranches where they differ.
-inline uint8_t loop_label(const TracedLoop& loop, const uint8_t* branch_of) {
+static inline uint8_t loop_label(const TracedLoop& loop, const uint8_t* branch_of) {
     const uint8_t label = branch_of[loop.ids[0]];
     for (uint32_t i = 1; i < loop.length; ++i)
         if (branch_of[loop.ids[i]] != label) return kBeyondBranches;
@@ -11490,7 +11490,7 @@ struct SideLoops {
     double branch_height[kMaxBranches];
 };
 
-inline void find_side_loops(const CapLoop& loops, size_t entries, const uint8_t* branch_of,
+static inline void find_side_loops(const CapLoop& loops, size_t entries, const uint8_t* branch_of,
                             uint8_t first_label, uint32_t branches, const SideView& view,
                             const uint32_t* taken, SideLoops& side) {
     side.trunk = {nullptr, 0};
@@ -11528,7 +11528,7 @@ struct TrunkCentre {
     double angle(double x, double y) const { return std::atan2(sense * (y - cy), x - cx); }
 };
 
-inline TrunkCentre trunk_centre(const TracedLoop& trunk, const SideView& view) {
+static inline TrunkCentre trunk_centre(const TracedLoop& trunk, const SideView& view) {
     double cx = 0, cy = 0, area = 0;
     for (uint32_t i = 0; i < trunk.length; ++i) {
         const Local p = view.at(trunk.ids[i]);
@@ -11551,7 +11551,7 @@ inline TrunkCentre trunk_centre(const TracedLoop& trunk, const SideView& view) {
 // Adds the branch's loop to the side's, in the order of their angles around the trunk's
 // centre (kept in branch_angle): its centre, and where it opens, its vertex nearest the
 // trunk's centre. False (detail set) where its centre is not within the trunk's loop.
-inline bool add_rim_branch(const TracedLoop& loop, const SideView& view,
+static inline bool add_rim_branch(const TracedLoop& loop, const SideView& view,
                            const TrunkCentre& trunk, SideJunction& side, double* branch_angle,
                            const char*& detail) {
     double bx = 0, by = 0, nearest = DBL_MAX;
@@ -11594,7 +11594,7 @@ inline bool add_rim_branch(const TracedLoop& loop, const SideView& view,
 // The gap after each branch i: the trunk's vertex nearest in angle to the middle between
 // branch i and the next one. False (detail set) where the gaps do not follow one another
 // along the trunk's loop as the branches do.
-inline bool place_rim_gaps(const SideView& view, const TrunkCentre& centre,
+static inline bool place_rim_gaps(const SideView& view, const TrunkCentre& centre,
                            const double* branch_angle, SideJunction& side, const char*& detail) {
     const TracedLoop& trunk = side.trunk;
     const double two_pi = 6.28318530717958647693;
@@ -11628,7 +11628,7 @@ inline bool place_rim_gaps(const SideView& view, const TrunkCentre& centre,
 
 // Plans the rim junction of a side with `branches` branches, from its loops, with its cut
 // and gap as heights of the view: false (detail set) if it cannot be joined so.
-inline bool plan_junction(const SideLoops& loops, uint32_t branches, double cut, double gap,
+static inline bool plan_junction(const SideLoops& loops, uint32_t branches, double cut, double gap,
                           const SideView& view, SideJunction& side, const char*& detail) {
     side.trunk = loops.trunk;
     // Loops farther than kJoinReach gaps from the cut are not the junction's: a trunk
@@ -11673,7 +11673,7 @@ struct AngleAround {
 };
 
 // Writes the junction's side.triangles() triangles at out.
-inline void write_junction(const SideJunction& side, const SideView& view, uint32_t* out) {
+static inline void write_junction(const SideJunction& side, const SideView& view, uint32_t* out) {
     const TracedLoop& trunk = side.trunk;
     auto emit = [&out](uint32_t a, uint32_t b, uint32_t c) {
         out[0] = a;
@@ -11752,7 +11752,7 @@ struct Graft {
 };
 
 // How many times the loop winds around (x, y) across the axis, counter-clockwise positive.
-inline long loop_winding(const TracedLoop& loop, const SideView& view, double x, double y) {
+static inline long loop_winding(const TracedLoop& loop, const SideView& view, double x, double y) {
     const double p[2] = {x, y};
     auto corner = [&](uint32_t i) {
         const Local q = view.at(loop.ids[i]);
@@ -11763,13 +11763,13 @@ inline long loop_winding(const TracedLoop& loop, const SideView& view, double x,
 
 // The trunk's triangles a graft reads: the caller's, `count` of them, then those that
 // closed small gaps in the trunk's end (m.filled, see fill_gap).
-inline const uint32_t* trunk_corners(const uint32_t* tri, size_t count, const JoinMemory& m,
+static inline const uint32_t* trunk_corners(const uint32_t* tri, size_t count, const JoinMemory& m,
                                      size_t t) {
     return t < count ? tri + 3 * t : m.filled + 3 * (t - count);
 }
 
 // The first of the sorted edges m.edges[0 .. 3 * found) not below key.
-inline size_t first_edge_from(const JoinMemory& m, size_t found, const GraftEdge& key) {
+static inline size_t first_edge_from(const JoinMemory& m, size_t found, const GraftEdge& key) {
     size_t lo = 0, hi = 3 * found;
     while (lo < hi) {
         const size_t mid = lo + (hi - lo) / 2;
@@ -11783,7 +11783,7 @@ inline size_t first_edge_from(const JoinMemory& m, size_t found, const GraftEdge
 // m.edges): a triangle (x, y, z) beyond the hole's edge y -> x joins when z is free, and the
 // loop then runs y -> z -> x, so every vertex stays on the loop and keeps a triangle of the
 // trunk. Returns the triangles taken (marked in m.removed).
-inline size_t grow_hole(const uint32_t* tri, size_t count, JoinMemory& m, size_t found,
+static inline size_t grow_hole(const uint32_t* tri, size_t count, JoinMemory& m, size_t found,
                         size_t queued) {
     uint32_t* next = m.hole_next;
     size_t taken = 0;
@@ -11809,7 +11809,7 @@ inline size_t grow_hole(const uint32_t* tri, size_t count, JoinMemory& m, size_t
 }
 
 // Whether vertex v is a corner of one of m.under[0 .. found), whose edges m.edges holds sorted.
-inline bool corner_under(const JoinMemory& m, size_t found, uint32_t v) {
+static inline bool corner_under(const JoinMemory& m, size_t found, uint32_t v) {
     const size_t lo = first_edge_from(m, found, {v, 0, 0});
     return lo < 3 * found && m.edges[lo].from == v;
 }
@@ -11818,7 +11818,7 @@ inline bool corner_under(const JoinMemory& m, size_t found, uint32_t v) {
 // trunk of at most kGapLoopMost vertices, each held by no hole, within `reach` of (cx, cy)
 // across the axis and within [low, high] along it, one of them a corner of a triangle
 // under the branch; the one nearest (cx, cy), {nullptr, 0} if none.
-inline TracedLoop gap_beside(const JoinMemory& m, size_t entries, size_t found,
+static inline TracedLoop gap_beside(const JoinMemory& m, size_t entries, size_t found,
                              const uint8_t* branch_of, const SideView& view, double cx,
                              double cy, double reach, double low, double high) {
     TracedLoop best = {nullptr, 0};
@@ -11855,7 +11855,7 @@ static_assert(kGapLoopMost <= 32, "a gap's joins are bits of 32");
 // Notes in m.gap_joins, from the graph, which vertices of each loop small enough to be a
 // gap are joined by an edge of the caller's surface: the graph keeps the edges between
 // boundary vertices, and its memory goes to the grafts.
-inline void note_gap_joins(JoinMemory& m, size_t entries) {
+static inline void note_gap_joins(JoinMemory& m, size_t entries) {
     for (size_t start = 0; start < entries;) {
         size_t end = start + 1;
         while (end < entries && m.loops.starts[end] == 0) ++end;
@@ -11897,7 +11897,7 @@ private:
 // (nothing added) where the loop is no simple polygon turning counter-clockwise in the view
 // (the way the triangles facing a branch turn) or no ear is left whose diagonal is not an
 // edge of the surface. count: the caller's triangles, which m.removed numbers first.
-inline bool fill_gap(size_t count, const TracedLoop& loop, const SideView& view, JoinMemory& m) {
+static inline bool fill_gap(size_t count, const TracedLoop& loop, const SideView& view, JoinMemory& m) {
     const uint32_t n = loop.length;
     if (m.filled_count + (n - 2) > kMostFilled) return false;
     double xy[2 * kGapLoopMost];
@@ -11930,7 +11930,7 @@ struct GraftSite {
 
 // The site of the branch's loop, within kJoinReach gaps below its mean height and one gap
 // above; false (detail set) where the loop does not go once around its centre.
-inline bool graft_site(const TracedLoop& loop, double gap, const SideView& view,
+static inline bool graft_site(const TracedLoop& loop, double gap, const SideView& view,
                        GraftSite& site, const char*& detail) {
     double cx = 0, cy = 0, height = 0;
     for (uint32_t i = 0; i < loop.length; ++i) {
@@ -11961,7 +11961,7 @@ inline bool graft_site(const TracedLoop& loop, double gap, const SideView& view,
 // Collects in m.under[0 .. found) the trunk's triangles under the branch's loop that face
 // it (see "grafts" above) and no planned hole takes; false (detail set) if there are more
 // than m.under holds.
-inline bool find_under(const uint32_t* tri, size_t count, const uint8_t* branch_of,
+static inline bool find_under(const uint32_t* tri, size_t count, const uint8_t* branch_of,
                        const TracedLoop& loop, const SideView& view, const GraftSite& site,
                        JoinMemory& m, size_t& found, const char*& detail) {
     found = 0;
@@ -11992,7 +11992,7 @@ inline bool find_under(const uint32_t* tri, size_t count, const uint8_t* branch_
 
 // The position in m.under[0 .. found) of the triangle nearest the site's centre whose
 // corners no hole holds; found if there is none.
-inline size_t hole_seed(const uint32_t* tri, size_t count, const JoinMemory& m, size_t found,
+static inline size_t hole_seed(const uint32_t* tri, size_t count, const JoinMemory& m, size_t found,
                         const SideView& view, const GraftSite& site) {
     size_t seed = found;
     double nearest = DBL_MAX;
@@ -12018,7 +12018,7 @@ enum class HolePlan { cut, refused, missed_centre };
 // graft.removed. Refused (detail set, nothing taken) where no triangle is there to take;
 // missed_centre where the disc does not go once around the site's centre. found: the
 // triangles under the loop, for gap_beside.
-inline HolePlan plan_hole(const uint32_t* tri, size_t count, const uint8_t* branch_of,
+static inline HolePlan plan_hole(const uint32_t* tri, size_t count, const uint8_t* branch_of,
                           const TracedLoop& loop, const SideView& view, const GraftSite& site,
                           JoinMemory& m, uint32_t* hole, size_t& found, Graft& graft,
                           const char*& detail) {
@@ -12058,7 +12058,7 @@ inline HolePlan plan_hole(const uint32_t* tri, size_t count, const uint8_t* bran
 // triangles out in m.removed and its vertices in m.hole_next, its loop appended to m.holes
 // at holes_used; false (nothing taken, detail set) if it cannot be grafted. tri: the
 // caller's `count` triangles; entries: the count of m.loops' ids.
-inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_of,
+static inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_of,
                        const TracedLoop& loop, double gap, const SideView& view, JoinMemory& m,
                        size_t entries, size_t& holes_used, Graft& graft, const char*& detail) {
     GraftSite site;
@@ -12096,7 +12096,7 @@ inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_
 // Writes the graft's graft.triangles() triangles at out: the hole's loop, counter-clockwise
 // from its vertex first in angle after the branch loop's first vertex, and the branch's loop
 // against its cap order, merged by angle around the branch's centre.
-inline void write_graft(const Graft& graft, const SideView& view, uint32_t* out) {
+static inline void write_graft(const Graft& graft, const SideView& view, uint32_t* out) {
     const uint32_t m = graft.hole.length, n = graft.branch.length;
     const uint32_t* branch = graft.branch.ids;
     const AngleAround turn = {view, graft.centre[0], graft.centre[1], view.at(branch[0]), 1.0};
@@ -12152,7 +12152,7 @@ struct JoinPlan {
 // Plans side k (0 above the cut, 1 below) with `branches` branches: its rim junction where
 // a trunk loop goes around them, else a graft for each branch where it stands; counts the
 // side into r.
-inline void plan_side(int k, uint32_t branches, const JoinInput& in, JoinMemory& m,
+static inline void plan_side(int k, uint32_t branches, const JoinInput& in, JoinMemory& m,
                       JoinPlan& plan, JoinReport& r) {
     const SideView view = {in.reader, in.frame, k == 0 ? 1.0 : -1.0};
     const uint8_t first = static_cast<uint8_t>(k == 0 ? kFirstAboveBranch : kFirstBelowBranch);
@@ -12196,7 +12196,7 @@ inline void plan_side(int k, uint32_t branches, const JoinInput& in, JoinMemory&
 
 // Writes the plan over the caller's triangles: those the holes take out gone, then the
 // gaps' triangles, the rims' and the grafts'; counts into r; returns the triangles in all.
-inline size_t write_join(const JoinInput& in, const JoinMemory& m, const JoinPlan& plan,
+static inline size_t write_join(const JoinInput& in, const JoinMemory& m, const JoinPlan& plan,
                          uint32_t* triangles, JoinReport& r) {
     size_t kept = 0;
     for (size_t t = 0; t < in.given; ++t) {
@@ -12231,7 +12231,7 @@ inline size_t write_join(const JoinInput& in, const JoinMemory& m, const JoinPla
 
 // join_branches()'s checks of the points and the triangles: ok, or a status with
 // checks.detail set.
-inline Status check_join_input(const CloudReader& reader, size_t point_count,
+static inline Status check_join_input(const CloudReader& reader, size_t point_count,
                                const CloudSums& sums, const Options& options,
                                const uint32_t* triangles, size_t given, Report& checks) {
     const Status status = reject_invalid_points(reader, point_count, sums, options, checks);
@@ -12245,7 +12245,7 @@ inline Status check_join_input(const CloudReader& reader, size_t point_count,
 }
 
 // The frame join_branches() sees the sides in: along the parting's axis.
-inline Status join_frame(const CloudSums& sums, const Options& options, const Parting& parting,
+static inline Status join_frame(const CloudSums& sums, const Options& options, const Parting& parting,
                          Frame& frame) {
     Options along = options;
     along.axis = Axis::direction;
@@ -13230,23 +13230,23 @@ static void c_run_job(void* batch, uint32_t index) {
 }
 
 // The adapters' user pointer is the caller's stratmesh_options, alive during the call.
-inline void c_progress(void* user, Phase phase, double fraction) {
+static inline void c_progress(void* user, Phase phase, double fraction) {
     const stratmesh_options* c = static_cast<const stratmesh_options*>(user);
     c->progress(c->progress_user, static_cast<stratmesh_phase>(phase), fraction);
 }
 
-inline void c_run_jobs(void* user, uint32_t count, JobFunction job, void* context) {
+static inline void c_run_jobs(void* user, uint32_t count, JobFunction job, void* context) {
     const stratmesh_options* c = static_cast<const stratmesh_options*>(user);
     CJobBatch batch = {job, context};
     c->run_jobs(c->jobs_user, count, c_run_job, &batch);
 }
 
-inline void c_emit(void* user, const uint32_t* triangles, size_t count) {
+static inline void c_emit(void* user, const uint32_t* triangles, size_t count) {
     const stratmesh_stream* s = static_cast<const stratmesh_stream*>(user);
     s->emit(s->emit_user, triangles, count);
 }
 
-inline Options c_options(const stratmesh_options* c) {
+static inline Options c_options(const stratmesh_options* c) {
     Options o;
     std::memset(&o, 0, sizeof o);
     if (!c) return o;
@@ -13272,12 +13272,12 @@ inline Options c_options(const stratmesh_options* c) {
     return o;
 }
 
-inline Cloud c_cloud(const stratmesh_cloud& c) {
+static inline Cloud c_cloud(const stratmesh_cloud& c) {
     return Cloud{c.xyz, c.count, c.stride_bytes, static_cast<Scalar>(c.scalar)};
 }
 
 // The C++ report into the C one; the layer array is the caller's already.
-inline void c_report(const Report& r, stratmesh_report& c) {
+static inline void c_report(const Report& r, stratmesh_report& c) {
     c.triangle_count = r.triangle_count;
     for (int i = 0; i < 3; ++i) {
         c.axis[i] = r.axis[i];
@@ -13325,7 +13325,7 @@ inline void c_report(const Report& r, stratmesh_report& c) {
 }
 
 // A C++ report that writes the layers into the C report's array.
-inline void c_report_start(Report& r, const stratmesh_report* c) {
+static inline void c_report_start(Report& r, const stratmesh_report* c) {
     std::memset(&r, 0, sizeof r);
     if (!c || !c->layers.info) return;
     r.layers.info = reinterpret_cast<LayerInfo*>(c->layers.info);
@@ -13333,17 +13333,17 @@ inline void c_report_start(Report& r, const stratmesh_report* c) {
 }
 
 // The stream's C report, its workspace counted from the start of the caller's buffer.
-inline void c_stream_report(const stratmesh_stream& s) {
+static inline void c_stream_report(const stratmesh_stream& s) {
     if (!s.user_report) return;
     c_report(s.report, *s.user_report);
     s.user_report->workspace_used_bytes += s.prefix;
 }
 
-inline ByteRange c_report_bytes(const stratmesh_report* c) {
+static inline ByteRange c_report_bytes(const stratmesh_report* c) {
     return byte_range(c, sizeof *c);
 }
 
-inline ByteRange c_layer_bytes(const stratmesh_report* c) {
+static inline ByteRange c_layer_bytes(const stratmesh_report* c) {
     return c ? byte_range(c->layers.info, saturating_product(c->layers.info_capacity,
                                                              sizeof(stratmesh_layer_info)))
              : ByteRange{0, 0};

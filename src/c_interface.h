@@ -113,23 +113,23 @@ static void c_run_job(void* batch, uint32_t index) {
 }
 
 // The adapters' user pointer is the caller's stratmesh_options, alive during the call.
-inline void c_progress(void* user, Phase phase, double fraction) {
+static inline void c_progress(void* user, Phase phase, double fraction) {
     const stratmesh_options* c = static_cast<const stratmesh_options*>(user);
     c->progress(c->progress_user, static_cast<stratmesh_phase>(phase), fraction);
 }
 
-inline void c_run_jobs(void* user, uint32_t count, JobFunction job, void* context) {
+static inline void c_run_jobs(void* user, uint32_t count, JobFunction job, void* context) {
     const stratmesh_options* c = static_cast<const stratmesh_options*>(user);
     CJobBatch batch = {job, context};
     c->run_jobs(c->jobs_user, count, c_run_job, &batch);
 }
 
-inline void c_emit(void* user, const uint32_t* triangles, size_t count) {
+static inline void c_emit(void* user, const uint32_t* triangles, size_t count) {
     const stratmesh_stream* s = static_cast<const stratmesh_stream*>(user);
     s->emit(s->emit_user, triangles, count);
 }
 
-inline Options c_options(const stratmesh_options* c) {
+static inline Options c_options(const stratmesh_options* c) {
     Options o;
     std::memset(&o, 0, sizeof o);
     if (!c) return o;
@@ -155,12 +155,12 @@ inline Options c_options(const stratmesh_options* c) {
     return o;
 }
 
-inline Cloud c_cloud(const stratmesh_cloud& c) {
+static inline Cloud c_cloud(const stratmesh_cloud& c) {
     return Cloud{c.xyz, c.count, c.stride_bytes, static_cast<Scalar>(c.scalar)};
 }
 
 // The C++ report into the C one; the layer array is the caller's already.
-inline void c_report(const Report& r, stratmesh_report& c) {
+static inline void c_report(const Report& r, stratmesh_report& c) {
     c.triangle_count = r.triangle_count;
     for (int i = 0; i < 3; ++i) {
         c.axis[i] = r.axis[i];
@@ -208,7 +208,7 @@ inline void c_report(const Report& r, stratmesh_report& c) {
 }
 
 // A C++ report that writes the layers into the C report's array.
-inline void c_report_start(Report& r, const stratmesh_report* c) {
+static inline void c_report_start(Report& r, const stratmesh_report* c) {
     std::memset(&r, 0, sizeof r);
     if (!c || !c->layers.info) return;
     r.layers.info = reinterpret_cast<LayerInfo*>(c->layers.info);
@@ -216,17 +216,17 @@ inline void c_report_start(Report& r, const stratmesh_report* c) {
 }
 
 // The stream's C report, its workspace counted from the start of the caller's buffer.
-inline void c_stream_report(const stratmesh_stream& s) {
+static inline void c_stream_report(const stratmesh_stream& s) {
     if (!s.user_report) return;
     c_report(s.report, *s.user_report);
     s.user_report->workspace_used_bytes += s.prefix;
 }
 
-inline ByteRange c_report_bytes(const stratmesh_report* c) {
+static inline ByteRange c_report_bytes(const stratmesh_report* c) {
     return byte_range(c, sizeof *c);
 }
 
-inline ByteRange c_layer_bytes(const stratmesh_report* c) {
+static inline ByteRange c_layer_bytes(const stratmesh_report* c) {
     return c ? byte_range(c->layers.info, saturating_product(c->layers.info_capacity,
                                                              sizeof(stratmesh_layer_info)))
              : ByteRange{0, 0};

@@ -45,7 +45,7 @@ const double kCapHeightTie = 0x1p-40;
 // How far d lies below the plane through a, b and w (counter-clockwise across the axis),
 // each at its height (heights: a's, b's, w's, d's): the plane's height at d's place, the
 // heights weighted by the triangles d makes with the opposite edges, less d's own.
-inline double depth_below_plane(const double* a, const double* b, const double* w,
+static inline double depth_below_plane(const double* a, const double* b, const double* w,
                                 const double* d, const double* heights) {
     auto orient = [d](const double* p, const double* q) {
         return (p[0] - d[0]) * (q[1] - d[1]) - (p[1] - d[1]) * (q[0] - d[0]);
@@ -303,18 +303,18 @@ const char* const kLoopLeftOpenDetail =
 // The per point key of a loop's fin chords: at the chord's first corner (position i - 1),
 // the fin's position i, for the fins with a flag in `wanted`. `key` is all kNoIndex outside
 // these calls: clear_fin_chords puts it back.
-inline void key_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length,
+static inline void key_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length,
                            const unsigned char* fins, unsigned char wanted) {
     for (uint32_t i = 0; i < length; ++i)
         if (fins[i] & wanted) key[ids[i == 0 ? length - 1 : i - 1]] = i;
 }
 
-inline void clear_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length) {
+static inline void clear_fin_chords(uint32_t* key, const uint32_t* ids, uint32_t length) {
     for (uint32_t i = 0; i < length; ++i) key[ids[i]] = kNoIndex;
 }
 
 // The fin position whose chord is a - b (either way round), or kNoIndex.
-inline uint32_t keyed_fin(const uint32_t* key, const uint32_t* ids, uint32_t length,
+static inline uint32_t keyed_fin(const uint32_t* key, const uint32_t* ids, uint32_t length,
                           uint32_t a, uint32_t b) {
     for (int side = 0; side < 2; ++side) {
         const uint32_t i = key[side == 0 ? a : b];
@@ -324,7 +324,7 @@ inline uint32_t keyed_fin(const uint32_t* key, const uint32_t* ids, uint32_t len
 }
 
 // Whether (u, x, m) and (x, v, m) face the way (u, v, m) and (v, u, x) do together.
-inline bool fin_flip_keeps_facing(const CloudReader& cloud, const Frame& frame, uint32_t u,
+static inline bool fin_flip_keeps_facing(const CloudReader& cloud, const Frame& frame, uint32_t u,
                                   uint32_t v, uint32_t m, uint32_t x) {
     const Vec3 pu = frame.offset(cloud.point(u)), pv = frame.offset(cloud.point(v));
     const Vec3 pm = frame.offset(cloud.point(m)), px = frame.offset(cloud.point(x));
@@ -335,7 +335,7 @@ inline bool fin_flip_keeps_facing(const CloudReader& cloud, const Frame& frame, 
 
 // Marks kFinWaived the fins of the loop ids[0 .. length) that may be flipped (above),
 // scanning the wall tri[0 .. 3 wall); returns how many.
-inline uint32_t mark_flippable_fins(const uint32_t* tri, size_t wall, const CloudReader& cloud,
+static inline uint32_t mark_flippable_fins(const uint32_t* tri, size_t wall, const CloudReader& cloud,
                                     const Frame& frame, const CapGraph& g, uint32_t* key,
                                     const uint32_t* ids, uint32_t length, unsigned char* fins) {
     if (length <= 4) return 0;  // a chord two corners apart either way: no single fin
@@ -370,7 +370,7 @@ inline uint32_t mark_flippable_fins(const uint32_t* tri, size_t wall, const Clou
 
 // Flips the wall's edge under each fin marked kFinUsed; returns how many it flipped. slots:
 // two size_t per position (in the memory of the loop's projection, free once its cap is made).
-inline size_t flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const uint32_t* ids,
+static inline size_t flip_used_fins(uint32_t* tri, size_t wall, uint32_t* key, const uint32_t* ids,
                              uint32_t length, const unsigned char* fins, double* slots) {
     auto slot = [slots](uint32_t i, uint32_t which) { return slots + 2 * static_cast<size_t>(i) + which; };
     static_assert(sizeof(size_t) <= sizeof(double), "a slot holds a triangle index");
@@ -431,7 +431,7 @@ const double kPocketTurn = 3.14159265358979323846 / 8;
 // axis, at a radius exp((h - h_first) / r) for the height h (-h for a bottom loop) and the
 // loop's mean radius r, mirrored so that the loop turns clockwise. False if it does not
 // run once around its centroid monotonically.
-inline bool unroll_loop(const CloudReader& cloud, const Frame& frame, const uint32_t* ids,
+static inline bool unroll_loop(const CloudReader& cloud, const Frame& frame, const uint32_t* ids,
                         uint32_t length, bool lower, double* xy) {
     double cx = 0, cy = 0, radius = 0;
     for (uint32_t i = 0; i < length; ++i) {
@@ -506,7 +506,7 @@ private:
 // clipping from its second corner on (it turns counter-clockwise there); appends its
 // triangles at tri[3 * count]. False, with count unchanged, where no ear is left whose
 // diagonal is not already an edge of the surface.
-inline bool close_pocket(uint32_t* tri, size_t& count, const CapGraph& g, const uint32_t* ids,
+static inline bool close_pocket(uint32_t* tri, size_t& count, const CapGraph& g, const uint32_t* ids,
                          uint32_t length, const double* run, uint32_t from, uint32_t corners,
                          const EarRing& ring) {
     PocketEars ears(tri, count, g, ids, length, from);
@@ -520,7 +520,7 @@ inline bool close_pocket(uint32_t* tri, size_t& count, const CapGraph& g, const 
 // highest position (its lowest, for a bottom loop) comes first, and keeps in ids, in order,
 // the positions left for the cap; returns their number. The cap loop's arrays serve as
 // scratch.
-inline uint32_t fill_pockets(uint32_t* tri, size_t& count, const CapGraph& g, CapLoop& c,
+static inline uint32_t fill_pockets(uint32_t* tri, size_t& count, const CapGraph& g, CapLoop& c,
                              const CloudReader& cloud, const Frame& frame, uint32_t* ids,
                              uint32_t length, bool lower) {
     uint32_t top = 0;
@@ -588,7 +588,7 @@ inline uint32_t fill_pockets(uint32_t* tri, size_t& count, const CapGraph& g, Ca
 // each loop is projected across the frame's axis. Returns ok; out_of_memory; or
 // triangle_capacity with *needed the triangles every cap closing would take, and nothing
 // written.
-inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
+static inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
                                  const CloudReader& cloud, size_t point_count,
                                  const Frame& frame, Arena& arena, CapCounts& caps,
                                  size_t* needed) {

@@ -59,7 +59,7 @@ const uint32_t kHeldVertex = kNoIndex - 1;
 // The arena sequence of the call, shared with join_branches_workspace_size(): the loops,
 // then the graph after them, then (allocate_grafts) once the loops are traced and the gaps'
 // joins noted, the grafts' arrays in the graph's room.
-inline bool allocate_join(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
+static inline bool allocate_join(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
     m.loops.ids = arena.alloc<uint32_t>(point_count);  // every point on a loop at most
     m.loops.starts = arena.alloc<unsigned char>(point_count);
     m.gap_joins = arena.alloc<uint32_t>(point_count);
@@ -68,7 +68,7 @@ inline bool allocate_join(JoinMemory& m, size_t point_count, size_t triangle_cou
     return !arena.failed;
 }
 
-inline bool allocate_grafts(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
+static inline bool allocate_grafts(JoinMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
     arena.rewind(m.room);
     m.under_capacity = triangle_count < kGraftMaxTriangles ? triangle_count : kGraftMaxTriangles;
     m.hole_next = arena.alloc<uint32_t>(point_count);
@@ -119,14 +119,14 @@ struct SideView {
     }
 };
 
-inline double loop_mean_height(const TracedLoop& loop, const SideView& view) {
+static inline double loop_mean_height(const TracedLoop& loop, const SideView& view) {
     double sum = 0;
     for (uint32_t i = 0; i < loop.length; ++i) sum += view.at(loop.ids[i]).h;
     return sum / loop.length;
 }
 
 // The label every point of the loop has, or kBeyondBranches where they differ.
-inline uint8_t loop_label(const TracedLoop& loop, const uint8_t* branch_of) {
+static inline uint8_t loop_label(const TracedLoop& loop, const uint8_t* branch_of) {
     const uint8_t label = branch_of[loop.ids[0]];
     for (uint32_t i = 1; i < loop.length; ++i)
         if (branch_of[loop.ids[i]] != label) return kBeyondBranches;
@@ -145,7 +145,7 @@ struct SideLoops {
     double branch_height[kMaxBranches];
 };
 
-inline void find_side_loops(const CapLoop& loops, size_t entries, const uint8_t* branch_of,
+static inline void find_side_loops(const CapLoop& loops, size_t entries, const uint8_t* branch_of,
                             uint8_t first_label, uint32_t branches, const SideView& view,
                             const uint32_t* taken, SideLoops& side) {
     side.trunk = {nullptr, 0};
@@ -183,7 +183,7 @@ struct TrunkCentre {
     double angle(double x, double y) const { return std::atan2(sense * (y - cy), x - cx); }
 };
 
-inline TrunkCentre trunk_centre(const TracedLoop& trunk, const SideView& view) {
+static inline TrunkCentre trunk_centre(const TracedLoop& trunk, const SideView& view) {
     double cx = 0, cy = 0, area = 0;
     for (uint32_t i = 0; i < trunk.length; ++i) {
         const Local p = view.at(trunk.ids[i]);
@@ -206,7 +206,7 @@ inline TrunkCentre trunk_centre(const TracedLoop& trunk, const SideView& view) {
 // Adds the branch's loop to the side's, in the order of their angles around the trunk's
 // centre (kept in branch_angle): its centre, and where it opens, its vertex nearest the
 // trunk's centre. False (detail set) where its centre is not within the trunk's loop.
-inline bool add_rim_branch(const TracedLoop& loop, const SideView& view,
+static inline bool add_rim_branch(const TracedLoop& loop, const SideView& view,
                            const TrunkCentre& trunk, SideJunction& side, double* branch_angle,
                            const char*& detail) {
     double bx = 0, by = 0, nearest = DBL_MAX;
@@ -249,7 +249,7 @@ inline bool add_rim_branch(const TracedLoop& loop, const SideView& view,
 // The gap after each branch i: the trunk's vertex nearest in angle to the middle between
 // branch i and the next one. False (detail set) where the gaps do not follow one another
 // along the trunk's loop as the branches do.
-inline bool place_rim_gaps(const SideView& view, const TrunkCentre& centre,
+static inline bool place_rim_gaps(const SideView& view, const TrunkCentre& centre,
                            const double* branch_angle, SideJunction& side, const char*& detail) {
     const TracedLoop& trunk = side.trunk;
     const double two_pi = 6.28318530717958647693;
@@ -283,7 +283,7 @@ inline bool place_rim_gaps(const SideView& view, const TrunkCentre& centre,
 
 // Plans the rim junction of a side with `branches` branches, from its loops, with its cut
 // and gap as heights of the view: false (detail set) if it cannot be joined so.
-inline bool plan_junction(const SideLoops& loops, uint32_t branches, double cut, double gap,
+static inline bool plan_junction(const SideLoops& loops, uint32_t branches, double cut, double gap,
                           const SideView& view, SideJunction& side, const char*& detail) {
     side.trunk = loops.trunk;
     // Loops farther than kJoinReach gaps from the cut are not the junction's: a trunk
@@ -328,7 +328,7 @@ struct AngleAround {
 };
 
 // Writes the junction's side.triangles() triangles at out.
-inline void write_junction(const SideJunction& side, const SideView& view, uint32_t* out) {
+static inline void write_junction(const SideJunction& side, const SideView& view, uint32_t* out) {
     const TracedLoop& trunk = side.trunk;
     auto emit = [&out](uint32_t a, uint32_t b, uint32_t c) {
         out[0] = a;
@@ -407,7 +407,7 @@ struct Graft {
 };
 
 // How many times the loop winds around (x, y) across the axis, counter-clockwise positive.
-inline long loop_winding(const TracedLoop& loop, const SideView& view, double x, double y) {
+static inline long loop_winding(const TracedLoop& loop, const SideView& view, double x, double y) {
     const double p[2] = {x, y};
     auto corner = [&](uint32_t i) {
         const Local q = view.at(loop.ids[i]);
@@ -418,13 +418,13 @@ inline long loop_winding(const TracedLoop& loop, const SideView& view, double x,
 
 // The trunk's triangles a graft reads: the caller's, `count` of them, then those that
 // closed small gaps in the trunk's end (m.filled, see fill_gap).
-inline const uint32_t* trunk_corners(const uint32_t* tri, size_t count, const JoinMemory& m,
+static inline const uint32_t* trunk_corners(const uint32_t* tri, size_t count, const JoinMemory& m,
                                      size_t t) {
     return t < count ? tri + 3 * t : m.filled + 3 * (t - count);
 }
 
 // The first of the sorted edges m.edges[0 .. 3 * found) not below key.
-inline size_t first_edge_from(const JoinMemory& m, size_t found, const GraftEdge& key) {
+static inline size_t first_edge_from(const JoinMemory& m, size_t found, const GraftEdge& key) {
     size_t lo = 0, hi = 3 * found;
     while (lo < hi) {
         const size_t mid = lo + (hi - lo) / 2;
@@ -438,7 +438,7 @@ inline size_t first_edge_from(const JoinMemory& m, size_t found, const GraftEdge
 // m.edges): a triangle (x, y, z) beyond the hole's edge y -> x joins when z is free, and the
 // loop then runs y -> z -> x, so every vertex stays on the loop and keeps a triangle of the
 // trunk. Returns the triangles taken (marked in m.removed).
-inline size_t grow_hole(const uint32_t* tri, size_t count, JoinMemory& m, size_t found,
+static inline size_t grow_hole(const uint32_t* tri, size_t count, JoinMemory& m, size_t found,
                         size_t queued) {
     uint32_t* next = m.hole_next;
     size_t taken = 0;
@@ -464,7 +464,7 @@ inline size_t grow_hole(const uint32_t* tri, size_t count, JoinMemory& m, size_t
 }
 
 // Whether vertex v is a corner of one of m.under[0 .. found), whose edges m.edges holds sorted.
-inline bool corner_under(const JoinMemory& m, size_t found, uint32_t v) {
+static inline bool corner_under(const JoinMemory& m, size_t found, uint32_t v) {
     const size_t lo = first_edge_from(m, found, {v, 0, 0});
     return lo < 3 * found && m.edges[lo].from == v;
 }
@@ -473,7 +473,7 @@ inline bool corner_under(const JoinMemory& m, size_t found, uint32_t v) {
 // trunk of at most kGapLoopMost vertices, each held by no hole, within `reach` of (cx, cy)
 // across the axis and within [low, high] along it, one of them a corner of a triangle
 // under the branch; the one nearest (cx, cy), {nullptr, 0} if none.
-inline TracedLoop gap_beside(const JoinMemory& m, size_t entries, size_t found,
+static inline TracedLoop gap_beside(const JoinMemory& m, size_t entries, size_t found,
                              const uint8_t* branch_of, const SideView& view, double cx,
                              double cy, double reach, double low, double high) {
     TracedLoop best = {nullptr, 0};
@@ -510,7 +510,7 @@ static_assert(kGapLoopMost <= 32, "a gap's joins are bits of 32");
 // Notes in m.gap_joins, from the graph, which vertices of each loop small enough to be a
 // gap are joined by an edge of the caller's surface: the graph keeps the edges between
 // boundary vertices, and its memory goes to the grafts.
-inline void note_gap_joins(JoinMemory& m, size_t entries) {
+static inline void note_gap_joins(JoinMemory& m, size_t entries) {
     for (size_t start = 0; start < entries;) {
         size_t end = start + 1;
         while (end < entries && m.loops.starts[end] == 0) ++end;
@@ -552,7 +552,7 @@ private:
 // (nothing added) where the loop is no simple polygon turning counter-clockwise in the view
 // (the way the triangles facing a branch turn) or no ear is left whose diagonal is not an
 // edge of the surface. count: the caller's triangles, which m.removed numbers first.
-inline bool fill_gap(size_t count, const TracedLoop& loop, const SideView& view, JoinMemory& m) {
+static inline bool fill_gap(size_t count, const TracedLoop& loop, const SideView& view, JoinMemory& m) {
     const uint32_t n = loop.length;
     if (m.filled_count + (n - 2) > kMostFilled) return false;
     double xy[2 * kGapLoopMost];
@@ -585,7 +585,7 @@ struct GraftSite {
 
 // The site of the branch's loop, within kJoinReach gaps below its mean height and one gap
 // above; false (detail set) where the loop does not go once around its centre.
-inline bool graft_site(const TracedLoop& loop, double gap, const SideView& view,
+static inline bool graft_site(const TracedLoop& loop, double gap, const SideView& view,
                        GraftSite& site, const char*& detail) {
     double cx = 0, cy = 0, height = 0;
     for (uint32_t i = 0; i < loop.length; ++i) {
@@ -616,7 +616,7 @@ inline bool graft_site(const TracedLoop& loop, double gap, const SideView& view,
 // Collects in m.under[0 .. found) the trunk's triangles under the branch's loop that face
 // it (see "grafts" above) and no planned hole takes; false (detail set) if there are more
 // than m.under holds.
-inline bool find_under(const uint32_t* tri, size_t count, const uint8_t* branch_of,
+static inline bool find_under(const uint32_t* tri, size_t count, const uint8_t* branch_of,
                        const TracedLoop& loop, const SideView& view, const GraftSite& site,
                        JoinMemory& m, size_t& found, const char*& detail) {
     found = 0;
@@ -647,7 +647,7 @@ inline bool find_under(const uint32_t* tri, size_t count, const uint8_t* branch_
 
 // The position in m.under[0 .. found) of the triangle nearest the site's centre whose
 // corners no hole holds; found if there is none.
-inline size_t hole_seed(const uint32_t* tri, size_t count, const JoinMemory& m, size_t found,
+static inline size_t hole_seed(const uint32_t* tri, size_t count, const JoinMemory& m, size_t found,
                         const SideView& view, const GraftSite& site) {
     size_t seed = found;
     double nearest = DBL_MAX;
@@ -673,7 +673,7 @@ enum class HolePlan { cut, refused, missed_centre };
 // graft.removed. Refused (detail set, nothing taken) where no triangle is there to take;
 // missed_centre where the disc does not go once around the site's centre. found: the
 // triangles under the loop, for gap_beside.
-inline HolePlan plan_hole(const uint32_t* tri, size_t count, const uint8_t* branch_of,
+static inline HolePlan plan_hole(const uint32_t* tri, size_t count, const uint8_t* branch_of,
                           const TracedLoop& loop, const SideView& view, const GraftSite& site,
                           JoinMemory& m, uint32_t* hole, size_t& found, Graft& graft,
                           const char*& detail) {
@@ -713,7 +713,7 @@ inline HolePlan plan_hole(const uint32_t* tri, size_t count, const uint8_t* bran
 // triangles out in m.removed and its vertices in m.hole_next, its loop appended to m.holes
 // at holes_used; false (nothing taken, detail set) if it cannot be grafted. tri: the
 // caller's `count` triangles; entries: the count of m.loops' ids.
-inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_of,
+static inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_of,
                        const TracedLoop& loop, double gap, const SideView& view, JoinMemory& m,
                        size_t entries, size_t& holes_used, Graft& graft, const char*& detail) {
     GraftSite site;
@@ -751,7 +751,7 @@ inline bool plan_graft(const uint32_t* tri, size_t count, const uint8_t* branch_
 // Writes the graft's graft.triangles() triangles at out: the hole's loop, counter-clockwise
 // from its vertex first in angle after the branch loop's first vertex, and the branch's loop
 // against its cap order, merged by angle around the branch's centre.
-inline void write_graft(const Graft& graft, const SideView& view, uint32_t* out) {
+static inline void write_graft(const Graft& graft, const SideView& view, uint32_t* out) {
     const uint32_t m = graft.hole.length, n = graft.branch.length;
     const uint32_t* branch = graft.branch.ids;
     const AngleAround turn = {view, graft.centre[0], graft.centre[1], view.at(branch[0]), 1.0};
@@ -807,7 +807,7 @@ struct JoinPlan {
 // Plans side k (0 above the cut, 1 below) with `branches` branches: its rim junction where
 // a trunk loop goes around them, else a graft for each branch where it stands; counts the
 // side into r.
-inline void plan_side(int k, uint32_t branches, const JoinInput& in, JoinMemory& m,
+static inline void plan_side(int k, uint32_t branches, const JoinInput& in, JoinMemory& m,
                       JoinPlan& plan, JoinReport& r) {
     const SideView view = {in.reader, in.frame, k == 0 ? 1.0 : -1.0};
     const uint8_t first = static_cast<uint8_t>(k == 0 ? kFirstAboveBranch : kFirstBelowBranch);
@@ -851,7 +851,7 @@ inline void plan_side(int k, uint32_t branches, const JoinInput& in, JoinMemory&
 
 // Writes the plan over the caller's triangles: those the holes take out gone, then the
 // gaps' triangles, the rims' and the grafts'; counts into r; returns the triangles in all.
-inline size_t write_join(const JoinInput& in, const JoinMemory& m, const JoinPlan& plan,
+static inline size_t write_join(const JoinInput& in, const JoinMemory& m, const JoinPlan& plan,
                          uint32_t* triangles, JoinReport& r) {
     size_t kept = 0;
     for (size_t t = 0; t < in.given; ++t) {
@@ -886,7 +886,7 @@ inline size_t write_join(const JoinInput& in, const JoinMemory& m, const JoinPla
 
 // join_branches()'s checks of the points and the triangles: ok, or a status with
 // checks.detail set.
-inline Status check_join_input(const CloudReader& reader, size_t point_count,
+static inline Status check_join_input(const CloudReader& reader, size_t point_count,
                                const CloudSums& sums, const Options& options,
                                const uint32_t* triangles, size_t given, Report& checks) {
     const Status status = reject_invalid_points(reader, point_count, sums, options, checks);
@@ -900,7 +900,7 @@ inline Status check_join_input(const CloudReader& reader, size_t point_count,
 }
 
 // The frame join_branches() sees the sides in: along the parting's axis.
-inline Status join_frame(const CloudSums& sums, const Options& options, const Parting& parting,
+static inline Status join_frame(const CloudSums& sums, const Options& options, const Parting& parting,
                          Frame& frame) {
     Options along = options;
     along.axis = Axis::direction;

@@ -4,10 +4,10 @@
 namespace stratmesh {
 namespace detail {
 
-inline bool same_point(const double* a, const double* b) { return a[0] == b[0] && a[1] == b[1]; }
+static inline bool same_point(const double* a, const double* b) { return a[0] == b[0] && a[1] == b[1]; }
 
 // For p collinear with a and b: whether it lies on the closed segment ab.
-inline bool on_segment(const double* a, const double* b, const double* p) {
+static inline bool on_segment(const double* a, const double* b, const double* p) {
     for (int k = 0; k < 2; ++k) {
         double low = a[k] < b[k] ? a[k] : b[k], high = a[k] < b[k] ? b[k] : a[k];
         if (p[k] < low || p[k] > high) return false;
@@ -16,10 +16,10 @@ inline bool on_segment(const double* a, const double* b, const double* p) {
 }
 
 // -1, 0 or 1 as x is below, at or above y: the sign of x - y, without rounding.
-inline int compare(double x, double y) { return (x > y) - (x < y); }
+static inline int compare(double x, double y) { return (x > y) - (x < y); }
 
 // Whether the closed segments pq and rs share a point.
-inline bool segments_meet(const double* p, const double* q, const double* r, const double* s) {
+static inline bool segments_meet(const double* p, const double* q, const double* r, const double* s) {
     double d1 = orient2d_robust(r, s, p), d2 = orient2d_robust(r, s, q);
     double d3 = orient2d_robust(p, q, r), d4 = orient2d_robust(p, q, s);
     if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0)))
@@ -31,7 +31,7 @@ inline bool segments_meet(const double* p, const double* q, const double* r, con
 // Whether the closed polygon xy[0 .. length) is simple: no repeated point, no edge folding
 // back onto the next, no two other edges meeting. Edges are swept in order of their
 // smaller x; each is tested against those whose x range reaches into its own.
-inline bool polygon_is_simple(const double* xy, uint32_t length, uint64_t* sweep) {
+static inline bool polygon_is_simple(const double* xy, uint32_t length, uint64_t* sweep) {
     if (length < 3) return false;
     auto at = [&](uint32_t i) { return xy + 2 * static_cast<size_t>(i); };
     for (uint32_t i = 0; i < length; ++i) {
@@ -69,7 +69,7 @@ inline bool polygon_is_simple(const double* xy, uint32_t length, uint64_t* sweep
 }
 
 // Whether p lies in the closed triangle abc (counter-clockwise).
-inline bool in_closed_triangle(const double* a, const double* b, const double* c, const double* p) {
+static inline bool in_closed_triangle(const double* a, const double* b, const double* c, const double* p) {
     return orient2d_robust(a, b, p) >= 0 && orient2d_robust(b, c, p) >= 0 &&
            orient2d_robust(c, a, p) >= 0;
 }
@@ -77,7 +77,7 @@ inline bool in_closed_triangle(const double* a, const double* b, const double* c
 // Whether corners i and j of the simple counter-clockwise polygon xy[0 .. length) see each
 // other through it: the segment leaves both corners into the polygon and meets no edge that
 // does not end at i or j (touching one counts as meeting it).
-inline bool diagonal_inside(const double* xy, uint32_t length, uint32_t i, uint32_t j) {
+static inline bool diagonal_inside(const double* xy, uint32_t length, uint32_t i, uint32_t j) {
     auto point = [xy](uint32_t k) { return xy + 2 * static_cast<size_t>(k); };
     auto within_corner = [&](uint32_t a, uint32_t b) {
         const double* pa = point(a);
@@ -107,7 +107,7 @@ inline bool diagonal_inside(const double* xy, uint32_t length, uint32_t i, uint3
 
 // The turning direction of the simple polygon xy[0 .. length): orient2d at its
 // lexicographically lowest corner, which is strictly convex; positive counter-clockwise.
-inline double simple_polygon_turn(const double* xy, uint32_t length) {
+static inline double simple_polygon_turn(const double* xy, uint32_t length) {
     auto at = [xy](uint32_t i) { return xy + 2 * static_cast<size_t>(i); };
     uint32_t lowest = 0;
     for (uint32_t i = 1; i < length; ++i)

@@ -29,7 +29,7 @@ struct CapGraph {
 // the index. Coarser than x, the key still never orders an edge before one whose smaller x
 // is below its own, so the sweep meets every pair whose x ranges overlap (and a few more,
 // which the exact test settles).
-inline uint32_t sweep_key(double x) {
+static inline uint32_t sweep_key(double x) {
     x += 0.0;
     uint64_t bits;
     std::memcpy(&bits, &x, sizeof bits);
@@ -67,7 +67,7 @@ const unsigned char kFinSeen = 1, kFinFlippable = 2, kFinWaived = 4, kFinUsed = 
 
 // The allocation sequences of the cap phase: the call runs them with its real sizes,
 // reconstruct_workspace_size with the largest possible ones, so the two cannot disagree.
-inline bool allocate_cap_graph(CapGraph& g, size_t point_count, size_t triangle_count,
+static inline bool allocate_cap_graph(CapGraph& g, size_t point_count, size_t triangle_count,
                                Arena& arena) {
     g.offsets = arena.alloc<size_t>(point_count + 1);
     g.targets = arena.alloc<uint32_t>(3 * triangle_count);
@@ -75,7 +75,7 @@ inline bool allocate_cap_graph(CapGraph& g, size_t point_count, size_t triangle_
     return !arena.failed;
 }
 
-inline bool allocate_cap_loop(CapLoop& c, size_t length, Arena& arena) {
+static inline bool allocate_cap_loop(CapLoop& c, size_t length, Arena& arena) {
     c.ids = arena.alloc<uint32_t>(length);
     c.starts = arena.alloc<unsigned char>(length);
     c.xy = arena.alloc<double>(2 * length);
@@ -105,7 +105,7 @@ inline bool allocate_cap_loop(CapLoop& c, size_t length, Arena& arena) {
 // Fills the graph from the triangles; returns the number of boundary vertices. Only edges
 // between boundary vertices are kept (the diagonals of a cap join boundary vertices), so
 // on a tube the graph is small and built in three streaming passes.
-inline size_t build_cap_graph(const uint32_t* tri, size_t count, size_t point_count,
+static inline size_t build_cap_graph(const uint32_t* tri, size_t count, size_t point_count,
                               CapGraph& g) {
     // Around an inner vertex the triangles leave towards the same vertices they arrive
     // from; around a boundary vertex (one fan, a chain) the two sets differ by the far
@@ -166,7 +166,7 @@ inline size_t build_cap_graph(const uint32_t* tri, size_t count, size_t point_co
 // Chains the boundary edges into loops, stored one after another in cap order (the
 // boundary reversed); a chain that does not come back to its start is marked broken.
 // Returns the cap triangles all the unbroken loops would need.
-inline size_t trace_boundary_loops(CapGraph& g, size_t point_count, CapLoop& c,
+static inline size_t trace_boundary_loops(CapGraph& g, size_t point_count, CapLoop& c,
                                    size_t* loop_entries) {
     size_t filled = 0, triangles = 0;
     for (size_t v = 0; v < point_count; ++v) {

@@ -41,7 +41,7 @@
 // along which the cloud's sections are loops around one centre line, tried on a sample),
 // the layers are chosen automatically, the cloud is searched for where it parts into
 // branches and, where it does, the trunk and each branch are meshed along their own axes
-// and joined into one surface; the ends stay open (close_ends caps them) and the layers stay
+// and joined into one surface; the ends stay open (add_caps caps them) and the layers stay
 // Delaunay on their unrolled annulus, as in the paper (surface_flips refines them on the
 // surface, for about three times the time).
 //
@@ -119,7 +119,7 @@
 // As a guide: delaunay_2d needs 72 bytes per point plus about 10 KiB, and its output is at
 // most 2n - 5 triangles (24 bytes per point). reconstruct needs about 115 bytes per point
 // (the triangulation of its largest possible layer, the layer grouping and the boundary
-// loops; measuring the webs at the end takes less), about 121 with close_ends (plus up to
+// loops; measuring the webs at the end takes less), about 121 with add_caps (plus up to
 // 32 KiB for the exhaustive search of a cap), about 166 with a jobs runner; its output is
 // at most 2n triangles plus 160 for the junctions of branches. A stream needs about 190
 // bytes per point it holds at once, whatever the size of the whole cloud.
@@ -356,7 +356,7 @@ enum Flags : uint32_t {
     // still returns ok, Report::caps.open_count counts it and Report::detail says so.
     // reconstruct_max_triangles() still suffices (a closed surface through V vertices has
     // 2V - 4 triangles). The stream refuses the flag: cap_ends() caps its surface afterwards.
-    close_ends = 1u << 1,
+    add_caps = 1u << 1,
     // The frame's reference point is Options::origin instead of the centroid of the cloud
     // (reconstruct) or of the first layer (the stream). The reference point changes only
     // rounding, but a stream and a reconstruct() that are to give the same triangles need
@@ -404,7 +404,7 @@ enum Flags : uint32_t {
 // Phases reported to Options::progress, in the order they run. Each layer is stitched to
 // the one below as soon as it is triangulated, so stitching time falls within
 // `triangulate`; `stitch` is announced once, when the last band is done. The caps of
-// close_ends are made within `manifold`.
+// add_caps are made within `manifold`.
 enum class Phase : uint32_t { validate = 0, layers, triangulate, stitch, manifold, done };
 
 // One job of a batch run by Options::run_jobs: job(context, index).
@@ -468,7 +468,7 @@ const uint32_t kMaxJobs = 64;
 // across the end, not only around its rim) is meshed across that end, up to a small loop
 // around its pole: the layer is unrolled around a pole inside the end rather than on the
 // cylinder, which would fold the end's points onto its rim. The small loop is a boundary
-// (close_ends caps it). An end left open as a tube's rim, any other layer, and every layer
+// (add_caps caps it). An end left open as a tube's rim, any other layer, and every layer
 // of the reduced build report 0.
 enum ClosedEnd : uint32_t { closed_bottom = 1u << 0, closed_top = 1u << 1 };
 
@@ -593,7 +593,7 @@ struct LayerCounts {
     size_t info_capacity;
 };
 
-// Report::caps, with close_ends (and from cap_ends()); all 0 without it.
+// Report::caps, with add_caps (and from cap_ends()); all 0 without it.
 struct CapCounts {
     size_t closed_count;     // boundary loops closed by a cap
     size_t open_count;       // loops left open: their projection across the axis is not a
@@ -602,7 +602,7 @@ struct CapCounts {
                              // in Report::triangle_count
     size_t wall_flip_count;  // the surface's edges flipped under fins so that a loop could
                              // be capped, each changing two triangles in place (see
-                             // close_ends); 0 in STRATMESH_SMALL_CODE
+                             // add_caps); 0 in STRATMESH_SMALL_CODE
 };
 
 // A web triangle (Diagnostics) has its longest edge over this many times the largest local
@@ -667,7 +667,7 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 
 // Reconstructs a triangle mesh through the points of a columnar cloud: one surface,
 // edge- and vertex-manifold, consistently oriented, an open tube (two boundary loops) on
-// columnar input, closed by caps with the close_ends flag, with every valid distinct
+// columnar input, closed by caps with the add_caps flag, with every valid distinct
 // point a vertex unless the report says why not. Where the cloud's end is closed (points
 // across it: a dome, a flat base), the surface goes across it too, and that end's loop is
 // a small one around the axis (see ClosedEnd).
@@ -680,7 +680,7 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // join_branches()); otherwise, or where the parts cannot all be joined, or where the
 // joined surface is not smaller than the one tube's (unless keep_parts), mesh one tube:
 // layer by layer, each unrolled and triangulated, stitched to the layer below, passed
-// through the manifold safety net; then the caps (close_ends). A tube that wraps branches
+// through the manifold safety net; then the caps (add_caps). A tube that wraps branches
 // bridges the gaps between them with webs, which add area, and so does a join that folds,
 // so the smaller surface is the one kept; the comparison meshes the one tube too, which
 // roughly doubles the time on clouds that part. A point beyond a cut in no branch (a
@@ -699,11 +699,11 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // triangles       receives 3 * (*triangle_count) indices into the cloud, each triangle
 //                 counter-clockwise seen from outside (normals point away from the axis).
 //                 Triangles come layer by layer, bottom to top: each layer's own triangles,
-//                 then the band joining it to the layer below; then the caps (close_ends),
+//                 then the band joining it to the layer below; then the caps (add_caps),
 //                 one loop after another. The order is deterministic.
 // triangle_capacity  triangles that fit in `triangles`; reconstruct_max_triangles() always
 //                 suffices. When too small: Status::triangle_capacity and *triangle_count
-//                 says how many are needed (with close_ends, counting every loop as closed;
+//                 says how many are needed (with add_caps, counting every loop as closed;
 //                 the array's contents are then unspecified; nothing is written past the
 //                 capacity).
 // triangle_count  required; receives the number of triangles (0 on failure).
@@ -765,7 +765,7 @@ Status reconstruct(const Cloud& cloud, const Options& options,
 // gives the same triangles in the same order, with the same global indices,
 // provided no point lies within 2^-40 of the height range below a cut (reconstruct()
 // counts such a point in the layer above) and no cut lies outside the points' height
-// range. The stream makes no caps (the close_ends flag is refused): cap_ends() closes its
+// range. The stream makes no caps (the add_caps flag is refused): cap_ends() closes its
 // surface afterwards (below).
 //
 // Memory: stream_workspace_size(max_points_held) bytes, about 190 per point held. The
@@ -795,7 +795,7 @@ size_t stream_workspace_size(size_t max_points_held, const Options& options);
 // the layers). emit receives the triangles; report (optional) is updated after every push
 // and at close, and must stay valid until then (its layer array too). On success *stream
 // is the handle, valid until stream_close or until the workspace is reused.
-// Returns ok, invalid_argument (a null emit or stream, close_ends or drop_outliers, a null
+// Returns ok, invalid_argument (a null emit or stream, add_caps or drop_outliers, a null
 // workspace, a workspace that shares a byte with the report or its layer array),
 // invalid_origin (a NaN or infinite origin), invalid_axis, out_of_memory (a workspace too
 // small to hold 16 points).
@@ -829,7 +829,7 @@ Status stream_close(Stream* stream);
 // ---- Caps for a surface you hold ----
 //
 // cap_ends() closes the boundary loops of a surface the caller holds with caps, as the
-// close_ends flag does inside reconstruct(): made for the stream, whose triangles leave
+// add_caps flag does inside reconstruct(): made for the stream, whose triangles leave
 // through the callback before its last loop is known. Collect them, close the stream, then
 //
 //     size_t count = tris.size() / 3;  // the triangles collected from the callback
@@ -840,12 +840,12 @@ Status stream_close(Stream* stream);
 //
 // With the stream's triangles, the same Options and `cloud` the concatenated pushes (every
 // point pushed, in order: the triangles' global indices), the result is reconstruct()'s
-// with close_ends for the same cuts, triangle for triangle, wherever the stream gives
+// with add_caps for the same cuts, triangle for triangle, wherever the stream gives
 // reconstruct()'s triangles (origin_given; see the stream above): the caps come last.
 // The frame is chosen from the whole cloud as reconstruct() chooses it, so the caps do not
 // depend on how the cloud was pushed. Any other surface works too: each boundary loop is
 // projected across the axis and capped if that projection is a simple polygon (see
-// close_ends). The result is edge- and vertex-manifold and consistently oriented if the
+// add_caps). The result is edge- and vertex-manifold and consistently oriented if the
 // input was (as stratmesh's output is); on any other input the call stays within its
 // buffers but the caps may join edges that were already full.
 
@@ -856,7 +856,7 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count);
 
 // Appends caps to triangles[0 .. 3 * *triangle_count) (global indices into `cloud`) and
 // sets *triangle_count to the new total. Where a loop can be capped only so, the edge under
-// a fin of the surface is flipped (see close_ends): two of the given triangles then
+// a fin of the surface is flipped (see add_caps): two of the given triangles then
 // change, in place. options: axis, direction, origin (with
 // origin_given) and skip_invalid_points as given to the stream or reconstruct(); the rest
 // is not used. report (optional): only Report::caps, workspace_used_bytes (this call's)
@@ -1090,10 +1090,10 @@ typedef enum stratmesh_axis {
 } stratmesh_axis;
 
 // stratmesh::Flags: bits of stratmesh_options::flags, each documented at its C++ name
-// (STRATMESH_FLAG_CLOSE_ENDS is stratmesh::close_ends).
+// (STRATMESH_FLAG_ADD_CAPS is stratmesh::add_caps).
 enum stratmesh_flags {
     STRATMESH_FLAG_SKIP_INVALID_POINTS = 1 << 0,
-    STRATMESH_FLAG_CLOSE_ENDS = 1 << 1,
+    STRATMESH_FLAG_ADD_CAPS = 1 << 1,
     STRATMESH_FLAG_ORIGIN_GIVEN = 1 << 2,
     STRATMESH_FLAG_DROP_OUTLIERS = 1 << 3,
     STRATMESH_FLAG_SURFACE_FLIPS = 1 << 4,
@@ -1235,7 +1235,7 @@ typedef struct stratmesh_layer_counts {
     size_t info_capacity;
 } stratmesh_layer_counts;
 
-// stratmesh::CapCounts, with STRATMESH_FLAG_CLOSE_ENDS; all 0 without it.
+// stratmesh::CapCounts, with STRATMESH_FLAG_ADD_CAPS; all 0 without it.
 typedef struct stratmesh_cap_counts {
     size_t closed_count;     // boundary loops closed by a cap
     size_t open_count;       // loops left open
@@ -3798,7 +3798,7 @@ struct TubeRequest {
     double direction[3];    // with Axis::direction
     LayerRequest layers;
     uint32_t cut_ends;      // ClosedEnd bits: the ends that are cuts, never closed ones
-    bool caps;              // the boundary loops closed (close_ends)
+    bool caps;              // the boundary loops closed (add_caps)
     bool surface_flips;
     bool drop_outliers;     // the cloud is read without its outliers
     const double* origin;   // the frame's reference point, or null for the centroid
@@ -3819,7 +3819,7 @@ static inline TubeRequest tube_request(const Options& options) {
             {options.direction[0], options.direction[1], options.direction[2]},
             {options.cuts, options.cut_count, options.layer_count, options.layer_height},
             kClosedEnds && (f & open_ends) ? closed_bottom | closed_top : 0u,
-            (f & close_ends) != 0,
+            (f & add_caps) != 0,
             kSurfaceFlips && (f & surface_flips),
             kDropOutliers && (f & drop_outliers),
             (f & origin_given) ? options.origin : nullptr,
@@ -4998,7 +4998,7 @@ static inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* 
 // under it are a web across the gap, down to where the branches meet. There an end loop
 // peels at any slope short of vertical, up to kFoldedEndPeelPasses passes, and most of the
 // web goes (on a bust with horns, half the mean distance to the true surface). A cap
-// (close_ends) over such a loop, which dips to where the branches meet, can cross them.
+// (add_caps) over such a loop, which dips to where the branches meet, can cross them.
 // The passes are bounded:
 // each peels every loop edge at most once.
 // Each loop keeps, per vertex, the pass that put it there (LayerLoops::bottom_flags,
@@ -6625,7 +6625,7 @@ namespace detail {
 // degenerate, the new triangles' widest angle is at most 150 degrees (kWidestAngle) or
 // less wide than the old ones' (the bend alone makes needles: without that limit 17% of
 // the bust's triangles had an angle under 5 degrees, with it 2%, as without flips), pq is
-// not already an edge nor a chord of a loop (where close_ends puts its cap), and, unless
+// not already an edge nor a chord of a loop (where add_caps puts its cap), and, unless
 // both new normals are within 26 degrees of the old pair's (kGentleFlip: the new
 // triangles cover about the same place as the old), neither new triangle meets a surface
 // triangle around the quad's corners (the test is in floating point, on triangles shrunk
@@ -6847,7 +6847,7 @@ static inline bool flip_on_surface(Triangulation& tr, const Local* points, const
     if (!on_surface(tr, u)) return false;
     const uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)], p = tr.vertex[prev_edge(e)];
     const uint32_t q = tr.vertex[prev_edge(f)];
-    // A chord of a loop would stand where close_ends puts its cap.
+    // A chord of a loop would stand where add_caps puts its cap.
     if (p == q || (flags[p] & flags[q] & (kOnBottomLoop | kOnTopLoop))) return false;
     const Local &la = points[a - 1], &lb = points[b - 1], &lp = points[p - 1], &lq = points[q - 1];
     if (!flip_wanted(la, lb, lp, lq, normals.at(a), normals.at(b), normals.at(p), normals.at(q)))
@@ -7857,7 +7857,7 @@ private:
 // >>caps =================================================================================
 // Closing a boundary loop: pockets, lowered caps, fins.
 //
-// With the close_ends flag, each boundary loop of the final surface is closed by a cap
+// With the add_caps flag, each boundary loop of the final surface is closed by a cap
 // made of triangles over the loop's own vertices. The loop is triangulated in its
 // projection across the axis: first checked to be a simple polygon (a sweep over its edges
 // sorted by x, exact orient2d), then ear clipping (see the polygon section), then flips of
@@ -9744,7 +9744,7 @@ static inline bool has_no_area(const CloudReader& reader, const Frame& frame, co
                            kLeastArea * frame.cloud_share * frame.cloud_share;
 }
 
-// Closes the tube's boundary loops with caps (close_ends) and fills the caps' report.
+// Closes the tube's boundary loops with caps (add_caps) and fills the caps' report.
 static inline Status cap_tube(const TubeInput& in, const TubeRequest& request, const Frame& frame,
                        Arena& arena, uint32_t* triangles, size_t capacity, size_t& count,
                        size_t* triangle_count, Report& rep) {
@@ -10070,7 +10070,7 @@ size_t stream_workspace_size(size_t max_points_held, const Options& options) {
 
 Status stream_open(const Options& options, void* workspace, size_t workspace_bytes,
                    TriangleCallback emit, void* emit_user, Report* report, Stream** stream) {
-    if (!stream || !emit || !workspace || (options.flags & (close_ends | drop_outliers))) return Status::invalid_argument;
+    if (!stream || !emit || !workspace || (options.flags & (add_caps | drop_outliers))) return Status::invalid_argument;
     *stream = nullptr;
     const detail::ByteRange work = detail::byte_range(workspace, workspace_bytes);
     if (report) {
@@ -12354,7 +12354,7 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
 // branches and the gaps between them, so where find_parting() finds a cut, the trunk (the
 // points labelled kInTrunk) is meshed along the cloud's axis, each branch as a tube of its
 // own around its own automatic axis, and join_branches() zips them into one surface (caps
-// last, with close_ends, once joined). That is kept only when it is whole: every part
+// last, with add_caps, once joined). That is kept only when it is whole: every part
 // meshed, every side joined, every point in a part; otherwise, unless keep_parts, the cloud
 // is meshed as one tube after all (PartsOutcome::undone). A part is meshed in place: the
 // points of the other parts join the outliers in the reader's bitmap, so its triangles
@@ -13156,7 +13156,7 @@ STRATMESH_C_SAME(STRATMESH_AXIS_Y, stratmesh::Axis::y)
 STRATMESH_C_SAME(STRATMESH_AXIS_Z, stratmesh::Axis::z)
 STRATMESH_C_SAME(STRATMESH_AXIS_DIRECTION, stratmesh::Axis::direction)
 STRATMESH_C_SAME(STRATMESH_FLAG_SKIP_INVALID_POINTS, stratmesh::skip_invalid_points)
-STRATMESH_C_SAME(STRATMESH_FLAG_CLOSE_ENDS, stratmesh::close_ends)
+STRATMESH_C_SAME(STRATMESH_FLAG_ADD_CAPS, stratmesh::add_caps)
 STRATMESH_C_SAME(STRATMESH_FLAG_ORIGIN_GIVEN, stratmesh::origin_given)
 STRATMESH_C_SAME(STRATMESH_FLAG_DROP_OUTLIERS, stratmesh::drop_outliers)
 STRATMESH_C_SAME(STRATMESH_FLAG_SURFACE_FLIPS, stratmesh::surface_flips)

@@ -990,7 +990,7 @@ Result measure_stream(const std::string& name, const std::vector<double>& coords
             return whole.seconds;
         });
     // The stream's surface closed afterwards by cap_ends(), against reconstruct() with
-    // close_ends on the same cuts (once each: they run after the timed alternation).
+    // add_caps on the same cuts (once each: they run after the timed alternation).
     const size_t surface = streamed.triangles.size() / 3;
     const size_t cap_bytes = stratmesh::cap_ends_workspace_size(cloud.count, surface);
     std::unique_ptr<unsigned char[]> cap_workspace = allocate_touched(cap_bytes);
@@ -1005,7 +1005,7 @@ Result measure_stream(const std::string& name, const std::vector<double>& coords
     const double cap_seconds = seconds_between(cap_start, Clock::now());
     capped.resize(3 * capped_count);
     stratmesh::Options closing = batch;
-    closing.flags |= stratmesh::close_ends;
+    closing.flags |= stratmesh::add_caps;
     const size_t closing_bytes = stratmesh::reconstruct_workspace_size(cloud.count, closing);
     batch_workspace.reset();
     std::unique_ptr<unsigned char[]> closing_workspace = allocate_touched(closing_bytes);
@@ -1044,8 +1044,8 @@ Result measure_stream(const std::string& name, const std::vector<double>& coords
              static_cast<double>(cap_bytes) / static_cast<double>(cloud.count));
     line.add("cap_ends_status", status_name(cap_status));
     line.add("caps_closed", cap_report.caps.closed_count);
-    line.add("close_ends_seconds", closed.seconds);
-    line.add("stream_and_cap_ends_over_close_ends",
+    line.add("add_caps_seconds", closed.seconds);
+    line.add("stream_and_cap_ends_over_add_caps",
              (median(stream_times) + cap_seconds) / closed.seconds);
     line.add("capped_identical", capped == closed.triangles);
     line.print();
@@ -1270,10 +1270,10 @@ void print_help(std::FILE* out) {
         "  points_held, identical    the stream's Report::points.held_count; same triangles\n"
         "  cap_ends_seconds, cap_ends_workspace_bytes, cap_ends_bytes_per_point,\n"
         "  cap_ends_status, caps_closed   cap_ends() on the stream's triangles, once\n"
-        "  close_ends_seconds        reconstruct with close_ends on the same cuts, once\n"
-        "  stream_and_cap_ends_over_close_ends   (stream_seconds + cap_ends_seconds) /\n"
-        "                            close_ends_seconds\n"
-        "  capped_identical          cap_ends' output equals close_ends', triangle for triangle\n"
+        "  add_caps_seconds          reconstruct with add_caps on the same cuts, once\n"
+        "  stream_and_cap_ends_over_add_caps   (stream_seconds + cap_ends_seconds) /\n"
+        "                            add_caps_seconds\n"
+        "  capped_identical          cap_ends' output equals reconstruct's with add_caps\n"
         "\n"
         "  --case NAME   run only this case or family (repeatable, or a comma list);\n"
         "                see --list. Without --case, --xy or --cloud, every case runs.\n"

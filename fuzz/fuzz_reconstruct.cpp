@@ -6,7 +6,7 @@
 // after the last point's z, the workspace is exactly reconstruct_workspace_size() and the
 // triangle array ends where its allocation ends, so any overrun trips AddressSanitizer.
 // Options: every axis (direction with zero/NaN components too), cuts with NaN, unsorted and
-// repeated values, layer_count, layer_height, skip_invalid_points, close_ends (caps),
+// repeated values, layer_count, layer_height, skip_invalid_points, add_caps (caps),
 // drop_outliers, surface_flips, open_ends, layer and part arrays to fill. Under libFuzzer a
 // structure-aware mutator (fuzz_cloud_mutator.h) makes the clouds that sensors make.
 //
@@ -194,7 +194,7 @@ void read_options(Bytes& in, const stratmesh_fuzz::FuzzCloud& fc, Setup& s) {
     }
     read_layers(in, fc, static_cast<uint8_t>((ocfg >> 3) % 4), s);
     if (ocfg & 0x20) options.flags |= stratmesh::skip_invalid_points;
-    if (ocfg & 0x80) options.flags |= stratmesh::close_ends;
+    if (ocfg & 0x80) options.flags |= stratmesh::add_caps;
     s.small_capacity = (ocfg & 0x40) != 0;
     if (s.small_capacity) s.capacity_wanted = in.below(64);
     s.info_capacity = in.below(8);

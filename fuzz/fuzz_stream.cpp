@@ -12,7 +12,7 @@
 // cut and the origin was given, the output equals reconstruct() of the accepted points
 // with cuts at the pushes' tops, triangle for triangle (the documented equivalence).
 // Then cap_ends() on the emitted mesh: an oriented manifold still, its loops closed or
-// counted open, and with the equivalence, reconstruct()'s close_ends triangles (the caps
+// counted open, and with the equivalence, reconstruct()'s add_caps triangles (the caps
 // and any edges under fins it flipped); on a soup
 // made of the mesh by moving corners, a documented status and no write past its buffers.
 #include "fuzz_cloud.h"
@@ -283,7 +283,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         STRATMESH_FUZZ_CHECK(rewritten == 2 * cap_report.caps.wall_flip_count, "wall flips miscounted");
     }
 
-    // ---- the same as reconstruct() on the same layers (with close_ends: the caps too)
+    // ---- the same as reconstruct() on the same layers (with add_caps: the caps too)
     if (!(sorted && all_accepted && origin_given && tops.size() >= 1)) return 0;
     double lo = HUGE_VAL, hi = -HUGE_VAL;
     for (size_t i = 0; i < m; ++i)
@@ -325,9 +325,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (batch.empty() && !t.empty()) return 0;  // refused as degenerate (see run_batch)
     STRATMESH_FUZZ_CHECK(batch == t, "the stream's triangles differ from reconstruct()'s on the same layers");
     if (soup) return 0;
-    // With close_ends, cap_ends' output whole: the caps, and the wall's edges flipped under fins.
+    // With add_caps, cap_ends' output whole: the caps, and the wall's edges flipped under fins.
     capped.resize(3 * capped_count);
-    STRATMESH_FUZZ_CHECK(run_batch(stratmesh::close_ends) == capped,
-                         "cap_ends' caps differ from reconstruct()'s with close_ends");
+    STRATMESH_FUZZ_CHECK(run_batch(stratmesh::add_caps) == capped,
+                         "cap_ends' caps differ from reconstruct()'s with add_caps");
     return 0;
 }

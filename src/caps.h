@@ -1,7 +1,7 @@
 // >>caps =================================================================================
 // Closing a boundary loop: pockets, lowered caps, fins.
 //
-// With the close_ends flag, each boundary loop of the final surface is closed by a cap
+// With the add_caps flag, each boundary loop of the final surface is closed by a cap
 // made of triangles over the loop's own vertices. The loop is triangulated in its
 // projection across the axis: first checked to be a simple polygon (a sweep over its edges
 // sorted by x, exact orient2d), then ear clipping (see the polygon section), then flips of

@@ -35,7 +35,7 @@ namespace detail {
 // degenerate, the new triangles' widest angle is at most 150 degrees (kWidestAngle) or
 // less wide than the old ones' (the bend alone makes needles: without that limit 17% of
 // the bust's triangles had an angle under 5 degrees, with it 2%, as without flips), pq is
-// not already an edge nor a chord of a loop (where close_ends puts its cap), and, unless
+// not already an edge nor a chord of a loop (where add_caps puts its cap), and, unless
 // both new normals are within 26 degrees of the old pair's (kGentleFlip: the new
 // triangles cover about the same place as the old), neither new triangle meets a surface
 // triangle around the quad's corners (the test is in floating point, on triangles shrunk
@@ -257,7 +257,7 @@ static inline bool flip_on_surface(Triangulation& tr, const Local* points, const
     if (!on_surface(tr, u)) return false;
     const uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)], p = tr.vertex[prev_edge(e)];
     const uint32_t q = tr.vertex[prev_edge(f)];
-    // A chord of a loop would stand where close_ends puts its cap.
+    // A chord of a loop would stand where add_caps puts its cap.
     if (p == q || (flags[p] & flags[q] & (kOnBottomLoop | kOnTopLoop))) return false;
     const Local &la = points[a - 1], &lb = points[b - 1], &lp = points[p - 1], &lq = points[q - 1];
     if (!flip_wanted(la, lb, lp, lq, normals.at(a), normals.at(b), normals.at(p), normals.at(q)))

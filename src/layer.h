@@ -126,7 +126,7 @@ static inline void hull_loop(const Triangulation& tr, uint32_t* loop, uint32_t* 
 // under it are a web across the gap, down to where the branches meet. There an end loop
 // peels at any slope short of vertical, up to kFoldedEndPeelPasses passes, and most of the
 // web goes (on a bust with horns, half the mean distance to the true surface). A cap
-// (close_ends) over such a loop, which dips to where the branches meet, can cross them.
+// (add_caps) over such a loop, which dips to where the branches meet, can cross them.
 // The passes are bounded:
 // each peels every loop edge at most once.
 // Each loop keeps, per vertex, the pass that put it there (LayerLoops::bottom_flags,

@@ -5,7 +5,7 @@
 // branches and the gaps between them, so where find_parting() finds a cut, the trunk (the
 // points labelled kInTrunk) is meshed along the cloud's axis, each branch as a tube of its
 // own around its own automatic axis, and join_branches() zips them into one surface (caps
-// last, with close_ends, once joined). That is kept only when it is whole: every part
+// last, with add_caps, once joined). That is kept only when it is whole: every part
 // meshed, every side joined, every point in a part; otherwise, unless keep_parts, the cloud
 // is meshed as one tube after all (PartsOutcome::undone). A part is meshed in place: the
 // points of the other parts join the outliers in the reader's bitmap, so its triangles

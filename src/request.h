@@ -31,7 +31,7 @@ struct TubeRequest {
     double direction[3];    // with Axis::direction
     LayerRequest layers;
     uint32_t cut_ends;      // ClosedEnd bits: the ends that are cuts, never closed ones
-    bool caps;              // the boundary loops closed (close_ends)
+    bool caps;              // the boundary loops closed (add_caps)
     bool surface_flips;
     bool drop_outliers;     // the cloud is read without its outliers
     const double* origin;   // the frame's reference point, or null for the centroid
@@ -52,7 +52,7 @@ static inline TubeRequest tube_request(const Options& options) {
             {options.direction[0], options.direction[1], options.direction[2]},
             {options.cuts, options.cut_count, options.layer_count, options.layer_height},
             kClosedEnds && (f & open_ends) ? closed_bottom | closed_top : 0u,
-            (f & close_ends) != 0,
+            (f & add_caps) != 0,
             kSurfaceFlips && (f & surface_flips),
             kDropOutliers && (f & drop_outliers),
             (f & origin_given) ? options.origin : nullptr,

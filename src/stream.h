@@ -244,7 +244,7 @@ size_t stream_workspace_size(size_t max_points_held, const Options& options) {
 
 Status stream_open(const Options& options, void* workspace, size_t workspace_bytes,
                    TriangleCallback emit, void* emit_user, Report* report, Stream** stream) {
-    if (!stream || !emit || !workspace || (options.flags & (close_ends | drop_outliers))) return Status::invalid_argument;
+    if (!stream || !emit || !workspace || (options.flags & (add_caps | drop_outliers))) return Status::invalid_argument;
     *stream = nullptr;
     const detail::ByteRange work = detail::byte_range(workspace, workspace_bytes);
     if (report) {

@@ -244,7 +244,7 @@ static inline bool has_no_area(const CloudReader& reader, const Frame& frame, co
                            kLeastArea * frame.cloud_share * frame.cloud_share;
 }
 
-// Closes the tube's boundary loops with caps (close_ends) and fills the caps' report.
+// Closes the tube's boundary loops with caps (add_caps) and fills the caps' report.
 static inline Status cap_tube(const TubeInput& in, const TubeRequest& request, const Frame& frame,
                        Arena& arena, uint32_t* triangles, size_t capacity, size_t& count,
                        size_t* triangle_count, Report& rep) {

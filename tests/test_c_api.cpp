@@ -165,7 +165,7 @@ Report check_same_reconstruction(const Shape& s, const Options& o) {
 TEST_CASE("C interface: reconstruct gives the C++ triangles and report") {
     const Shape tilted = shapes::bumpy_tube(2000, Pose::tilted);
     Options o = axis_options(tilted);
-    o.flags = stratmesh::close_ends;
+    o.flags = stratmesh::add_caps;
     o.layer_count = 6;
     check_same_reconstruction(tilted, o);
 
@@ -178,7 +178,7 @@ TEST_CASE("C interface: reconstruct gives the C++ triangles and report") {
     Options cut = axis_options(upright);
     cut.cuts = cuts;
     cut.cut_count = 3;
-    cut.flags = stratmesh::close_ends;
+    cut.flags = stratmesh::add_caps;
     check_same_reconstruction(upright, cut);
 
     // A fork meshed as one tube spans the gap between its prongs: the web fields too.

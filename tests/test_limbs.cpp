@@ -198,7 +198,7 @@ TEST_CASE("limbs: parts joined are kept only where their surface is smaller than
         for (int variant = 0; variant < 3; ++variant) {
             CAPTURE(variant);  // along z, automatic, along z with caps
             Options options = variant == 1 ? Options{} : along_z();
-            if (variant == 2) options.flags = stratmesh::close_ends;
+            if (variant == 2) options.flags = stratmesh::add_caps;
             const Meshed m = mesh(s.xyz, options);
             REQUIRE(m.status == Status::ok);
             CHECK(m.report.workspace_used_bytes <= m.bound);

@@ -243,7 +243,7 @@ TEST_CASE("parallel layers: any workspace below the bound gives out_of_memory or
     const Case cases[] = {
         {shapes::bumpy_tube(2000, Pose::tilted), 6, 0},
         {shapes::bumpy_tube(2000, Pose::tilted), 6, uint32_t(stratmesh::surface_flips)},
-        {shapes::capsule(2000, Pose::x), 5, uint32_t(stratmesh::close_ends)},
+        {shapes::capsule(2000, Pose::x), 5, uint32_t(stratmesh::add_caps)},
         {shapes::cylinder(2000, Pose::z), 30, 0},  // thin layers: the safety net repairs
     };
     unsigned two = 2;

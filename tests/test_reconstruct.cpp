@@ -2230,7 +2230,7 @@ TEST_CASE("workspace sizes: never wrap around, 0 beyond what can be served") {
     // ones the address space.
     Options plain = {};
     Options capped = {};
-    capped.flags = stratmesh::close_ends;
+    capped.flags = stratmesh::add_caps;
     Options jobs = {};
     jobs.run_jobs = run_jobs_in_order;
     struct Bound {
@@ -2239,7 +2239,7 @@ TEST_CASE("workspace sizes: never wrap around, 0 beyond what can be served") {
     };
     const Bound bounds[] = {
         {"reconstruct", [&](size_t n) { return stratmesh::reconstruct_workspace_size(n, plain); }},
-        {"reconstruct with close_ends", [&](size_t n) { return stratmesh::reconstruct_workspace_size(n, capped); }},
+        {"reconstruct with add_caps", [&](size_t n) { return stratmesh::reconstruct_workspace_size(n, capped); }},
         {"reconstruct with a runner", [&](size_t n) { return stratmesh::reconstruct_workspace_size(n, jobs); }},
         {"stream", [&](size_t n) { return stratmesh::stream_workspace_size(n, plain); }},
 #if !defined(STRATMESH_SMALL_CODE)
@@ -2295,11 +2295,11 @@ TEST_CASE("workspace: the bound suffices, the reported peak is exact, one byte s
         six.layer_count = 6;
         setups.push_back({"six layers", s, six});
         Options one_closed = one;
-        one_closed.flags = stratmesh::close_ends;
-        setups.push_back({"one layer, close_ends", s, one_closed});
+        one_closed.flags = stratmesh::add_caps;
+        setups.push_back({"one layer, add_caps", s, one_closed});
         Options six_closed = six;
-        six_closed.flags = stratmesh::close_ends;
-        setups.push_back({"six layers, close_ends", s, six_closed});
+        six_closed.flags = stratmesh::add_caps;
+        setups.push_back({"six layers, add_caps", s, six_closed});
         Options six_dropping = six;
         six_dropping.flags = stratmesh::drop_outliers;
         setups.push_back({"six layers, drop_outliers", s, six_dropping});
@@ -2311,8 +2311,8 @@ TEST_CASE("workspace: the bound suffices, the reported peak is exact, one byte s
             for (size_t k = 0; k < 3; ++k) s.xyz[3 * i + k] = s.xyz[3 * (i % distinct) + k];
         setups.push_back({"heavy duplicates", s, axis_options(s)});
         Options closed = axis_options(s);
-        closed.flags = stratmesh::close_ends;
-        setups.push_back({"heavy duplicates, close_ends", s, closed});
+        closed.flags = stratmesh::add_caps;
+        setups.push_back({"heavy duplicates, add_caps", s, closed});
     }
     for (const Setup& setup : setups) {
         INFO(setup.name);
@@ -2770,7 +2770,7 @@ TEST_CASE("automatic layers: a tall thin tube is cut into layers at most 24 radi
 }
 
 // ===========================================================================================
-// close_ends: caps over the boundary loops make the tube a closed surface.
+// add_caps: caps over the boundary loops make the tube a closed surface.
 
 namespace {
 
@@ -2922,7 +2922,7 @@ const bool kLiftedCaps = false;
 const bool kLiftedCaps = true;
 #endif
 
-TEST_CASE("close_ends: cylinder, vase, bumpy tube, head and CT slices become closed, outward surfaces, the tube unchanged") {
+TEST_CASE("add_caps: cylinder, vase, bumpy tube, head and CT slices become closed, outward surfaces, the tube unchanged") {
     // Measured (g++ 12 -O2): every run below closes both loops, 29 to 196 cap triangles at
     // 2000 points (the CT stack's end contours hold 100 points each), no intersection.
     const size_t kinds[] = {0, 4, 2, 8, 6};
@@ -2935,7 +2935,7 @@ TEST_CASE("close_ends: cylinder, vase, bumpy tube, head and CT slices become clo
                     std::vector<double> cuts;
                     Options open = layered_options(s, layering, cuts);
                     Options closed = open;
-                    closed.flags |= stratmesh::close_ends;
+                    closed.flags |= stratmesh::add_caps;
                     Run tube = reconstruct_guarded(cloud_of(s), open);
                     Run run = reconstruct_guarded(cloud_of(s), closed);
                     mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, true);
@@ -2981,7 +2981,7 @@ TEST_CASE("close_ends: cylinder, vase, bumpy tube, head and CT slices become clo
 }
 
 #if !defined(STRATMESH_SMALL_CODE)
-TEST_CASE("close_ends on a noisy tube: caps as low (bottom) and high (top) as their ragged loops allow stay clear of the wall") {
+TEST_CASE("add_caps on a noisy tube: caps as low (bottom) and high (top) as their ragged loops allow stay clear of the wall") {
     // With Delaunay caps (before they were lowered and raised: see the header's >>caps) a
     // cap crossed the wall of the 2000-point tube along Z, with each of these layerings.
     const Layering layerings[] = {Layering::single, Layering::equal, Layering::automatic};
@@ -2991,7 +2991,7 @@ TEST_CASE("close_ends on a noisy tube: caps as low (bottom) and high (top) as th
             for (Layering layering : layerings) {
                 std::vector<double> cuts;
                 Options o = layered_options(s, layering, cuts);
-                o.flags |= stratmesh::close_ends;
+                o.flags |= stratmesh::add_caps;
                 Run run = reconstruct_guarded(cloud_of(s), o);
                 REQUIRE(run.status == Status::ok);
                 mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, true);
@@ -3013,7 +3013,7 @@ TEST_CASE("close_ends on a noisy tube: caps as low (bottom) and high (top) as th
 #endif
 
 #if !defined(STRATMESH_SMALL_CODE)
-TEST_CASE("close_ends on a tilted tube that flares toward its ends: the caps stay clear of the wall") {
+TEST_CASE("add_caps on a tilted tube that flares toward its ends: the caps stay clear of the wall") {
     // Where the wall widens toward an end, a ragged loop's lower points lie inside it seen
     // along the axis, and a cap over the whole loop dips with them through the wall's top
     // row; the pockets under the loop's upper hull are closed along the wall first (see
@@ -3026,7 +3026,7 @@ TEST_CASE("close_ends on a tilted tube that flares toward its ends: the caps sta
         Shape s = shapes::radial_random("flared tube", Pose::tilted, flared, 0, size.height,
                                         size.points, size.seed);
         Options o = {};
-        o.flags = stratmesh::close_ends;
+        o.flags = stratmesh::add_caps;
         Run run = reconstruct_guarded(cloud_of(s), o);
         REQUIRE(run.status == Status::ok);
         mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, true);
@@ -3045,11 +3045,11 @@ TEST_CASE("close_ends on a tilted tube that flares toward its ends: the caps sta
 }
 #endif
 
-TEST_CASE("close_ends at 20000 points: closed, oriented, the bound on triangles holds") {
+TEST_CASE("add_caps at 20000 points: closed, oriented, the bound on triangles holds") {
     for (size_t kind : {size_t{2}, size_t{6}}) {
         Shape s = shapes::kinds()[kind].make(kLarge, Pose::tilted);
         Options o = axis_options(s);
-        o.flags = stratmesh::close_ends;
+        o.flags = stratmesh::add_caps;
         Run run = reconstruct_guarded(cloud_of(s), o);
         REQUIRE(run.status == Status::ok);
         mesh_check::Result m = check_mesh(s, run.triangles.data(), run.count, kind == 2);
@@ -3067,10 +3067,10 @@ TEST_CASE("close_ends at 20000 points: closed, oriented, the bound on triangles 
     }
 }
 
-TEST_CASE("close_ends: a triangle array too small for the caps gives triangle_capacity with the needed count") {
+TEST_CASE("add_caps: a triangle array too small for the caps gives triangle_capacity with the needed count") {
     const Shape& s = reference_cylinder();
     Options o = axis_options(s);
-    o.flags = stratmesh::close_ends;
+    o.flags = stratmesh::add_caps;
     Run reference = reconstruct_guarded(cloud_of(s), o);
     REQUIRE(reference.status == Status::ok);
     std::vector<unsigned char> work(stratmesh::reconstruct_workspace_size(s.size(), o));

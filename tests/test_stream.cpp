@@ -418,12 +418,12 @@ Capped cap_surface(const Layered& l, const Options& o, const std::vector<uint32_
 
 }  // namespace
 
-TEST_CASE("cap_ends: the stream's surface capped is reconstruct()'s with close_ends, triangle for triangle") {
+TEST_CASE("cap_ends: the stream's surface capped is reconstruct()'s with add_caps, triangle for triangle") {
     const std::vector<std::vector<double>> plans = {equal_fractions(6), {0.03, 0.06, 0.85, 0.97}, {}};
     size_t compared = 0, closed = 0;
     for_every_shape(plans, [&](const Layered& l, const Options& o) {
         Options closing = o;
-        closing.flags |= stratmesh::close_ends;
+        closing.flags |= stratmesh::add_caps;
         const Output batch = run_batch(l, closing);
         const Output stream = run_stream(l, o, l.size());
         REQUIRE(stream.status == batch.status);

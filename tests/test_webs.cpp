@@ -177,8 +177,8 @@ TEST_CASE("webs: single columns show none, with or without caps, whatever the po
     for (const shapes::Kind& kind : shapes::kinds())
         for (Pose pose : {Pose::z, Pose::tilted}) {
             const Shape s = kind.make(2000, pose);
-            for (uint32_t flags : {0u, uint32_t(stratmesh::close_ends)}) {
-                INFO(s.name << (flags ? ", close_ends" : ""));
+            for (uint32_t flags : {0u, uint32_t(stratmesh::add_caps)}) {
+                INFO(s.name << (flags ? ", add_caps" : ""));
                 Options o = {};
                 o.flags = flags;
                 const Mesh m = mesh(s.xyz, o);
@@ -203,7 +203,7 @@ TEST_CASE("webs: caps are left out, and would count as web if they were not") {
     const Shape ct = shapes::ct_slices(20000, Pose::z);
     Options o = {};
     o.axis = stratmesh::Axis::z;
-    o.flags = stratmesh::close_ends;
+    o.flags = stratmesh::add_caps;
     const Mesh capped = mesh(ct.xyz, o);
     REQUIRE(capped.status == Status::ok);
     REQUIRE(capped.report.caps.closed_count == 2);

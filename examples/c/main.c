@@ -38,7 +38,7 @@ int main(void) {
     memset(&options, 0, sizeof options); /* all zero: the defaults */
     options.axis = STRATMESH_AXIS_Z;
     options.layer_count = 4;
-    options.flags = STRATMESH_FLAG_CLOSE_ENDS;
+    options.flags = STRATMESH_FLAG_ADD_CAPS;
     cloud.xyz = xyz;
     cloud.count = count;
     cloud.stride_bytes = 0; /* packed x, y, z */

@@ -27,7 +27,7 @@ struct CommandLine {
     bool ascii = false;
     bool no_attributes = false;    // --no-attributes: write the points' coordinates only
     bool skip_invalid = false;
-    bool cap = false;              // --cap: close the ends (stratmesh::close_ends)
+    bool cap = false;              // --cap: close the ends (stratmesh::add_caps)
     bool drop_outliers = false;    // --drop-outliers (stratmesh::drop_outliers)
     bool surface_flips = false;    // --surface-flips (stratmesh::surface_flips)
     bool open_ends = false;        // --open-ends (stratmesh::open_ends)

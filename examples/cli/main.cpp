@@ -106,7 +106,7 @@ stratmesh::Options make_options(const CommandLine& line, ProgressMonitor& monito
     options.layer_count = line.layer_count;
     options.layer_height = line.layer_height;
     options.flags = (line.skip_invalid ? stratmesh::skip_invalid_points : 0u) |
-                    (line.cap ? stratmesh::close_ends : 0u) |
+                    (line.cap ? stratmesh::add_caps : 0u) |
                     (line.drop_outliers ? stratmesh::drop_outliers : 0u) |
                     (line.surface_flips ? stratmesh::surface_flips : 0u) |
                     (line.open_ends ? stratmesh::open_ends : 0u) |

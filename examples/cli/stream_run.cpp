@@ -82,8 +82,8 @@ public:
                  AtomicFile& mesh)
         : line_(line), options_(options), record_(record), mesh_(mesh), tops_(line),
           layers_(kLayerCapacity) {
-        // The stream refuses close_ends: --cap runs cap_ends() once it is closed.
-        options_.flags &= ~static_cast<uint32_t>(stratmesh::close_ends);
+        // The stream refuses add_caps: --cap runs cap_ends() once it is closed.
+        options_.flags &= ~static_cast<uint32_t>(stratmesh::add_caps);
         unit_axis(options_, axis_);
         report_.layers.info = layers_.data();
         report_.layers.info_capacity = layers_.size();

@@ -47,7 +47,7 @@ struct FlagName {
 };
 const FlagName kFlags[] = {
     {"skip_invalid_points", stratmesh::skip_invalid_points},
-    {"close_ends", stratmesh::close_ends},
+    {"add_caps", stratmesh::add_caps},
     {"origin_given", stratmesh::origin_given},
     {"drop_outliers", stratmesh::drop_outliers},
     {"surface_flips", stratmesh::surface_flips},

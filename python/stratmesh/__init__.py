@@ -36,7 +36,7 @@ class Workspace(_core.Workspace):
 _AXIS_CODES = {"auto": 0, "x": 1, "y": 2, "z": 3}
 _DIRECTION = 4
 # Each keyword that sets one flag, with that flag's name.
-_SWITCHES = {"cap": "close_ends", "skip_invalid": "skip_invalid_points",
+_SWITCHES = {"cap": "add_caps", "skip_invalid": "skip_invalid_points",
              "drop_outliers": "drop_outliers", "surface_flips": "surface_flips",
              "open_ends": "open_ends", "one_tube": "one_tube", "keep_parts": "keep_parts"}
 _MOST_THREADS = 2**32 - 1     # the binding counts threads in an unsigned
@@ -44,7 +44,7 @@ _MOST_LAYERS = 2**32 - 1      # Options::layer_count is a uint32_t
 _LEAST_HELD = 16              # the fewest points a stream's workspace holds
 _MOST_HELD = 2**32 - 3        # the most: 32-bit indices, two values reserved
 _MOST_STREAM_LAYERS = 2**28   # a stream's layers hold 16 points or more
-_NOT_STREAMED = ("close_ends", "drop_outliers")  # flags the stream refuses
+_NOT_STREAMED = ("add_caps", "drop_outliers")  # flags the stream refuses
 
 
 def _flag_bits(flags, switches, refused):
@@ -93,7 +93,7 @@ def reconstruct(points, *, axis="auto", cuts=None, layers=0, layer_height=0.0, c
     cuts           a one-dimensional sequence of finite heights along the axis where layers
                    start; else layers equal layers; else layers of about layer_height (a
                    finite number from 0); else the library's automatic layers.
-    cap            close the tube's ends (the close_ends flag).
+    cap            close the tube's ends (the add_caps flag).
     skip_invalid, drop_outliers, surface_flips, open_ends, one_tube, keep_parts
                    the flags of the same names (skip_invalid: skip_invalid_points).
     origin         the frame's reference point, 3 finite numbers (sets origin_given).

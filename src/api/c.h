@@ -74,10 +74,10 @@ typedef enum stratmesh_axis {
 } stratmesh_axis;
 
 // stratmesh::Flags: bits of stratmesh_options::flags, each documented at its C++ name
-// (STRATMESH_FLAG_CLOSE_ENDS is stratmesh::close_ends).
+// (STRATMESH_FLAG_ADD_CAPS is stratmesh::add_caps).
 enum stratmesh_flags {
     STRATMESH_FLAG_SKIP_INVALID_POINTS = 1 << 0,
-    STRATMESH_FLAG_CLOSE_ENDS = 1 << 1,
+    STRATMESH_FLAG_ADD_CAPS = 1 << 1,
     STRATMESH_FLAG_ORIGIN_GIVEN = 1 << 2,
     STRATMESH_FLAG_DROP_OUTLIERS = 1 << 3,
     STRATMESH_FLAG_SURFACE_FLIPS = 1 << 4,
@@ -219,7 +219,7 @@ typedef struct stratmesh_layer_counts {
     size_t info_capacity;
 } stratmesh_layer_counts;
 
-// stratmesh::CapCounts, with STRATMESH_FLAG_CLOSE_ENDS; all 0 without it.
+// stratmesh::CapCounts, with STRATMESH_FLAG_ADD_CAPS; all 0 without it.
 typedef struct stratmesh_cap_counts {
     size_t closed_count;     // boundary loops closed by a cap
     size_t open_count;       // loops left open

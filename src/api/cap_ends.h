@@ -1,7 +1,7 @@
 // ---- Caps for a surface you hold ----
 //
 // cap_ends() closes the boundary loops of a surface the caller holds with caps, as the
-// close_ends flag does inside reconstruct(): made for the stream, whose triangles leave
+// add_caps flag does inside reconstruct(): made for the stream, whose triangles leave
 // through the callback before its last loop is known. Collect them, close the stream, then
 //
 //     size_t count = tris.size() / 3;  // the triangles collected from the callback
@@ -12,12 +12,12 @@
 //
 // With the stream's triangles, the same Options and `cloud` the concatenated pushes (every
 // point pushed, in order: the triangles' global indices), the result is reconstruct()'s
-// with close_ends for the same cuts, triangle for triangle, wherever the stream gives
+// with add_caps for the same cuts, triangle for triangle, wherever the stream gives
 // reconstruct()'s triangles (origin_given; see the stream above): the caps come last.
 // The frame is chosen from the whole cloud as reconstruct() chooses it, so the caps do not
 // depend on how the cloud was pushed. Any other surface works too: each boundary loop is
 // projected across the axis and capped if that projection is a simple polygon (see
-// close_ends). The result is edge- and vertex-manifold and consistently oriented if the
+// add_caps). The result is edge- and vertex-manifold and consistently oriented if the
 // input was (as stratmesh's output is); on any other input the call stays within its
 // buffers but the caps may join edges that were already full.
 
@@ -28,7 +28,7 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count);
 
 // Appends caps to triangles[0 .. 3 * *triangle_count) (global indices into `cloud`) and
 // sets *triangle_count to the new total. Where a loop can be capped only so, the edge under
-// a fin of the surface is flipped (see close_ends): two of the given triangles then
+// a fin of the surface is flipped (see add_caps): two of the given triangles then
 // change, in place. options: axis, direction, origin (with
 // origin_given) and skip_invalid_points as given to the stream or reconstruct(); the rest
 // is not used. report (optional): only Report::caps, workspace_used_bytes (this call's)

@@ -41,7 +41,7 @@
 // along which the cloud's sections are loops around one centre line, tried on a sample),
 // the layers are chosen automatically, the cloud is searched for where it parts into
 // branches and, where it does, the trunk and each branch are meshed along their own axes
-// and joined into one surface; the ends stay open (close_ends caps them) and the layers stay
+// and joined into one surface; the ends stay open (add_caps caps them) and the layers stay
 // Delaunay on their unrolled annulus, as in the paper (surface_flips refines them on the
 // surface, for about three times the time).
 //
@@ -119,7 +119,7 @@
 // As a guide: delaunay_2d needs 72 bytes per point plus about 10 KiB, and its output is at
 // most 2n - 5 triangles (24 bytes per point). reconstruct needs about 115 bytes per point
 // (the triangulation of its largest possible layer, the layer grouping and the boundary
-// loops; measuring the webs at the end takes less), about 121 with close_ends (plus up to
+// loops; measuring the webs at the end takes less), about 121 with add_caps (plus up to
 // 32 KiB for the exhaustive search of a cap), about 166 with a jobs runner; its output is
 // at most 2n triangles plus 160 for the junctions of branches. A stream needs about 190
 // bytes per point it holds at once, whatever the size of the whole cloud.

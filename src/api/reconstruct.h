@@ -44,7 +44,7 @@ enum Flags : uint32_t {
     // still returns ok, Report::caps.open_count counts it and Report::detail says so.
     // reconstruct_max_triangles() still suffices (a closed surface through V vertices has
     // 2V - 4 triangles). The stream refuses the flag: cap_ends() caps its surface afterwards.
-    close_ends = 1u << 1,
+    add_caps = 1u << 1,
     // The frame's reference point is Options::origin instead of the centroid of the cloud
     // (reconstruct) or of the first layer (the stream). The reference point changes only
     // rounding, but a stream and a reconstruct() that are to give the same triangles need
@@ -92,7 +92,7 @@ enum Flags : uint32_t {
 // Phases reported to Options::progress, in the order they run. Each layer is stitched to
 // the one below as soon as it is triangulated, so stitching time falls within
 // `triangulate`; `stitch` is announced once, when the last band is done. The caps of
-// close_ends are made within `manifold`.
+// add_caps are made within `manifold`.
 enum class Phase : uint32_t { validate = 0, layers, triangulate, stitch, manifold, done };
 
 // One job of a batch run by Options::run_jobs: job(context, index).
@@ -156,7 +156,7 @@ const uint32_t kMaxJobs = 64;
 // across the end, not only around its rim) is meshed across that end, up to a small loop
 // around its pole: the layer is unrolled around a pole inside the end rather than on the
 // cylinder, which would fold the end's points onto its rim. The small loop is a boundary
-// (close_ends caps it). An end left open as a tube's rim, any other layer, and every layer
+// (add_caps caps it). An end left open as a tube's rim, any other layer, and every layer
 // of the reduced build report 0.
 enum ClosedEnd : uint32_t { closed_bottom = 1u << 0, closed_top = 1u << 1 };
 

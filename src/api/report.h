@@ -106,7 +106,7 @@ struct LayerCounts {
     size_t info_capacity;
 };
 
-// Report::caps, with close_ends (and from cap_ends()); all 0 without it.
+// Report::caps, with add_caps (and from cap_ends()); all 0 without it.
 struct CapCounts {
     size_t closed_count;     // boundary loops closed by a cap
     size_t open_count;       // loops left open: their projection across the axis is not a
@@ -115,7 +115,7 @@ struct CapCounts {
                              // in Report::triangle_count
     size_t wall_flip_count;  // the surface's edges flipped under fins so that a loop could
                              // be capped, each changing two triangles in place (see
-                             // close_ends); 0 in STRATMESH_SMALL_CODE
+                             // add_caps); 0 in STRATMESH_SMALL_CODE
 };
 
 // A web triangle (Diagnostics) has its longest edge over this many times the largest local
@@ -180,7 +180,7 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 
 // Reconstructs a triangle mesh through the points of a columnar cloud: one surface,
 // edge- and vertex-manifold, consistently oriented, an open tube (two boundary loops) on
-// columnar input, closed by caps with the close_ends flag, with every valid distinct
+// columnar input, closed by caps with the add_caps flag, with every valid distinct
 // point a vertex unless the report says why not. Where the cloud's end is closed (points
 // across it: a dome, a flat base), the surface goes across it too, and that end's loop is
 // a small one around the axis (see ClosedEnd).
@@ -193,7 +193,7 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // join_branches()); otherwise, or where the parts cannot all be joined, or where the
 // joined surface is not smaller than the one tube's (unless keep_parts), mesh one tube:
 // layer by layer, each unrolled and triangulated, stitched to the layer below, passed
-// through the manifold safety net; then the caps (close_ends). A tube that wraps branches
+// through the manifold safety net; then the caps (add_caps). A tube that wraps branches
 // bridges the gaps between them with webs, which add area, and so does a join that folds,
 // so the smaller surface is the one kept; the comparison meshes the one tube too, which
 // roughly doubles the time on clouds that part. A point beyond a cut in no branch (a
@@ -212,11 +212,11 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // triangles       receives 3 * (*triangle_count) indices into the cloud, each triangle
 //                 counter-clockwise seen from outside (normals point away from the axis).
 //                 Triangles come layer by layer, bottom to top: each layer's own triangles,
-//                 then the band joining it to the layer below; then the caps (close_ends),
+//                 then the band joining it to the layer below; then the caps (add_caps),
 //                 one loop after another. The order is deterministic.
 // triangle_capacity  triangles that fit in `triangles`; reconstruct_max_triangles() always
 //                 suffices. When too small: Status::triangle_capacity and *triangle_count
-//                 says how many are needed (with close_ends, counting every loop as closed;
+//                 says how many are needed (with add_caps, counting every loop as closed;
 //                 the array's contents are then unspecified; nothing is written past the
 //                 capacity).
 // triangle_count  required; receives the number of triangles (0 on failure).

@@ -28,7 +28,7 @@
 // gives the same triangles in the same order, with the same global indices,
 // provided no point lies within 2^-40 of the height range below a cut (reconstruct()
 // counts such a point in the layer above) and no cut lies outside the points' height
-// range. The stream makes no caps (the close_ends flag is refused): cap_ends() closes its
+// range. The stream makes no caps (the add_caps flag is refused): cap_ends() closes its
 // surface afterwards (below).
 //
 // Memory: stream_workspace_size(max_points_held) bytes, about 190 per point held. The
@@ -58,7 +58,7 @@ size_t stream_workspace_size(size_t max_points_held, const Options& options);
 // the layers). emit receives the triangles; report (optional) is updated after every push
 // and at close, and must stay valid until then (its layer array too). On success *stream
 // is the handle, valid until stream_close or until the workspace is reused.
-// Returns ok, invalid_argument (a null emit or stream, close_ends or drop_outliers, a null
+// Returns ok, invalid_argument (a null emit or stream, add_caps or drop_outliers, a null
 // workspace, a workspace that shares a byte with the report or its layer array),
 // invalid_origin (a NaN or infinite origin), invalid_axis, out_of_memory (a workspace too
 // small to hold 16 points).

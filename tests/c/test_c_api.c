@@ -129,7 +129,7 @@ static void check_counts(const stratmesh_report* r) {
     CHECK(r->points.outlier_count <= r->points.rejected_count);
 }
 
-static void test_reconstruct(const double* xyz, int close_ends) {
+static void test_reconstruct(const double* xyz, int add_caps) {
     stratmesh_cloud cloud;
     stratmesh_options options;
     stratmesh_report report;
@@ -142,7 +142,7 @@ static void test_reconstruct(const double* xyz, int close_ends) {
     memset(&options, 0, sizeof options);
     options.axis = STRATMESH_AXIS_Z;
     options.layer_count = LAYERS;
-    if (close_ends) options.flags = STRATMESH_FLAG_CLOSE_ENDS;
+    if (add_caps) options.flags = STRATMESH_FLAG_ADD_CAPS;
     cloud = packed_cloud(xyz);
 
     work_bytes = stratmesh_reconstruct_workspace_size(POINTS, &options);
@@ -181,7 +181,7 @@ static void test_reconstruct(const double* xyz, int close_ends) {
     CHECK(report.diagnostics.web_box_min[0] == 0 && report.diagnostics.web_box_max[2] == 0);
     CHECK(STRATMESH_WEB_SPACINGS > 1);
     CHECK(report.parts.outcome == STRATMESH_PARTS_ONE_TUBE);
-    if (close_ends) {
+    if (add_caps) {
         CHECK(report.caps.closed_count == 2);
         CHECK(report.caps.open_count == 0);
         /* A closed surface through V points: 2V - 4 triangles (Euler characteristic 2). */
@@ -191,7 +191,7 @@ static void test_reconstruct(const double* xyz, int close_ends) {
         /* An open tube, two loops of PER_RING points: V - E + F = 0. */
         CHECK(count == 2 * (size_t)POINTS - 2 * PER_RING);
     }
-    check_mesh(tris, count, POINTS, close_ends);
+    check_mesh(tris, count, POINTS, add_caps);
     CHECK(guard_intact(work, work_bytes));
     CHECK(guard_intact((unsigned char*)tris, 3 * max_tris * sizeof(uint32_t)));
     CHECK(guard_intact((unsigned char*)layers, LAYERS * sizeof(stratmesh_layer_info)));
@@ -421,7 +421,7 @@ static void test_stream(const double* xyz) {
     CHECK(stratmesh_stream_open(&options, stream_work, 16, collect, &got, NULL, &stream) ==
           STRATMESH_STATUS_OUT_OF_MEMORY);
     CHECK(guard_intact(stream_work, stream_bytes + 1));
-    options.flags |= STRATMESH_FLAG_CLOSE_ENDS;
+    options.flags |= STRATMESH_FLAG_ADD_CAPS;
     CHECK(stratmesh_stream_open(&options, stream_work, stream_bytes, collect, &got, NULL,
                                 &stream) == STRATMESH_STATUS_INVALID_ARGUMENT);
     free(work);

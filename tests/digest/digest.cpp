@@ -243,8 +243,8 @@ int main(int argc, char** argv) {
     reconstruct_case("slanted tube (crescent), 6 layers", shapes::slanted_tube(3000, Pose::z).xyz,
                      axis_z(6), g_full_input, g_full);
     stratmesh::Options capped = axis_z(4);
-    capped.flags = stratmesh::close_ends;
-    reconstruct_case("vase, 4 layers, close_ends", vase, capped, g_full_input, g_full);
+    capped.flags = stratmesh::add_caps;
+    reconstruct_case("vase, 4 layers, add_caps", vase, capped, g_full_input, g_full);
     // The bumpy tube with 12 far strays and a speck of 5, each a whole multiple of 2^-4
     // away: drop_outliers must leave out the same 17 points everywhere.
     std::vector<double> strays = bumpy;

@@ -99,7 +99,7 @@ OPTIONS = [
     (WRONG_VALUE, "invalid_argument", "origin", (np.nan, 0, 0)),
     (WRONG_VALUE, "invalid_argument", "origin", (0, 0)),
     (WRONG_TYPE, "invalid_argument", "origin", "abc"),
-    (WRONG_TYPE, "invalid_argument", "flags", "close_ends"),
+    (WRONG_TYPE, "invalid_argument", "flags", "add_caps"),
     (WRONG_TYPE, "invalid_argument", "flags", 3),
     (WRONG_TYPE, "invalid_argument", "flags", np.array(3.0)),
     (WRONG_TYPE, "invalid_argument", "flags", (1,)),

@@ -108,7 +108,7 @@ def test_open_ends_and_flags_by_name(tube):
     a, _ = stratmesh.reconstruct(tube, axis="z", layers=6, open_ends=True, surface_flips=True)
     b, _ = stratmesh.reconstruct(tube, axis="z", layers=6, flags=("open_ends", "surface_flips"))
     assert np.array_equal(a, b)
-    assert set(stratmesh.FLAGS) >= {"skip_invalid_points", "close_ends", "origin_given",
+    assert set(stratmesh.FLAGS) >= {"skip_invalid_points", "add_caps", "origin_given",
                                     "drop_outliers", "surface_flips", "open_ends"}
 
 

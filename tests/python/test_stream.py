@@ -103,7 +103,7 @@ STREAM_OPTIONS = [
     (WRONG_VALUE, "invalid_argument", "layer_info", -1),
     (WRONG_VALUE, "invalid_argument", "layer_info", 2**28 + 1),
     (WRONG_TYPE, "invalid_argument", "layer_info", "256"),
-    (WRONG_VALUE, "invalid_argument", "flags", ("close_ends",)),
+    (WRONG_VALUE, "invalid_argument", "flags", ("add_caps",)),
     (WRONG_VALUE, "invalid_argument", "flags", ("drop_outliers",)),
     (WRONG_TYPE, "invalid_argument", "flags", "open_ends"),
     (WRONG_VALUE, "invalid_argument", "origin", (0, np.inf, 0)),

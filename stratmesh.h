@@ -103,7 +103,7 @@
 //                            - the measure of webs (Report::diagnostics' web fields
 //                              stay 0);
 //                            - the C interface, unless STRATMESH_C_API is 1;
-//                            - the flags drop_outliers, surface_flips and open_ends,
+//                            - the flags drop_outliers, surface_flips and ends_are_cuts,
 //                              which also return not_compiled (filter the cloud before
 //                              it reaches the device).
 //
@@ -390,7 +390,7 @@ enum Flags : uint32_t {
     // up to its highest points). For a cloud cut out of a larger object (a region of
     // interest, a branch meshed on its own), whose ends are cuts however many points lie
     // across them. The reduced build, which has no closed ends, returns not_compiled.
-    open_ends = 1u << 5,
+    ends_are_cuts = 1u << 5,
     // reconstruct() meshes the cloud as one tube without looking for where it parts into
     // branches (see PartCounts): the paper's single column, and the search's time saved
     // (a few percent on a cloud that does not part). The stream always meshes one tube.
@@ -721,7 +721,7 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // skip_invalid_points); invalid_axis (an unknown Axis, or Axis::direction zero, NaN or
 // infinite); invalid_layers (a NaN or infinite cut, more than 2^32 - 2 cuts, a negative or
 // non-finite layer_height);
-// not_compiled (Axis::automatic, drop_outliers, surface_flips or open_ends in the reduced
+// not_compiled (Axis::automatic, drop_outliers, surface_flips or ends_are_cuts in the reduced
 // build);
 // too_few_points (fewer than 3 valid points, or no surface spans them); degenerate (the
 // surface would have no area: see the robustness contract; Report::detail says whether the
@@ -884,7 +884,7 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
 // find_parting() finds where along the axis the cloud parts: the lowest cut above which
 // the points make two separate branches or more, and the highest below which they do.
 // reconstruct() uses it by default; a caller can also mesh each side on its own, the
-// branches with open_ends, and join them with join_branches().
+// branches with ends_are_cuts, and join them with join_branches().
 //
 // Points join one piece when they lie within Parting::gap of each other (single linkage).
 // The gap is four times the median distance from a point to its nearest distinct
@@ -1097,7 +1097,7 @@ enum stratmesh_flags {
     STRATMESH_FLAG_ORIGIN_GIVEN = 1 << 2,
     STRATMESH_FLAG_DROP_OUTLIERS = 1 << 3,
     STRATMESH_FLAG_SURFACE_FLIPS = 1 << 4,
-    STRATMESH_FLAG_OPEN_ENDS = 1 << 5,
+    STRATMESH_FLAG_ENDS_ARE_CUTS = 1 << 5,
     STRATMESH_FLAG_ONE_TUBE = 1 << 6,
     STRATMESH_FLAG_KEEP_PARTS = 1 << 7
 };
@@ -3689,7 +3689,7 @@ struct TubeInput {
 static inline bool flags_compiled(const Options& options) {
     const uint32_t f = options.flags;
     return (kDropOutliers || !(f & drop_outliers)) && (kSurfaceFlips || !(f & surface_flips)) &&
-           (kClosedEnds || !(f & open_ends));
+           (kClosedEnds || !(f & ends_are_cuts));
 }
 
 const char* const kNotCompiledDetail =
@@ -3818,7 +3818,7 @@ static inline TubeRequest tube_request(const Options& options) {
     return {options.axis,
             {options.direction[0], options.direction[1], options.direction[2]},
             {options.cuts, options.cut_count, options.layer_count, options.layer_height},
-            kClosedEnds && (f & open_ends) ? closed_bottom | closed_top : 0u,
+            kClosedEnds && (f & ends_are_cuts) ? closed_bottom | closed_top : 0u,
             (f & add_caps) != 0,
             kSurfaceFlips && (f & surface_flips),
             kDropOutliers && (f & drop_outliers),
@@ -13160,7 +13160,7 @@ STRATMESH_C_SAME(STRATMESH_FLAG_ADD_CAPS, stratmesh::add_caps)
 STRATMESH_C_SAME(STRATMESH_FLAG_ORIGIN_GIVEN, stratmesh::origin_given)
 STRATMESH_C_SAME(STRATMESH_FLAG_DROP_OUTLIERS, stratmesh::drop_outliers)
 STRATMESH_C_SAME(STRATMESH_FLAG_SURFACE_FLIPS, stratmesh::surface_flips)
-STRATMESH_C_SAME(STRATMESH_FLAG_OPEN_ENDS, stratmesh::open_ends)
+STRATMESH_C_SAME(STRATMESH_FLAG_ENDS_ARE_CUTS, stratmesh::ends_are_cuts)
 STRATMESH_C_SAME(STRATMESH_FLAG_ONE_TUBE, stratmesh::one_tube)
 STRATMESH_C_SAME(STRATMESH_FLAG_KEEP_PARTS, stratmesh::keep_parts)
 STRATMESH_C_SAME(STRATMESH_CLOSED_BOTTOM, stratmesh::closed_bottom)

@@ -7,7 +7,7 @@
 // triangle array ends where its allocation ends, so any overrun trips AddressSanitizer.
 // Options: every axis (direction with zero/NaN components too), cuts with NaN, unsorted and
 // repeated values, layer_count, layer_height, skip_invalid_points, add_caps (caps),
-// drop_outliers, surface_flips, open_ends, layer and part arrays to fill. Under libFuzzer a
+// drop_outliers, surface_flips, ends_are_cuts, layer and part arrays to fill. Under libFuzzer a
 // structure-aware mutator (fuzz_cloud_mutator.h) makes the clouds that sensors make.
 //
 // How much of the pipeline runs, by a hash of the input's bytes (a given input always runs
@@ -202,7 +202,7 @@ void read_options(Bytes& in, const stratmesh_fuzz::FuzzCloud& fc, Setup& s) {
     const uint8_t last = in.u8();
     if (last & 1) options.flags |= stratmesh::drop_outliers;
     if (last & 2) options.flags |= stratmesh::surface_flips;
-    if (last & 4) options.flags |= stratmesh::open_ends;
+    if (last & 4) options.flags |= stratmesh::ends_are_cuts;
 }
 
 // The status is a documented one and the report's counts add up; a NaN/Inf point is

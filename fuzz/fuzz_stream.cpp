@@ -70,7 +70,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (options.axis == stratmesh::Axis::direction)
         for (double& d : options.direction) d = static_cast<double>(in.centered(3));
     if (ocfg & 0x08) options.flags |= stratmesh::skip_invalid_points;
-    if (ocfg & 0x80) options.flags |= stratmesh::open_ends;
+    if (ocfg & 0x80) options.flags |= stratmesh::ends_are_cuts;
     const bool origin_given = (ocfg & 0x10) != 0;
     if (origin_given) {
         options.flags |= stratmesh::origin_given;

@@ -149,7 +149,7 @@ struct TubeInput {
 static inline bool flags_compiled(const Options& options) {
     const uint32_t f = options.flags;
     return (kDropOutliers || !(f & drop_outliers)) && (kSurfaceFlips || !(f & surface_flips)) &&
-           (kClosedEnds || !(f & open_ends));
+           (kClosedEnds || !(f & ends_are_cuts));
 }
 
 const char* const kNotCompiledDetail =

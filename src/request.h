@@ -51,7 +51,7 @@ static inline TubeRequest tube_request(const Options& options) {
     return {options.axis,
             {options.direction[0], options.direction[1], options.direction[2]},
             {options.cuts, options.cut_count, options.layer_count, options.layer_height},
-            kClosedEnds && (f & open_ends) ? closed_bottom | closed_top : 0u,
+            kClosedEnds && (f & ends_are_cuts) ? closed_bottom | closed_top : 0u,
             (f & add_caps) != 0,
             kSurfaceFlips && (f & surface_flips),
             kDropOutliers && (f & drop_outliers),

@@ -1656,21 +1656,21 @@ TEST_CASE("closed ends: a flat-ended cylinder and a capsule are meshed across th
     }
 }
 
-// open_ends: a cloud cut out of a larger object has cuts for ends, however many points lie
+// ends_are_cuts: a cloud cut out of a larger object has cuts for ends, however many points lie
 // across them. With the flag no end of the closed shapes above is unrolled around a pole:
 // no layer reports a closed end, and the surface is still one manifold annulus through
 // every point. On the cylinder picture a flat end's points come onto its rim, so its loops
 // run out to the rim (radius 1; around a pole within 0.3); a dome's top still reaches the
 // loop's highest points (0.37 from the axis on the capsule, 0.26 around its pole). A shape
 // with no closed end gives the same triangles with or without the flag.
-TEST_CASE("open_ends: no end is unrolled around a pole, on a manifold tube through every point") {
+TEST_CASE("ends_are_cuts: no end is unrolled around a pole, on a manifold tube through every point") {
     for (bool flat : {true, false}) {
         for (Pose pose : {Pose::z, Pose::x, Pose::tilted}) {
             for (uint32_t planned : {1u, 4u, 12u}) {
                 const Shape s = closed_shape(flat, pose);
                 CAPTURE(s.name);
                 CAPTURE(planned);
-                const Run run = reconstruct_closed_shape(s, planned, stratmesh::open_ends);
+                const Run run = reconstruct_closed_shape(s, planned, stratmesh::ends_are_cuts);
                 for (const LayerInfo& layer : run.layers) CHECK(layer.closed_ends == 0);
                 if (flat) CHECK(widest_boundary_vertex(s, run) > 0.9);
             }
@@ -1681,7 +1681,7 @@ TEST_CASE("open_ends: no end is unrolled around a pole, on a manifold tube throu
         Options o = axis_options(s);
         o.layer_count = 4;
         Run plain = reconstruct_guarded(cloud_of(s), o);
-        o.flags |= stratmesh::open_ends;
+        o.flags |= stratmesh::ends_are_cuts;
         Run open = reconstruct_guarded(cloud_of(s), o);
         REQUIRE(plain.status == Status::ok);
         CHECK(open.status == Status::ok);

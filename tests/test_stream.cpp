@@ -213,10 +213,10 @@ TEST_CASE("stream: with surface_flips, the same triangles as reconstruct() with 
     });
 }
 
-// open_ends reaches both paths: the closed shapes' ends stay open in either.
-TEST_CASE("stream: with open_ends, the same triangles as reconstruct() with it, no end closed") {
+// ends_are_cuts reaches both paths: the closed shapes' ends stay open in either.
+TEST_CASE("stream: with ends_are_cuts, the same triangles as reconstruct() with it, no end closed") {
     for_every_shape({equal_fractions(6), {0.03, 0.06, 0.85, 0.97}}, [](const Layered& l, Options o) {
-        o.flags |= stratmesh::open_ends;
+        o.flags |= stratmesh::ends_are_cuts;
         const Output batch = run_batch(l, o);
         check_same(batch, run_stream(l, o, l.size()));
         for (size_t k = 0; k < batch.report.layers.used_count && k < batch.layers.size(); ++k)

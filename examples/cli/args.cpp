@@ -76,10 +76,10 @@ const char kUsage[] =
     "                        empty-circle rule and toward where the surface curves least\n"
     "                        (stratmesh's surface_flips): closer to the true surface where\n"
     "                        the unrolling squeezes it, for about three times the time\n"
-    "  --open-ends           take no end of the cloud for a closed one (a dome, a base,\n"
+    "  --ends-are-cuts       take no end of the cloud for a closed one (a dome, a base,\n"
     "                        otherwise meshed across from a pole): both are unrolled on\n"
     "                        the cylinder like the rest; for a cloud cut out of a larger\n"
-    "                        object (stratmesh's open_ends)\n"
+    "                        object (stratmesh's ends_are_cuts)\n"
     "  --one-tube            do not look for branches (see Branches below): one tube\n"
     "                        through every point\n"
     "  --branches            only find and report where the cloud parts (summary and\n"
@@ -290,7 +290,7 @@ bool apply_flag(std::string_view name, CommandLine& line) {
     if (name == "--cap") line.cap = true;
     if (name == "--drop-outliers") line.drop_outliers = true;
     if (name == "--surface-flips") line.surface_flips = true;
-    if (name == "--open-ends") line.open_ends = true;
+    if (name == "--ends-are-cuts") line.ends_are_cuts = true;
     if (name == "--branches") line.find_branches = true;
     if (name == "--split-branches") line.split_branches = true;
     if (name == "--one-tube") line.one_tube = true;
@@ -307,7 +307,7 @@ const char* const kValuedOptions[] = {"--output",  "--report",        "--axis",
                                       "--format",  "--preview"};
 const char* const kFlags[] = {"--ascii", "--skip-invalid", "--cap",     "--quiet",
                               "--help",  "--version",      "--stream", "--drop-outliers",
-                              "--surface-flips", "--open-ends", "--branches",
+                              "--surface-flips", "--ends-are-cuts", "--branches",
                               "--split-branches", "--one-tube", "--verbose", "--strict",
                               "--no-attributes"};
 

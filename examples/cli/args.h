@@ -30,7 +30,7 @@ struct CommandLine {
     bool cap = false;              // --cap: close the ends (stratmesh::add_caps)
     bool drop_outliers = false;    // --drop-outliers (stratmesh::drop_outliers)
     bool surface_flips = false;    // --surface-flips (stratmesh::surface_flips)
-    bool open_ends = false;        // --open-ends (stratmesh::open_ends)
+    bool ends_are_cuts = false;    // --ends-are-cuts (stratmesh::ends_are_cuts)
     // Where the cloud parts into branches (stratmesh::find_parting). Without any of these
     // three the tool looks, meshes the parts apart and joins them, and keeps that only if
     // every part was meshed and joined (else one tube, see main.cpp).

@@ -87,7 +87,7 @@ void record_command_line(const CommandLine& line, RunRecord& record) {
     record.cap = line.cap;
     record.drop_outliers = line.drop_outliers;
     record.surface_flips = line.surface_flips;
-    record.open_ends = line.open_ends;
+    record.ends_are_cuts = line.ends_are_cuts;
     record.find_branches = line.find_branches;
     record.split_branches = line.split_branches;
     record.one_tube = line.one_tube;
@@ -109,7 +109,7 @@ stratmesh::Options make_options(const CommandLine& line, ProgressMonitor& monito
                     (line.cap ? stratmesh::add_caps : 0u) |
                     (line.drop_outliers ? stratmesh::drop_outliers : 0u) |
                     (line.surface_flips ? stratmesh::surface_flips : 0u) |
-                    (line.open_ends ? stratmesh::open_ends : 0u) |
+                    (line.ends_are_cuts ? stratmesh::ends_are_cuts : 0u) |
                     (line.one_tube || line.find_branches ? stratmesh::one_tube : 0u) |
                     (line.split_branches ? stratmesh::keep_parts : 0u);
     options.progress = &ProgressMonitor::callback;

@@ -206,7 +206,7 @@ void write_options(JsonWriter& j, const RunRecord& r) {
     j.flag_field("cap", r.cap);
     j.flag_field("drop_outliers", r.drop_outliers);
     j.flag_field("surface_flips", r.surface_flips);
-    j.flag_field("open_ends", r.open_ends);
+    j.flag_field("ends_are_cuts", r.ends_are_cuts);
     j.flag_field("branches", r.find_branches);
     j.flag_field("split_branches", r.split_branches);
     j.flag_field("one_tube", r.one_tube);

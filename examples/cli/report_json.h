@@ -39,7 +39,7 @@ struct RunRecord {
     bool cap = false;
     bool drop_outliers = false;
     bool surface_flips = false;
-    bool open_ends = false;
+    bool ends_are_cuts = false;
     bool find_branches = false;
     bool split_branches = false;
     bool one_tube = false;

@@ -14,7 +14,7 @@ std::string in_tool_words(const char* library_sentence) {
         const char* library;
         const char* tool;
     } kWords[] = {{"drop_outliers", "--drop-outliers"}, {"skip_invalid_points", "--skip-invalid"},
-                  {"add_caps", "--cap"},              {"open_ends", "--open-ends"},
+                  {"add_caps", "--cap"}, {"ends_are_cuts", "--ends-are-cuts"},
                   {"surface_flips", "--surface-flips"}, {"one_tube", "--one-tube"},
                   {"keep_parts", "--split-branches"}};
     std::string text = library_sentence ? library_sentence : "";

@@ -51,7 +51,7 @@ const FlagName kFlags[] = {
     {"origin_given", stratmesh::origin_given},
     {"drop_outliers", stratmesh::drop_outliers},
     {"surface_flips", stratmesh::surface_flips},
-    {"open_ends", stratmesh::open_ends},
+    {"ends_are_cuts", stratmesh::ends_are_cuts},
     {"one_tube", stratmesh::one_tube},
     {"keep_parts", stratmesh::keep_parts},
 };

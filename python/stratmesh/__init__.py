@@ -38,7 +38,8 @@ _DIRECTION = 4
 # Each keyword that sets one flag, with that flag's name.
 _SWITCHES = {"cap": "add_caps", "skip_invalid": "skip_invalid_points",
              "drop_outliers": "drop_outliers", "surface_flips": "surface_flips",
-             "open_ends": "open_ends", "one_tube": "one_tube", "keep_parts": "keep_parts"}
+             "ends_are_cuts": "ends_are_cuts", "one_tube": "one_tube",
+             "keep_parts": "keep_parts"}
 _MOST_THREADS = 2**32 - 1     # the binding counts threads in an unsigned
 _MOST_LAYERS = 2**32 - 1      # Options::layer_count is a uint32_t
 _LEAST_HELD = 16              # the fewest points a stream's workspace holds
@@ -81,9 +82,9 @@ def _options(axis="auto", cuts=None, layers=0, layer_height=0.0, origin=None, th
 
 @_check.signature_checked
 def reconstruct(points, *, axis="auto", cuts=None, layers=0, layer_height=0.0, cap=False,
-                skip_invalid=False, drop_outliers=False, surface_flips=False, open_ends=False,
-                one_tube=False, keep_parts=False, origin=None, threads=1, progress=None,
-                flags=(), copy=True, workspace=None):
+                skip_invalid=False, drop_outliers=False, surface_flips=False,
+                ends_are_cuts=False, one_tube=False, keep_parts=False, origin=None, threads=1,
+                progress=None, flags=(), copy=True, workspace=None):
     """Meshes a columnar cloud; returns (triangles, report).
 
     points         (n, 3) float32 or float64. Read in place when each point's x, y, z are
@@ -94,7 +95,7 @@ def reconstruct(points, *, axis="auto", cuts=None, layers=0, layer_height=0.0, c
                    start; else layers equal layers; else layers of about layer_height (a
                    finite number from 0); else the library's automatic layers.
     cap            close the tube's ends (the add_caps flag).
-    skip_invalid, drop_outliers, surface_flips, open_ends, one_tube, keep_parts
+    skip_invalid, drop_outliers, surface_flips, ends_are_cuts, one_tube, keep_parts
                    the flags of the same names (skip_invalid: skip_invalid_points).
     origin         the frame's reference point, 3 finite numbers (sets origin_given).
     threads        the layers are triangulated on this many threads (0: one per core); the
@@ -111,8 +112,8 @@ def reconstruct(points, *, axis="auto", cuts=None, layers=0, layer_height=0.0, c
     """
     options = _options(axis, cuts, layers, layer_height, origin, threads, flags, cap=cap,
                        skip_invalid=skip_invalid, drop_outliers=drop_outliers,
-                       surface_flips=surface_flips, open_ends=open_ends, one_tube=one_tube,
-                       keep_parts=keep_parts)
+                       surface_flips=surface_flips, ends_are_cuts=ends_are_cuts,
+                       one_tube=one_tube, keep_parts=keep_parts)
     progress = _check.optional_callable("progress", progress)
     if workspace is not None:
         _check.instance("workspace", workspace, Workspace, "a stratmesh.Workspace or None")
@@ -134,9 +135,10 @@ def cap_ends(points, triangles, *, axis="z", origin=None, skip_invalid=False, fl
 
 
 @_check.signature_checked
-def stream_workspace_size(max_points, *, axis="z", surface_flips=False, open_ends=False):
+def stream_workspace_size(max_points, *, axis="z", surface_flips=False, ends_are_cuts=False):
     """Bytes of workspace a Stream holding at most max_points points at once allocates."""
-    options = _options(axis, automatic=False, surface_flips=surface_flips, open_ends=open_ends)
+    options = _options(axis, automatic=False, surface_flips=surface_flips,
+                       ends_are_cuts=ends_are_cuts)
     held = _check.whole("max_points", max_points, 0, _MOST_HELD)
     return _core.stream_workspace_size(held, options)
 
@@ -159,10 +161,10 @@ class Stream:
 
     @_check.signature_checked
     def __init__(self, *, axis, max_points, origin=None, skip_invalid=False,
-                 surface_flips=False, open_ends=False, flags=(), layer_info=256):
+                 surface_flips=False, ends_are_cuts=False, flags=(), layer_info=256):
         options = _options(axis, origin=origin, flags=flags, refused=_NOT_STREAMED,
                            automatic=False, skip_invalid=skip_invalid,
-                           surface_flips=surface_flips, open_ends=open_ends)
+                           surface_flips=surface_flips, ends_are_cuts=ends_are_cuts)
         held = _check.whole("max_points", max_points, _LEAST_HELD, _MOST_HELD)
         layer_info = _check.whole("layer_info", layer_info, 0, _MOST_STREAM_LAYERS)
         self._stream = _core.Stream(options, held, layer_info)

@@ -149,7 +149,7 @@ def heights(name, value, status):
 
 def flag_names(value, refused=()):
     """flags: a sequence of names from FLAGS (none of refused), not a string."""
-    what = "a sequence of flag names such as ('open_ends',)"
+    what = "a sequence of flag names such as ('ends_are_cuts',)"
     if isinstance(value, (str, bytes)):
         raise must(wrong_type, "invalid_argument", "flags", what, value)
     try:

@@ -38,7 +38,7 @@ class Plan:
     height_max: float       # the highest point's height: the last layer's top
     bounds: tuple           # range k holds layers bounds[k] <= j < bounds[k + 1]
     offsets: tuple          # global index of each partition's first point, then the count
-    options: dict           # stream keywords: skip_invalid, surface_flips, open_ends
+    options: dict           # stream keywords: skip_invalid, surface_flips, ends_are_cuts
 
     @property
     def layer_count(self):
@@ -124,7 +124,7 @@ def _measure(parts, unit, skip_invalid):
 
 @_check.signature_checked
 def plan(points, *, axis, layer_height=None, layers=None, ranges=None, skip_invalid=False,
-         surface_flips=False, open_ends=False):
+         surface_flips=False, ends_are_cuts=False):
     """Measures the cloud in parallel and fixes the layers, the ranges and the origin.
 
     layers: that many equal layers over the cloud's height; else layer_height: the nearest
@@ -137,7 +137,7 @@ def plan(points, *, axis, layer_height=None, layers=None, ranges=None, skip_inva
         ranges = _check.whole("ranges", ranges, 1, _MOST_LAYERS)
     options = {"skip_invalid": _check.switch("skip_invalid", skip_invalid),
                "surface_flips": _check.switch("surface_flips", surface_flips),
-               "open_ends": _check.switch("open_ends", open_ends)}
+               "ends_are_cuts": _check.switch("ends_are_cuts", ends_are_cuts)}
     parts = _partitions(points)
     unit = _UNIT[name] if name else unit
     low, high, origin, counts = _measure(parts, np.array(unit), options["skip_invalid"])
@@ -209,7 +209,7 @@ def _check_edges(report, lo, hi, first, last, plan):
     if ((first < lo and info[0].closed_ends & _CLOSED_BOTTOM)
             or (last > hi - 1 and info[-1].closed_ends & _CLOSED_TOP)):
         raise refuse("not_columnar",
-                     "a range's edge was taken for a closed end: mesh with open_ends=True")
+                     "a range's edge was taken for a closed end: mesh with ends_are_cuts=True")
 
 
 def _mesh_range(k, plan, *pieces):

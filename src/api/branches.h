@@ -7,7 +7,7 @@
 // find_parting() finds where along the axis the cloud parts: the lowest cut above which
 // the points make two separate branches or more, and the highest below which they do.
 // reconstruct() uses it by default; a caller can also mesh each side on its own, the
-// branches with open_ends, and join them with join_branches().
+// branches with ends_are_cuts, and join them with join_branches().
 //
 // Points join one piece when they lie within Parting::gap of each other (single linkage).
 // The gap is four times the median distance from a point to its nearest distinct

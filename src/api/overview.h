@@ -103,7 +103,7 @@
 //                            - the measure of webs (Report::diagnostics' web fields
 //                              stay 0);
 //                            - the C interface, unless STRATMESH_C_API is 1;
-//                            - the flags drop_outliers, surface_flips and open_ends,
+//                            - the flags drop_outliers, surface_flips and ends_are_cuts,
 //                              which also return not_compiled (filter the cloud before
 //                              it reaches the device).
 //

@@ -78,7 +78,7 @@ enum Flags : uint32_t {
     // up to its highest points). For a cloud cut out of a larger object (a region of
     // interest, a branch meshed on its own), whose ends are cuts however many points lie
     // across them. The reduced build, which has no closed ends, returns not_compiled.
-    open_ends = 1u << 5,
+    ends_are_cuts = 1u << 5,
     // reconstruct() meshes the cloud as one tube without looking for where it parts into
     // branches (see PartCounts): the paper's single column, and the search's time saved
     // (a few percent on a cloud that does not part). The stream always meshes one tube.

@@ -234,7 +234,7 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // skip_invalid_points); invalid_axis (an unknown Axis, or Axis::direction zero, NaN or
 // infinite); invalid_layers (a NaN or infinite cut, more than 2^32 - 2 cuts, a negative or
 // non-finite layer_height);
-// not_compiled (Axis::automatic, drop_outliers, surface_flips or open_ends in the reduced
+// not_compiled (Axis::automatic, drop_outliers, surface_flips or ends_are_cuts in the reduced
 // build);
 // too_few_points (fewer than 3 valid points, or no surface spans them); degenerate (the
 // surface would have no area: see the robustness contract; Report::detail says whether the

@@ -122,7 +122,7 @@ PLAN_ARGUMENTS = [
     (WRONG_TYPE, "invalid_argument", "ranges", {"ranges": 1.5}),
     (WRONG_TYPE, "invalid_argument", "skip_invalid", {"skip_invalid": "yes"}),
     (WRONG_TYPE, "invalid_argument", "surface_flips", {"surface_flips": 1}),
-    (WRONG_TYPE, "invalid_argument", "open_ends", {"open_ends": None}),
+    (WRONG_TYPE, "invalid_argument", "ends_are_cuts", {"ends_are_cuts": None}),
     (WRONG_TYPE, "invalid_argument", "plan", {"layer": 2}),
 ]
 

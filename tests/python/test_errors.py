@@ -117,7 +117,7 @@ def test_each_option_is_checked_before_the_call(kind, status, name, value):
 
 
 @pytest.mark.parametrize("name", ["cap", "skip_invalid", "drop_outliers", "surface_flips",
-                                  "open_ends", "one_tube", "keep_parts"])
+                                  "ends_are_cuts", "one_tube", "keep_parts"])
 @pytest.mark.parametrize("value", ["no", 1, None])
 def test_switches_take_true_or_false(name, value):
     refused_argument(WRONG_TYPE, "invalid_argument", name, stratmesh.reconstruct, CLOUD, axis="z",

@@ -104,12 +104,12 @@ def test_drop_outliers_counts_them(tube):
     assert len(tube) not in triangles and len(tube) + 1 not in triangles
 
 
-def test_open_ends_and_flags_by_name(tube):
-    a, _ = stratmesh.reconstruct(tube, axis="z", layers=6, open_ends=True, surface_flips=True)
-    b, _ = stratmesh.reconstruct(tube, axis="z", layers=6, flags=("open_ends", "surface_flips"))
+def test_ends_are_cuts_and_flags_by_name(tube):
+    a, _ = stratmesh.reconstruct(tube, axis="z", layers=6, ends_are_cuts=True, surface_flips=True)
+    b, _ = stratmesh.reconstruct(tube, axis="z", layers=6, flags=("ends_are_cuts", "surface_flips"))
     assert np.array_equal(a, b)
     assert set(stratmesh.FLAGS) >= {"skip_invalid_points", "add_caps", "origin_given",
-                                    "drop_outliers", "surface_flips", "open_ends"}
+                                    "drop_outliers", "surface_flips", "ends_are_cuts"}
 
 
 def test_progress_sees_the_phases_in_order(tube):

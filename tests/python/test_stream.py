@@ -105,11 +105,11 @@ STREAM_OPTIONS = [
     (WRONG_TYPE, "invalid_argument", "layer_info", "256"),
     (WRONG_VALUE, "invalid_argument", "flags", ("add_caps",)),
     (WRONG_VALUE, "invalid_argument", "flags", ("drop_outliers",)),
-    (WRONG_TYPE, "invalid_argument", "flags", "open_ends"),
+    (WRONG_TYPE, "invalid_argument", "flags", "ends_are_cuts"),
     (WRONG_VALUE, "invalid_argument", "origin", (0, np.inf, 0)),
     (WRONG_TYPE, "invalid_argument", "skip_invalid", "yes"),
     (WRONG_TYPE, "invalid_argument", "surface_flips", 1),
-    (WRONG_TYPE, "invalid_argument", "open_ends", None),
+    (WRONG_TYPE, "invalid_argument", "ends_are_cuts", None),
 ]
 
 
@@ -143,7 +143,7 @@ def test_stream_workspace_size_checks_its_arguments():
     refused_argument(WRONG_VALUE, "invalid_argument", "max_points", size, 2**32 - 2)
     refused_argument(WRONG_TYPE, "invalid_argument", "max_points", size, "10")
     refused_argument(WRONG_VALUE, "invalid_axis", "axis", size, 10, axis="auto")
-    refused_argument(WRONG_TYPE, "invalid_argument", "open_ends", size, 10, open_ends="yes")
+    refused_argument(WRONG_TYPE, "invalid_argument", "ends_are_cuts", size, 10, ends_are_cuts="yes")
     assert size(2**32 - 3) > size(10) > 0
 
 

@@ -4892,7 +4892,9 @@ struct LayerLoops {
     size_t interior_used;
 };
 
-struct LayerCounts {
+// A layer's points that fell on a vertex already there: duplicates (merged into it) and
+// collisions (not vertices).
+struct CoincidentPoints {
     size_t duplicates;   // same 3D coordinates as an earlier point
     size_t collisions;   // distinct in 3D, same place on the annulus
 };
@@ -4902,7 +4904,7 @@ struct LayerDuplicates {
     const CloudReader* cloud;
     const uint32_t* ids;    // layer-local index -> reader index
     const uint32_t* order;  // vertex - 1 -> layer-local index (vertex 0 is the centre)
-    LayerCounts* counts;
+    CoincidentPoints* counts;
 
     static void report(void* context, uint32_t point, uint32_t vertex) {
         LayerDuplicates* d = static_cast<LayerDuplicates*>(context);
@@ -6511,7 +6513,7 @@ struct LayerAhead {
     Cylinder fitted;         // the cylinder before the centre search, and its layer_sectors
     uint32_t sectors;
     uint32_t ends;           // the ends of the surface it was taken for (find_closed_ends)
-    LayerCounts counts;
+    CoincidentPoints counts;
     size_t triangle_count, folds;
     uint32_t* triangles;     // as the sink writes them; in reader indices if replayable
     uint32_t* bottom;        // the loops in layer-local indices
@@ -6532,14 +6534,14 @@ struct GroupResult {
     uint32_t last;           // the group is planned layers [first, last]
     bool waiting;            // the queue must grow (or complete) before this group is known
     size_t points;           // its points, duplicates included
-    LayerCounts counts;
+    CoincidentPoints counts;
     size_t triangles, folds; // its chunk, before the safety net
     Cylinder cylinder;
 };
 
 // What triangulate_layer would do now, from a job's result.
 static inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops& loops,
-                                LayerCounts& counts) {
+                                CoincidentPoints& counts) {
     if (ahead.status != Status::ok) return ahead.status;
     if (sink.count < sink.capacity) {
         size_t room = sink.capacity - sink.count;
@@ -7347,7 +7349,7 @@ static inline void emit_layer(const Triangulation& tr, const uint32_t* order, ui
 // layer's points are left in insertion order (layer.points[k] is layer-local point
 // order[k], an order not kept).
 static inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Arena& arena,
-                                       TriangleSink& sink, LayerLoops& loops, LayerCounts& counts) {
+                                       TriangleSink& sink, LayerLoops& loops, CoincidentPoints& counts) {
     const size_t count = layer.count, total = count + 1;  // vertex 0 is the centre
     choose_centre(layer, arena);
     size_t mark = arena.mark();
@@ -7358,7 +7360,7 @@ static inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& la
     Triangulation tr;
     tr.xy = xy;
     if (!allocate_triangulation(tr, total, arena)) return Status::out_of_memory;
-    counts = LayerCounts{0, 0};
+    counts = CoincidentPoints{0, 0};
     LayerDuplicates classify = {&cloud, layer.ids, order, &counts};
     DuplicateSink duplicates = {LayerDuplicates::report, &classify};
     uint32_t inserted = 0;
@@ -8131,7 +8133,9 @@ private:
     const unsigned char* waived_ = nullptr;
 };
 
-struct CapCounts {
+// What capping a surface's loops did: loops closed and left open, the caps' triangles and
+// the wall edges flipped under fins (Report::caps).
+struct CapTally {
     size_t closed, left_open, triangles, wall_flips;
 };
 
@@ -8446,7 +8450,7 @@ static inline uint32_t fill_pockets(uint32_t* tri, size_t& count, const CapGraph
 // written.
 static inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
                                  const CloudReader& cloud, size_t point_count,
-                                 const Frame& frame, Arena& arena, CapCounts& caps,
+                                 const Frame& frame, Arena& arena, CapTally& caps,
                                  size_t* needed) {
     auto project = [&](uint32_t id, double* xy, double* height) {
         const Local p = frame.local(cloud.point(id));
@@ -9750,7 +9754,7 @@ static inline Status cap_tube(const TubeInput& in, const TubeRequest& request, c
                        size_t* triangle_count, Report& rep) {
     notify(request, Phase::manifold, 0);
     if (!request.caps) return Status::ok;
-    CapCounts caps = {0, 0, 0, 0};
+    CapTally caps = {0, 0, 0, 0};
     size_t needed = 0;
     const Status status = cap_boundary_loops(triangles, count, capacity, in.reader, in.count,
                                              frame, arena, caps, &needed);
@@ -10684,7 +10688,7 @@ namespace detail {
 // Caps the boundary loops of the surface of `count` triangles (`in` reads the whole cloud)
 // in the frame along the request's axis, which is resolved.
 static inline Status cap_surface(const TubeInput& in, const TubeRequest& request, Arena& arena,
-                          uint32_t* triangles, size_t capacity, size_t& count, CapCounts& caps,
+                          uint32_t* triangles, size_t capacity, size_t& count, CapTally& caps,
                           size_t* needed) {
     Frame frame;
     const Status status = choose_frame(in.sums, request, frame);
@@ -10715,7 +10719,7 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
                                             triangle_capacity, triangle_count, report))
         return Status::invalid_argument;
     Report checks = {};  // what the shared checks write, copied out in part
-    detail::CapCounts caps = {0, 0, 0, 0};
+    detail::CapTally caps = {0, 0, 0, 0};
     detail::Arena arena = detail::Arena::over(workspace, workspace_bytes);
     const size_t given = triangle_count ? *triangle_count : 0;
     size_t count = given, needed = 0;
@@ -12816,7 +12820,7 @@ static inline Status join_parts(const Cloud& cloud, const PartsWork& w, bool who
         // Around the axis the cut was made along, in the frame of the whole cloud.
         const CloudReader reader = reader_of(cloud);
         const TubeInput all = {reader, cloud.count, sum_cloud(reader, cloud.count)};
-        CapCounts caps = {0, 0, 0, 0};
+        CapTally caps = {0, 0, 0, 0};
         size_t needed = 0;
         status = cap_surface(all, w.cut, arena, triangles, capacity, count, caps, &needed);
         arena.rewind(mark);

@@ -11,7 +11,7 @@ namespace detail {
 // Caps the boundary loops of the surface of `count` triangles (`in` reads the whole cloud)
 // in the frame along the request's axis, which is resolved.
 static inline Status cap_surface(const TubeInput& in, const TubeRequest& request, Arena& arena,
-                          uint32_t* triangles, size_t capacity, size_t& count, CapCounts& caps,
+                          uint32_t* triangles, size_t capacity, size_t& count, CapTally& caps,
                           size_t* needed) {
     Frame frame;
     const Status status = choose_frame(in.sums, request, frame);
@@ -42,7 +42,7 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
                                             triangle_capacity, triangle_count, report))
         return Status::invalid_argument;
     Report checks = {};  // what the shared checks write, copied out in part
-    detail::CapCounts caps = {0, 0, 0, 0};
+    detail::CapTally caps = {0, 0, 0, 0};
     detail::Arena arena = detail::Arena::over(workspace, workspace_bytes);
     const size_t given = triangle_count ? *triangle_count : 0;
     size_t count = given, needed = 0;

@@ -275,7 +275,9 @@ private:
     const unsigned char* waived_ = nullptr;
 };
 
-struct CapCounts {
+// What capping a surface's loops did: loops closed and left open, the caps' triangles and
+// the wall edges flipped under fins (Report::caps).
+struct CapTally {
     size_t closed, left_open, triangles, wall_flips;
 };
 
@@ -590,7 +592,7 @@ static inline uint32_t fill_pockets(uint32_t* tri, size_t& count, const CapGraph
 // written.
 static inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t capacity,
                                  const CloudReader& cloud, size_t point_count,
-                                 const Frame& frame, Arena& arena, CapCounts& caps,
+                                 const Frame& frame, Arena& arena, CapTally& caps,
                                  size_t* needed) {
     auto project = [&](uint32_t id, double* xy, double* height) {
         const Local p = frame.local(cloud.point(id));

@@ -335,7 +335,7 @@ struct LayerAhead {
     Cylinder fitted;         // the cylinder before the centre search, and its layer_sectors
     uint32_t sectors;
     uint32_t ends;           // the ends of the surface it was taken for (find_closed_ends)
-    LayerCounts counts;
+    CoincidentPoints counts;
     size_t triangle_count, folds;
     uint32_t* triangles;     // as the sink writes them; in reader indices if replayable
     uint32_t* bottom;        // the loops in layer-local indices
@@ -356,14 +356,14 @@ struct GroupResult {
     uint32_t last;           // the group is planned layers [first, last]
     bool waiting;            // the queue must grow (or complete) before this group is known
     size_t points;           // its points, duplicates included
-    LayerCounts counts;
+    CoincidentPoints counts;
     size_t triangles, folds; // its chunk, before the safety net
     Cylinder cylinder;
 };
 
 // What triangulate_layer would do now, from a job's result.
 static inline Status take_ahead(const LayerAhead& ahead, TriangleSink& sink, LayerLoops& loops,
-                                LayerCounts& counts) {
+                                CoincidentPoints& counts) {
     if (ahead.status != Status::ok) return ahead.status;
     if (sink.count < sink.capacity) {
         size_t room = sink.capacity - sink.count;

@@ -20,7 +20,9 @@ struct LayerLoops {
     size_t interior_used;
 };
 
-struct LayerCounts {
+// A layer's points that fell on a vertex already there: duplicates (merged into it) and
+// collisions (not vertices).
+struct CoincidentPoints {
     size_t duplicates;   // same 3D coordinates as an earlier point
     size_t collisions;   // distinct in 3D, same place on the annulus
 };
@@ -30,7 +32,7 @@ struct LayerDuplicates {
     const CloudReader* cloud;
     const uint32_t* ids;    // layer-local index -> reader index
     const uint32_t* order;  // vertex - 1 -> layer-local index (vertex 0 is the centre)
-    LayerCounts* counts;
+    CoincidentPoints* counts;
 
     static void report(void* context, uint32_t point, uint32_t vertex) {
         LayerDuplicates* d = static_cast<LayerDuplicates*>(context);

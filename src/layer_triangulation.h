@@ -94,7 +94,7 @@ static inline void emit_layer(const Triangulation& tr, const uint32_t* order, ui
 // layer's points are left in insertion order (layer.points[k] is layer-local point
 // order[k], an order not kept).
 static inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& layer, Arena& arena,
-                                       TriangleSink& sink, LayerLoops& loops, LayerCounts& counts) {
+                                       TriangleSink& sink, LayerLoops& loops, CoincidentPoints& counts) {
     const size_t count = layer.count, total = count + 1;  // vertex 0 is the centre
     choose_centre(layer, arena);
     size_t mark = arena.mark();
@@ -105,7 +105,7 @@ static inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& la
     Triangulation tr;
     tr.xy = xy;
     if (!allocate_triangulation(tr, total, arena)) return Status::out_of_memory;
-    counts = LayerCounts{0, 0};
+    counts = CoincidentPoints{0, 0};
     LayerDuplicates classify = {&cloud, layer.ids, order, &counts};
     DuplicateSink duplicates = {LayerDuplicates::report, &classify};
     uint32_t inserted = 0;

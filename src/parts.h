@@ -467,7 +467,7 @@ static inline Status join_parts(const Cloud& cloud, const PartsWork& w, bool who
         // Around the axis the cut was made along, in the frame of the whole cloud.
         const CloudReader reader = reader_of(cloud);
         const TubeInput all = {reader, cloud.count, sum_cloud(reader, cloud.count)};
-        CapCounts caps = {0, 0, 0, 0};
+        CapTally caps = {0, 0, 0, 0};
         size_t needed = 0;
         status = cap_surface(all, w.cut, arena, triangles, capacity, count, caps, &needed);
         arena.rewind(mark);

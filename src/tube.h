@@ -250,7 +250,7 @@ static inline Status cap_tube(const TubeInput& in, const TubeRequest& request, c
                        size_t* triangle_count, Report& rep) {
     notify(request, Phase::manifold, 0);
     if (!request.caps) return Status::ok;
-    CapCounts caps = {0, 0, 0, 0};
+    CapTally caps = {0, 0, 0, 0};
     size_t needed = 0;
     const Status status = cap_boundary_loops(triangles, count, capacity, in.reader, in.count,
                                              frame, arena, caps, &needed);

@@ -970,10 +970,10 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 // it under its loop, and that side stays apart. reconstruct() therefore cuts square to the
 // trunk's own axis.
 struct JoinReport {
-    uint32_t joined_side_count;      // 0, 1 or 2
-    uint32_t apart_side_count;  // sides that part whose loops could not be joined (detail)
-    uint32_t grafted_branch_count;  // branches joined through a hole in the trunk's closed end
-    size_t added_triangle_count;
+    size_t joined_side_count;        // 0, 1 or 2
+    size_t apart_side_count;         // sides that part whose loops could not be joined (detail)
+    size_t grafted_branch_count;     // branches joined through a hole in the trunk's closed end
+    size_t junction_triangle_count;  // triangles the junctions added
     size_t removed_triangle_count;   // the trunk's triangles the holes took out
     size_t workspace_used_bytes;      // peak workspace bytes, from the start of the buffer
     const char* detail;         // a static sentence on why, on failure or a side left apart
@@ -12215,22 +12215,22 @@ static inline size_t write_join(const JoinInput& in, const JoinMemory& m, const 
         if (m.removed[in.given + f]) continue;
         for (size_t e = 0; e < 3; ++e) out[e] = m.filled[3 * f + e];
         out += 3;
-        ++r.added_triangle_count;
+        ++r.junction_triangle_count;
     }
     for (int k = 0; k < 2; ++k) {
         if (!plan.rim[k]) continue;
         const SideView view = {in.reader, in.frame, k == 0 ? 1.0 : -1.0};
         write_junction(plan.junction[k], view, out);
         out += 3 * plan.junction[k].triangles();
-        r.added_triangle_count += plan.junction[k].triangles();
+        r.junction_triangle_count += plan.junction[k].triangles();
     }
     for (uint32_t g = 0; g < plan.graft_count; ++g) {
         const SideView view = {in.reader, in.frame, plan.grafts[g].side};
         write_graft(plan.grafts[g], view, out);
         out += 3 * plan.grafts[g].triangles();
-        r.added_triangle_count += plan.grafts[g].triangles();
+        r.junction_triangle_count += plan.grafts[g].triangles();
     }
-    return kept + r.added_triangle_count;
+    return kept + r.junction_triangle_count;
 }
 
 // join_branches()'s checks of the points and the triangles: ok, or a status with
@@ -12807,7 +12807,7 @@ static inline Status join_parts(const Cloud& cloud, const PartsWork& w, bool who
     rep.parts.joined_side_count = join.joined_side_count;
     rep.parts.apart_side_count = join.apart_side_count;
     rep.parts.grafted_branch_count = join.grafted_branch_count;
-    rep.parts.junction_triangle_count = join.added_triangle_count;
+    rep.parts.junction_triangle_count = join.junction_triangle_count;
     rep.parts.removed_triangle_count = join.removed_triangle_count;
     if (!rep.detail) rep.detail = join.detail;
     whole = whole && status == Status::ok && join.apart_side_count == 0;

@@ -11,9 +11,10 @@
 // Checked after each call: the status is a documented one; on every status but ok the
 // triangles are unchanged (on triangle_capacity the count needed is above the capacity);
 // on ok the given triangles are kept in their order but removed_triangle_count of them, the
-// count is the kept ones and added_triangle_count (at most join_branches_max_triangles()), nothing
-// is written past them, every new index names a valid point, no new triangle
-// repeats one, the sides joined and left apart are at most the sides that part, and where
+// count is the kept ones and junction_triangle_count (at most
+// join_branches_max_triangles()), nothing is written past them, every new index names a
+// valid point, no new triangle repeats one, the sides joined and left apart are at most the
+// sides that part, and where
 // the given surface was an oriented edge- and vertex-manifold (tests/support/mesh_check.h),
 // the joined one still is.
 #include "fuzz_cloud.h"
@@ -186,8 +187,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     STRATMESH_FUZZ_CHECK(report.removed_triangle_count <= given, "more triangles removed than given");
     const size_t kept = given - report.removed_triangle_count;
-    STRATMESH_FUZZ_CHECK(count == kept + report.added_triangle_count, "count != kept + added");
-    STRATMESH_FUZZ_CHECK(report.added_triangle_count <= stratmesh::join_branches_max_triangles(n),
+    STRATMESH_FUZZ_CHECK(count == kept + report.junction_triangle_count, "count != kept + added");
+    STRATMESH_FUZZ_CHECK(report.junction_triangle_count <= stratmesh::join_branches_max_triangles(n),
                          "more triangles than join_branches_max_triangles()");
     size_t matched = 0;
     for (size_t g = 0; g < given && matched < kept; ++g)

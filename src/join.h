@@ -866,22 +866,22 @@ static inline size_t write_join(const JoinInput& in, const JoinMemory& m, const 
         if (m.removed[in.given + f]) continue;
         for (size_t e = 0; e < 3; ++e) out[e] = m.filled[3 * f + e];
         out += 3;
-        ++r.added_triangle_count;
+        ++r.junction_triangle_count;
     }
     for (int k = 0; k < 2; ++k) {
         if (!plan.rim[k]) continue;
         const SideView view = {in.reader, in.frame, k == 0 ? 1.0 : -1.0};
         write_junction(plan.junction[k], view, out);
         out += 3 * plan.junction[k].triangles();
-        r.added_triangle_count += plan.junction[k].triangles();
+        r.junction_triangle_count += plan.junction[k].triangles();
     }
     for (uint32_t g = 0; g < plan.graft_count; ++g) {
         const SideView view = {in.reader, in.frame, plan.grafts[g].side};
         write_graft(plan.grafts[g], view, out);
         out += 3 * plan.grafts[g].triangles();
-        r.added_triangle_count += plan.grafts[g].triangles();
+        r.junction_triangle_count += plan.grafts[g].triangles();
     }
-    return kept + r.added_triangle_count;
+    return kept + r.junction_triangle_count;
 }
 
 // join_branches()'s checks of the points and the triangles: ok, or a status with

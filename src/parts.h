@@ -454,7 +454,7 @@ static inline Status join_parts(const Cloud& cloud, const PartsWork& w, bool who
     rep.parts.joined_side_count = join.joined_side_count;
     rep.parts.apart_side_count = join.apart_side_count;
     rep.parts.grafted_branch_count = join.grafted_branch_count;
-    rep.parts.junction_triangle_count = join.added_triangle_count;
+    rep.parts.junction_triangle_count = join.junction_triangle_count;
     rep.parts.removed_triangle_count = join.removed_triangle_count;
     if (!rep.detail) rep.detail = join.detail;
     whole = whole && status == Status::ok && join.apart_side_count == 0;

@@ -143,7 +143,7 @@ TEST_CASE("join_branches: a trunk and two prongs meshed apart become one oriente
         CHECK(joined.report.detail == nullptr);
         CHECK(joined.report.grafted_branch_count == 0);
         CHECK(joined.report.removed_triangle_count == 0);
-        CHECK(joined.triangles.size() == parted.triangles.size() + 3 * joined.report.added_triangle_count);
+        CHECK(joined.triangles.size() == parted.triangles.size() + 3 * joined.report.junction_triangle_count);
         CHECK(joined.report.workspace_used_bytes <= joined.workspace_bytes);
         // The junction names only points on the loops it joins, each a vertex already.
         const mesh_check::Result m = check(xyz, joined.triangles, parted.parting.axis);
@@ -195,7 +195,7 @@ TEST_CASE("join_branches: prongs standing on a dome are grafted onto holes cut i
         CHECK(joined.report.detail == nullptr);
         CHECK(joined.report.removed_triangle_count > 0);
         const size_t kept = parted.triangles.size() / 3 - joined.report.removed_triangle_count;
-        REQUIRE(joined.triangles.size() / 3 == kept + joined.report.added_triangle_count);
+        REQUIRE(joined.triangles.size() / 3 == kept + joined.report.junction_triangle_count);
         CHECK(kept_in_order(parted.triangles, joined.triangles.data(), kept));
         const mesh_check::Result m = check(s.xyz, joined.triangles, parted.parting.axis);
         INFO("joined: " << m.summary());

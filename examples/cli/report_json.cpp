@@ -354,7 +354,7 @@ void write_junction(JsonWriter& j, const RunRecord& r) {
     j.count_field("sides_joined", r.junction.joined_side_count);
     j.count_field("sides_left_apart", r.junction.apart_side_count);
     j.count_field("branches_grafted", r.junction.grafted_branch_count);
-    j.count_field("triangles", r.junction.added_triangle_count);
+    j.count_field("triangles", r.junction.junction_triangle_count);
     j.count_field("triangles_removed", r.junction.removed_triangle_count);
     j.key("detail");
     if (r.junction.detail)
@@ -490,10 +490,10 @@ void RunRecord::take_parts(const stratmesh::PartCounts& parts,
     }
     // The junctions were made once the trunk was meshed.
     junction_run = count > 0 && filled[0].status == stratmesh::Status::ok;
-    junction.joined_side_count = static_cast<uint32_t>(parts.joined_side_count);
-    junction.apart_side_count = static_cast<uint32_t>(parts.apart_side_count);
-    junction.grafted_branch_count = static_cast<uint32_t>(parts.grafted_branch_count);
-    junction.added_triangle_count = parts.junction_triangle_count;
+    junction.joined_side_count = parts.joined_side_count;
+    junction.apart_side_count = parts.apart_side_count;
+    junction.grafted_branch_count = parts.grafted_branch_count;
+    junction.junction_triangle_count = parts.junction_triangle_count;
     junction.removed_triangle_count = parts.removed_triangle_count;
 }
 

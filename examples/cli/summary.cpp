@@ -341,8 +341,8 @@ void print_split(std::FILE* out, const RunRecord& r) {
     if (r.junction_status != stratmesh::Status::ok)
         std::fprintf(out, "             not joined: %s\n", stratmesh::status_string(r.junction_status));
     else if (j.joined_side_count > 0 || j.grafted_branch_count > 0)
-        std::fprintf(out, "             joined at %u side%s by %zu triangles%s%s\n", j.joined_side_count,
-                     j.joined_side_count == 1 ? "" : "s", j.added_triangle_count,
+        std::fprintf(out, "             joined at %zu side%s by %zu triangles%s%s\n", j.joined_side_count,
+                     j.joined_side_count == 1 ? "" : "s", j.junction_triangle_count,
                      j.apart_side_count ? " (a side left apart)" : "",
                      grafted_note(j).c_str());
     if (j.detail)

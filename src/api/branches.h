@@ -93,10 +93,10 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 // it under its loop, and that side stays apart. reconstruct() therefore cuts square to the
 // trunk's own axis.
 struct JoinReport {
-    uint32_t joined_side_count;      // 0, 1 or 2
-    uint32_t apart_side_count;  // sides that part whose loops could not be joined (detail)
-    uint32_t grafted_branch_count;  // branches joined through a hole in the trunk's closed end
-    size_t added_triangle_count;
+    size_t joined_side_count;        // 0, 1 or 2
+    size_t apart_side_count;         // sides that part whose loops could not be joined (detail)
+    size_t grafted_branch_count;     // branches joined through a hole in the trunk's closed end
+    size_t junction_triangle_count;  // triangles the junctions added
     size_t removed_triangle_count;   // the trunk's triangles the holes took out
     size_t workspace_used_bytes;      // peak workspace bytes, from the start of the buffer
     const char* detail;         // a static sentence on why, on failure or a side left apart

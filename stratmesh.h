@@ -84,8 +84,8 @@
 //                            - what only makes it faster (parallel layers, the safety
 //                              net's shortcut, the staging of grouped points, the
 //                              predicates' integer stages): same bytes, slower;
-//                            - the search for branches (as if one_tube were always
-//                              given), the automatic axis (Axis::automatic returns
+//                            - the search for branches (as if Options::parts were
+//                              always Parts::one_tube), the automatic axis (Axis::automatic returns
 //                              Status::not_compiled), the check for a degenerate
 //                              cloud, find_parting(), join_branches() and cap_ends()
 //                              (not declared);
@@ -391,14 +391,20 @@ enum Flags : uint32_t {
     // interest, a branch meshed on its own), whose ends are cuts however many points lie
     // across them. The reduced build, which has no closed ends, returns not_compiled.
     ends_are_cuts = 1u << 5,
-    // reconstruct() meshes the cloud as one tube without looking for where it parts into
-    // branches (see PartCounts): the paper's single column, and the search's time saved
-    // (a few percent on a cloud that does not part). The stream always meshes one tube.
-    one_tube = 1u << 6,
-    // reconstruct() keeps the trunk and branches meshed apart even where a side could not
-    // be joined or points past a cut belong to no branch (left apart or unused, as
-    // Report::parts says), instead of meshing the cloud as one tube then.
-    keep_parts = 1u << 7,
+};
+
+// What reconstruct() meshes where the cloud parts into branches (Options::parts; see
+// PartCounts and find_parting()). The stream and the reduced build (STRATMESH_SMALL_CODE)
+// always mesh one tube.
+enum class Parts : uint32_t {
+    // Looks for where the cloud parts, meshes the trunk and its branches apart and joins
+    // them; keeps that where it is whole and smaller than one tube, else meshes one tube.
+    automatic = 0,
+    // One tube through every point, without looking: the paper's single column.
+    one_tube,
+    // The parts, joined where they can be, kept even where a side could not be joined or
+    // points past a cut belong to no branch (left apart or unused, as Report::parts says).
+    apart,
 };
 
 // Phases reported to Options::progress, in the order they run. Each layer is stitched to
@@ -443,6 +449,7 @@ struct Options {
     uint32_t layer_count;
     double layer_height;
     uint32_t flags;          // Flags bits
+    Parts parts;
     double origin[3];        // with the origin_given flag
     // Optional progress callback: called with each phase as it starts, and with the
     // fraction of that phase done from time to time. Must not call back into stratmesh.
@@ -527,9 +534,9 @@ const uint8_t kBeyondBranches = 255;
 
 // How reconstruct() met a cloud that parts into branches (PartCounts::outcome).
 enum class PartsOutcome : uint32_t {
-    one_tube = 0,  // one tube through every point: nothing parts, or the one_tube flag
+    one_tube = 0,  // one tube through every point: nothing parts, or Parts::one_tube
     joined,        // the trunk and its branches meshed apart and joined into one surface
-    kept_apart,    // with keep_parts: meshed apart, kept though not all joined
+    kept_apart,    // with Parts::apart: meshed apart, kept though not all joined
     undone,        // meshed apart, but a side could not be joined, a part was refused,
                    // points belong to no part, or the joined surface was no smaller than
                    // the one tube's: meshed as one tube instead
@@ -551,8 +558,8 @@ struct PartInfo {
 // Report::parts.
 struct PartCounts {
     PartsOutcome outcome;
-    Parting parting;         // where the cloud parts along Report::axis (all zero with the
-                             // one_tube flag)
+    Parting parting;         // where the cloud parts along Report::axis (all zero with
+                             // Parts::one_tube)
     size_t part_count;       // parts meshed apart: the trunk and its branches (0: one tube)
     size_t joined_side_count;     // sides whose branches were joined (see join_branches())
     size_t apart_side_count;      // sides left apart
@@ -674,11 +681,11 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 //
 // In its steps: check the arguments and read the cloud (refusing NaN, a degenerate cloud);
 // choose the axis (Axis::automatic); look for where the cloud parts into branches along it
-// (unless one_tube) and, where it does, mesh the trunk and each branch around its own
+// (unless Parts::one_tube) and, where it does, mesh the trunk and each branch around its own
 // automatic axis (the trunk along the cloud's axis where the options lay out the layers:
 // cuts, layer_count or layer_height), and join them into one surface (see PartCounts and
 // join_branches()); otherwise, or where the parts cannot all be joined, or where the
-// joined surface is not smaller than the one tube's (unless keep_parts), mesh one tube:
+// joined surface is not smaller than the one tube's (unless Parts::apart), mesh one tube:
 // layer by layer, each unrolled and triangulated, stitched to the layer below, passed
 // through the manifold safety net; then the caps (add_caps). A tube that wraps branches
 // bridges the gaps between them with webs, which add area, and so does a join that folds,
@@ -754,14 +761,14 @@ Status reconstruct(const Cloud& cloud, const Options& options,
 //     stratmesh::stream_close(stream);
 //
 // The stream meshes one tube (it cannot know where a cloud parts before it has seen it):
-// the same triangles as reconstruct() with the one_tube flag. A push is one planned
+// the same triangles as reconstruct() with Parts::one_tube. A push is one planned
 // layer, as between two cuts, and
 // the stream forms layers from pushes by the rules reconstruct() applies to its planned
 // layers (a push too small, too thin, not surrounding its axis or next to a crescent joins
 // the next; a last rest too small or thin joins the layer below it), waiting for later
 // pushes where a rule needs them. So reconstruct() of the concatenated pushes, with
 // Options::cuts at the tops of all pushes but the last, the same axis, the same origin
-// (flag origin_given), the one_tube flag and the points of each push in the same order,
+// (flag origin_given), Parts::one_tube and the points of each push in the same order,
 // gives the same triangles in the same order, with the same global indices,
 // provided no point lies within 2^-40 of the height range below a cut (reconstruct()
 // counts such a point in the layer above) and no cut lies outside the points' height
@@ -975,8 +982,8 @@ struct JoinReport {
     size_t grafted_branch_count;     // branches joined through a hole in the trunk's closed end
     size_t junction_triangle_count;  // triangles the junctions added
     size_t removed_triangle_count;   // the trunk's triangles the holes took out
-    size_t workspace_used_bytes;      // peak workspace bytes, from the start of the buffer
-    const char* detail;         // a static sentence on why, on failure or a side left apart
+    size_t workspace_used_bytes;     // peak workspace bytes, from the start of the buffer
+    const char* detail;              // a static sentence on why, on failure or a side left apart
 };
 
 // Bytes of workspace join_branches() needs for a surface of triangle_count triangles over
@@ -1097,10 +1104,16 @@ enum stratmesh_flags {
     STRATMESH_FLAG_ORIGIN_GIVEN = 1 << 2,
     STRATMESH_FLAG_DROP_OUTLIERS = 1 << 3,
     STRATMESH_FLAG_SURFACE_FLIPS = 1 << 4,
-    STRATMESH_FLAG_ENDS_ARE_CUTS = 1 << 5,
-    STRATMESH_FLAG_ONE_TUBE = 1 << 6,
-    STRATMESH_FLAG_KEEP_PARTS = 1 << 7
+    STRATMESH_FLAG_ENDS_ARE_CUTS = 1 << 5
 };
+
+// stratmesh::Parts: what reconstruction meshes where the cloud parts into branches
+// (stratmesh_options::parts).
+typedef enum stratmesh_parts {
+    STRATMESH_PARTS_AUTOMATIC = 0,
+    STRATMESH_PARTS_ONE_TUBE,
+    STRATMESH_PARTS_APART
+} stratmesh_parts;
 
 // stratmesh::ClosedEnd: bits of stratmesh_layer_info::closed_ends.
 enum stratmesh_closed_end {
@@ -1121,10 +1134,10 @@ typedef enum stratmesh_phase {
 // stratmesh::PartsOutcome: how reconstruction met a cloud that parts into branches
 // (stratmesh_part_counts::outcome).
 typedef enum stratmesh_parts_outcome {
-    STRATMESH_PARTS_ONE_TUBE = 0,
-    STRATMESH_PARTS_JOINED,
-    STRATMESH_PARTS_KEPT_APART,
-    STRATMESH_PARTS_UNDONE
+    STRATMESH_PARTS_OUTCOME_ONE_TUBE = 0,
+    STRATMESH_PARTS_OUTCOME_JOINED,
+    STRATMESH_PARTS_OUTCOME_KEPT_APART,
+    STRATMESH_PARTS_OUTCOME_UNDONE
 } stratmesh_parts_outcome;
 
 // The name of a status (a stratmesh_status value) and a one-line explanation
@@ -1191,6 +1204,7 @@ typedef struct stratmesh_options {
     uint32_t layer_count;           // else equal-height layers
     double layer_height;            // else layers of about this height; else automatic
     uint32_t flags;                 // stratmesh_flags bits
+    uint32_t parts;                 // stratmesh_parts
     double origin[3];               // with STRATMESH_FLAG_ORIGIN_GIVEN
     // Optional: called with each phase as it starts and with the fraction done; must not
     // call back into stratmesh.
@@ -3786,13 +3800,6 @@ struct LayerRequest {
     double height;
 };
 
-// What reconstruct() does where the cloud parts into branches (see PartCounts).
-enum class PartsPolicy : uint32_t {
-    compare,   // the parts joined where whole and smaller than one tube, else the one tube
-    one_tube,  // one tube, without a search (the one_tube flag)
-    keep,      // the parts, joined where they can be (the keep_parts flag)
-};
-
 struct TubeRequest {
     Axis axis;              // Axis::automatic until resolve_axis() chooses
     double direction[3];    // with Axis::direction
@@ -3802,7 +3809,7 @@ struct TubeRequest {
     bool surface_flips;
     bool drop_outliers;     // the cloud is read without its outliers
     const double* origin;   // the frame's reference point, or null for the centroid
-    PartsPolicy parts;
+    Parts parts;            // Parts::one_tube where this build cannot look for parts
     // The caller's Options: its job runner, or null for none (an axis trial).
     const Options* caller;
     // The Options whose progress callback is told, or null: none (a branch, whose progress
@@ -3812,9 +3819,6 @@ struct TubeRequest {
 
 static inline TubeRequest tube_request(const Options& options) {
     const uint32_t f = options.flags;
-    const PartsPolicy parts = !kFindParts || (f & one_tube) ? PartsPolicy::one_tube
-                              : (f & keep_parts) ? PartsPolicy::keep
-                                                 : PartsPolicy::compare;
     return {options.axis,
             {options.direction[0], options.direction[1], options.direction[2]},
             {options.cuts, options.cut_count, options.layer_count, options.layer_height},
@@ -3823,7 +3827,7 @@ static inline TubeRequest tube_request(const Options& options) {
             kSurfaceFlips && (f & surface_flips),
             kDropOutliers && (f & drop_outliers),
             (f & origin_given) ? options.origin : nullptr,
-            parts,
+            kFindParts ? options.parts : Parts::one_tube,
             &options,
             &options};
 }
@@ -12359,7 +12363,7 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
 // points labelled kInTrunk) is meshed along the cloud's axis, each branch as a tube of its
 // own around its own automatic axis, and join_branches() zips them into one surface (caps
 // last, with add_caps, once joined). That is kept only when it is whole: every part
-// meshed, every side joined, every point in a part; otherwise, unless keep_parts, the cloud
+// meshed, every side joined, every point in a part; otherwise, unless Parts::apart, the cloud
 // is meshed as one tube after all (PartsOutcome::undone). A part is meshed in place: the
 // points of the other parts join the outliers in the reader's bitmap, so its triangles
 // index the cloud directly and its frame is the one a copy of its points would get.
@@ -12660,7 +12664,7 @@ static inline Status one_tube_area(const TubeInput& in, const TubeRequest& reque
                             Arena& arena, uint32_t* triangles, size_t capacity,
                             const Report& before, double* area) {
     *area = DBL_MAX;
-    if (request.parts == PartsPolicy::keep || !all_in_parts) return Status::ok;
+    if (request.parts == Parts::apart || !all_in_parts) return Status::ok;
     Report tube = before;
     size_t count = 0;
     const size_t mark = arena.mark();
@@ -12811,7 +12815,7 @@ static inline Status join_parts(const Cloud& cloud, const PartsWork& w, bool who
     rep.parts.removed_triangle_count = join.removed_triangle_count;
     if (!rep.detail) rep.detail = join.detail;
     whole = whole && status == Status::ok && join.apart_side_count == 0;
-    if (!whole && w.cut.parts != PartsPolicy::keep) {
+    if (!whole && w.cut.parts != Parts::apart) {
         rep.parts.outcome = PartsOutcome::undone;
         return Status::ok;
     }
@@ -12982,7 +12986,7 @@ static inline Status read_cloud(const Cloud& cloud, const Options& options, Aren
 
 // Whether reconstruct() looks for branches.
 static inline bool searches_parts(const TubeRequest& request) {
-    return kFindParts && request.parts != PartsPolicy::one_tube;
+    return kFindParts && request.parts != Parts::one_tube;
 }
 
 static inline Status mesh_cloud(const Cloud& cloud, const TubeInput& in, const TubeRequest& request,
@@ -13165,8 +13169,6 @@ STRATMESH_C_SAME(STRATMESH_FLAG_ORIGIN_GIVEN, stratmesh::origin_given)
 STRATMESH_C_SAME(STRATMESH_FLAG_DROP_OUTLIERS, stratmesh::drop_outliers)
 STRATMESH_C_SAME(STRATMESH_FLAG_SURFACE_FLIPS, stratmesh::surface_flips)
 STRATMESH_C_SAME(STRATMESH_FLAG_ENDS_ARE_CUTS, stratmesh::ends_are_cuts)
-STRATMESH_C_SAME(STRATMESH_FLAG_ONE_TUBE, stratmesh::one_tube)
-STRATMESH_C_SAME(STRATMESH_FLAG_KEEP_PARTS, stratmesh::keep_parts)
 STRATMESH_C_SAME(STRATMESH_CLOSED_BOTTOM, stratmesh::closed_bottom)
 STRATMESH_C_SAME(STRATMESH_CLOSED_TOP, stratmesh::closed_top)
 STRATMESH_C_SAME(STRATMESH_PHASE_VALIDATE, stratmesh::Phase::validate)
@@ -13175,10 +13177,13 @@ STRATMESH_C_SAME(STRATMESH_PHASE_TRIANGULATE, stratmesh::Phase::triangulate)
 STRATMESH_C_SAME(STRATMESH_PHASE_STITCH, stratmesh::Phase::stitch)
 STRATMESH_C_SAME(STRATMESH_PHASE_MANIFOLD, stratmesh::Phase::manifold)
 STRATMESH_C_SAME(STRATMESH_PHASE_DONE, stratmesh::Phase::done)
-STRATMESH_C_SAME(STRATMESH_PARTS_ONE_TUBE, stratmesh::PartsOutcome::one_tube)
-STRATMESH_C_SAME(STRATMESH_PARTS_JOINED, stratmesh::PartsOutcome::joined)
-STRATMESH_C_SAME(STRATMESH_PARTS_KEPT_APART, stratmesh::PartsOutcome::kept_apart)
-STRATMESH_C_SAME(STRATMESH_PARTS_UNDONE, stratmesh::PartsOutcome::undone)
+STRATMESH_C_SAME(STRATMESH_PARTS_AUTOMATIC, stratmesh::Parts::automatic)
+STRATMESH_C_SAME(STRATMESH_PARTS_ONE_TUBE, stratmesh::Parts::one_tube)
+STRATMESH_C_SAME(STRATMESH_PARTS_APART, stratmesh::Parts::apart)
+STRATMESH_C_SAME(STRATMESH_PARTS_OUTCOME_ONE_TUBE, stratmesh::PartsOutcome::one_tube)
+STRATMESH_C_SAME(STRATMESH_PARTS_OUTCOME_JOINED, stratmesh::PartsOutcome::joined)
+STRATMESH_C_SAME(STRATMESH_PARTS_OUTCOME_KEPT_APART, stratmesh::PartsOutcome::kept_apart)
+STRATMESH_C_SAME(STRATMESH_PARTS_OUTCOME_UNDONE, stratmesh::PartsOutcome::undone)
 #undef STRATMESH_C_SAME
 static_assert(STRATMESH_WEB_SPACINGS == stratmesh::kWebSpacings,
               "STRATMESH_WEB_SPACINGS differs from stratmesh::kWebSpacings");
@@ -13260,6 +13265,7 @@ static inline Options c_options(const stratmesh_options* c) {
     o.layer_count = c->layer_count;
     o.layer_height = c->layer_height;
     o.flags = c->flags;
+    o.parts = static_cast<Parts>(c->parts);
     for (int i = 0; i < 3; ++i) {
         o.direction[i] = c->direction[i];
         o.origin[i] = c->origin[i];

@@ -139,6 +139,7 @@ struct Layering {
     const double* cuts;    // coordinates along the axis
     size_t cut_count;
     uint32_t flags = 0;    // stratmesh::Options::flags
+    stratmesh::Parts parts = stratmesh::Parts::automatic;
 };
 
 constexpr Layering kNoLayering = {stratmesh::Axis::automatic, 0, nullptr, 0};
@@ -151,7 +152,8 @@ constexpr Layering kAutomaticAlongZ = {stratmesh::Axis::z, 0, nullptr, 0};
 // The library's defaults (Options all zero), and the same without the search for branches
 // or with the flips on the surface: what each costs on top.
 constexpr Layering kDefaults = {stratmesh::Axis::automatic, 0, nullptr, 0};
-constexpr Layering kDefaultsOneTube = {stratmesh::Axis::automatic, 0, nullptr, 0, stratmesh::one_tube};
+constexpr Layering kDefaultsOneTube = {stratmesh::Axis::automatic, 0, nullptr, 0, 0,
+                                       stratmesh::Parts::one_tube};
 constexpr Layering kDefaultsFlipped = {stratmesh::Axis::automatic, 0, nullptr, 0, stratmesh::surface_flips};
 // A hundred equal layers along z (the stream case cuts them itself, between the extremes).
 constexpr Layering kHundredLayers = {stratmesh::Axis::z, 100, nullptr, 0};
@@ -620,6 +622,7 @@ stratmesh::Options reconstruct_options(const Layering& layering, PhaseClock* clo
     options.cut_count = layering.cut_count;
     options.layer_count = layering.layer_count;
     options.flags = layering.flags;
+    options.parts = layering.parts;
     options.progress = note_phase;
     options.progress_user = clock;
     return options;

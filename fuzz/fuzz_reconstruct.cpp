@@ -15,7 +15,7 @@
 //  - one input in kWholeShare: the whole pipeline as a caller gets it: every point, the
 //    automatic axis where the options ask for it, the search for branches;
 //  - one in kAxisShare of the others: the first kQuickPoints points as one tube
-//    (one_tube), the automatic axis where the options ask for it;
+//    (Parts::one_tube), the automatic axis where the options ask for it;
 //  - the rest: the same, along z where the options ask for the automatic axis.
 // Choosing the axis meshes up to six samples and the branch search meshes a cloud that parts
 // twice; with both on every input of up to 512 points the harness ran tens of inputs a
@@ -394,7 +394,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const bool own_axis = whole || (hash >> 9) % kAxisShare == 0;
     const stratmesh_fuzz::FuzzCloud fc = read.first(whole ? read.n : kQuickPoints);
     stratmesh::Options& options = setup.options;
-    if (!whole) options.flags |= stratmesh::one_tube;
+    if (!whole) options.parts = stratmesh::Parts::one_tube;
     if (!own_axis && options.axis == stratmesh::Axis::automatic) options.axis = stratmesh::Axis::z;
     const stratmesh::Cloud cloud = fc.cloud();
     const size_t max_tris = stratmesh::reconstruct_max_triangles(fc.n, options);

@@ -308,7 +308,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     options.cut_count = cuts.size();
     auto run_batch = [&](uint32_t flags) {
         stratmesh::Options o = options;
-        o.flags |= flags | stratmesh::one_tube;  // the stream meshes one tube
+        o.flags |= flags;
+        o.parts = stratmesh::Parts::one_tube;  // the stream meshes one tube
         std::vector<unsigned char> batch_work(stratmesh::reconstruct_workspace_size(m, o));
         std::vector<uint32_t> batch(3 * stratmesh::reconstruct_max_triangles(m, o) + 3);
         size_t batch_count = 0;

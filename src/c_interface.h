@@ -44,8 +44,6 @@ STRATMESH_C_SAME(STRATMESH_FLAG_ORIGIN_GIVEN, stratmesh::origin_given)
 STRATMESH_C_SAME(STRATMESH_FLAG_DROP_OUTLIERS, stratmesh::drop_outliers)
 STRATMESH_C_SAME(STRATMESH_FLAG_SURFACE_FLIPS, stratmesh::surface_flips)
 STRATMESH_C_SAME(STRATMESH_FLAG_ENDS_ARE_CUTS, stratmesh::ends_are_cuts)
-STRATMESH_C_SAME(STRATMESH_FLAG_ONE_TUBE, stratmesh::one_tube)
-STRATMESH_C_SAME(STRATMESH_FLAG_KEEP_PARTS, stratmesh::keep_parts)
 STRATMESH_C_SAME(STRATMESH_CLOSED_BOTTOM, stratmesh::closed_bottom)
 STRATMESH_C_SAME(STRATMESH_CLOSED_TOP, stratmesh::closed_top)
 STRATMESH_C_SAME(STRATMESH_PHASE_VALIDATE, stratmesh::Phase::validate)
@@ -54,10 +52,13 @@ STRATMESH_C_SAME(STRATMESH_PHASE_TRIANGULATE, stratmesh::Phase::triangulate)
 STRATMESH_C_SAME(STRATMESH_PHASE_STITCH, stratmesh::Phase::stitch)
 STRATMESH_C_SAME(STRATMESH_PHASE_MANIFOLD, stratmesh::Phase::manifold)
 STRATMESH_C_SAME(STRATMESH_PHASE_DONE, stratmesh::Phase::done)
-STRATMESH_C_SAME(STRATMESH_PARTS_ONE_TUBE, stratmesh::PartsOutcome::one_tube)
-STRATMESH_C_SAME(STRATMESH_PARTS_JOINED, stratmesh::PartsOutcome::joined)
-STRATMESH_C_SAME(STRATMESH_PARTS_KEPT_APART, stratmesh::PartsOutcome::kept_apart)
-STRATMESH_C_SAME(STRATMESH_PARTS_UNDONE, stratmesh::PartsOutcome::undone)
+STRATMESH_C_SAME(STRATMESH_PARTS_AUTOMATIC, stratmesh::Parts::automatic)
+STRATMESH_C_SAME(STRATMESH_PARTS_ONE_TUBE, stratmesh::Parts::one_tube)
+STRATMESH_C_SAME(STRATMESH_PARTS_APART, stratmesh::Parts::apart)
+STRATMESH_C_SAME(STRATMESH_PARTS_OUTCOME_ONE_TUBE, stratmesh::PartsOutcome::one_tube)
+STRATMESH_C_SAME(STRATMESH_PARTS_OUTCOME_JOINED, stratmesh::PartsOutcome::joined)
+STRATMESH_C_SAME(STRATMESH_PARTS_OUTCOME_KEPT_APART, stratmesh::PartsOutcome::kept_apart)
+STRATMESH_C_SAME(STRATMESH_PARTS_OUTCOME_UNDONE, stratmesh::PartsOutcome::undone)
 #undef STRATMESH_C_SAME
 static_assert(STRATMESH_WEB_SPACINGS == stratmesh::kWebSpacings,
               "STRATMESH_WEB_SPACINGS differs from stratmesh::kWebSpacings");
@@ -139,6 +140,7 @@ static inline Options c_options(const stratmesh_options* c) {
     o.layer_count = c->layer_count;
     o.layer_height = c->layer_height;
     o.flags = c->flags;
+    o.parts = static_cast<Parts>(c->parts);
     for (int i = 0; i < 3; ++i) {
         o.direction[i] = c->direction[i];
         o.origin[i] = c->origin[i];

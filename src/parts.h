@@ -6,7 +6,7 @@
 // points labelled kInTrunk) is meshed along the cloud's axis, each branch as a tube of its
 // own around its own automatic axis, and join_branches() zips them into one surface (caps
 // last, with add_caps, once joined). That is kept only when it is whole: every part
-// meshed, every side joined, every point in a part; otherwise, unless keep_parts, the cloud
+// meshed, every side joined, every point in a part; otherwise, unless Parts::apart, the cloud
 // is meshed as one tube after all (PartsOutcome::undone). A part is meshed in place: the
 // points of the other parts join the outliers in the reader's bitmap, so its triangles
 // index the cloud directly and its frame is the one a copy of its points would get.
@@ -307,7 +307,7 @@ static inline Status one_tube_area(const TubeInput& in, const TubeRequest& reque
                             Arena& arena, uint32_t* triangles, size_t capacity,
                             const Report& before, double* area) {
     *area = DBL_MAX;
-    if (request.parts == PartsPolicy::keep || !all_in_parts) return Status::ok;
+    if (request.parts == Parts::apart || !all_in_parts) return Status::ok;
     Report tube = before;
     size_t count = 0;
     const size_t mark = arena.mark();
@@ -458,7 +458,7 @@ static inline Status join_parts(const Cloud& cloud, const PartsWork& w, bool who
     rep.parts.removed_triangle_count = join.removed_triangle_count;
     if (!rep.detail) rep.detail = join.detail;
     whole = whole && status == Status::ok && join.apart_side_count == 0;
-    if (!whole && w.cut.parts != PartsPolicy::keep) {
+    if (!whole && w.cut.parts != Parts::apart) {
         rep.parts.outcome = PartsOutcome::undone;
         return Status::ok;
     }

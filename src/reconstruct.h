@@ -30,7 +30,7 @@ static inline Status read_cloud(const Cloud& cloud, const Options& options, Aren
 
 // Whether reconstruct() looks for branches.
 static inline bool searches_parts(const TubeRequest& request) {
-    return kFindParts && request.parts != PartsPolicy::one_tube;
+    return kFindParts && request.parts != Parts::one_tube;
 }
 
 static inline Status mesh_cloud(const Cloud& cloud, const TubeInput& in, const TubeRequest& request,

@@ -19,13 +19,6 @@ struct LayerRequest {
     double height;
 };
 
-// What reconstruct() does where the cloud parts into branches (see PartCounts).
-enum class PartsPolicy : uint32_t {
-    compare,   // the parts joined where whole and smaller than one tube, else the one tube
-    one_tube,  // one tube, without a search (the one_tube flag)
-    keep,      // the parts, joined where they can be (the keep_parts flag)
-};
-
 struct TubeRequest {
     Axis axis;              // Axis::automatic until resolve_axis() chooses
     double direction[3];    // with Axis::direction
@@ -35,7 +28,7 @@ struct TubeRequest {
     bool surface_flips;
     bool drop_outliers;     // the cloud is read without its outliers
     const double* origin;   // the frame's reference point, or null for the centroid
-    PartsPolicy parts;
+    Parts parts;            // Parts::one_tube where this build cannot look for parts
     // The caller's Options: its job runner, or null for none (an axis trial).
     const Options* caller;
     // The Options whose progress callback is told, or null: none (a branch, whose progress
@@ -45,9 +38,6 @@ struct TubeRequest {
 
 static inline TubeRequest tube_request(const Options& options) {
     const uint32_t f = options.flags;
-    const PartsPolicy parts = !kFindParts || (f & one_tube) ? PartsPolicy::one_tube
-                              : (f & keep_parts) ? PartsPolicy::keep
-                                                 : PartsPolicy::compare;
     return {options.axis,
             {options.direction[0], options.direction[1], options.direction[2]},
             {options.cuts, options.cut_count, options.layer_count, options.layer_height},
@@ -56,7 +46,7 @@ static inline TubeRequest tube_request(const Options& options) {
             kSurfaceFlips && (f & surface_flips),
             kDropOutliers && (f & drop_outliers),
             (f & origin_given) ? options.origin : nullptr,
-            parts,
+            kFindParts ? options.parts : Parts::one_tube,
             &options,
             &options};
 }

@@ -36,6 +36,7 @@ stratmesh_options to_c(const Options& o) {
     c.layer_count = o.layer_count;
     c.layer_height = o.layer_height;
     c.flags = o.flags;
+    c.parts = static_cast<uint32_t>(o.parts);
     return c;
 }
 
@@ -184,7 +185,7 @@ TEST_CASE("C interface: reconstruct gives the C++ triangles and report") {
     // A fork meshed as one tube spans the gap between its prongs: the web fields too.
     const Shape fork = shapes::forked_tube(3000, Pose::z);
     Options one = {};
-    one.flags = stratmesh::one_tube;
+    one.parts = stratmesh::Parts::one_tube;
     CHECK(check_same_reconstruction(fork, one).diagnostics.web_triangle_count > 0);
 }
 

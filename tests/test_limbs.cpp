@@ -80,7 +80,7 @@ TEST_CASE("limbs: a Y of tubes meshed along its trunk is one oriented manifold t
     check_joined_y(check(y, m), 0.05);
     // One tube along z wraps both arms.
     Options wrapped = along_z();
-    wrapped.flags = stratmesh::one_tube;
+    wrapped.parts = stratmesh::Parts::one_tube;
     const Meshed tube = mesh(y.xyz, wrapped);
     REQUIRE(tube.status == Status::ok);
     CHECK(check(y, tube).max_deviation() > 0.3);
@@ -202,7 +202,7 @@ TEST_CASE("limbs: parts joined are kept only where their surface is smaller than
             const Meshed m = mesh(s.xyz, options);
             REQUIRE(m.status == Status::ok);
             CHECK(m.report.workspace_used_bytes <= m.bound);
-            options.flags |= stratmesh::one_tube;
+            options.parts = stratmesh::Parts::one_tube;
             const Meshed tube = mesh(s.xyz, options);
             REQUIRE(tube.status == Status::ok);
             switch (m.report.parts.outcome) {

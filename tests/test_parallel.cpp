@@ -211,7 +211,7 @@ TEST_CASE("parallel layers: a workspace too small for the jobs falls back to wor
     const Shape s = shapes::bumpy_tube(4000, Pose::z);
     Options o = axis_options(s);
     o.layer_count = 8;
-    o.flags |= stratmesh::one_tube;  // the search for branches would take more room
+    o.parts = stratmesh::Parts::one_tube;  // the search for branches would take more room
     const Result sequential = run(s, o);
     Options p = o;
     p.run_jobs = run_in_order;

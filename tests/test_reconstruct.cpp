@@ -1544,7 +1544,7 @@ TEST_CASE("a crescent end layer joins its neighbour, a half cylinder keeps its l
 
 namespace {
 
-// Reconstructs s as one tube (the one_tube flag) in `planned` layers along its axis and
+// Reconstructs s as one tube (Parts::one_tube) in `planned` layers along its axis and
 // checks what every run must give:
 // ok, one manifold tube (one component, two boundary loops) through every point. The mesh
 // check (with self-intersections if asked) goes to *m; `flags` are added to the options.
@@ -1552,7 +1552,8 @@ Run reconstruct_tube(const Shape& s, uint32_t planned, bool self_intersections, 
                      uint32_t flags = 0) {
     Options o = axis_options(s);
     o.layer_count = planned;
-    o.flags |= flags | stratmesh::one_tube;
+    o.flags |= flags;
+    o.parts = stratmesh::Parts::one_tube;
     Run run = reconstruct_guarded(cloud_of(s), o);
     REQUIRE(run.status == Status::ok);
     CHECK(run.report.points.unused_count == 0);

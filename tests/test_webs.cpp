@@ -258,7 +258,7 @@ TEST_CASE("webs: the same report with a job runner, and at every magnitude") {
     // (Along a given axis and as one tube: the same triangles at every magnitude.)
     Options along = {};
     along.axis = stratmesh::Axis::z;
-    along.flags = stratmesh::one_tube;
+    along.parts = stratmesh::Parts::one_tube;
     const Mesh unit = mesh(fork.xyz, along);
     REQUIRE(unit.status == Status::ok);
     REQUIRE(unit.report.diagnostics.web_triangle_count > 0);
@@ -280,7 +280,7 @@ TEST_CASE("webs: the same report with a job runner, and at every magnitude") {
 }
 
 TEST_CASE("webs: the stream does not measure them, reconstruct() of the same tube does") {
-    // One push: one layer, the tube reconstruct() gives with one_tube and a single layer.
+    // One push: one layer, the tube reconstruct() gives with Parts::one_tube and a single layer.
     const Shape fork = shapes::y_of_tubes(3000, Pose::z);
     Options o = {};
     o.axis = stratmesh::Axis::z;
@@ -302,7 +302,7 @@ TEST_CASE("webs: the stream does not measure them, reconstruct() of the same tub
     CHECK(std::memcmp(&report.diagnostics.web_triangle_count, &none.web_triangle_count,
                       sizeof(Diagnostics) - offsetof(Diagnostics, web_triangle_count)) == 0);
     CHECK(recompute(fork.xyz, triangles, 0).count > 0);
-    o.flags = stratmesh::one_tube;
+    o.parts = stratmesh::Parts::one_tube;
     o.layer_count = 1;
     const Mesh batch = mesh(fork.xyz, o);
     REQUIRE(batch.status == Status::ok);

@@ -80,13 +80,15 @@ const char kUsage[] =
     "                        otherwise meshed across from a pole): both are unrolled on\n"
     "                        the cylinder like the rest; for a cloud cut out of a larger\n"
     "                        object (stratmesh's ends_are_cuts)\n"
-    "  --one-tube            do not look for branches (see Branches below): one tube\n"
-    "                        through every point\n"
-    "  --branches            only find and report where the cloud parts (summary and\n"
-    "                        report), and mesh one tube\n"
-    "  --split-branches      keep the parts even where a side cannot be joined (left\n"
+    "  --parts automatic|one-tube|apart  where the cloud parts into branches (see\n"
+    "                        Branches below): automatic (the default) looks and joins\n"
+    "                        the parts where that is whole and smaller than one tube;\n"
+    "                        one-tube does not look: one tube through every point; apart\n"
+    "                        keeps the parts even where a side cannot be joined (left\n"
     "                        apart, as the summary says) or points past a cut are in no\n"
     "                        branch (left unused)\n"
+    "  --branches            only find and report where the cloud parts (summary and\n"
+    "                        report), and mesh one tube\n"
     "  --cap                 close the tube's ends with caps over its boundary loops: a\n"
     "                        closed, watertight surface (a loop that cannot be capped\n"
     "                        stays open; the summary and the report count it). Parts\n"
@@ -259,6 +261,19 @@ bool parse_format(std::string_view text, CommandLine& line, std::string& error) 
     return false;
 }
 
+bool parse_parts(std::string_view text, CommandLine& line, std::string& error) {
+    const stratmesh::Parts choices[] = {stratmesh::Parts::automatic, stratmesh::Parts::one_tube,
+                                        stratmesh::Parts::apart};
+    for (stratmesh::Parts parts : choices)
+        if (text == parts_name(parts)) {
+            line.parts = parts;
+            line.parts_given = true;
+            return true;
+        }
+    error = "--parts: expected automatic, one-tube or apart, not '" + std::string(text) + "'";
+    return false;
+}
+
 bool parse_cuts(std::string_view text, CommandLine& line, std::string& error) {
     if (parse_number_list(text, line.cuts)) return true;
     error = "--cuts: expected numbers separated by commas, not '" + std::string(text) + "'";
@@ -279,6 +294,7 @@ bool apply_valued(std::string_view name, std::string_view value, CommandLine& li
     if (name == "--stream-points") return parse_stream_points(value, line, error);
     if (name == "--origin") return parse_origin(value, line, error);
     if (name == "--format") return parse_format(value, line, error);
+    if (name == "--parts") return parse_parts(value, line, error);
     if (value.empty()) error = std::string(name) + ": the file name is empty";
     return error.empty();
 }
@@ -292,8 +308,6 @@ bool apply_flag(std::string_view name, CommandLine& line) {
     if (name == "--surface-flips") line.surface_flips = true;
     if (name == "--ends-are-cuts") line.ends_are_cuts = true;
     if (name == "--branches") line.find_branches = true;
-    if (name == "--split-branches") line.split_branches = true;
-    if (name == "--one-tube") line.one_tube = true;
     if (name == "--quiet") line.quiet = true;
     if (name == "--verbose") line.verbose = true;
     if (name == "--strict") line.strict = true;
@@ -304,12 +318,11 @@ bool apply_flag(std::string_view name, CommandLine& line) {
 const char* const kValuedOptions[] = {"--output",  "--report",        "--axis",
                                       "--cuts",    "--layers",        "--layer-height",
                                       "--threads", "--stream-points", "--origin",
-                                      "--format",  "--preview"};
+                                      "--format",  "--preview",       "--parts"};
 const char* const kFlags[] = {"--ascii", "--skip-invalid", "--cap",     "--quiet",
                               "--help",  "--version",      "--stream", "--drop-outliers",
                               "--surface-flips", "--ends-are-cuts", "--branches",
-                              "--split-branches", "--one-tube", "--verbose", "--strict",
-                              "--no-attributes"};
+                              "--verbose", "--strict", "--no-attributes"};
 
 // What --stream cannot do, or an empty string.
 std::string stream_conflict(const CommandLine& line) {
@@ -322,8 +335,8 @@ std::string stream_conflict(const CommandLine& line) {
     if (line.drop_outliers)
         return "--stream cannot --drop-outliers: an outlier is told from the whole cloud's "
                "spacing, which the stream never holds";
-    if (line.find_branches || line.split_branches)
-        return "--stream cannot find --branches (nor --split-branches): where a cloud parts "
+    if (line.find_branches || line.parts == stratmesh::Parts::apart)
+        return "--stream cannot find --branches (nor --parts apart): where a cloud parts "
                "is told from all of its points, which the stream never holds";
     if (!line.preview.empty())
         return "--stream cannot --preview: it writes the triangles as they come and keeps "
@@ -462,8 +475,9 @@ private:
         if (line_.quiet && line_.verbose) return fail("give at most one of --quiet and --verbose");
         if (layer_choices > 1)
             return fail("give at most one of --cuts, --layers and --layer-height");
-        if (int(line_.find_branches) + int(line_.split_branches) + int(line_.one_tube) > 1)
-            return fail("give at most one of --branches, --split-branches and --one-tube");
+        if (line_.find_branches && line_.parts_given)
+            return fail("give at most one of --branches and --parts: --branches meshes one "
+                        "tube");
         if (line_.stream) fail(stream_conflict(line_));
     }
 
@@ -510,6 +524,15 @@ const char* axis_name(stratmesh::Axis axis) {
                  {stratmesh::Axis::direction, "direction"}};
     for (const auto& n : names)
         if (n.axis == axis) return n.name;
+    return "unknown";
+}
+
+const char* parts_name(stratmesh::Parts parts) {
+    switch (parts) {
+        case stratmesh::Parts::automatic: return "automatic";
+        case stratmesh::Parts::one_tube: return "one-tube";
+        case stratmesh::Parts::apart: return "apart";
+    }
     return "unknown";
 }
 

@@ -31,12 +31,13 @@ struct CommandLine {
     bool drop_outliers = false;    // --drop-outliers (stratmesh::drop_outliers)
     bool surface_flips = false;    // --surface-flips (stratmesh::surface_flips)
     bool ends_are_cuts = false;    // --ends-are-cuts (stratmesh::ends_are_cuts)
-    // Where the cloud parts into branches (stratmesh::find_parting). Without any of these
-    // three the tool looks, meshes the parts apart and joins them, and keeps that only if
-    // every part was meshed and joined (else one tube, see main.cpp).
+    // Where the cloud parts into branches (stratmesh::find_parting). By default the tool
+    // looks, meshes the parts apart and joins them, and keeps that only if every part was
+    // meshed and joined (else one tube, see main.cpp).
     bool find_branches = false;    // --branches: only find and report where it parts
-    bool split_branches = false;   // --split-branches: keep the parts, joined or apart
-    bool one_tube = false;         // --one-tube: do not look; one tube through every point
+    // --parts automatic|one-tube|apart (stratmesh::Options::parts)
+    stratmesh::Parts parts = stratmesh::Parts::automatic;
+    bool parts_given = false;
     bool quiet = false;             // no summary (warnings and errors still)
     bool verbose = false;           // --verbose: timings, memory and details in the summary
     bool strict = false;            // --strict: warnings give an exit status of their own
@@ -64,6 +65,9 @@ const char* usage_text();
 
 // "automatic", "x", "y", "z" or "direction".
 const char* axis_name(stratmesh::Axis axis);
+
+// --parts' spelling: "automatic", "one-tube" or "apart".
+const char* parts_name(stratmesh::Parts parts);
 
 } // namespace stratmesh_cli
 

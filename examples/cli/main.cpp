@@ -89,8 +89,7 @@ void record_command_line(const CommandLine& line, RunRecord& record) {
     record.surface_flips = line.surface_flips;
     record.ends_are_cuts = line.ends_are_cuts;
     record.find_branches = line.find_branches;
-    record.split_branches = line.split_branches;
-    record.one_tube = line.one_tube;
+    record.parts_option = line.parts;
     record.threads = line.threads;
     record.origin_given = line.origin_given || line.stream;
     for (size_t k = 0; k < 3; ++k) record.origin[k] = line.origin[k];
@@ -109,9 +108,8 @@ stratmesh::Options make_options(const CommandLine& line, ProgressMonitor& monito
                     (line.cap ? stratmesh::add_caps : 0u) |
                     (line.drop_outliers ? stratmesh::drop_outliers : 0u) |
                     (line.surface_flips ? stratmesh::surface_flips : 0u) |
-                    (line.ends_are_cuts ? stratmesh::ends_are_cuts : 0u) |
-                    (line.one_tube || line.find_branches ? stratmesh::one_tube : 0u) |
-                    (line.split_branches ? stratmesh::keep_parts : 0u);
+                    (line.ends_are_cuts ? stratmesh::ends_are_cuts : 0u);
+    options.parts = line.find_branches ? stratmesh::Parts::one_tube : line.parts;
     options.progress = &ProgressMonitor::callback;
     options.progress_user = &monitor;
     if (line.origin_given) {

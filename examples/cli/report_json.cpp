@@ -1,5 +1,6 @@
 #include "report_json.h"
 
+#include "args.h"
 #include "safe_output.h"
 #include "summary.h"
 
@@ -208,8 +209,7 @@ void write_options(JsonWriter& j, const RunRecord& r) {
     j.flag_field("surface_flips", r.surface_flips);
     j.flag_field("ends_are_cuts", r.ends_are_cuts);
     j.flag_field("branches", r.find_branches);
-    j.flag_field("split_branches", r.split_branches);
-    j.flag_field("one_tube", r.one_tube);
+    j.text_field("parts", parts_name(r.parts_option));
     j.count_field("threads", r.threads);
     j.flag_field("stream", r.stream);
     j.key("stream_points");
@@ -472,7 +472,7 @@ RunRecord::RunRecord() {
 
 void RunRecord::take_parts(const stratmesh::PartCounts& parts,
                            const std::vector<stratmesh::PartInfo>& filled) {
-    if (!one_tube && !find_branches) {
+    if (parts_option != stratmesh::Parts::one_tube && !find_branches) {
         parting_run = true;
         parting = parts.parting;
     }

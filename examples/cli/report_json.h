@@ -41,8 +41,7 @@ struct RunRecord {
     bool surface_flips = false;
     bool ends_are_cuts = false;
     bool find_branches = false;
-    bool split_branches = false;
-    bool one_tube = false;
+    stratmesh::Parts parts_option = stratmesh::Parts::automatic;  // --parts
     uint32_t threads = 1;
     bool origin_given = false;
     double origin[3] = {0, 0, 0};

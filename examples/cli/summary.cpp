@@ -15,8 +15,7 @@ std::string in_tool_words(const char* library_sentence) {
         const char* tool;
     } kWords[] = {{"drop_outliers", "--drop-outliers"}, {"skip_invalid_points", "--skip-invalid"},
                   {"add_caps", "--cap"}, {"ends_are_cuts", "--ends-are-cuts"},
-                  {"surface_flips", "--surface-flips"}, {"one_tube", "--one-tube"},
-                  {"keep_parts", "--split-branches"}};
+                  {"surface_flips", "--surface-flips"}};
     std::string text = library_sentence ? library_sentence : "";
     for (const auto& w : kWords) {
         const std::string from = w.library;
@@ -255,7 +254,7 @@ std::string branches_warning(const RunRecord& r) {
     if (r.split_undone)
         return "the cloud parts into branches (" + where +
                ") but the parts were not kept: meshed as one tube instead, which wraps the "
-               "branches and the gaps between them (--verbose says why; --split-branches "
+               "branches and the gaps between them (--verbose says why; --parts apart "
                "keeps the parts)";
     if (r.junction.apart_side_count > 0 || r.junction_status != stratmesh::Status::ok)
         return "branches left apart from the trunk, not joined (" + where +
@@ -348,7 +347,7 @@ void print_split(std::FILE* out, const RunRecord& r) {
     if (j.detail)
         std::fprintf(out, "             %s%s\n", j.joined_side_count ? "" : "left apart: ", j.detail);
     if (r.split_undone)
-        std::fprintf(out, "             not kept%s%s: meshed as one tube instead (--split-branches "
+        std::fprintf(out, "             not kept%s%s: meshed as one tube instead (--parts apart "
                           "keeps the parts)\n",
                      r.report.detail ? ", " : "", in_tool_words(r.report.detail).c_str());
 }

@@ -44,7 +44,7 @@ int main() {
     options.layer_count = kLayers;
     // One tube, as the reduced build meshes it: no search for branches, whose room the
     // bounds would otherwise include in a full build.
-    options.flags = stratmesh::one_tube;
+    options.parts = stratmesh::Parts::one_tube;
 
     // The startup check: the constants above against the library's own bounds.
     if (stratmesh::reconstruct_workspace_size(kCloudPoints, options) > sizeof g_workspace) return 1;

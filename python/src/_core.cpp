@@ -52,8 +52,17 @@ const FlagName kFlags[] = {
     {"drop_outliers", stratmesh::drop_outliers},
     {"surface_flips", stratmesh::surface_flips},
     {"ends_are_cuts", stratmesh::ends_are_cuts},
-    {"one_tube", stratmesh::one_tube},
-    {"keep_parts", stratmesh::keep_parts},
+};
+
+// The Parts values by their names in the header (parts="...").
+struct PartsName {
+    const char* name;
+    stratmesh::Parts parts;
+};
+const PartsName kParts[] = {
+    {"automatic", stratmesh::Parts::automatic},
+    {"one_tube", stratmesh::Parts::one_tube},
+    {"apart", stratmesh::Parts::apart},
 };
 
 const char* phase_name(stratmesh::Phase phase) {
@@ -234,6 +243,7 @@ void read_options(const py::dict& d, OptionSet& set) {
     o.layer_count = d["layer_count"].cast<uint32_t>();
     o.layer_height = d["layer_height"].cast<double>();
     o.flags = d["flags"].cast<uint32_t>();
+    o.parts = static_cast<stratmesh::Parts>(d["parts"].cast<uint32_t>());
     set.threads = d["threads"].cast<unsigned>();
 }
 
@@ -492,6 +502,9 @@ PYBIND11_MODULE(_core, m) {
     py::dict flags;
     for (const FlagName& f : kFlags) flags[f.name] = f.bit;
     m.attr("FLAGS") = flags;
+    py::dict parts;
+    for (const PartsName& p : kParts) parts[p.name] = static_cast<uint32_t>(p.parts);
+    m.attr("PARTS") = parts;
     py::dict statuses;
 #define STRATMESH_PY_ENTRY(name, message) statuses[#name] = message;
     STRATMESH_STATUS_LIST(STRATMESH_PY_ENTRY)

@@ -13,12 +13,14 @@ from ._error import ArgumentTypeError, Error
 Error.__module__ = __name__  # shown as stratmesh.Error, where users catch it
 ArgumentTypeError.__module__ = __name__
 
-__all__ = ["ArgumentTypeError", "Error", "FLAGS", "STATUSES", "Stream", "Workspace", "cap_ends",
-           "reconstruct", "stream_workspace_size"]
+__all__ = ["ArgumentTypeError", "Error", "FLAGS", "PARTS", "STATUSES", "Stream", "Workspace",
+           "cap_ends", "reconstruct", "stream_workspace_size"]
 __version__ = _core.__version__
 
 #: The library's Flags bits by name; flags=(...) accepts any of them.
 FLAGS = dict(_core.FLAGS)
+#: The library's Parts values by name; parts="..." accepts any of them.
+PARTS = dict(_core.PARTS)
 #: Every status name with its one-line explanation.
 STATUSES = dict(_core.STATUSES)
 
@@ -38,8 +40,7 @@ _DIRECTION = 4
 # Each keyword that sets one flag, with that flag's name.
 _SWITCHES = {"cap": "add_caps", "skip_invalid": "skip_invalid_points",
              "drop_outliers": "drop_outliers", "surface_flips": "surface_flips",
-             "ends_are_cuts": "ends_are_cuts", "one_tube": "one_tube",
-             "keep_parts": "keep_parts"}
+             "ends_are_cuts": "ends_are_cuts"}
 _MOST_THREADS = 2**32 - 1     # the binding counts threads in an unsigned
 _MOST_LAYERS = 2**32 - 1      # Options::layer_count is a uint32_t
 _LEAST_HELD = 16              # the fewest points a stream's workspace holds
@@ -59,7 +60,7 @@ def _flag_bits(flags, switches, refused):
 
 
 def _options(axis="auto", cuts=None, layers=0, layer_height=0.0, origin=None, threads=1,
-             flags=(), refused=(), automatic=True, **switches):
+             flags=(), refused=(), automatic=True, parts="automatic", **switches):
     """The options dict _core reads, every value checked; switches are the keywords of
     _SWITCHES."""
     name, direction = _check.direction(axis, automatic)
@@ -75,6 +76,7 @@ def _options(axis="auto", cuts=None, layers=0, layer_height=0.0, origin=None, th
         "layer_count": _check.whole("layers", layers, 0, _MOST_LAYERS, "invalid_layers"),
         "layer_height": _check.real("layer_height", layer_height, "invalid_layers", "from 0"),
         "flags": bits,
+        "parts": _check.choice("parts", parts, PARTS),
         "origin": (0.0, 0.0, 0.0) if origin is None else origin,
         "threads": threads or (os.cpu_count() or 1),
     }
@@ -83,8 +85,8 @@ def _options(axis="auto", cuts=None, layers=0, layer_height=0.0, origin=None, th
 @_check.signature_checked
 def reconstruct(points, *, axis="auto", cuts=None, layers=0, layer_height=0.0, cap=False,
                 skip_invalid=False, drop_outliers=False, surface_flips=False,
-                ends_are_cuts=False, one_tube=False, keep_parts=False, origin=None, threads=1,
-                progress=None, flags=(), copy=True, workspace=None):
+                ends_are_cuts=False, parts="automatic", origin=None, threads=1, progress=None,
+                flags=(), copy=True, workspace=None):
     """Meshes a columnar cloud; returns (triangles, report).
 
     points         (n, 3) float32 or float64. Read in place when each point's x, y, z are
@@ -95,8 +97,12 @@ def reconstruct(points, *, axis="auto", cuts=None, layers=0, layer_height=0.0, c
                    start; else layers equal layers; else layers of about layer_height (a
                    finite number from 0); else the library's automatic layers.
     cap            close the tube's ends (the add_caps flag).
-    skip_invalid, drop_outliers, surface_flips, ends_are_cuts, one_tube, keep_parts
+    skip_invalid, drop_outliers, surface_flips, ends_are_cuts
                    the flags of the same names (skip_invalid: skip_invalid_points).
+    parts          where the cloud parts into branches: "automatic" (look, join the parts,
+                   keep them where whole and smaller than one tube), "one_tube" (do not
+                   look) or "apart" (keep the parts, joined where they can be): the keys
+                   of stratmesh.PARTS.
     origin         the frame's reference point, 3 finite numbers (sets origin_given).
     threads        the layers are triangulated on this many threads (0: one per core); the
                    triangles are the same bytes for any number.
@@ -104,16 +110,16 @@ def reconstruct(points, *, axis="auto", cuts=None, layers=0, layer_height=0.0, c
     flags          more flags: a sequence of names, keys of stratmesh.FLAGS.
     workspace      a stratmesh.Workspace to reuse; by default each call allocates its own.
 
-    The switches (cap, ..., copy) take True or False, the counts (layers, threads) integers.
+    The switches (cap, ..., ends_are_cuts, copy) take True or False, the counts (layers,
+    threads) integers.
     triangles is an (m, 3) uint32 array of indices into points; report a namespace with
     status, triangle_count, axis, axis_origin and the groups points, layers, caps, parts,
     diagnostics, then detail and workspace_used_bytes. Any refusal raises stratmesh.Error
     (ArgumentTypeError, also a TypeError, for an argument of the wrong type).
     """
-    options = _options(axis, cuts, layers, layer_height, origin, threads, flags, cap=cap,
-                       skip_invalid=skip_invalid, drop_outliers=drop_outliers,
-                       surface_flips=surface_flips, ends_are_cuts=ends_are_cuts,
-                       one_tube=one_tube, keep_parts=keep_parts)
+    options = _options(axis, cuts, layers, layer_height, origin, threads, flags, parts=parts,
+                       cap=cap, skip_invalid=skip_invalid, drop_outliers=drop_outliers,
+                       surface_flips=surface_flips, ends_are_cuts=ends_are_cuts)
     progress = _check.optional_callable("progress", progress)
     if workspace is not None:
         _check.instance("workspace", workspace, Workspace, "a stratmesh.Workspace or None")

@@ -165,6 +165,16 @@ def flag_names(value, refused=()):
     return names
 
 
+def choice(name, value, choices):
+    """A name among the keys of choices, as its value."""
+    what = " or ".join(repr(n) for n in choices)
+    if not isinstance(value, str):
+        raise must(wrong_type, "invalid_argument", name, what, value)
+    if value not in choices:
+        raise must(refuse, "invalid_argument", name, what, value)
+    return choices[value]
+
+
 def optional_callable(name, value):
     if value is not None and not callable(value):
         raise must(wrong_type, "invalid_argument", name, "callable or None", value)

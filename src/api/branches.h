@@ -98,8 +98,8 @@ struct JoinReport {
     size_t grafted_branch_count;     // branches joined through a hole in the trunk's closed end
     size_t junction_triangle_count;  // triangles the junctions added
     size_t removed_triangle_count;   // the trunk's triangles the holes took out
-    size_t workspace_used_bytes;      // peak workspace bytes, from the start of the buffer
-    const char* detail;         // a static sentence on why, on failure or a side left apart
+    size_t workspace_used_bytes;     // peak workspace bytes, from the start of the buffer
+    const char* detail;              // a static sentence on why, on failure or a side left apart
 };
 
 // Bytes of workspace join_branches() needs for a surface of triangle_count triangles over

@@ -81,10 +81,16 @@ enum stratmesh_flags {
     STRATMESH_FLAG_ORIGIN_GIVEN = 1 << 2,
     STRATMESH_FLAG_DROP_OUTLIERS = 1 << 3,
     STRATMESH_FLAG_SURFACE_FLIPS = 1 << 4,
-    STRATMESH_FLAG_ENDS_ARE_CUTS = 1 << 5,
-    STRATMESH_FLAG_ONE_TUBE = 1 << 6,
-    STRATMESH_FLAG_KEEP_PARTS = 1 << 7
+    STRATMESH_FLAG_ENDS_ARE_CUTS = 1 << 5
 };
+
+// stratmesh::Parts: what reconstruction meshes where the cloud parts into branches
+// (stratmesh_options::parts).
+typedef enum stratmesh_parts {
+    STRATMESH_PARTS_AUTOMATIC = 0,
+    STRATMESH_PARTS_ONE_TUBE,
+    STRATMESH_PARTS_APART
+} stratmesh_parts;
 
 // stratmesh::ClosedEnd: bits of stratmesh_layer_info::closed_ends.
 enum stratmesh_closed_end {
@@ -105,10 +111,10 @@ typedef enum stratmesh_phase {
 // stratmesh::PartsOutcome: how reconstruction met a cloud that parts into branches
 // (stratmesh_part_counts::outcome).
 typedef enum stratmesh_parts_outcome {
-    STRATMESH_PARTS_ONE_TUBE = 0,
-    STRATMESH_PARTS_JOINED,
-    STRATMESH_PARTS_KEPT_APART,
-    STRATMESH_PARTS_UNDONE
+    STRATMESH_PARTS_OUTCOME_ONE_TUBE = 0,
+    STRATMESH_PARTS_OUTCOME_JOINED,
+    STRATMESH_PARTS_OUTCOME_KEPT_APART,
+    STRATMESH_PARTS_OUTCOME_UNDONE
 } stratmesh_parts_outcome;
 
 // The name of a status (a stratmesh_status value) and a one-line explanation
@@ -175,6 +181,7 @@ typedef struct stratmesh_options {
     uint32_t layer_count;           // else equal-height layers
     double layer_height;            // else layers of about this height; else automatic
     uint32_t flags;                 // stratmesh_flags bits
+    uint32_t parts;                 // stratmesh_parts
     double origin[3];               // with STRATMESH_FLAG_ORIGIN_GIVEN
     // Optional: called with each phase as it starts and with the fraction done; must not
     // call back into stratmesh.

@@ -84,8 +84,8 @@
 //                            - what only makes it faster (parallel layers, the safety
 //                              net's shortcut, the staging of grouped points, the
 //                              predicates' integer stages): same bytes, slower;
-//                            - the search for branches (as if one_tube were always
-//                              given), the automatic axis (Axis::automatic returns
+//                            - the search for branches (as if Options::parts were
+//                              always Parts::one_tube), the automatic axis (Axis::automatic returns
 //                              Status::not_compiled), the check for a degenerate
 //                              cloud, find_parting(), join_branches() and cap_ends()
 //                              (not declared);

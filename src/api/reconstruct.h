@@ -79,14 +79,20 @@ enum Flags : uint32_t {
     // interest, a branch meshed on its own), whose ends are cuts however many points lie
     // across them. The reduced build, which has no closed ends, returns not_compiled.
     ends_are_cuts = 1u << 5,
-    // reconstruct() meshes the cloud as one tube without looking for where it parts into
-    // branches (see PartCounts): the paper's single column, and the search's time saved
-    // (a few percent on a cloud that does not part). The stream always meshes one tube.
-    one_tube = 1u << 6,
-    // reconstruct() keeps the trunk and branches meshed apart even where a side could not
-    // be joined or points past a cut belong to no branch (left apart or unused, as
-    // Report::parts says), instead of meshing the cloud as one tube then.
-    keep_parts = 1u << 7,
+};
+
+// What reconstruct() meshes where the cloud parts into branches (Options::parts; see
+// PartCounts and find_parting()). The stream and the reduced build (STRATMESH_SMALL_CODE)
+// always mesh one tube.
+enum class Parts : uint32_t {
+    // Looks for where the cloud parts, meshes the trunk and its branches apart and joins
+    // them; keeps that where it is whole and smaller than one tube, else meshes one tube.
+    automatic = 0,
+    // One tube through every point, without looking: the paper's single column.
+    one_tube,
+    // The parts, joined where they can be, kept even where a side could not be joined or
+    // points past a cut belong to no branch (left apart or unused, as Report::parts says).
+    apart,
 };
 
 // Phases reported to Options::progress, in the order they run. Each layer is stitched to
@@ -131,6 +137,7 @@ struct Options {
     uint32_t layer_count;
     double layer_height;
     uint32_t flags;          // Flags bits
+    Parts parts;
     double origin[3];        // with the origin_given flag
     // Optional progress callback: called with each phase as it starts, and with the
     // fraction of that phase done from time to time. Must not call back into stratmesh.

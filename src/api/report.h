@@ -40,9 +40,9 @@ const uint8_t kBeyondBranches = 255;
 
 // How reconstruct() met a cloud that parts into branches (PartCounts::outcome).
 enum class PartsOutcome : uint32_t {
-    one_tube = 0,  // one tube through every point: nothing parts, or the one_tube flag
+    one_tube = 0,  // one tube through every point: nothing parts, or Parts::one_tube
     joined,        // the trunk and its branches meshed apart and joined into one surface
-    kept_apart,    // with keep_parts: meshed apart, kept though not all joined
+    kept_apart,    // with Parts::apart: meshed apart, kept though not all joined
     undone,        // meshed apart, but a side could not be joined, a part was refused,
                    // points belong to no part, or the joined surface was no smaller than
                    // the one tube's: meshed as one tube instead
@@ -64,8 +64,8 @@ struct PartInfo {
 // Report::parts.
 struct PartCounts {
     PartsOutcome outcome;
-    Parting parting;         // where the cloud parts along Report::axis (all zero with the
-                             // one_tube flag)
+    Parting parting;         // where the cloud parts along Report::axis (all zero with
+                             // Parts::one_tube)
     size_t part_count;       // parts meshed apart: the trunk and its branches (0: one tube)
     size_t joined_side_count;     // sides whose branches were joined (see join_branches())
     size_t apart_side_count;      // sides left apart
@@ -187,11 +187,11 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 //
 // In its steps: check the arguments and read the cloud (refusing NaN, a degenerate cloud);
 // choose the axis (Axis::automatic); look for where the cloud parts into branches along it
-// (unless one_tube) and, where it does, mesh the trunk and each branch around its own
+// (unless Parts::one_tube) and, where it does, mesh the trunk and each branch around its own
 // automatic axis (the trunk along the cloud's axis where the options lay out the layers:
 // cuts, layer_count or layer_height), and join them into one surface (see PartCounts and
 // join_branches()); otherwise, or where the parts cannot all be joined, or where the
-// joined surface is not smaller than the one tube's (unless keep_parts), mesh one tube:
+// joined surface is not smaller than the one tube's (unless Parts::apart), mesh one tube:
 // layer by layer, each unrolled and triangulated, stitched to the layer below, passed
 // through the manifold safety net; then the caps (add_caps). A tube that wraps branches
 // bridges the gaps between them with webs, which add area, and so does a join that folds,

@@ -17,14 +17,14 @@
 //     stratmesh::stream_close(stream);
 //
 // The stream meshes one tube (it cannot know where a cloud parts before it has seen it):
-// the same triangles as reconstruct() with the one_tube flag. A push is one planned
+// the same triangles as reconstruct() with Parts::one_tube. A push is one planned
 // layer, as between two cuts, and
 // the stream forms layers from pushes by the rules reconstruct() applies to its planned
 // layers (a push too small, too thin, not surrounding its axis or next to a crescent joins
 // the next; a last rest too small or thin joins the layer below it), waiting for later
 // pushes where a rule needs them. So reconstruct() of the concatenated pushes, with
 // Options::cuts at the tops of all pushes but the last, the same axis, the same origin
-// (flag origin_given), the one_tube flag and the points of each push in the same order,
+// (flag origin_given), Parts::one_tube and the points of each push in the same order,
 // gives the same triangles in the same order, with the same global indices,
 // provided no point lies within 2^-40 of the height range below a cut (reconstruct()
 // counts such a point in the layer above) and no cut lies outside the points' height

@@ -180,7 +180,7 @@ static void test_reconstruct(const double* xyz, int add_caps) {
     CHECK(report.diagnostics.web_area == 0 && report.diagnostics.web_area_fraction == 0);
     CHECK(report.diagnostics.web_box_min[0] == 0 && report.diagnostics.web_box_max[2] == 0);
     CHECK(STRATMESH_WEB_SPACINGS > 1);
-    CHECK(report.parts.outcome == STRATMESH_PARTS_ONE_TUBE);
+    CHECK(report.parts.outcome == STRATMESH_PARTS_OUTCOME_ONE_TUBE);
     if (add_caps) {
         CHECK(report.caps.closed_count == 2);
         CHECK(report.caps.open_count == 0);

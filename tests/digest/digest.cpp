@@ -294,7 +294,7 @@ int main(int argc, char** argv) {
                      g_full_input, g_full);
     // One tube around a Y's two arms: webs across the gap (Report::diagnostics).
     stratmesh::Options one_tube = axis_z();
-    one_tube.flags = stratmesh::one_tube;
+    one_tube.parts = stratmesh::Parts::one_tube;
     reconstruct_case("Y of tubes, one tube", shapes::y_of_tubes(3000, Pose::z).xyz, one_tube,
                      g_full_input, g_full);
 #endif

@@ -107,6 +107,9 @@ OPTIONS = [
     (WRONG_TYPE, "invalid_argument", "progress", 5),
     (WRONG_TYPE, "invalid_argument", "workspace", bytearray(10)),
     (WRONG_TYPE, "invalid_argument", "copy", "no"),
+    (WRONG_VALUE, "invalid_argument", "parts", "keep"),
+    (WRONG_TYPE, "invalid_argument", "parts", 1),
+    (WRONG_TYPE, "invalid_argument", "parts", None),
 ]
 
 
@@ -117,7 +120,7 @@ def test_each_option_is_checked_before_the_call(kind, status, name, value):
 
 
 @pytest.mark.parametrize("name", ["cap", "skip_invalid", "drop_outliers", "surface_flips",
-                                  "ends_are_cuts", "one_tube", "keep_parts"])
+                                  "ends_are_cuts"])
 @pytest.mark.parametrize("value", ["no", 1, None])
 def test_switches_take_true_or_false(name, value):
     refused_argument(WRONG_TYPE, "invalid_argument", name, stratmesh.reconstruct, CLOUD, axis="z",

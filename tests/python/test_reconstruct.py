@@ -199,6 +199,6 @@ def test_a_forked_cloud_is_meshed_in_parts_joined_into_one_surface():
     assert report.parts.joined_side_count == 1
     assert report.points.used_count == len(points)
     assert_manifold(triangles)
-    _, one = stratmesh.reconstruct(points, axis="z", layers=4, one_tube=True)
+    _, one = stratmesh.reconstruct(points, axis="z", layers=4, parts="one_tube")
     assert one.parts.outcome == "one_tube"
     assert one.parts.part_count == 0

@@ -32,7 +32,7 @@ def test_the_stream_gives_reconstructs_triangles(flips):
     parts, stream = stream_all(cloud, layer, surface_flips=flips)
     streamed = np.concatenate(parts)
     whole, report = stratmesh.reconstruct(cloud, axis="z", cuts=CUTS, origin=ORIGIN,
-                                          surface_flips=flips, one_tube=True)
+                                          surface_flips=flips, parts="one_tube")
     assert stream.closed and stream.report.status == "ok"
     assert stream.report.layers.used_count == report.layers.used_count == len(CUTS) + 1
     assert np.array_equal(streamed, whole)
@@ -46,7 +46,7 @@ def test_cap_ends_on_the_stream_gives_reconstructs_caps():
     streamed = np.concatenate(stream_all(cloud, layer)[0])
     capped, report = stratmesh.cap_ends(cloud, streamed, axis="z", origin=ORIGIN)
     whole, _ = stratmesh.reconstruct(cloud, axis="z", cuts=CUTS, origin=ORIGIN, cap=True,
-                                     one_tube=True)
+                                     parts="one_tube")
     assert report.caps.closed_count == 2
     assert np.array_equal(capped, whole)
 

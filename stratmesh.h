@@ -428,11 +428,12 @@ typedef void (*JobRunner)(void* user, uint32_t count, JobFunction job, void* con
 struct Options {
     Axis axis;
     double direction[3];     // for Axis::direction; any finite non-zero length
-    // Layers, first match wins: explicit cut positions along the axis, as the coordinate
-    // dot(point, axis) (with Axis::z, a cut at 68 is the plane z = 68; a point on a cut,
-    // up to 2^-40 of the cloud's height, belongs to the layer above); any order,
-    // repeats and cuts outside the cloud are ignored; else layer_count equal-height
-    // layers; else layers of about layer_height; else automatic: the fewest layers such
+    // Layers, at most one of three ways (more than one is invalid_argument): explicit cut
+    // positions along the axis, as the coordinate dot(point, axis) (with Axis::z, a cut at
+    // 68 is the plane z = 68; a point on a cut, up to 2^-40 of the cloud's height, belongs
+    // to the layer above; any order, repeats and cuts outside the cloud are ignored); or
+    // layer_count equal-height layers; or layers of about layer_height; with none of them,
+    // automatic: the fewest layers such
     // that one centre line serves each layer, none is taller than 24 of its radii and none
     // holds more than an eighth of the points (or 65,536, if that is more, so that large
     // clouds come in layers that jobs can triangulate side by side), cut where the
@@ -448,8 +449,8 @@ struct Options {
     size_t cut_count;
     uint32_t layer_count;
     double layer_height;
-    uint32_t flags;          // Flags bits
-    Parts parts;
+    uint32_t flags;          // Flags bits; any other bit is invalid_argument
+    Parts parts;             // a value outside Parts is invalid_argument
     double origin[3];        // with the origin_given flag
     // Optional progress callback: called with each phase as it starts, and with the
     // fraction of that phase done from time to time. Must not call back into stratmesh.
@@ -718,7 +719,9 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 //                 when buffers overlap: see invalid_argument below).
 //
 // Returns ok; invalid_argument (a null pointer with a non-zero count, a stride smaller than
-// one point, an unknown Scalar, cut_count without cuts, a null triangle_count, or any two
+// one point, an unknown Scalar, cut_count without cuts, more than one of cuts, layer_count
+// and layer_height, a flag bit Flags does not define, a Parts value outside the enum (these
+// three with Report::detail saying which), a null triangle_count, or any two
 // of the span of the cloud's points, the workspace, the triangle array, *triangle_count,
 // *report and the report's layer array sharing a byte: then nothing at all is written, not
 // even the report); invalid_origin (with origin_given, an origin that is NaN or infinite,
@@ -802,8 +805,11 @@ size_t stream_workspace_size(size_t max_points_held, const Options& options);
 // the layers). emit receives the triangles; report (optional) is updated after every push
 // and at close, and must stay valid until then (its layer array too). On success *stream
 // is the handle, valid until stream_close or until the workspace is reused.
-// Returns ok, invalid_argument (a null emit or stream, add_caps or drop_outliers, a null
-// workspace, a workspace that shares a byte with the report or its layer array),
+// Returns ok, invalid_argument (a null emit or stream, a null workspace, a workspace that
+// shares a byte with the report or its layer array; or, with Report::detail saying which
+// and nothing else written to the report: add_caps or drop_outliers, a flag bit Flags does
+// not define, a Parts value outside the enum, more than one of cuts, layer_count and
+// layer_height),
 // invalid_origin (a NaN or infinite origin), invalid_axis, out_of_memory (a workspace too
 // small to hold 16 points).
 // The stream uses as many points as the workspace holds.
@@ -871,7 +877,8 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count);
 // counts kept (its workspace_used_bytes replaced).
 // Returns ok (loops that cannot be capped stay open: Report::caps.open_count);
 // invalid_argument (a null triangle_count, triangles or workspace where needed, a bad
-// stride or scalar, *triangle_count above triangle_capacity, an index outside the cloud or
+// stride or scalar, a flag bit Flags does not define, a Parts value outside the enum,
+// *triangle_count above triangle_capacity, an index outside the cloud or
 // naming an invalid point, buffers sharing a byte); too_many_points; invalid_point (a NaN
 // or infinite point without skip_invalid_points); invalid_axis; invalid_origin (as for
 // reconstruct()); out_of_memory (a workspace below cap_ends_workspace_size());
@@ -921,7 +928,8 @@ size_t find_parting_workspace_size(size_t point_count, const Options& options);
 // order of the points changes only rounding (the frame's origin is their centroid) and
 // which points sample the scale. Returns ok (parting filled, whether or not
 // a cut was found); invalid_argument (a null parting, or workspace with points; a bad
-// stride or scalar; buffers sharing a byte); too_many_points; invalid_point (a NaN or
+// stride or scalar; a flag bit Flags does not define, a Parts value outside the enum;
+// buffers sharing a byte); too_many_points; invalid_point (a NaN or
 // infinite point without skip_invalid_points); invalid_axis; too_few_points (fewer than 3
 // distinct valid points); flat_cloud (every point at the same height); out_of_memory (a
 // workspace below find_parting_workspace_size()). On a status other than ok only
@@ -999,9 +1007,10 @@ size_t join_branches_max_triangles(size_t point_count);
 // Takes the grafts' holes out of triangles[0 .. 3 * *triangle_count) (indices into
 // `cloud`; the triangles kept stay in their order, removed_triangle_count fewer), appends the
 // junctions' triangles and sets *triangle_count to the new total. parting and branch_of:
-// find_parting()'s on the same cloud (its axis is used); options: only skip_invalid_points
-// is read. report (optional) is filled on every status. Returns ok (a side counts as joined
-// when all its branches are; the others in apart_side_count, their branches grafted where
+// find_parting()'s on the same cloud (its axis is used); options: skip_invalid_points is
+// used, the rest only checked (a flag bit Flags does not define, or a Parts value outside
+// the enum, is invalid_argument). report (optional) is filled on every status. Returns ok
+// (a side counts as joined when all its branches are; the others in apart_side_count, their branches grafted where
 // they could be, the rest of their triangles left as they were); invalid_argument (a
 // null triangle_count, branch_of, workspace or triangles where needed; a bad stride or
 // scalar; *triangle_count above triangle_capacity; an index outside the cloud or naming an
@@ -3791,8 +3800,8 @@ template <class Pass> static inline void run_pass(const Options& options, Pass& 
 namespace stratmesh {
 namespace detail {
 
-// The layers asked for, first match wins (see Options::cuts): the cuts, else `count`
-// equal layers, else layers of about `height`, else automatic.
+// The layers asked for (see Options::cuts): the cuts, or `count` equal layers, or layers
+// of about `height` (at most one of them: layer_choice_refusal()), else automatic.
 struct LayerRequest {
     const double* cuts;
     size_t cut_count;
@@ -3816,6 +3825,28 @@ struct TubeRequest {
     // would run backwards from part to part; an axis trial).
     const Options* progress;
 };
+
+// The bits Flags defines: any other is refused.
+const uint32_t kDefinedFlags =
+    skip_invalid_points | add_caps | origin_given | drop_outliers | surface_flips | ends_are_cuts;
+
+// Why a call that takes Options refuses them with invalid_argument, or null: a flag bit
+// that Flags does not define, or a Parts value outside the enum.
+static inline const char* options_refusal(const Options& options) {
+    if (options.flags & ~kDefinedFlags) return "Options::flags has a bit that Flags does not define";
+    if (static_cast<uint32_t>(options.parts) > static_cast<uint32_t>(Parts::apart))
+        return "Options::parts is not a Parts value";
+    return nullptr;
+}
+
+// Why reconstruct() and the stream refuse the layer options with invalid_argument, or
+// null: more than one of the cuts, layer_count and layer_height is given, which would
+// leave one of them unused.
+static inline const char* layer_choice_refusal(const Options& options) {
+    const int given = (options.cut_count > 0 ? 1 : 0) + (options.layer_count > 0 ? 1 : 0) +
+                      (options.layer_height > 0 ? 1 : 0);
+    return given > 1 ? "give at most one of Options::cuts, layer_count and layer_height" : nullptr;
+}
 
 static inline TubeRequest tube_request(const Options& options) {
     const uint32_t f = options.flags;
@@ -10078,7 +10109,7 @@ size_t stream_workspace_size(size_t max_points_held, const Options& options) {
 
 Status stream_open(const Options& options, void* workspace, size_t workspace_bytes,
                    TriangleCallback emit, void* emit_user, Report* report, Stream** stream) {
-    if (!stream || !emit || !workspace || (options.flags & (add_caps | drop_outliers))) return Status::invalid_argument;
+    if (!stream || !emit || !workspace) return Status::invalid_argument;
     *stream = nullptr;
     const detail::ByteRange work = detail::byte_range(workspace, workspace_bytes);
     if (report) {
@@ -10087,6 +10118,15 @@ Status stream_open(const Options& options, void* workspace, size_t workspace_byt
             detail::byte_range(report->layers.info,
                                detail::saturating_product(report->layers.info_capacity, sizeof(LayerInfo)))};
         if (detail::any_overlap(ranges, 3)) return Status::invalid_argument;
+    }
+    const char* refusal = (options.flags & (add_caps | drop_outliers))
+                              ? "the stream takes neither add_caps (cap_ends() caps its surface) "
+                                "nor drop_outliers (outliers are told from the whole cloud)"
+                              : detail::options_refusal(options);
+    if (!refusal) refusal = detail::layer_choice_refusal(options);
+    if (refusal) {
+        if (report) report->detail = refusal;
+        return Status::invalid_argument;
     }
     if (options.axis == Axis::automatic) return Status::invalid_axis;
     if (!detail::flags_compiled(options)) return Status::not_compiled;
@@ -10743,6 +10783,10 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
     Status status = detail::check_reconstruct_arguments(cloud, triangles, triangle_capacity,
                                                         triangle_count, workspace, checks);
     if (status != Status::ok) return finish(status);
+    if (const char* refusal = detail::options_refusal(options)) {
+        checks.detail = refusal;
+        return finish(Status::invalid_argument);
+    }
     if (given > triangle_capacity) {
         checks.detail = "triangle_count is above triangle_capacity";
         return finish(Status::invalid_argument);
@@ -11244,6 +11288,9 @@ static inline Status find_parting_with(const Cloud& cloud, const TubeRequest& re
     };
     Status status = check_reconstruct_arguments(cloud, nullptr, 0, &no_triangles, workspace, rep);
     if (status != Status::ok) return finish(status);
+    // The caller's Options, for find_parting() (reconstruct() has checked its own).
+    rep.detail = request.caller ? options_refusal(*request.caller) : nullptr;
+    if (rep.detail) return finish(Status::invalid_argument);
     if (branch_of) std::memset(branch_of, kInTrunk, cloud.count);
     CloudReader reader = reader_of(cloud);
     CloudSums sums = sum_cloud(reader, cloud.count);
@@ -12309,6 +12356,10 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
     Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
                                                 triangle_count, workspace, checks);
     if (status != Status::ok) return finish(status);
+    if (const char* refusal = options_refusal(options)) {
+        checks.detail = refusal;
+        return finish(Status::invalid_argument);
+    }
     if (given > triangle_capacity || (cloud.count > 0 && !branch_of)) {
         checks.detail = given > triangle_capacity ? "triangle_count is above triangle_capacity"
                                                   : "branch_of is null";
@@ -13012,6 +13063,12 @@ static inline Status run_reconstruction(const Cloud& cloud, const Options& optio
     Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
                                                 triangle_count, workspace, rep);
     if (status != Status::ok) return status;
+    const char* refusal = options_refusal(options);
+    if (!refusal) refusal = layer_choice_refusal(options);
+    if (refusal) {
+        rep.detail = refusal;
+        return Status::invalid_argument;
+    }
     notify(options, Phase::validate, 0);
     Arena arena = Arena::over(workspace, workspace_bytes);
     TubeInput in = {};

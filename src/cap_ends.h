@@ -62,6 +62,10 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
     Status status = detail::check_reconstruct_arguments(cloud, triangles, triangle_capacity,
                                                         triangle_count, workspace, checks);
     if (status != Status::ok) return finish(status);
+    if (const char* refusal = detail::options_refusal(options)) {
+        checks.detail = refusal;
+        return finish(Status::invalid_argument);
+    }
     if (given > triangle_capacity) {
         checks.detail = "triangle_count is above triangle_capacity";
         return finish(Status::invalid_argument);

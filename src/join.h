@@ -956,6 +956,10 @@ Status join_branches(const Cloud& cloud, const Options& options, const Parting& 
     Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
                                                 triangle_count, workspace, checks);
     if (status != Status::ok) return finish(status);
+    if (const char* refusal = options_refusal(options)) {
+        checks.detail = refusal;
+        return finish(Status::invalid_argument);
+    }
     if (given > triangle_capacity || (cloud.count > 0 && !branch_of)) {
         checks.detail = given > triangle_capacity ? "triangle_count is above triangle_capacity"
                                                   : "branch_of is null";

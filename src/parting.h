@@ -465,6 +465,9 @@ static inline Status find_parting_with(const Cloud& cloud, const TubeRequest& re
     };
     Status status = check_reconstruct_arguments(cloud, nullptr, 0, &no_triangles, workspace, rep);
     if (status != Status::ok) return finish(status);
+    // The caller's Options, for find_parting() (reconstruct() has checked its own).
+    rep.detail = request.caller ? options_refusal(*request.caller) : nullptr;
+    if (rep.detail) return finish(Status::invalid_argument);
     if (branch_of) std::memset(branch_of, kInTrunk, cloud.count);
     CloudReader reader = reader_of(cloud);
     CloudSums sums = sum_cloud(reader, cloud.count);

@@ -56,6 +56,12 @@ static inline Status run_reconstruction(const Cloud& cloud, const Options& optio
     Status status = check_reconstruct_arguments(cloud, triangles, triangle_capacity,
                                                 triangle_count, workspace, rep);
     if (status != Status::ok) return status;
+    const char* refusal = options_refusal(options);
+    if (!refusal) refusal = layer_choice_refusal(options);
+    if (refusal) {
+        rep.detail = refusal;
+        return Status::invalid_argument;
+    }
     notify(options, Phase::validate, 0);
     Arena arena = Arena::over(workspace, workspace_bytes);
     TubeInput in = {};

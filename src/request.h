@@ -10,8 +10,8 @@
 namespace stratmesh {
 namespace detail {
 
-// The layers asked for, first match wins (see Options::cuts): the cuts, else `count`
-// equal layers, else layers of about `height`, else automatic.
+// The layers asked for (see Options::cuts): the cuts, or `count` equal layers, or layers
+// of about `height` (at most one of them: layer_choice_refusal()), else automatic.
 struct LayerRequest {
     const double* cuts;
     size_t cut_count;
@@ -35,6 +35,28 @@ struct TubeRequest {
     // would run backwards from part to part; an axis trial).
     const Options* progress;
 };
+
+// The bits Flags defines: any other is refused.
+const uint32_t kDefinedFlags =
+    skip_invalid_points | add_caps | origin_given | drop_outliers | surface_flips | ends_are_cuts;
+
+// Why a call that takes Options refuses them with invalid_argument, or null: a flag bit
+// that Flags does not define, or a Parts value outside the enum.
+static inline const char* options_refusal(const Options& options) {
+    if (options.flags & ~kDefinedFlags) return "Options::flags has a bit that Flags does not define";
+    if (static_cast<uint32_t>(options.parts) > static_cast<uint32_t>(Parts::apart))
+        return "Options::parts is not a Parts value";
+    return nullptr;
+}
+
+// Why reconstruct() and the stream refuse the layer options with invalid_argument, or
+// null: more than one of the cuts, layer_count and layer_height is given, which would
+// leave one of them unused.
+static inline const char* layer_choice_refusal(const Options& options) {
+    const int given = (options.cut_count > 0 ? 1 : 0) + (options.layer_count > 0 ? 1 : 0) +
+                      (options.layer_height > 0 ? 1 : 0);
+    return given > 1 ? "give at most one of Options::cuts, layer_count and layer_height" : nullptr;
+}
 
 static inline TubeRequest tube_request(const Options& options) {
     const uint32_t f = options.flags;

@@ -244,7 +244,7 @@ size_t stream_workspace_size(size_t max_points_held, const Options& options) {
 
 Status stream_open(const Options& options, void* workspace, size_t workspace_bytes,
                    TriangleCallback emit, void* emit_user, Report* report, Stream** stream) {
-    if (!stream || !emit || !workspace || (options.flags & (add_caps | drop_outliers))) return Status::invalid_argument;
+    if (!stream || !emit || !workspace) return Status::invalid_argument;
     *stream = nullptr;
     const detail::ByteRange work = detail::byte_range(workspace, workspace_bytes);
     if (report) {
@@ -253,6 +253,15 @@ Status stream_open(const Options& options, void* workspace, size_t workspace_byt
             detail::byte_range(report->layers.info,
                                detail::saturating_product(report->layers.info_capacity, sizeof(LayerInfo)))};
         if (detail::any_overlap(ranges, 3)) return Status::invalid_argument;
+    }
+    const char* refusal = (options.flags & (add_caps | drop_outliers))
+                              ? "the stream takes neither add_caps (cap_ends() caps its surface) "
+                                "nor drop_outliers (outliers are told from the whole cloud)"
+                              : detail::options_refusal(options);
+    if (!refusal) refusal = detail::layer_choice_refusal(options);
+    if (refusal) {
+        if (report) report->detail = refusal;
+        return Status::invalid_argument;
     }
     if (options.axis == Axis::automatic) return Status::invalid_axis;
     if (!detail::flags_compiled(options)) return Status::not_compiled;

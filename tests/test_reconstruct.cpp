@@ -2062,6 +2062,84 @@ TEST_CASE("statuses for bad arguments and options") {
     }
 }
 
+namespace {
+
+// Options that name a flag bit Flags does not define, a Parts value outside the enum, or
+// more than one way to lay out the layers (the last three).
+std::vector<Options> refused_options(const Shape& s) {
+    static const double cut = 0.5;
+    std::vector<Options> refused;
+    for (uint32_t bit = 6; bit < 32; ++bit) {
+        Options o = axis_options(s);
+        o.flags = stratmesh::add_caps | (1u << bit);
+        refused.push_back(o);
+    }
+    Options parts = axis_options(s);
+    parts.parts = static_cast<stratmesh::Parts>(3);
+    refused.push_back(parts);
+    for (int pair = 0; pair < 3; ++pair) {
+        Options o = axis_options(s);
+        if (pair != 0) o.cuts = &cut, o.cut_count = 1;
+        if (pair != 1) o.layer_count = 4;
+        if (pair != 2) o.layer_height = 1;
+        refused.push_back(o);
+    }
+    return refused;
+}
+
+}  // namespace
+
+TEST_CASE("unknown flag bits, a Parts value outside the enum, two ways to lay out the layers: invalid_argument with a detail") {
+    const Shape& s = reference_cylinder();
+    const Cloud cloud = cloud_of(s);
+    const std::vector<Options> refused = refused_options(s);
+    for (size_t k = 0; k < refused.size(); ++k) {
+        CAPTURE(k);
+        const Options& o = refused[k];
+        const Run run = reconstruct_guarded(cloud, o);
+        CHECK(run.status == Status::invalid_argument);
+        REQUIRE(run.report.detail != nullptr);
+        CHECK(run.count == 0);
+        // The stream refuses the same, saying why in the report.
+        Options streamed = o;
+        streamed.flags &= ~uint32_t(stratmesh::add_caps);
+        std::vector<unsigned char> work(stratmesh::stream_workspace_size(64, streamed));
+        Report report = {};
+        stratmesh::Stream* stream = nullptr;
+        const auto ignore = [](void*, const uint32_t*, size_t) {};
+        CHECK(stratmesh::stream_open(streamed, work.data(), work.size(), ignore, nullptr, &report,
+                                     &stream) == Status::invalid_argument);
+        CHECK(stream == nullptr);
+        CHECK(report.detail != nullptr);
+    }
+    // The calls that take Options but lay out no layers refuse the flags and Parts alike.
+    const size_t n = s.size();
+    for (size_t k = 0; k + 3 < refused.size(); ++k) {
+        CAPTURE(k);
+        const Options& o = refused[k];
+        std::vector<unsigned char> work(stratmesh::find_parting_workspace_size(n, o));
+        stratmesh::Parting parting;
+        CHECK(stratmesh::find_parting(cloud, o, work.data(), work.size(), &parting, nullptr) ==
+              Status::invalid_argument);
+        CHECK(parting.detail != nullptr);
+        std::vector<uint32_t> triangles(3 * stratmesh::join_branches_max_triangles(n));
+        std::vector<uint8_t> branch_of(n, stratmesh::kInTrunk);
+        size_t count = 0;
+        work.assign(stratmesh::join_branches_workspace_size(n, 0), 0);
+        stratmesh::JoinReport joined;
+        CHECK(stratmesh::join_branches(cloud, o, parting, branch_of.data(), work.data(),
+                                       work.size(), triangles.data(), triangles.size() / 3,
+                                       &count, &joined) == Status::invalid_argument);
+        CHECK(joined.detail != nullptr);
+        work.assign(stratmesh::cap_ends_workspace_size(n, 0), 0);
+        Report capped = {};
+        CHECK(stratmesh::cap_ends(cloud, o, work.data(), work.size(), triangles.data(),
+                                  triangles.size() / 3, &count, &capped) ==
+              Status::invalid_argument);
+        CHECK(capped.detail != nullptr);
+    }
+}
+
 TEST_CASE("progress: every phase in order, fractions in [0, 1]") {
     struct Log {
         std::vector<stratmesh::Phase> phases;

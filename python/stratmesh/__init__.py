@@ -69,12 +69,16 @@ def _options(axis="auto", cuts=None, layers=0, layer_height=0.0, origin=None, th
         origin = _check.vector("origin", origin, "invalid_argument")
         bits |= FLAGS["origin_given"]
     threads = _check.whole("threads", threads, 0, _MOST_THREADS)
+    cuts = None if cuts is None else _check.heights("cuts", cuts, "invalid_layers")
+    layers = _check.whole("layers", layers, 0, _MOST_LAYERS, "invalid_layers")
+    layer_height = _check.real("layer_height", layer_height, "invalid_layers", "from 0")
+    _check.one_layering(cuts is not None and len(cuts) > 0, layers > 0, layer_height > 0)
     return {
         "axis": _AXIS_CODES[name] if name else _DIRECTION,
         "direction": direction,
-        "cuts": None if cuts is None else _check.heights("cuts", cuts, "invalid_layers"),
-        "layer_count": _check.whole("layers", layers, 0, _MOST_LAYERS, "invalid_layers"),
-        "layer_height": _check.real("layer_height", layer_height, "invalid_layers", "from 0"),
+        "cuts": cuts,
+        "layer_count": layers,
+        "layer_height": layer_height,
         "flags": bits,
         "parts": _check.choice("parts", parts, PARTS),
         "origin": (0.0, 0.0, 0.0) if origin is None else origin,
@@ -94,8 +98,9 @@ def reconstruct(points, *, axis="auto", cuts=None, layers=0, layer_height=0.0, c
                    otherwise copied first, or refused with copy=False.
     axis           "auto", "x", "y", "z" or a 3-vector of any finite non-zero length.
     cuts           a one-dimensional sequence of finite heights along the axis where layers
-                   start; else layers equal layers; else layers of about layer_height (a
-                   finite number from 0); else the library's automatic layers.
+                   start; or layers equal layers; or layers of about layer_height (a finite
+                   number from 0); at most one of the three; without any, the library's
+                   automatic layers.
     cap            close the tube's ends (the add_caps flag).
     skip_invalid, drop_outliers, surface_flips, ends_are_cuts
                    the flags of the same names (skip_invalid: skip_invalid_points).

@@ -175,6 +175,12 @@ def choice(name, value, choices):
     return choices[value]
 
 
+def one_layering(cuts, layers, layer_height):
+    """At most one of the layer options is given (each flag: whether it is)."""
+    if cuts + layers + layer_height > 1:
+        raise refuse("invalid_argument", "cuts, layers and layer_height: give at most one")
+
+
 def optional_callable(name, value):
     if value is not None and not callable(value):
         raise must(wrong_type, "invalid_argument", name, "callable or None", value)

@@ -37,7 +37,8 @@ size_t find_parting_workspace_size(size_t point_count, const Options& options);
 // order of the points changes only rounding (the frame's origin is their centroid) and
 // which points sample the scale. Returns ok (parting filled, whether or not
 // a cut was found); invalid_argument (a null parting, or workspace with points; a bad
-// stride or scalar; buffers sharing a byte); too_many_points; invalid_point (a NaN or
+// stride or scalar; a flag bit Flags does not define, a Parts value outside the enum;
+// buffers sharing a byte); too_many_points; invalid_point (a NaN or
 // infinite point without skip_invalid_points); invalid_axis; too_few_points (fewer than 3
 // distinct valid points); flat_cloud (every point at the same height); out_of_memory (a
 // workspace below find_parting_workspace_size()). On a status other than ok only
@@ -115,9 +116,10 @@ size_t join_branches_max_triangles(size_t point_count);
 // Takes the grafts' holes out of triangles[0 .. 3 * *triangle_count) (indices into
 // `cloud`; the triangles kept stay in their order, removed_triangle_count fewer), appends the
 // junctions' triangles and sets *triangle_count to the new total. parting and branch_of:
-// find_parting()'s on the same cloud (its axis is used); options: only skip_invalid_points
-// is read. report (optional) is filled on every status. Returns ok (a side counts as joined
-// when all its branches are; the others in apart_side_count, their branches grafted where
+// find_parting()'s on the same cloud (its axis is used); options: skip_invalid_points is
+// used, the rest only checked (a flag bit Flags does not define, or a Parts value outside
+// the enum, is invalid_argument). report (optional) is filled on every status. Returns ok
+// (a side counts as joined when all its branches are; the others in apart_side_count, their branches grafted where
 // they could be, the rest of their triangles left as they were); invalid_argument (a
 // null triangle_count, branch_of, workspace or triangles where needed; a bad stride or
 // scalar; *triangle_count above triangle_capacity; an index outside the cloud or naming an

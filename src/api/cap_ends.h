@@ -36,7 +36,8 @@ size_t cap_ends_workspace_size(size_t point_count, size_t triangle_count);
 // counts kept (its workspace_used_bytes replaced).
 // Returns ok (loops that cannot be capped stay open: Report::caps.open_count);
 // invalid_argument (a null triangle_count, triangles or workspace where needed, a bad
-// stride or scalar, *triangle_count above triangle_capacity, an index outside the cloud or
+// stride or scalar, a flag bit Flags does not define, a Parts value outside the enum,
+// *triangle_count above triangle_capacity, an index outside the cloud or
 // naming an invalid point, buffers sharing a byte); too_many_points; invalid_point (a NaN
 // or infinite point without skip_invalid_points); invalid_axis; invalid_origin (as for
 // reconstruct()); out_of_memory (a workspace below cap_ends_workspace_size());

@@ -116,11 +116,12 @@ typedef void (*JobRunner)(void* user, uint32_t count, JobFunction job, void* con
 struct Options {
     Axis axis;
     double direction[3];     // for Axis::direction; any finite non-zero length
-    // Layers, first match wins: explicit cut positions along the axis, as the coordinate
-    // dot(point, axis) (with Axis::z, a cut at 68 is the plane z = 68; a point on a cut,
-    // up to 2^-40 of the cloud's height, belongs to the layer above); any order,
-    // repeats and cuts outside the cloud are ignored; else layer_count equal-height
-    // layers; else layers of about layer_height; else automatic: the fewest layers such
+    // Layers, at most one of three ways (more than one is invalid_argument): explicit cut
+    // positions along the axis, as the coordinate dot(point, axis) (with Axis::z, a cut at
+    // 68 is the plane z = 68; a point on a cut, up to 2^-40 of the cloud's height, belongs
+    // to the layer above; any order, repeats and cuts outside the cloud are ignored); or
+    // layer_count equal-height layers; or layers of about layer_height; with none of them,
+    // automatic: the fewest layers such
     // that one centre line serves each layer, none is taller than 24 of its radii and none
     // holds more than an eighth of the points (or 65,536, if that is more, so that large
     // clouds come in layers that jobs can triangulate side by side), cut where the
@@ -136,8 +137,8 @@ struct Options {
     size_t cut_count;
     uint32_t layer_count;
     double layer_height;
-    uint32_t flags;          // Flags bits
-    Parts parts;
+    uint32_t flags;          // Flags bits; any other bit is invalid_argument
+    Parts parts;             // a value outside Parts is invalid_argument
     double origin[3];        // with the origin_given flag
     // Optional progress callback: called with each phase as it starts, and with the
     // fraction of that phase done from time to time. Must not call back into stratmesh.

@@ -224,7 +224,9 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 //                 when buffers overlap: see invalid_argument below).
 //
 // Returns ok; invalid_argument (a null pointer with a non-zero count, a stride smaller than
-// one point, an unknown Scalar, cut_count without cuts, a null triangle_count, or any two
+// one point, an unknown Scalar, cut_count without cuts, more than one of cuts, layer_count
+// and layer_height, a flag bit Flags does not define, a Parts value outside the enum (these
+// three with Report::detail saying which), a null triangle_count, or any two
 // of the span of the cloud's points, the workspace, the triangle array, *triangle_count,
 // *report and the report's layer array sharing a byte: then nothing at all is written, not
 // even the report); invalid_origin (with origin_given, an origin that is NaN or infinite,

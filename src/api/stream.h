@@ -58,8 +58,11 @@ size_t stream_workspace_size(size_t max_points_held, const Options& options);
 // the layers). emit receives the triangles; report (optional) is updated after every push
 // and at close, and must stay valid until then (its layer array too). On success *stream
 // is the handle, valid until stream_close or until the workspace is reused.
-// Returns ok, invalid_argument (a null emit or stream, add_caps or drop_outliers, a null
-// workspace, a workspace that shares a byte with the report or its layer array),
+// Returns ok, invalid_argument (a null emit or stream, a null workspace, a workspace that
+// shares a byte with the report or its layer array; or, with Report::detail saying which
+// and nothing else written to the report: add_caps or drop_outliers, a flag bit Flags does
+// not define, a Parts value outside the enum, more than one of cuts, layer_count and
+// layer_height),
 // invalid_origin (a NaN or infinite origin), invalid_axis, out_of_memory (a workspace too
 // small to hold 16 points).
 // The stream uses as many points as the workspace holds.

@@ -127,6 +127,14 @@ def test_switches_take_true_or_false(name, value):
                      **{name: value})
 
 
+@pytest.mark.parametrize("layering", [{"cuts": [1.0], "layers": 4},
+                                      {"layers": 4, "layer_height": 2.0},
+                                      {"cuts": [1.0], "layer_height": 2.0}])
+def test_at_most_one_layer_option(layering):
+    refused_argument(WRONG_VALUE, "invalid_argument", "cuts", stratmesh.reconstruct, CLOUD,
+                     axis="z", **layering)
+
+
 def test_a_call_that_does_not_fit_the_signature():
     for call, args, kwargs, named in [
             (stratmesh.reconstruct, (CLOUD,), {"axis": "z", "lyers": 4}, "'lyers'"),

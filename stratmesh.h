@@ -43,7 +43,7 @@
 // branches and, where it does, the trunk and each branch are meshed along their own axes
 // and joined into one surface; the ends stay open (add_caps caps them) and the layers stay
 // Delaunay on their unrolled annulus, as in the paper (surface_flips refines them on the
-// surface, for about three times the time).
+// surface, at a cost in time).
 //
 // ==== Integration ==========================================================================
 //
@@ -68,25 +68,24 @@
 //                            invariants in debug builds. Bad *data* never reaches an
 //                            assert: it returns a Status.
 //   STRATMESH_NO_PARALLEL_LAYERS   default: not defined. Define it where the implementation
-//                            is compiled to leave out the parallel-layers code (about
-//                            2 KiB on a Cortex-M7): Options::run_jobs is then ignored
-//                            and everything runs in order, with the same result. For
-//                            single-core targets.
+//                            is compiled to leave out the parallel-layers code:
+//                            Options::run_jobs is then ignored and everything runs in
+//                            order, with the same result. For single-core targets.
 //   STRATMESH_C_API          0 or 1; default 1, or 0 with STRATMESH_SMALL_CODE. Declares
 //                            and compiles the C interface (see "C interface"); define it
 //                            alike where the implementation is compiled and where the
 //                            header is included.
 //   STRATMESH_SMALL_CODE     default: not defined. The reduced build, for targets where
-//                            code size comes first (under 32 KiB of Cortex-M7 code at
-//                            -Os, against under 80 KiB for the full library): it meshes
-//                            one tube along the axis the caller gives, as the paper
-//                            does. It leaves out:
+//                            code size comes first (CI holds it within 32 KiB of
+//                            Cortex-M7 code at -Os): it meshes one tube along the axis
+//                            the caller gives, as the paper does. It leaves out:
 //                            - what only makes it faster (parallel layers, the safety
 //                              net's shortcut, the staging of grouped points, the
 //                              predicates' integer stages): same bytes, slower;
 //                            - the search for branches (as if Options::parts were
-//                              always Parts::one_tube), the automatic axis (Axis::automatic returns
-//                              Status::not_compiled), the check for a degenerate
+//                              always Parts::one_tube), the automatic axis
+//                              (Axis::automatic returns Status::not_compiled), the
+//                              check for a degenerate
 //                              cloud, find_parting(), join_branches() and cap_ends()
 //                              (not declared);
 //                            - closed ends (a dome or a flat base is unrolled on the
@@ -96,7 +95,7 @@
 //                            - the caps' lowering and raising along the axis, their
 //                              pockets, restarts, exhaustive search and fin flips: its
 //                              caps are the Delaunay triangulation of each loop's
-//                              projection, and a few more loops stay open;
+//                              projection, and more loops stay open;
 //                            - the finer peeling of loops where layers fold: where the
 //                              object forks at its end (horns), a web of triangles may
 //                              stay between the branches' tips;
@@ -116,25 +115,24 @@
 // library never writes outside the workspace and the output arrays it is given, whatever
 // the input.
 //
-// As a guide: delaunay_2d needs 72 bytes per point plus about 10 KiB, and its output is at
-// most 2n - 5 triangles (24 bytes per point). reconstruct needs about 115 bytes per point
-// (the triangulation of its largest possible layer, the layer grouping and the boundary
-// loops; measuring the webs at the end takes less), about 121 with add_caps (plus up to
-// 32 KiB for the exhaustive search of a cap), about 166 with a jobs runner; its output is
-// at most 2n triangles plus 160 for the junctions of branches. A stream needs about 190
-// bytes per point it holds at once, whatever the size of the whole cloud.
+// What a call needs follows from its arguments through those functions alone:
+// delaunay_2d_workspace_size() and delaunay_2d_max_triangles(); reconstruct_workspace_size()
+// (which grows with add_caps, drop_outliers, a jobs runner and the search for branches)
+// and reconstruct_max_triangles() (with the search for branches); stream_workspace_size()
+// of the points held at once, whatever the size of the whole cloud; and the bounds of
+// cap_ends(), find_parting() and join_branches(). Report::workspace_used_bytes tells what
+// a run used.
 //
 // The whole workspace belongs to the call while it runs, including what it does not need:
-// without a runner, reconstruct keeps the points grouped by layer (24 bytes each) in spare
-// workspace when they fit, instead of reading the cloud at random once per layer. The
+// without a runner, reconstruct keeps the points grouped by layer in spare workspace when
+// they fit, instead of reading the cloud at random once per layer. The
 // output is the same either way, and Report::workspace_used_bytes leaves that room out (it
 // is the least workspace that suffices).
 //
-// Stack: no recursion anywhere. The exact incircle's expansions (about 8 KiB) live in the
-// workspace when called from the triangulation, and on the stack only when you call
-// incircle() yourself. On a Cortex-M7 (GCC -Os, the reduced build) reconstruct needs under
-// 4 KiB of stack, stream_push and delaunay_2d under 3 KiB (your progress callback and libm
-// not included); inlining at -O3 on x86-64 makes frames about twice as large.
+// Stack: no recursion anywhere. The exact
+// incircle's expansions live in the workspace when called from the triangulation, and on
+// the stack only when you call incircle() yourself. CI bounds the reduced build's stack on
+// a Cortex-M7 from its call graph.
 //
 // ==== Errors ===============================================================================
 //
@@ -216,7 +214,7 @@ namespace stratmesh {
     /* success */                                                                         \
     X(ok, "success")                                                                      \
     /* argument checks: a caller error, detected before any work */                      \
-    X(invalid_argument, "a null pointer with a non-zero count, a stride too small, or buffers that overlap") \
+    X(invalid_argument, "a null pointer with a non-zero count, a stride too small, buffers that overlap, or options that are undefined or contradict each other") \
     X(too_many_points, "more points than 32-bit indices can address")                    \
     X(not_compiled, "the options ask for a feature this build leaves out (STRATMESH_SMALL_CODE)") \
     /* the data */                                                                        \
@@ -342,47 +340,41 @@ enum Flags : uint32_t {
     // NaN/Inf points are skipped and counted (Report::points.rejected_count) instead of refused with
     // Status::invalid_point.
     skip_invalid_points = 1u << 0,
-    // Closes the surface's boundary loops with caps, so a tube becomes a closed, edge- and
-    // vertex-manifold, consistently oriented surface (Euler characteristic 2, normals
-    // outward: the bottom cap faces -axis, the top one +axis). A cap triangulates its loop
-    // over the loop's own vertices (no new vertex), as seen across the axis: pockets of the
-    // loop along the wall are closed first, then the rest by a triangulation lowered (bottom)
-    // or raised (top) along the axis as far as the loop allows, so that a wall leaning over
-    // a ragged loop stays clear of it, and Delaunay where the loop is planar. No cap repeats
-    // an edge of the surface; where the surface's fins (triangles with two edges on the
-    // loop) leave no such cap, the edge under a fin may be flipped (two triangles change in
-    // place, same corners, same count; Report::caps.wall_flip_count). A loop whose
-    // projection is not a simple polygon, or that no cap closes, stays open: the call
+    // Closes the surface's boundary loops with caps over the loops' own vertices (no new
+    // vertex), so that a tube becomes a closed, edge- and vertex-manifold, consistently
+    // oriented surface (Euler characteristic 2, normals outward: the bottom cap faces -axis,
+    // the top one +axis): what solid modelling, printing and volumes need. No cap repeats an
+    // edge of the surface; where the surface's fins (triangles with two edges on the loop)
+    // leave no such cap, the edge under a fin may be flipped (two triangles change in place,
+    // same corners, same count; Report::caps.wall_flip_count). A loop whose projection
+    // across the axis is not a simple polygon, or that no cap closes, stays open: the call
     // still returns ok, Report::caps.open_count counts it and Report::detail says so.
-    // reconstruct_max_triangles() still suffices (a closed surface through V vertices has
-    // 2V - 4 triangles). The stream refuses the flag: cap_ends() caps its surface afterwards.
+    // reconstruct_max_triangles() still suffices. The stream refuses the flag: cap_ends()
+    // caps its surface afterwards.
     add_caps = 1u << 1,
     // The frame's reference point is Options::origin instead of the centroid of the cloud
     // (reconstruct) or of the first layer (the stream). The reference point changes only
     // rounding, but a stream and a reconstruct() that are to give the same triangles need
     // the same one.
     origin_given = 1u << 2,
-    // Points far from the rest of the cloud (stray returns, flying pixels, specks of fewer
-    // than 8 points) are left out before anything else and counted (outlier_count, part of
-    // rejected_count in Report::points), so they neither tilt the automatic axis nor stretch
-    // the layers nor become spikes: a point with fewer than 8 points, itself included,
-    // within 4 to 12 times the distance that nine points in ten have to their nearest
-    // neighbour. For raw sensor clouds; off by default, since without it every valid point
-    // is a vertex. Assumes that fewer than a tenth of the points are outliers. The
-    // workspace bound grows by a bit per point. The stream refuses it (invalid_argument);
-    // the reduced build returns not_compiled.
+    // Points far from the rest of the cloud (stray returns, flying pixels, small specks)
+    // are left out before anything else and counted (Report::points.outlier_count, part of
+    // rejected_count), so that they neither tilt the automatic axis nor stretch the layers
+    // nor become spikes. For raw sensor clouds whose outliers are a small share of the
+    // points; off by default, since without it every valid point is a vertex.
+    // reconstruct_workspace_size() includes what it needs. The stream refuses it
+    // (invalid_argument); the reduced build returns not_compiled.
     drop_outliers = 1u << 3,
     // After each layer is triangulated on its unrolled annulus (the paper's method), its
-    // edges are flipped on the surface itself: by the empty-circle rule with angles
-    // measured in 3D, and toward the direction in which the surface curves least. The
-    // unrolling squeezes whatever lies almost across the axis (the underside of an ear, a
-    // chin, a crease); there the flips join the points that are near on the surface. Each
-    // seam between layers is flipped the same way once the layers are stitched. No vertex
-    // or loop changes; a flip never makes a fold nor an angle over 150 degrees (unless it
-    // narrows one) and is checked against crossing the nearby triangles; the stream gives
-    // the same triangles as reconstruct() with it. Closer to the true surface (by about
-    // 10% on scans, 30 to 45% on smooth analytic tubes), for about three times the time:
-    // off by default. The reduced build returns not_compiled.
+    // edges are flipped on the surface itself, by the empty-circle rule with angles
+    // measured in 3D and toward the direction in which the surface curves least, and so is
+    // each seam between layers once they are stitched: the unrolling squeezes whatever lies
+    // almost across the axis (the underside of an ear, a chin), and there the flips join
+    // the points that are near on the surface. No vertex or loop changes; a flip never
+    // makes a fold nor an angle wider than a fixed obtuse limit (unless it narrows one) and
+    // is checked against crossing the nearby triangles; the stream gives the same triangles
+    // as reconstruct() with it. Off by default: it costs time. The reduced build returns
+    // not_compiled.
     surface_flips = 1u << 4,
     // No end of the surface is taken for a closed one (see ClosedEnd): the end layers are
     // unrolled on the cylinder like the others, never around a pole, so the surface's loops
@@ -424,25 +416,31 @@ typedef void (*JobFunction)(void* context, uint32_t index);
 // [0, count) is ignored; the same job on two threads at once is a data race.
 typedef void (*JobRunner)(void* user, uint32_t count, JobFunction job, void* context);
 
+// The layer rules' thresholds (see Options::cuts), shared with the stream: a point on a
+// cut, up to this share of the cloud's height, belongs to the layer above; a layer with
+// fewer points than kMinLayerPoints (the last needs 3), or thinner than kMinLayerRows rows
+// of points around its radius, joins the next one, since thinner layers make bands that
+// fold and cross.
+const double kCutTolerance = 0x1p-40;
+const size_t kMinLayerPoints = 16;
+const double kMinLayerRows = 1.5;
+
 // All zero means defaults: `Options options = {};` is always valid.
 struct Options {
     Axis axis;
     double direction[3];     // for Axis::direction; any finite non-zero length
-    // Layers, at most one of three ways (more than one is invalid_argument): explicit cut
+    // Layers, in at most one of three ways (more than one: invalid_argument): explicit cut
     // positions along the axis, as the coordinate dot(point, axis) (with Axis::z, a cut at
-    // 68 is the plane z = 68; a point on a cut, up to 2^-40 of the cloud's height, belongs
-    // to the layer above; any order, repeats and cuts outside the cloud are ignored); or
-    // layer_count equal-height layers; or layers of about layer_height; with none of them,
-    // automatic: the fewest layers such
-    // that one centre line serves each layer, none is taller than 24 of its radii and none
-    // holds more than an eighth of the points (or 65,536, if that is more, so that large
-    // clouds come in layers that jobs can triangulate side by side), cut where the
-    // cross-section changes least and not through dense detail (the paper's rule).
-    // Planned layers are then merged where the method needs it: a layer with fewer than
-    // 16 points, thinner than about one and a half rows of points around its radius, or
-    // whose points do not surround its centre joins the next one (a remainder like that
-    // joins the last); a layer next to a slanted end of the tube (a crescent: an arc with a
-    // gap of over 34 degrees that the two layers together narrow) joins it; a layer with
+    // 68 is the plane z = 68; a point on a cut, up to kCutTolerance of the cloud's height,
+    // belongs to the layer above; any order, repeats and cuts outside the cloud are
+    // ignored); or layer_count equal-height layers; or layers of about layer_height. With
+    // none of them the layers are automatic: the fewest such that one centre line serves
+    // each, cut where the cross-section changes least and not through dense detail (the
+    // paper's rule), and small enough for jobs to triangulate side by side. Planned layers
+    // are then merged where the method needs it: a layer with fewer than kMinLayerPoints
+    // points, thinner than kMinLayerRows rows of points around its radius, or whose points
+    // do not surround its centre joins the next one (a remainder like that joins the
+    // last); a layer next to a slanted end of the tube (a crescent) joins it; a layer with
     // triangles facing the axis is joined with the next one or two where that leaves
     // fewer. Report::layers gives the planned and used counts and the layers used.
     const double* cuts;
@@ -485,7 +483,8 @@ struct LayerInfo {
     double centre[3];        // the axis of the unrolling cylinder passes through this
                              // (the fitted centre, or the one the centre search chose)
     double radius;           // the unrolling cylinder's radius: the layer's mean distance
-                             // from its centre line, at least a 24th of its height
+                             // from its centre line, raised for a layer many radii tall
+                             // (so that its unrolled heights stay in range)
     uint32_t point_count;    // distinct valid points in the layer
     uint32_t triangle_count; // the layer's own triangles plus the band joining it to the
                              // layer below, before the safety net
@@ -614,8 +613,8 @@ struct CapCounts {
 };
 
 // A web triangle (Diagnostics) has its longest edge over this many times the largest local
-// spacing of its corners: single columns then show none or a few, objects with limbs
-// meshed as one tube a few percent of their area or more.
+// spacing of its corners: far enough above a surface's own spread of edge lengths that a
+// single column shows next to none, while a tube wrapped around limbs shows its spans.
 constexpr double kWebSpacings = 6.0;
 
 // Report::diagnostics: what a user checks before trusting the mesh.
@@ -662,15 +661,15 @@ struct Report {
 // A size in bytes that is always enough workspace for reconstruct() of point_count
 // points with these options. It assumes the worst layout (every point in one layer);
 // Report::workspace_used_bytes tells what a run really needed, which follows its largest
-// layer, or the measure of webs at the end (60 bytes a point, about half of the bound, on
-// a tube of six or more layers). With Options::run_jobs it also covers the layers
+// layer, or the measure of webs at the end. With Options::run_jobs it also covers the layers
 // triangulated ahead and the jobs' scratch. 0 if no workspace can serve that many points
 // (as for delaunay_2d_workspace_size).
 size_t reconstruct_workspace_size(size_t point_count, const Options& options);
 
-// The most triangles reconstruct() can produce for point_count points: 2n, plus four per
-// possible branch (160) where the options search for branches (0 if that does not fit in
-// size_t).
+// The most triangles reconstruct() can produce for point_count points: 2 * point_count
+// (a manifold surface through n vertices has at most 2n triangles), plus four per branch
+// on either side of a cut (8 * kMaxBranches) for the junctions where the options search
+// for branches; 0 if that does not fit in size_t.
 size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 
 // Reconstructs a triangle mesh through the points of a columnar cloud: one surface,
@@ -680,25 +679,16 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // across it: a dome, a flat base), the surface goes across it too, and that end's loop is
 // a small one around the axis (see ClosedEnd).
 //
-// In its steps: check the arguments and read the cloud (refusing NaN, a degenerate cloud);
-// choose the axis (Axis::automatic); look for where the cloud parts into branches along it
-// (unless Parts::one_tube) and, where it does, mesh the trunk and each branch around its own
-// automatic axis (the trunk along the cloud's axis where the options lay out the layers:
-// cuts, layer_count or layer_height), and join them into one surface (see PartCounts and
-// join_branches()); otherwise, or where the parts cannot all be joined, or where the
-// joined surface is not smaller than the one tube's (unless Parts::apart), mesh one tube:
-// layer by layer, each unrolled and triangulated, stitched to the layer below, passed
-// through the manifold safety net; then the caps (add_caps). A tube that wraps branches
-// bridges the gaps between them with webs, which add area, and so does a join that folds,
-// so the smaller surface is the one kept; the comparison meshes the one tube too, which
-// roughly doubles the time on clouds that part. A point beyond a cut in no branch (a
-// sparse point of a thin branch's tip) goes to the part of the nearest point within two
-// gaps (Parting::gap). Where the trunk's own axis leans from the axis by half a degree to
-// 30 degrees (a fork scanned askew), the parting is searched again until the cut is square
-// to the trunk, whose end must lie under every branch (Report::parts.parting.axis is the
-// axis of the cut kept). The branch search runs on a sample of 4,096 points first on
-// larger clouds and in full only where the sample parts, so a branch of fewer than about
-// n / 64 points can go unseen in a cloud of n points.
+// It meshes one tube (layer by layer, each unrolled and triangulated, stitched to the layer
+// below and passed through the manifold safety net), or, unless Parts::one_tube, the trunk
+// and the branches where the cloud parts (each around its own automatic axis; the trunk
+// along the cloud's axis where the options lay out the layers) joined into one surface:
+// see Parts, PartCounts, find_parting() and join_branches(). With Parts::automatic the
+// joined parts are kept only where every part was meshed, every side joined, every point
+// is in a part and their surface is smaller than the one tube's: a tube that wraps
+// branches bridges the gaps between them with webs, and a join that folds adds area too.
+// Report::parts.parting.axis is the axis of the cut kept, which is squared to the trunk's
+// own axis where the two differ. The caps (add_caps) come last.
 //
 // cloud           the points (see Cloud), at most 2^32 - 3. They are only read.
 // options         see Options; `Options options = {};` gives the defaults.
@@ -773,17 +763,17 @@ Status reconstruct(const Cloud& cloud, const Options& options,
 // Options::cuts at the tops of all pushes but the last, the same axis, the same origin
 // (flag origin_given), Parts::one_tube and the points of each push in the same order,
 // gives the same triangles in the same order, with the same global indices,
-// provided no point lies within 2^-40 of the height range below a cut (reconstruct()
+// provided no point lies within kCutTolerance of the height range below a cut (reconstruct()
 // counts such a point in the layer above) and no cut lies outside the points' height
 // range. The stream makes no caps (the add_caps flag is refused): cap_ends() closes its
 // surface afterwards (below).
 //
-// Memory: stream_workspace_size(max_points_held) bytes, about 190 per point held. The
-// stream holds the last layer's top loop, the layer being formed (pushes that join it
-// included) and the pushes after it until they can form a layer. A layer that folds waits
-// for the two pushes after it (it may join them), so when every push is at least 16 points
-// and 1.5 rows of points thick and none is a crescent, three times the largest push
-// suffices where no layer folds and about four times where layers fold.
+// Memory: stream_workspace_size(max_points_held) bytes. The stream holds the last layer's
+// top loop, the layer being formed (pushes that join it included) and the pushes after it
+// until they can form a layer. A layer that folds waits for the two pushes after it (it
+// may join them), so when every push holds at least kMinLayerPoints points and
+// kMinLayerRows rows of points and none is a crescent, three times the largest push
+// suffices where no layer folds, and more where layers fold.
 // A push that would hold more returns out_of_memory and changes nothing; Report::points.held_count
 // says what a run needed.
 
@@ -811,7 +801,7 @@ size_t stream_workspace_size(size_t max_points_held, const Options& options);
 // not define, a Parts value outside the enum, more than one of cuts, layer_count and
 // layer_height),
 // invalid_origin (a NaN or infinite origin), invalid_axis, out_of_memory (a workspace too
-// small to hold 16 points).
+// small to hold kMinLayerPoints points).
 // The stream uses as many points as the workspace holds.
 Status stream_open(const Options& options, void* workspace, size_t workspace_bytes,
                    TriangleCallback emit, void* emit_user, Report* report, Stream** stream);
@@ -893,38 +883,25 @@ Status cap_ends(const Cloud& cloud, const Options& options, void* workspace,
 
 // ---- Where the cloud parts into branches ----
 //
-// One tube cannot follow an object that forks (the horns on a head, the fingers of a hand,
-// the condyles at a femur's end): it wraps the branches and the gaps between them.
-// find_parting() finds where along the axis the cloud parts: the lowest cut above which
-// the points make two separate branches or more, and the highest below which they do.
-// reconstruct() uses it by default; a caller can also mesh each side on its own, the
-// branches with ends_are_cuts, and join them with join_branches().
-//
-// Points join one piece when they lie within Parting::gap of each other (single linkage).
-// The gap is four times the median distance from a point to its nearest distinct
-// neighbour (on every k-th point in the order of a grid, at most 2,048 of them): the
-// points of one branch lie closer, the branches of a fork farther apart. Cuts are tried
-// every half gap along the axis (at most one per point). A side of a cut parts when it is
-// four gaps thick or more (a thinner one is a rim, which falls apart into arcs). Its pieces
-// count from kSmallestBranch points and a twentieth of the side's (specks and scraps do not
-// make a branch); of those, the ones whose nearest point lies within a gap of the cut start
-// there, the others are left aside (a patch that a hole in the scan cut off, the tip of a
-// thin branch sampled too sparsely to stay joined to it). The side parts when two pieces
-// or more start at the cut and every one of them is a branch: its farthest point lies two
-// gaps or more from the cut (else it is a bump, or the crown of a skull between two horns),
-// and the centroids of its points within a gap of the cut and within the next gap lie less
-// than two gaps apart across the axis (else it is a cap joined to a branch, whose section
-// jumps). So horns above a skull are found; the condyles of a femur, which part for only
-// a gap below their notch, are not, as a bump would not be.
+// One tube cannot follow an object that forks (the horns on a head, the fingers of a hand):
+// it wraps the branches and the gaps between them. find_parting() finds where along the
+// axis the cloud parts: the lowest cut above which the points make two separate branches
+// or more, and the highest below which they do. Points join one piece when they lie within
+// Parting::gap of each other (single linkage, the gap scaled to the cloud's spacing). A
+// piece is a branch when it holds at least kSmallestBranch points and 1 / kMaxBranches of
+// its side's, starts at the cut and goes on beyond it (a bump, a rim or a crown between
+// horns is none). reconstruct() uses it by default; a caller can also mesh each side on its
+// own, the branches with ends_are_cuts, and join them with join_branches(). docs/design.md
+// gives the rule in full.
 
-// Bytes of workspace find_parting() needs for point_count points (about 100 a point);
-// 0 if that is beyond what this platform can address.
+// Bytes of workspace that always suffice for find_parting() of point_count points; 0 if
+// that is beyond what this platform can address.
 size_t find_parting_workspace_size(size_t point_count, const Options& options);
 
 
 // Finds where the cloud parts into branches (see above). options: axis, direction, and
 // the flags skip_invalid_points and drop_outliers (outliers are left out first); the rest
-// is not used. The same axis as reconstruct() with these options. Deterministic; another
+// is only checked. The same axis as reconstruct() with these options. Deterministic; another
 // order of the points changes only rounding (the frame's origin is their centroid) and
 // which points sample the scale. Returns ok (parting filled, whether or not
 // a cut was found); invalid_argument (a null parting, or workspace with points; a bad
@@ -944,78 +921,61 @@ Status find_parting(const Cloud& cloud, const Options& options, void* workspace,
 // ---- Joining the branches to the trunk ----
 //
 // join_branches() joins a trunk and its branches, meshed apart (each label of
-// find_parting's branch_of its own reconstruct(), as reconstruct() does by default),
-// into one surface. At each side that parts, the trunk's boundary loop nearest the
-// branches (the highest of the loops whose points are all kInTrunk, seen from that side)
-// is joined to each branch's loop nearest the cut: the trunk's loop is split at the gaps
-// between the branches, in their order around the trunk's centre (the vertex whose angle
-// is nearest the middle of each gap); each arc is zipped to its branch's whole loop, which
-// is opened at its point nearest the trunk's centre (the two chains merged in the order of
-// their angle around the branch's centre, which crosses itself far less than shortest
-// diagonals first, as contour stitching does); and the crotch is closed by a triangle per
-// gap, from the trunk's vertex there to the two branches' opening points, and a fan over
-// those points where three branches or more meet.
-//
-//       trunk's loop   ... m0 ---- branch 1's arc ---- m1 ---- branch 2's arc ---- m0 ...
-//       branch loops   p1 (opened) around to p1        p2 (opened) around to p2
-//       crotch         (p1, m1, p2) and (p2, m0, p1)
-//
-// The new triangles run each loop's edges against the surface's direction, and every
-// vertex keeps one fan, so a surface that is an oriented edge- and vertex-manifold (as
-// reconstruct()'s) stays one, whatever the geometry. The geometry decides whether a side
-// is joined (else it is counted in apart_side_count, the reason in detail): the trunk's
-// loop must lie within four gaps of the cut (a trunk closed there keeps only its far
-// loop), at least two branches must have a loop there whose points are all theirs, each
-// branch's centre must lie within the trunk loop's mean radius across the axis, and the
-// gaps must follow one another along the trunk's loop.
-//
-// Where that fails (branches standing on a closed end, as horns on a skull: no trunk loop
-// goes around them), each branch is grafted instead: the trunk's triangles under the
-// branch's loop (seen along the axis, facing the branch, within four gaps below it) are
-// taken out as a disc that keeps every vertex on a triangle, and the hole's loop is zipped
-// to the branch's by angle around the branch's centre. Such a disc never takes a triangle
-// with a corner on the surface's boundary, so where a small gap in the trunk's end (at
-// most 32 vertices) has a corner on the triangle under the branch's centre, the gap is
-// closed first (its loop triangulated, no vertex added) and the disc may take that
-// triangle; what the hole leaves of the closing stays, one gap fewer. The surface stays an
-// oriented edge- and vertex-manifold and every point stays a vertex; the band can cross
-// the trunk's triangles beside the stump where the stump's wall leans over the hole. A
-// graft needs the cut square to the fork: with the axis tilted two degrees within the
-// fork's plane, the cut runs lower under one branch, no triangle of the trunk's end faces
-// it under its loop, and that side stays apart. reconstruct() therefore cuts square to the
-// trunk's own axis.
+// find_parting's branch_of its own reconstruct(), as reconstruct() does by default), into
+// one surface, at each side that parts: where the trunk's boundary loop nearest the
+// branches goes around them, that loop is split at the gaps between the branches and each
+// arc is zipped to its branch's loop nearest the cut, the crotch closed by a triangle per
+// gap; where it does not (branches standing on a closed end, as horns on a skull), each
+// branch is grafted onto a hole taken out of the trunk's triangles under its loop, a small
+// gap of the trunk's end in the way (at most kMostGapCorners corners) closed first. The new
+// triangles run each loop's edges against the surface's direction and every vertex keeps
+// one fan, so a surface that is an oriented edge- and vertex-manifold (as reconstruct()'s)
+// stays one, and every point stays a vertex; a graft's band can cross the trunk's
+// triangles beside the stump where the stump's wall leans over the hole. A side whose
+// geometry allows neither (the trunk's loop far from the cut, fewer than two branch loops
+// there, a branch outside the trunk's loop, gaps out of order along it, a cut that is not
+// square to the fork) stays apart, counted in JoinReport::apart_side_count with the reason
+// in detail. docs/design.md describes the zip and the graft.
+
+// The most corners of a gap in the trunk's end that a graft closes, and so the most
+// triangles those closings add in all (two sides of kMaxBranches branches).
+const uint32_t kMostGapCorners = 32;
+const size_t kMostGapTriangles = 2 * size_t{kMaxBranches} * (kMostGapCorners - 2);
+
+// What join_branches() did, as Report::parts counts it for reconstruct().
 struct JoinReport {
     size_t joined_side_count;        // 0, 1 or 2
-    size_t apart_side_count;         // sides that part whose loops could not be joined (detail)
-    size_t grafted_branch_count;     // branches joined through a hole in the trunk's closed end
+    size_t apart_side_count;         // sides that part but could not be joined (detail)
+    size_t grafted_branch_count;     // branches joined through a hole in the trunk's end
     size_t junction_triangle_count;  // triangles the junctions added
     size_t removed_triangle_count;   // the trunk's triangles the holes took out
     size_t workspace_used_bytes;     // peak workspace bytes, from the start of the buffer
-    const char* detail;              // a static sentence on why, on failure or a side left apart
+    const char* detail;              // a static sentence on why, on failure or a side apart
 };
 
-// Bytes of workspace join_branches() needs for a surface of triangle_count triangles over
-// point_count points: 9 bytes a point, plus the larger of 12 a point and 12 a triangle (the
-// loops' tracing) and 8 a point, 1 a triangle, 56 for each triangle up to 65,536 and 15,600
-// for the gaps' closings (the grafts); 0 if that is beyond what this platform can address.
+// Bytes of workspace that always suffice for join_branches() on a surface of
+// triangle_count triangles over point_count points; 0 if that is beyond what this platform
+// can address.
 size_t join_branches_workspace_size(size_t point_count, size_t triangle_count);
 
-// The most triangles join_branches() adds: one per vertex of a loop it zips, four per
-// branch (each point on one loop at most) and 1,200 for the gaps the grafts close.
+// The most triangles join_branches() adds: point_count + 4 * kMaxBranches +
+// kMostGapTriangles (one per vertex of a loop it zips, each point on one loop at most; four
+// per branch for the crotches; the gaps the grafts close).
 size_t join_branches_max_triangles(size_t point_count);
 
 // Takes the grafts' holes out of triangles[0 .. 3 * *triangle_count) (indices into
-// `cloud`; the triangles kept stay in their order, removed_triangle_count fewer), appends the
-// junctions' triangles and sets *triangle_count to the new total. parting and branch_of:
-// find_parting()'s on the same cloud (its axis is used); options: skip_invalid_points is
-// used, the rest only checked (a flag bit Flags does not define, or a Parts value outside
-// the enum, is invalid_argument). report (optional) is filled on every status. Returns ok
-// (a side counts as joined when all its branches are; the others in apart_side_count, their branches grafted where
-// they could be, the rest of their triangles left as they were); invalid_argument (a
-// null triangle_count, branch_of, workspace or triangles where needed; a bad stride or
-// scalar; *triangle_count above triangle_capacity; an index outside the cloud or naming an
-// invalid point; buffers sharing a byte); too_many_points; invalid_point (a NaN or infinite point
-// without skip_invalid_points); invalid_axis (a parting whose axis is zero or not finite);
+// `cloud`; the triangles kept stay in their order, removed_triangle_count fewer), appends
+// the junctions' triangles and sets *triangle_count to the new total. parting and
+// branch_of: find_parting()'s on the same cloud (its axis is used); options:
+// skip_invalid_points is used, the rest only checked (a flag bit Flags does not define, or
+// a Parts value outside the enum, is invalid_argument). report (optional) is filled on
+// every status. Returns ok (a side counts as joined when all its branches are; the others
+// in apart_side_count, their branches grafted where they could be, the rest of their
+// triangles left as they were); invalid_argument (a null triangle_count, branch_of,
+// workspace or triangles where needed; a bad stride or scalar; *triangle_count above
+// triangle_capacity; an index outside the cloud or naming an invalid point; buffers
+// sharing a byte); too_many_points; invalid_point (a NaN or infinite point without
+// skip_invalid_points); invalid_axis (a parting whose axis is zero or not finite);
 // out_of_memory (a workspace below join_branches_workspace_size()); triangle_capacity
 // (*triangle_count set to the triangles needed; nothing written). On every status but ok
 // the triangles are unchanged. On a surface that is not a vertex-manifold the call stays
@@ -1208,10 +1168,11 @@ typedef void (*stratmesh_job_runner)(void* user, uint32_t count, stratmesh_job_f
 typedef struct stratmesh_options {
     uint32_t axis;                  // stratmesh_axis
     double direction[3];            // for STRATMESH_AXIS_DIRECTION
+    // At most one of the cuts, layer_count and layer_height; none: automatic layers.
     const double* cuts;             // explicit cut heights, dot(point, axis)
     size_t cut_count;
-    uint32_t layer_count;           // else equal-height layers
-    double layer_height;            // else layers of about this height; else automatic
+    uint32_t layer_count;           // equal-height layers
+    double layer_height;            // layers of about this height
     uint32_t flags;                 // stratmesh_flags bits
     uint32_t parts;                 // stratmesh_parts
     double origin[3];               // with STRATMESH_FLAG_ORIGIN_GIVEN
@@ -4136,8 +4097,6 @@ struct LayerPlan {
     double tolerance;
 };
 
-const double kCutTolerance = 0x1p-40;
-
 const size_t kMaxAutomaticLayers = 256;
 
 // Heights are divided by at least layer height / kMaxTurns when unrolled, so exp() stays
@@ -4145,16 +4104,10 @@ const size_t kMaxAutomaticLayers = 256;
 // up to kMaxTurns radii tall unrolls undistorted (see >>unroll).
 const double kMaxTurns = 24.0;
 
-// A layer with fewer points is merged with the next one (the last layer only needs 3).
-const size_t kMinLayerPoints = 16;
-
-// A layer also needs about one and a half rows of points: thinner ones make bands of a few
-// points that fold and cross. With n points over height h around radius r (the layer's
-// own), the spacing is about sqrt(2 pi r h / n), so the rows number sqrt(h n / (2 pi r)).
-// A stack of planar contours one per layer, as far apart as a few point spacings along the
-// contour, passes.
-const double kMinLayerRows = 1.5;
-
+// Whether a layer holds kMinLayerRows rows of points (see Options::cuts). With n points
+// over height h around radius r (the layer's own), the spacing is about sqrt(2 pi r h / n),
+// so the rows number sqrt(h n / (2 pi r)). A stack of planar contours one per layer, as far
+// apart as a few point spacings along the contour, passes.
 static inline bool thick_enough(size_t points, double height, double radius) {
     const double two_pi = 6.28318530717958647693;
     return static_cast<double>(points) * height >= kMinLayerRows * kMinLayerRows * two_pi * radius;
@@ -10138,7 +10091,7 @@ Status stream_open(const Options& options, void* workspace, size_t workspace_byt
         size_t bytes = detail::stream_bytes(mid);
         if (bytes != 0 && bytes <= workspace_bytes) low = mid; else high = mid - 1;
     }
-    if (low < detail::kMinLayerPoints) return Status::out_of_memory;
+    if (low < kMinLayerPoints) return Status::out_of_memory;
     detail::Arena arena = detail::Arena::over(workspace, workspace_bytes);
     Stream* s = arena.alloc<Stream>(1);
     if (!s) return Status::out_of_memory;
@@ -11418,14 +11371,10 @@ namespace detail {
 // arrays are sized for them, not for the whole surface.
 const size_t kGraftMaxTriangles = size_t{1} << 16;
 
-// The small gaps in the trunk's end a graft may close (see plan_graft): at most this many
-// vertices each, within kGapReach times the branch loop's reach of its centre, at most one
-// a graft, so at most kMostFilled triangles in all.
-const uint32_t kGapLoopMost = 32;
-
+// The small gaps in the trunk's end a graft may close (see plan_graft): at most
+// kMostGapCorners vertices each, within kGapReach times the branch loop's reach of its
+// centre, at most one a graft, so at most kMostGapTriangles triangles in all.
 const double kGapReach = 1.5;
-
-const size_t kMostFilled = 2 * size_t{kMaxBranches} * (kGapLoopMost - 2);
 
 // A directed edge of a triangle under a branch's loop, and which of them it belongs to.
 struct GraftEdge {
@@ -11436,7 +11385,7 @@ struct GraftEdge {
 
 struct JoinMemory {
     CapLoop loops;  // only ids and starts
-    uint32_t* gap_joins;  // per entry of loops.ids on a loop of at most kGapLoopMost: bit j
+    uint32_t* gap_joins;  // per entry of loops.ids on a loop of at most kMostGapCorners: bit j
                           // set where its vertex and the loop's j-th are joined by an edge of
                           // the caller's surface (the diagonals a gap fill may not make)
     CapGraph graph;  // until the loops are traced; the grafts' arrays then take its memory
@@ -11473,8 +11422,8 @@ static inline bool allocate_grafts(JoinMemory& m, size_t point_count, size_t tri
     m.under_capacity = triangle_count < kGraftMaxTriangles ? triangle_count : kGraftMaxTriangles;
     m.hole_next = arena.alloc<uint32_t>(point_count);
     m.holes = arena.alloc<uint32_t>(point_count);
-    m.removed = arena.alloc<unsigned char>(triangle_count + kMostFilled);
-    m.filled = arena.alloc<uint32_t>(3 * kMostFilled);
+    m.removed = arena.alloc<unsigned char>(triangle_count + kMostGapTriangles);
+    m.filled = arena.alloc<uint32_t>(3 * kMostGapTriangles);
     m.filled_count = 0;
     m.under = arena.alloc<uint32_t>(m.under_capacity);
     m.edges = arena.alloc<GraftEdge>(3 * m.under_capacity);
@@ -11870,7 +11819,7 @@ static inline bool corner_under(const JoinMemory& m, size_t found, uint32_t v) {
 }
 
 // A small gap in the trunk's end beside a branch's stump: a closed boundary loop of the
-// trunk of at most kGapLoopMost vertices, each held by no hole, within `reach` of (cx, cy)
+// trunk of at most kMostGapCorners vertices, each held by no hole, within `reach` of (cx, cy)
 // across the axis and within [low, high] along it, one of them a corner of a triangle
 // under the branch; the one nearest (cx, cy), {nullptr, 0} if none.
 static inline TracedLoop gap_beside(const JoinMemory& m, size_t entries, size_t found,
@@ -11884,7 +11833,7 @@ static inline TracedLoop gap_beside(const JoinMemory& m, size_t entries, size_t 
         const TracedLoop loop = {m.loops.ids + start, static_cast<uint32_t>(end - start)};
         const bool closed = m.loops.starts[start] == kLoopStart;
         start = end;
-        if (!closed || loop.length < 3 || loop.length > kGapLoopMost) continue;
+        if (!closed || loop.length < 3 || loop.length > kMostGapCorners) continue;
         bool near = true, touches = false;
         double x = 0, y = 0;
         for (uint32_t i = 0; i < loop.length && near; ++i) {
@@ -11905,7 +11854,7 @@ static inline TracedLoop gap_beside(const JoinMemory& m, size_t entries, size_t 
     return best;
 }
 
-static_assert(kGapLoopMost <= 32, "a gap's joins are bits of 32");
+static_assert(kMostGapCorners <= 32, "a gap's joins are bits of 32");
 
 // Notes in m.gap_joins, from the graph, which vertices of each loop small enough to be a
 // gap are joined by an edge of the caller's surface: the graph keeps the edges between
@@ -11915,7 +11864,7 @@ static inline void note_gap_joins(JoinMemory& m, size_t entries) {
         size_t end = start + 1;
         while (end < entries && m.loops.starts[end] == 0) ++end;
         const uint32_t* ids = m.loops.ids + start;
-        for (size_t i = 0; end - start <= kGapLoopMost && i < end - start; ++i) {
+        for (size_t i = 0; end - start <= kMostGapCorners && i < end - start; ++i) {
             uint32_t joins = 0;
             for (size_t j = 0; j < end - start; ++j)
                 if (m.graph.has_edge(ids[i], ids[j])) joins |= uint32_t{1} << j;
@@ -11954,17 +11903,17 @@ private:
 // edge of the surface. count: the caller's triangles, which m.removed numbers first.
 static inline bool fill_gap(size_t count, const TracedLoop& loop, const SideView& view, JoinMemory& m) {
     const uint32_t n = loop.length;
-    if (m.filled_count + (n - 2) > kMostFilled) return false;
-    double xy[2 * kGapLoopMost];
+    if (m.filled_count + (n - 2) > kMostGapTriangles) return false;
+    double xy[2 * kMostGapCorners];
     for (uint32_t i = 0; i < n; ++i) {
         const Local p = view.at(loop.ids[i]);
         xy[2 * i] = p.x;
         xy[2 * i + 1] = p.y;
     }
-    uint64_t sweep[kGapLoopMost];
+    uint64_t sweep[kMostGapCorners];
     if (!polygon_is_simple(xy, n, sweep) || !(simple_polygon_turn(xy, n) > 0)) return false;
-    uint32_t prev[kGapLoopMost], next[kGapLoopMost], reflex[kGapLoopMost];
-    unsigned char flags[kGapLoopMost];
+    uint32_t prev[kMostGapCorners], next[kMostGapCorners], reflex[kMostGapCorners];
+    unsigned char flags[kMostGapCorners];
     const size_t first = m.filled_count;
     GapEars ears(loop.ids, m.gap_joins + (loop.ids - m.loops.ids), m);
     EarClipper clipper(xy, n, {prev, next, reflex, flags});
@@ -12324,7 +12273,7 @@ size_t join_branches_workspace_size(size_t point_count, size_t triangle_count) {
 }
 
 size_t join_branches_max_triangles(size_t point_count) {
-    return point_count + 4 * static_cast<size_t>(kMaxBranches) + detail::kMostFilled;
+    return point_count + 4 * static_cast<size_t>(kMaxBranches) + kMostGapTriangles;
 }
 
 Status join_branches(const Cloud& cloud, const Options& options, const Parting& parting,

@@ -18,14 +18,10 @@ namespace detail {
 // arrays are sized for them, not for the whole surface.
 const size_t kGraftMaxTriangles = size_t{1} << 16;
 
-// The small gaps in the trunk's end a graft may close (see plan_graft): at most this many
-// vertices each, within kGapReach times the branch loop's reach of its centre, at most one
-// a graft, so at most kMostFilled triangles in all.
-const uint32_t kGapLoopMost = 32;
-
+// The small gaps in the trunk's end a graft may close (see plan_graft): at most
+// kMostGapCorners vertices each, within kGapReach times the branch loop's reach of its
+// centre, at most one a graft, so at most kMostGapTriangles triangles in all.
 const double kGapReach = 1.5;
-
-const size_t kMostFilled = 2 * size_t{kMaxBranches} * (kGapLoopMost - 2);
 
 // A directed edge of a triangle under a branch's loop, and which of them it belongs to.
 struct GraftEdge {
@@ -36,7 +32,7 @@ struct GraftEdge {
 
 struct JoinMemory {
     CapLoop loops;  // only ids and starts
-    uint32_t* gap_joins;  // per entry of loops.ids on a loop of at most kGapLoopMost: bit j
+    uint32_t* gap_joins;  // per entry of loops.ids on a loop of at most kMostGapCorners: bit j
                           // set where its vertex and the loop's j-th are joined by an edge of
                           // the caller's surface (the diagonals a gap fill may not make)
     CapGraph graph;  // until the loops are traced; the grafts' arrays then take its memory
@@ -73,8 +69,8 @@ static inline bool allocate_grafts(JoinMemory& m, size_t point_count, size_t tri
     m.under_capacity = triangle_count < kGraftMaxTriangles ? triangle_count : kGraftMaxTriangles;
     m.hole_next = arena.alloc<uint32_t>(point_count);
     m.holes = arena.alloc<uint32_t>(point_count);
-    m.removed = arena.alloc<unsigned char>(triangle_count + kMostFilled);
-    m.filled = arena.alloc<uint32_t>(3 * kMostFilled);
+    m.removed = arena.alloc<unsigned char>(triangle_count + kMostGapTriangles);
+    m.filled = arena.alloc<uint32_t>(3 * kMostGapTriangles);
     m.filled_count = 0;
     m.under = arena.alloc<uint32_t>(m.under_capacity);
     m.edges = arena.alloc<GraftEdge>(3 * m.under_capacity);
@@ -470,7 +466,7 @@ static inline bool corner_under(const JoinMemory& m, size_t found, uint32_t v) {
 }
 
 // A small gap in the trunk's end beside a branch's stump: a closed boundary loop of the
-// trunk of at most kGapLoopMost vertices, each held by no hole, within `reach` of (cx, cy)
+// trunk of at most kMostGapCorners vertices, each held by no hole, within `reach` of (cx, cy)
 // across the axis and within [low, high] along it, one of them a corner of a triangle
 // under the branch; the one nearest (cx, cy), {nullptr, 0} if none.
 static inline TracedLoop gap_beside(const JoinMemory& m, size_t entries, size_t found,
@@ -484,7 +480,7 @@ static inline TracedLoop gap_beside(const JoinMemory& m, size_t entries, size_t 
         const TracedLoop loop = {m.loops.ids + start, static_cast<uint32_t>(end - start)};
         const bool closed = m.loops.starts[start] == kLoopStart;
         start = end;
-        if (!closed || loop.length < 3 || loop.length > kGapLoopMost) continue;
+        if (!closed || loop.length < 3 || loop.length > kMostGapCorners) continue;
         bool near = true, touches = false;
         double x = 0, y = 0;
         for (uint32_t i = 0; i < loop.length && near; ++i) {
@@ -505,7 +501,7 @@ static inline TracedLoop gap_beside(const JoinMemory& m, size_t entries, size_t 
     return best;
 }
 
-static_assert(kGapLoopMost <= 32, "a gap's joins are bits of 32");
+static_assert(kMostGapCorners <= 32, "a gap's joins are bits of 32");
 
 // Notes in m.gap_joins, from the graph, which vertices of each loop small enough to be a
 // gap are joined by an edge of the caller's surface: the graph keeps the edges between
@@ -515,7 +511,7 @@ static inline void note_gap_joins(JoinMemory& m, size_t entries) {
         size_t end = start + 1;
         while (end < entries && m.loops.starts[end] == 0) ++end;
         const uint32_t* ids = m.loops.ids + start;
-        for (size_t i = 0; end - start <= kGapLoopMost && i < end - start; ++i) {
+        for (size_t i = 0; end - start <= kMostGapCorners && i < end - start; ++i) {
             uint32_t joins = 0;
             for (size_t j = 0; j < end - start; ++j)
                 if (m.graph.has_edge(ids[i], ids[j])) joins |= uint32_t{1} << j;
@@ -554,17 +550,17 @@ private:
 // edge of the surface. count: the caller's triangles, which m.removed numbers first.
 static inline bool fill_gap(size_t count, const TracedLoop& loop, const SideView& view, JoinMemory& m) {
     const uint32_t n = loop.length;
-    if (m.filled_count + (n - 2) > kMostFilled) return false;
-    double xy[2 * kGapLoopMost];
+    if (m.filled_count + (n - 2) > kMostGapTriangles) return false;
+    double xy[2 * kMostGapCorners];
     for (uint32_t i = 0; i < n; ++i) {
         const Local p = view.at(loop.ids[i]);
         xy[2 * i] = p.x;
         xy[2 * i + 1] = p.y;
     }
-    uint64_t sweep[kGapLoopMost];
+    uint64_t sweep[kMostGapCorners];
     if (!polygon_is_simple(xy, n, sweep) || !(simple_polygon_turn(xy, n) > 0)) return false;
-    uint32_t prev[kGapLoopMost], next[kGapLoopMost], reflex[kGapLoopMost];
-    unsigned char flags[kGapLoopMost];
+    uint32_t prev[kMostGapCorners], next[kMostGapCorners], reflex[kMostGapCorners];
+    unsigned char flags[kMostGapCorners];
     const size_t first = m.filled_count;
     GapEars ears(loop.ids, m.gap_joins + (loop.ids - m.loops.ids), m);
     EarClipper clipper(xy, n, {prev, next, reflex, flags});
@@ -924,7 +920,7 @@ size_t join_branches_workspace_size(size_t point_count, size_t triangle_count) {
 }
 
 size_t join_branches_max_triangles(size_t point_count) {
-    return point_count + 4 * static_cast<size_t>(kMaxBranches) + detail::kMostFilled;
+    return point_count + 4 * static_cast<size_t>(kMaxBranches) + kMostGapTriangles;
 }
 
 Status join_branches(const Cloud& cloud, const Options& options, const Parting& parting,

@@ -19,8 +19,6 @@ struct LayerPlan {
     double tolerance;
 };
 
-const double kCutTolerance = 0x1p-40;
-
 const size_t kMaxAutomaticLayers = 256;
 
 // Heights are divided by at least layer height / kMaxTurns when unrolled, so exp() stays
@@ -28,16 +26,10 @@ const size_t kMaxAutomaticLayers = 256;
 // up to kMaxTurns radii tall unrolls undistorted (see >>unroll).
 const double kMaxTurns = 24.0;
 
-// A layer with fewer points is merged with the next one (the last layer only needs 3).
-const size_t kMinLayerPoints = 16;
-
-// A layer also needs about one and a half rows of points: thinner ones make bands of a few
-// points that fold and cross. With n points over height h around radius r (the layer's
-// own), the spacing is about sqrt(2 pi r h / n), so the rows number sqrt(h n / (2 pi r)).
-// A stack of planar contours one per layer, as far apart as a few point spacings along the
-// contour, passes.
-const double kMinLayerRows = 1.5;
-
+// Whether a layer holds kMinLayerRows rows of points (see Options::cuts). With n points
+// over height h around radius r (the layer's own), the spacing is about sqrt(2 pi r h / n),
+// so the rows number sqrt(h n / (2 pi r)). A stack of planar contours one per layer, as far
+// apart as a few point spacings along the contour, passes.
 static inline bool thick_enough(size_t points, double height, double radius) {
     const double two_pi = 6.28318530717958647693;
     return static_cast<double>(points) * height >= kMinLayerRows * kMinLayerRows * two_pi * radius;

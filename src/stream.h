@@ -273,7 +273,7 @@ Status stream_open(const Options& options, void* workspace, size_t workspace_byt
         size_t bytes = detail::stream_bytes(mid);
         if (bytes != 0 && bytes <= workspace_bytes) low = mid; else high = mid - 1;
     }
-    if (low < detail::kMinLayerPoints) return Status::out_of_memory;
+    if (low < kMinLayerPoints) return Status::out_of_memory;
     detail::Arena arena = detail::Arena::over(workspace, workspace_bytes);
     Stream* s = arena.alloc<Stream>(1);
     if (!s) return Status::out_of_memory;

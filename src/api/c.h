@@ -176,10 +176,11 @@ typedef void (*stratmesh_job_runner)(void* user, uint32_t count, stratmesh_job_f
 typedef struct stratmesh_options {
     uint32_t axis;                  // stratmesh_axis
     double direction[3];            // for STRATMESH_AXIS_DIRECTION
+    // At most one of the cuts, layer_count and layer_height; none: automatic layers.
     const double* cuts;             // explicit cut heights, dot(point, axis)
     size_t cut_count;
-    uint32_t layer_count;           // else equal-height layers
-    double layer_height;            // else layers of about this height; else automatic
+    uint32_t layer_count;           // equal-height layers
+    double layer_height;            // layers of about this height
     uint32_t flags;                 // stratmesh_flags bits
     uint32_t parts;                 // stratmesh_parts
     double origin[3];               // with STRATMESH_FLAG_ORIGIN_GIVEN

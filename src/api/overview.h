@@ -43,7 +43,7 @@
 // branches and, where it does, the trunk and each branch are meshed along their own axes
 // and joined into one surface; the ends stay open (add_caps caps them) and the layers stay
 // Delaunay on their unrolled annulus, as in the paper (surface_flips refines them on the
-// surface, for about three times the time).
+// surface, at a cost in time).
 //
 // ==== Integration ==========================================================================
 //
@@ -68,25 +68,24 @@
 //                            invariants in debug builds. Bad *data* never reaches an
 //                            assert: it returns a Status.
 //   STRATMESH_NO_PARALLEL_LAYERS   default: not defined. Define it where the implementation
-//                            is compiled to leave out the parallel-layers code (about
-//                            2 KiB on a Cortex-M7): Options::run_jobs is then ignored
-//                            and everything runs in order, with the same result. For
-//                            single-core targets.
+//                            is compiled to leave out the parallel-layers code:
+//                            Options::run_jobs is then ignored and everything runs in
+//                            order, with the same result. For single-core targets.
 //   STRATMESH_C_API          0 or 1; default 1, or 0 with STRATMESH_SMALL_CODE. Declares
 //                            and compiles the C interface (see "C interface"); define it
 //                            alike where the implementation is compiled and where the
 //                            header is included.
 //   STRATMESH_SMALL_CODE     default: not defined. The reduced build, for targets where
-//                            code size comes first (under 32 KiB of Cortex-M7 code at
-//                            -Os, against under 80 KiB for the full library): it meshes
-//                            one tube along the axis the caller gives, as the paper
-//                            does. It leaves out:
+//                            code size comes first (CI holds it within 32 KiB of
+//                            Cortex-M7 code at -Os): it meshes one tube along the axis
+//                            the caller gives, as the paper does. It leaves out:
 //                            - what only makes it faster (parallel layers, the safety
 //                              net's shortcut, the staging of grouped points, the
 //                              predicates' integer stages): same bytes, slower;
 //                            - the search for branches (as if Options::parts were
-//                              always Parts::one_tube), the automatic axis (Axis::automatic returns
-//                              Status::not_compiled), the check for a degenerate
+//                              always Parts::one_tube), the automatic axis
+//                              (Axis::automatic returns Status::not_compiled), the
+//                              check for a degenerate
 //                              cloud, find_parting(), join_branches() and cap_ends()
 //                              (not declared);
 //                            - closed ends (a dome or a flat base is unrolled on the
@@ -96,7 +95,7 @@
 //                            - the caps' lowering and raising along the axis, their
 //                              pockets, restarts, exhaustive search and fin flips: its
 //                              caps are the Delaunay triangulation of each loop's
-//                              projection, and a few more loops stay open;
+//                              projection, and more loops stay open;
 //                            - the finer peeling of loops where layers fold: where the
 //                              object forks at its end (horns), a web of triangles may
 //                              stay between the branches' tips;
@@ -116,25 +115,24 @@
 // library never writes outside the workspace and the output arrays it is given, whatever
 // the input.
 //
-// As a guide: delaunay_2d needs 72 bytes per point plus about 10 KiB, and its output is at
-// most 2n - 5 triangles (24 bytes per point). reconstruct needs about 115 bytes per point
-// (the triangulation of its largest possible layer, the layer grouping and the boundary
-// loops; measuring the webs at the end takes less), about 121 with add_caps (plus up to
-// 32 KiB for the exhaustive search of a cap), about 166 with a jobs runner; its output is
-// at most 2n triangles plus 160 for the junctions of branches. A stream needs about 190
-// bytes per point it holds at once, whatever the size of the whole cloud.
+// What a call needs follows from its arguments through those functions alone:
+// delaunay_2d_workspace_size() and delaunay_2d_max_triangles(); reconstruct_workspace_size()
+// (which grows with add_caps, drop_outliers, a jobs runner and the search for branches)
+// and reconstruct_max_triangles() (with the search for branches); stream_workspace_size()
+// of the points held at once, whatever the size of the whole cloud; and the bounds of
+// cap_ends(), find_parting() and join_branches(). Report::workspace_used_bytes tells what
+// a run used.
 //
 // The whole workspace belongs to the call while it runs, including what it does not need:
-// without a runner, reconstruct keeps the points grouped by layer (24 bytes each) in spare
-// workspace when they fit, instead of reading the cloud at random once per layer. The
+// without a runner, reconstruct keeps the points grouped by layer in spare workspace when
+// they fit, instead of reading the cloud at random once per layer. The
 // output is the same either way, and Report::workspace_used_bytes leaves that room out (it
 // is the least workspace that suffices).
 //
-// Stack: no recursion anywhere. The exact incircle's expansions (about 8 KiB) live in the
-// workspace when called from the triangulation, and on the stack only when you call
-// incircle() yourself. On a Cortex-M7 (GCC -Os, the reduced build) reconstruct needs under
-// 4 KiB of stack, stream_push and delaunay_2d under 3 KiB (your progress callback and libm
-// not included); inlining at -O3 on x86-64 makes frames about twice as large.
+// Stack: no recursion anywhere. The exact
+// incircle's expansions live in the workspace when called from the triangulation, and on
+// the stack only when you call incircle() yourself. CI bounds the reduced build's stack on
+// a Cortex-M7 from its call graph.
 //
 // ==== Errors ===============================================================================
 //

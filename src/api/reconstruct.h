@@ -30,47 +30,41 @@ enum Flags : uint32_t {
     // NaN/Inf points are skipped and counted (Report::points.rejected_count) instead of refused with
     // Status::invalid_point.
     skip_invalid_points = 1u << 0,
-    // Closes the surface's boundary loops with caps, so a tube becomes a closed, edge- and
-    // vertex-manifold, consistently oriented surface (Euler characteristic 2, normals
-    // outward: the bottom cap faces -axis, the top one +axis). A cap triangulates its loop
-    // over the loop's own vertices (no new vertex), as seen across the axis: pockets of the
-    // loop along the wall are closed first, then the rest by a triangulation lowered (bottom)
-    // or raised (top) along the axis as far as the loop allows, so that a wall leaning over
-    // a ragged loop stays clear of it, and Delaunay where the loop is planar. No cap repeats
-    // an edge of the surface; where the surface's fins (triangles with two edges on the
-    // loop) leave no such cap, the edge under a fin may be flipped (two triangles change in
-    // place, same corners, same count; Report::caps.wall_flip_count). A loop whose
-    // projection is not a simple polygon, or that no cap closes, stays open: the call
+    // Closes the surface's boundary loops with caps over the loops' own vertices (no new
+    // vertex), so that a tube becomes a closed, edge- and vertex-manifold, consistently
+    // oriented surface (Euler characteristic 2, normals outward: the bottom cap faces -axis,
+    // the top one +axis): what solid modelling, printing and volumes need. No cap repeats an
+    // edge of the surface; where the surface's fins (triangles with two edges on the loop)
+    // leave no such cap, the edge under a fin may be flipped (two triangles change in place,
+    // same corners, same count; Report::caps.wall_flip_count). A loop whose projection
+    // across the axis is not a simple polygon, or that no cap closes, stays open: the call
     // still returns ok, Report::caps.open_count counts it and Report::detail says so.
-    // reconstruct_max_triangles() still suffices (a closed surface through V vertices has
-    // 2V - 4 triangles). The stream refuses the flag: cap_ends() caps its surface afterwards.
+    // reconstruct_max_triangles() still suffices. The stream refuses the flag: cap_ends()
+    // caps its surface afterwards.
     add_caps = 1u << 1,
     // The frame's reference point is Options::origin instead of the centroid of the cloud
     // (reconstruct) or of the first layer (the stream). The reference point changes only
     // rounding, but a stream and a reconstruct() that are to give the same triangles need
     // the same one.
     origin_given = 1u << 2,
-    // Points far from the rest of the cloud (stray returns, flying pixels, specks of fewer
-    // than 8 points) are left out before anything else and counted (outlier_count, part of
-    // rejected_count in Report::points), so they neither tilt the automatic axis nor stretch
-    // the layers nor become spikes: a point with fewer than 8 points, itself included,
-    // within 4 to 12 times the distance that nine points in ten have to their nearest
-    // neighbour. For raw sensor clouds; off by default, since without it every valid point
-    // is a vertex. Assumes that fewer than a tenth of the points are outliers. The
-    // workspace bound grows by a bit per point. The stream refuses it (invalid_argument);
-    // the reduced build returns not_compiled.
+    // Points far from the rest of the cloud (stray returns, flying pixels, small specks)
+    // are left out before anything else and counted (Report::points.outlier_count, part of
+    // rejected_count), so that they neither tilt the automatic axis nor stretch the layers
+    // nor become spikes. For raw sensor clouds whose outliers are a small share of the
+    // points; off by default, since without it every valid point is a vertex.
+    // reconstruct_workspace_size() includes what it needs. The stream refuses it
+    // (invalid_argument); the reduced build returns not_compiled.
     drop_outliers = 1u << 3,
     // After each layer is triangulated on its unrolled annulus (the paper's method), its
-    // edges are flipped on the surface itself: by the empty-circle rule with angles
-    // measured in 3D, and toward the direction in which the surface curves least. The
-    // unrolling squeezes whatever lies almost across the axis (the underside of an ear, a
-    // chin, a crease); there the flips join the points that are near on the surface. Each
-    // seam between layers is flipped the same way once the layers are stitched. No vertex
-    // or loop changes; a flip never makes a fold nor an angle over 150 degrees (unless it
-    // narrows one) and is checked against crossing the nearby triangles; the stream gives
-    // the same triangles as reconstruct() with it. Closer to the true surface (by about
-    // 10% on scans, 30 to 45% on smooth analytic tubes), for about three times the time:
-    // off by default. The reduced build returns not_compiled.
+    // edges are flipped on the surface itself, by the empty-circle rule with angles
+    // measured in 3D and toward the direction in which the surface curves least, and so is
+    // each seam between layers once they are stitched: the unrolling squeezes whatever lies
+    // almost across the axis (the underside of an ear, a chin), and there the flips join
+    // the points that are near on the surface. No vertex or loop changes; a flip never
+    // makes a fold nor an angle wider than a fixed obtuse limit (unless it narrows one) and
+    // is checked against crossing the nearby triangles; the stream gives the same triangles
+    // as reconstruct() with it. Off by default: it costs time. The reduced build returns
+    // not_compiled.
     surface_flips = 1u << 4,
     // No end of the surface is taken for a closed one (see ClosedEnd): the end layers are
     // unrolled on the cylinder like the others, never around a pole, so the surface's loops
@@ -112,25 +106,31 @@ typedef void (*JobFunction)(void* context, uint32_t index);
 // [0, count) is ignored; the same job on two threads at once is a data race.
 typedef void (*JobRunner)(void* user, uint32_t count, JobFunction job, void* context);
 
+// The layer rules' thresholds (see Options::cuts), shared with the stream: a point on a
+// cut, up to this share of the cloud's height, belongs to the layer above; a layer with
+// fewer points than kMinLayerPoints (the last needs 3), or thinner than kMinLayerRows rows
+// of points around its radius, joins the next one, since thinner layers make bands that
+// fold and cross.
+const double kCutTolerance = 0x1p-40;
+const size_t kMinLayerPoints = 16;
+const double kMinLayerRows = 1.5;
+
 // All zero means defaults: `Options options = {};` is always valid.
 struct Options {
     Axis axis;
     double direction[3];     // for Axis::direction; any finite non-zero length
-    // Layers, at most one of three ways (more than one is invalid_argument): explicit cut
+    // Layers, in at most one of three ways (more than one: invalid_argument): explicit cut
     // positions along the axis, as the coordinate dot(point, axis) (with Axis::z, a cut at
-    // 68 is the plane z = 68; a point on a cut, up to 2^-40 of the cloud's height, belongs
-    // to the layer above; any order, repeats and cuts outside the cloud are ignored); or
-    // layer_count equal-height layers; or layers of about layer_height; with none of them,
-    // automatic: the fewest layers such
-    // that one centre line serves each layer, none is taller than 24 of its radii and none
-    // holds more than an eighth of the points (or 65,536, if that is more, so that large
-    // clouds come in layers that jobs can triangulate side by side), cut where the
-    // cross-section changes least and not through dense detail (the paper's rule).
-    // Planned layers are then merged where the method needs it: a layer with fewer than
-    // 16 points, thinner than about one and a half rows of points around its radius, or
-    // whose points do not surround its centre joins the next one (a remainder like that
-    // joins the last); a layer next to a slanted end of the tube (a crescent: an arc with a
-    // gap of over 34 degrees that the two layers together narrow) joins it; a layer with
+    // 68 is the plane z = 68; a point on a cut, up to kCutTolerance of the cloud's height,
+    // belongs to the layer above; any order, repeats and cuts outside the cloud are
+    // ignored); or layer_count equal-height layers; or layers of about layer_height. With
+    // none of them the layers are automatic: the fewest such that one centre line serves
+    // each, cut where the cross-section changes least and not through dense detail (the
+    // paper's rule), and small enough for jobs to triangulate side by side. Planned layers
+    // are then merged where the method needs it: a layer with fewer than kMinLayerPoints
+    // points, thinner than kMinLayerRows rows of points around its radius, or whose points
+    // do not surround its centre joins the next one (a remainder like that joins the
+    // last); a layer next to a slanted end of the tube (a crescent) joins it; a layer with
     // triangles facing the axis is joined with the next one or two where that leaves
     // fewer. Report::layers gives the planned and used counts and the layers used.
     const double* cuts;
@@ -173,7 +173,8 @@ struct LayerInfo {
     double centre[3];        // the axis of the unrolling cylinder passes through this
                              // (the fitted centre, or the one the centre search chose)
     double radius;           // the unrolling cylinder's radius: the layer's mean distance
-                             // from its centre line, at least a 24th of its height
+                             // from its centre line, raised for a layer many radii tall
+                             // (so that its unrolled heights stay in range)
     uint32_t point_count;    // distinct valid points in the layer
     uint32_t triangle_count; // the layer's own triangles plus the band joining it to the
                              // layer below, before the safety net

@@ -119,8 +119,8 @@ struct CapCounts {
 };
 
 // A web triangle (Diagnostics) has its longest edge over this many times the largest local
-// spacing of its corners: single columns then show none or a few, objects with limbs
-// meshed as one tube a few percent of their area or more.
+// spacing of its corners: far enough above a surface's own spread of edge lengths that a
+// single column shows next to none, while a tube wrapped around limbs shows its spans.
 constexpr double kWebSpacings = 6.0;
 
 // Report::diagnostics: what a user checks before trusting the mesh.
@@ -167,15 +167,15 @@ struct Report {
 // A size in bytes that is always enough workspace for reconstruct() of point_count
 // points with these options. It assumes the worst layout (every point in one layer);
 // Report::workspace_used_bytes tells what a run really needed, which follows its largest
-// layer, or the measure of webs at the end (60 bytes a point, about half of the bound, on
-// a tube of six or more layers). With Options::run_jobs it also covers the layers
+// layer, or the measure of webs at the end. With Options::run_jobs it also covers the layers
 // triangulated ahead and the jobs' scratch. 0 if no workspace can serve that many points
 // (as for delaunay_2d_workspace_size).
 size_t reconstruct_workspace_size(size_t point_count, const Options& options);
 
-// The most triangles reconstruct() can produce for point_count points: 2n, plus four per
-// possible branch (160) where the options search for branches (0 if that does not fit in
-// size_t).
+// The most triangles reconstruct() can produce for point_count points: 2 * point_count
+// (a manifold surface through n vertices has at most 2n triangles), plus four per branch
+// on either side of a cut (8 * kMaxBranches) for the junctions where the options search
+// for branches; 0 if that does not fit in size_t.
 size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 
 // Reconstructs a triangle mesh through the points of a columnar cloud: one surface,
@@ -185,25 +185,16 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // across it: a dome, a flat base), the surface goes across it too, and that end's loop is
 // a small one around the axis (see ClosedEnd).
 //
-// In its steps: check the arguments and read the cloud (refusing NaN, a degenerate cloud);
-// choose the axis (Axis::automatic); look for where the cloud parts into branches along it
-// (unless Parts::one_tube) and, where it does, mesh the trunk and each branch around its own
-// automatic axis (the trunk along the cloud's axis where the options lay out the layers:
-// cuts, layer_count or layer_height), and join them into one surface (see PartCounts and
-// join_branches()); otherwise, or where the parts cannot all be joined, or where the
-// joined surface is not smaller than the one tube's (unless Parts::apart), mesh one tube:
-// layer by layer, each unrolled and triangulated, stitched to the layer below, passed
-// through the manifold safety net; then the caps (add_caps). A tube that wraps branches
-// bridges the gaps between them with webs, which add area, and so does a join that folds,
-// so the smaller surface is the one kept; the comparison meshes the one tube too, which
-// roughly doubles the time on clouds that part. A point beyond a cut in no branch (a
-// sparse point of a thin branch's tip) goes to the part of the nearest point within two
-// gaps (Parting::gap). Where the trunk's own axis leans from the axis by half a degree to
-// 30 degrees (a fork scanned askew), the parting is searched again until the cut is square
-// to the trunk, whose end must lie under every branch (Report::parts.parting.axis is the
-// axis of the cut kept). The branch search runs on a sample of 4,096 points first on
-// larger clouds and in full only where the sample parts, so a branch of fewer than about
-// n / 64 points can go unseen in a cloud of n points.
+// It meshes one tube (layer by layer, each unrolled and triangulated, stitched to the layer
+// below and passed through the manifold safety net), or, unless Parts::one_tube, the trunk
+// and the branches where the cloud parts (each around its own automatic axis; the trunk
+// along the cloud's axis where the options lay out the layers) joined into one surface:
+// see Parts, PartCounts, find_parting() and join_branches(). With Parts::automatic the
+// joined parts are kept only where every part was meshed, every side joined, every point
+// is in a part and their surface is smaller than the one tube's: a tube that wraps
+// branches bridges the gaps between them with webs, and a join that folds adds area too.
+// Report::parts.parting.axis is the axis of the cut kept, which is squared to the trunk's
+// own axis where the two differ. The caps (add_caps) come last.
 //
 // cloud           the points (see Cloud), at most 2^32 - 3. They are only read.
 // options         see Options; `Options options = {};` gives the defaults.

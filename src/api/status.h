@@ -5,7 +5,7 @@
     /* success */                                                                         \
     X(ok, "success")                                                                      \
     /* argument checks: a caller error, detected before any work */                      \
-    X(invalid_argument, "a null pointer with a non-zero count, a stride too small, or buffers that overlap") \
+    X(invalid_argument, "a null pointer with a non-zero count, a stride too small, buffers that overlap, or options that are undefined or contradict each other") \
     X(too_many_points, "more points than 32-bit indices can address")                    \
     X(not_compiled, "the options ask for a feature this build leaves out (STRATMESH_SMALL_CODE)") \
     /* the data */                                                                        \

@@ -26,17 +26,17 @@
 // Options::cuts at the tops of all pushes but the last, the same axis, the same origin
 // (flag origin_given), Parts::one_tube and the points of each push in the same order,
 // gives the same triangles in the same order, with the same global indices,
-// provided no point lies within 2^-40 of the height range below a cut (reconstruct()
+// provided no point lies within kCutTolerance of the height range below a cut (reconstruct()
 // counts such a point in the layer above) and no cut lies outside the points' height
 // range. The stream makes no caps (the add_caps flag is refused): cap_ends() closes its
 // surface afterwards (below).
 //
-// Memory: stream_workspace_size(max_points_held) bytes, about 190 per point held. The
-// stream holds the last layer's top loop, the layer being formed (pushes that join it
-// included) and the pushes after it until they can form a layer. A layer that folds waits
-// for the two pushes after it (it may join them), so when every push is at least 16 points
-// and 1.5 rows of points thick and none is a crescent, three times the largest push
-// suffices where no layer folds and about four times where layers fold.
+// Memory: stream_workspace_size(max_points_held) bytes. The stream holds the last layer's
+// top loop, the layer being formed (pushes that join it included) and the pushes after it
+// until they can form a layer. A layer that folds waits for the two pushes after it (it
+// may join them), so when every push holds at least kMinLayerPoints points and
+// kMinLayerRows rows of points and none is a crescent, three times the largest push
+// suffices where no layer folds, and more where layers fold.
 // A push that would hold more returns out_of_memory and changes nothing; Report::points.held_count
 // says what a run needed.
 
@@ -64,7 +64,7 @@ size_t stream_workspace_size(size_t max_points_held, const Options& options);
 // not define, a Parts value outside the enum, more than one of cuts, layer_count and
 // layer_height),
 // invalid_origin (a NaN or infinite origin), invalid_axis, out_of_memory (a workspace too
-// small to hold 16 points).
+// small to hold kMinLayerPoints points).
 // The stream uses as many points as the workspace holds.
 Status stream_open(const Options& options, void* workspace, size_t workspace_bytes,
                    TriangleCallback emit, void* emit_user, Report* report, Stream** stream);

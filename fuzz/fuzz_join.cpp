@@ -4,7 +4,7 @@
 //    and a Parting (branch counts past kMaxBranches, any axis, cuts and gap) from the bytes;
 //  - forked: a trunk with two to four prongs on its rim (radii, offsets, heights and point
 //    counts from the bytes), meshed apart by find_parting's labels as the tool's
-//    --split-branches does, then joined.
+//    --parts apart does, then joined.
 // Buffers are exact: the workspace is join_branches_workspace_size(), the triangle array
 // ends where its allocation ends, so any overrun trips AddressSanitizer.
 //

@@ -58,7 +58,7 @@ struct Parted {
 };
 
 // find_parting, then each label's points meshed on their own (the trunk along `axis`, each
-// branch around its automatic axis), as the tool's --split-branches does.
+// branch around its automatic axis), as the tool's --parts apart does.
 Parted mesh_apart(const std::vector<double>& xyz, const Options& options) {
     Parted r;
     const Cloud cloud = cloud_of(xyz);

@@ -76,8 +76,9 @@ enum Flags : uint32_t {
 };
 
 // What reconstruct() meshes where the cloud parts into branches (Options::parts; see
-// PartCounts and find_parting()). The stream and the reduced build (STRATMESH_SMALL_CODE)
-// always mesh one tube.
+// PartCounts and find_parting()): one tube cannot follow a fork, it wraps the branches and
+// the gaps between them. The stream and the reduced build (STRATMESH_SMALL_CODE) always
+// mesh one tube.
 enum class Parts : uint32_t {
     // Looks for where the cloud parts, meshes the trunk and its branches apart and joins
     // them; keeps that where it is whole and smaller than one tube, else meshes one tube.
@@ -156,7 +157,8 @@ struct Options {
     void* jobs_user;
 };
 
-// The most jobs reconstruct() hands to Options::run_jobs at once.
+// The most jobs reconstruct() hands to Options::run_jobs at once, so that the jobs' state
+// has a fixed size and their scratch, which reconstruct_workspace_size() covers, a bound.
 const uint32_t kMaxJobs = 64;
 
 // LayerInfo::closed_ends. The surface's first layer (closed_bottom) or last layer

@@ -594,8 +594,10 @@ struct LayerCounts {
     size_t planned_count;    // layers planned (cuts + 1, layer_count, or the automatic plan),
                              // before too small, thin, open or folding ones are merged
     size_t used_count;       // layers of the output
-    size_t parallel_count;   // of those, triangulated by Options::run_jobs' jobs (0 without
-                             // a runner, or when the workspace was too small for the jobs)
+    size_t parallel_count;   // planned layers that Options::run_jobs' jobs triangulated
+                             // ahead (0 without a runner, or when the workspace was too
+                             // small for the jobs); merges may redo some, so it can exceed
+                             // used_count
     // Optional per-layer details: the caller points `info` at an array of `info_capacity`
     // entries; the first min(used_count, info_capacity) are filled.
     LayerInfo* info;
@@ -614,34 +616,47 @@ struct CapCounts {
                              // add_caps); 0 in STRATMESH_SMALL_CODE
 };
 
-// A web triangle (Diagnostics) has its longest edge over this many times the largest local
-// spacing of its corners: far enough above a surface's own spread of edge lengths that a
-// single column shows next to none, while a tube wrapped around limbs shows its spans.
-constexpr double kWebSpacings = 6.0;
+// The fit of a surface to its cloud (Diagnostics). A sampled triangle misfits where its
+// normal parts from the cloud's own near its centroid (the direction in which the
+// kFitNeighbours nearest points spread least) by more than kMisfitDegrees, as where a layer
+// folds across the surface, or where its centroid lies farther than kMisfitSpacings point
+// spacings from every point, as where a web spans a gap between limbs.
+constexpr double kMisfitDegrees = 45.0;
+constexpr double kMisfitSpacings = 2.0;
+constexpr uint32_t kFitNeighbours = 12;
+// At most kMisfitSampleLimit triangles are sampled for misfit (every k-th); a surface of
+// at most kCrossingCheckLimit triangles is checked whole for crossing pairs, a larger one
+// not (crossing_check_complete false), as the check's cost grows faster than the cloud.
+constexpr size_t kMisfitSampleLimit = 4096;
+constexpr size_t kCrossingCheckLimit = 16384;
+// A surface with a crossing pair, or whose misfit share exceeds this, is poor: the
+// threshold that parts single columns from folded and webbed surfaces (the command line's
+// verdict; docs/design.md, "The fit measure").
+constexpr double kPoorMisfitFraction = 0.05;
 
 // Report::diagnostics: what a user checks before trusting the mesh.
 struct Diagnostics {
     size_t fold_count;             // output triangles whose normal faces the axis
     size_t illegal_removed_count;  // triangles removed by the manifold safety net
     size_t diagonal_swap_count;    // band diagonals swapped when stitching layers
-    // Webs: where one tube wraps limbs, fingers or branches, its triangles span the gaps
-    // between them, where the cloud has no surface; measured so that such a mesh does not
-    // pass silently. On ok, reconstruct() measures its output, caps left out (the last
-    // caps.triangle_count triangles span their loops by design). A vertex's local spacing
-    // is the median (the lower of two middles) of the lengths of the edges leaving it, one
-    // a triangle (so each of its edges once, but one of a boundary vertex's two boundary
-    // edges): the median, so that the long edges across a CT stack's slices and a few
-    // long edges at a web's border count as the vertex's own. A web triangle's longest
-    // edge exceeds kWebSpacings times the largest local spacing of its corners: the
-    // largest, so that a sparse region beside a dense one is no web. Lengths are measured
-    // in double and compared rounded to float; areas are summed in the triangles' order:
-    // the same bytes for every runner and platform. All 0 from the stream (it never holds
-    // the whole surface), cap_ends() and the reduced build (STRATMESH_SMALL_CODE).
-    size_t web_triangle_count;
-    double web_area;               // their area, in the cloud's units squared
-    double web_area_fraction;      // web_area over the surface's area, caps left out
-    double web_box_min[3];         // the bounding box of the web triangles' corners, to
-    double web_box_max[3];         // show where the gaps are (zeros without webs)
+    // The fit, measured by reconstruct() on ok from the cloud alone, in the same bytes on
+    // every platform and runner; all zero from the stream (it never holds the whole
+    // surface), cap_ends() and the reduced build (STRATMESH_SMALL_CODE).
+    double point_spacing;          // nine points in ten have their nearest neighbour within
+                                   // it (cloud units)
+    double area_per_point;         // the walls' area (caps left out; from the sample) over
+                                   // the vertices, in squared point spacings: near 1 where
+                                   // the surface follows the cloud, larger over gaps
+    size_t fit_sample_count;       // wall triangles measured (caps span their loops by design)
+    double misfit_area_fraction;   // the misfit samples' share of the samples' area
+    double misfit_area;            // the misfit area it implies, in cloud units squared
+    double misfit_box_min[3];      // the box of the misfit samples' corners (zeros without)
+    double misfit_box_max[3];
+    size_t crossing_pair_count;    // triangle pairs that share no corner and cross, caps
+                                   // included
+    bool crossing_check_complete;  // every pair was checked
+    double crossing_box_min[3];    // the box of the crossing triangles (zeros without)
+    double crossing_box_max[3];
 };
 
 struct Report {
@@ -1252,16 +1267,22 @@ typedef struct stratmesh_diagnostics {
     size_t fold_count;             // output triangles whose normal faces the axis
     size_t illegal_removed_count;  // triangles removed by the manifold safety net
     size_t diagonal_swap_count;    // band diagonals swapped when stitching layers
-    size_t web_triangle_count;     // triangles spanning gaps: the longest edge over
-                                   // STRATMESH_WEB_SPACINGS local spacings (caps left out)
-    double web_area;               // their area, in the cloud's units squared
-    double web_area_fraction;      // of the surface's area, caps left out
-    double web_box_min[3];         // where they lie (zeros without webs)
-    double web_box_max[3];
+    double point_spacing;          // the fit (stratmesh::Diagnostics says each)
+    double area_per_point;
+    size_t fit_sample_count;
+    double misfit_area_fraction;
+    double misfit_area;
+    double misfit_box_min[3];
+    double misfit_box_max[3];
+    size_t crossing_pair_count;
+    int crossing_check_complete;   // 1: every pair checked
+    double crossing_box_min[3];
+    double crossing_box_max[3];
 } stratmesh_diagnostics;
 
-// stratmesh::kWebSpacings.
-#define STRATMESH_WEB_SPACINGS 6.0
+// stratmesh::kPoorMisfitFraction: a surface with a crossing pair, or a misfit share above
+// this, is poor.
+#define STRATMESH_POOR_MISFIT_FRACTION 0.05
 
 // stratmesh::Report, its groups as nested structs, so that C code reads the same counts
 // under the same names. stratmesh_reconstruct fills it on every status, counts adding up,
@@ -1384,7 +1405,8 @@ stratmesh_status stratmesh_stream_close(stratmesh_stream* stream);
 //   >>polygon             simple polygons on the exact predicates: crossing edges,
 //                         winding, ear clipping
 //   >>caps                closing a boundary loop: pockets, lowered caps, fins
-//   >>webs                how much of a finished surface spans gaps (Diagnostics)
+//   >>fit                 how well the finished surface fits its cloud (Diagnostics):
+//                         misfit area and crossings
 //   >>group               a group of layers: triangulated, stitched to the loop below,
 //                         flipped and sealed
 //   >>parallel layers     layers triangulated ahead as jobs on the caller's runner
@@ -1484,7 +1506,7 @@ const bool kPeelFoldedEnds = false;
 const bool kFoldMerge = false;
 const uint32_t kFoldMergeReach = 0;
 const bool kFastLoops = false;
-const bool kMeasureWebs = false;
+const bool kMeasureFit = false;
 #else
 const bool kNetShortcut = true;  // a chunk whose loop fans are whole skips the net
 const bool kStagePoints = true;  // reconstruct() keeps the grouped points in spare workspace
@@ -1528,8 +1550,8 @@ const uint32_t kFoldMergeReach = 2;
 // layer guess in layer_of, pseudo_angle without branches, floor by truncation in
 // exp_portable, the height range from choose_frame's extremes, count_folds' prefetching.
 const bool kFastLoops = true;
-// reconstruct() measures the webs of its output (Diagnostics; see >>webs).
-const bool kMeasureWebs = true;
+// reconstruct() measures the fit of its output to the cloud (Diagnostics; see >>fit).
+const bool kMeasureFit = true;
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 
@@ -3081,6 +3103,7 @@ struct Vec3 {
 };
 
 static inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+static inline Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 
 static inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
@@ -3117,12 +3140,15 @@ struct CloudReader {
     }
 };
 
-// False unless v's squared length is a normal double (v's length between about 1.5e-154
-// and 1.3e154): a subnormal square has lost the bits that make the result unit.
 static inline double largest_of(Vec3 v) {
     const double xy = v.x > v.y ? v.x : v.y;
     return xy > v.z ? xy : v.z;
 }
+
+static inline double coordinate(Vec3 p, int k) { return k == 0 ? p.x : k == 1 ? p.y : p.z; }
+
+// False unless v's squared length is a normal double (v's length between about 1.5e-154
+// and 1.3e154): a subnormal square has lost the bits that make the result unit.
 
 static inline bool normalize(Vec3& v) {
     const double square = dot(v, v);
@@ -3315,12 +3341,13 @@ struct CellBlock {
     }
 };
 
-// `member` is an item of `cell`. With `fingers` (18 valid positions, updated), each range
-// end is searched from where the same end was found last: a caller that goes through cells
-// in key order then finds each a few items on.
-static inline CellBlock block_around(const GridItem* items, size_t count, size_t member,
-                              size_t* fingers = nullptr) {
-    const uint64_t cell = items[member].cell;
+// The items of the cells around `cell` (empty or not), searched from items[hint]. With
+// `fingers` (18 valid positions, updated), each range end is searched from where the same
+// end was found last: a caller that goes through cells in key order then finds each a few
+// items on.
+static inline CellBlock block_of_cell(const GridItem* items, size_t count, uint64_t cell,
+                                      size_t hint, size_t* fingers = nullptr) {
+    const size_t member = hint;
     CellBlock b;
     b.count = 0;
     const uint64_t x = cell >> (2 * kCellBits), y = (cell >> kCellBits) & kCellTop, z = cell & kCellTop;
@@ -3341,6 +3368,12 @@ static inline CellBlock block_around(const GridItem* items, size_t count, size_t
         if (b.end[b.count] > b.begin[b.count]) ++b.count;
     }
     return b;
+}
+
+// The items of the cells around items[member]'s.
+static inline CellBlock block_around(const GridItem* items, size_t count, size_t member,
+                                     size_t* fingers = nullptr) {
+    return block_of_cell(items, count, items[member].cell, member, fingers);
 }
 
 // The samples of the scale measures are taken by a hash of the coordinates, about one
@@ -8536,259 +8569,398 @@ static inline Status cap_boundary_loops(uint32_t* tri, size_t& count, size_t cap
 }  // namespace detail
 }  // namespace stratmesh
 
-// >>webs =================================================================================
-// How much of a finished surface spans gaps (Diagnostics).
+// >>fit ==================================================================================
+// How well the finished surface fits its cloud (Diagnostics): misfit area and crossings.
 //
-// How much of a finished surface is web (Diagnostics): triangles far longer than the
-// spacing of the points they join, as where one tube wraps limbs and spans the gaps between
-// them. A vertex's local spacing is the median length of its edges, each counted once: the
-// edge that leaves it in each of its triangles (a boundary vertex misses one of its two
-// boundary edges). The median, not the shortest: a CT stack's edges across its slices are
-// far longer than those along a slice, and a vertex at a web's border has a few long edges
-// among its own. A triangle is web when its longest edge exceeds kWebSpacings times the
-// largest spacing of its corners: the largest, so that a triangle between a densely and a
-// sparsely sampled region is measured by the sparse one's. With 6, single columns (tubes,
-// heads, cones, capsules, CT slices, scan grids, noisy tubes, the bundled bust) show no web
-// triangle or a few, under 0.3% of their area, while objects with limbs meshed as one tube
-// show 2 to 12% of theirs. Far more of such a mesh is folded surface whose vertices have
-// only long edges (a fan of slivers from a foot to the body): the measure counts the
-// spans, which is enough to tell. The caps are left out: a cap spans its loop by design.
-//
-// The pass runs once the surface is final, when the layers' scratch is free: 72 bytes a
-// point (with 2 triangles a point), within reconstruct_workspace_size()'s bound. Lengths
-// are measured in the cloud's coordinates times a power of two that brings its extent near
-// 1 (exact), so that no square overflows or underflows.
+// Measured once the surface is final, from the cloud alone, in the memory the meshing
+// used. A sample of the triangles (caps left out: a cap spans its loop by design), every
+// k-th of them up to kMisfitSampleLimit, each compared with the cloud around its centroid:
+//  - misfit, where its normal parts from the cloud's own there by more than 45 degrees
+//    (the normal of the kFitNeighbours points nearest the centroid: the direction in which
+//    they spread least), as where a layer folds and its triangles run across the surface
+//    or a sliver bridges a crease, or where its centroid lies farther than kMisfitSpacings
+//    times the cloud's spacing from every point, as where a web spans a gap. The misfit
+//    share of the sample's area estimates the share of the surface that does not follow
+//    the cloud: on single columns it stays near zero, on a fold or a limb wrapped in one
+//    tube it is a tenth of the surface or more;
+//  - crossing, where it and another triangle that shares no corner with it pierce each
+//    other (an edge of one through the other's inside, by more than rounding: coplanar
+//    triangles do not count), caps included. The triangles are swept in the order of their
+//    boxes along the side where they overlap least, each tested against those after it
+//    whose boxes meet its own. Surfaces of at most kCrossingCheckLimit triangles are
+//    checked whole, larger ones not (their misfit share judges them); past an average of
+//    kCrossingBudget box tests a triangle the check stops, incomplete.
+// The cloud's spacing is the outliers' scale (nearest_spacing), the grid's cells twice
+// that. A cloud that spans more than the largest double is not measured. Deterministic:
+// sums in the sample's order, no libm beyond sqrt.
 
 namespace stratmesh {
 namespace detail {
 
-// The vertices are numbered in the order the triangles first name them, their points
-// copied in that order, and the triangles renumbered in place (then restored): the passes
-// over the triangles then read nearby memory, whatever the cloud's order. The passes over
-// the vertices alone (copying their points, the medians) run as jobs where the caller gave
-// a runner; those over the triangles stay in order, as the areas are summed in it.
-struct WebMemory {
-    Vec3* points;      // a vertex's point (halved where the cloud spans more than a double)
-    size_t* ends;      // a vertex's count of edges, then where its lengths end once sorted
-    float* spacings;   // a vertex's local spacing
-    uint32_t* index;   // a vertex's index in the cloud
-    float* longest;    // a triangle's longest edge
-    // While the vertices are numbered, a point's number (or kNoIndex); then, in the same
-    // memory, the lengths of the edges leaving each vertex, vertex after vertex.
-    uint32_t* id;
-    float* lengths;
+const double kMisfitCosine = 0.70710678118654752;  // cos(kMisfitDegrees)
+static_assert(kMisfitDegrees == 45.0, "kMisfitCosine is the cosine of kMisfitDegrees");
+// The grid's cells, in spacings: the 27 around a centroid hold a few dozen points.
+const double kFitCellSpacings = 2.0;
+// A centroid over a gap: its nearest point at least this share of the way to the farthest
+// of its kFitNeighbours nearest (on a surface sampled without a gap, far less).
+const double kGapShare = 0.6;
+// Points whose scatter's middle eigenvalue is under kSurfaceSpread times its least, or
+// under kCurveSpread times its largest, spread along a curve (a contour), not a surface.
+const double kSurfaceSpread = 3.0;
+const double kCurveSpread = 0.1;
+// The most box tests a triangle the crossing check makes, on average, before it stops.
+const size_t kCrossingBudget = 1024;
+// A volume under this share of the product of its three edges' lengths is taken as zero.
+const double kFlatVolume = 1e-12;
+
+// The cloud's and the surface's points as the measure takes them: times a power of two
+// that brings the cloud's extent near 1 (exact), so that no square overflows.
+struct FitFrame {
+    double scale;
+    Vec3 point(const CloudReader& reader, uint32_t i) const { return scaled(reader.point(i), scale); }
 };
 
-static inline bool allocate_webs(WebMemory& m, size_t point_count, size_t triangle_count,
-                                 Arena& arena) {
-    m.points = arena.alloc<Vec3>(point_count);
-    m.ends = arena.alloc<size_t>(point_count);
-    m.spacings = arena.alloc<float>(point_count);
-    m.index = arena.alloc<uint32_t>(point_count);
-    m.longest = arena.alloc<float>(triangle_count);
-    const size_t lengths = saturating_product(3, triangle_count);
-    void* shared = arena.take(lengths > point_count ? lengths : point_count, sizeof(float));
-    m.id = static_cast<uint32_t*>(shared);
-    m.lengths = static_cast<float*>(shared);
+struct Box3f {
+    Vec3 low, high;
+    void add(Vec3 p) {
+        low = {p.x < low.x ? p.x : low.x, p.y < low.y ? p.y : low.y, p.z < low.z ? p.z : low.z};
+        high = {p.x > high.x ? p.x : high.x, p.y > high.y ? p.y : high.y, p.z > high.z ? p.z : high.z};
+    }
+    bool meets(const Box3f& o) const {
+        return low.x <= o.high.x && o.low.x <= high.x && low.y <= o.high.y && o.low.y <= high.y &&
+               low.z <= o.high.z && o.low.z <= high.z;
+    }
+};
+
+// The memory of the measure: the points in cells, then the triangles in sweep order.
+struct FitMemory {
+    CellScratch points;
+    GridItem* sweep;
+    GridItem* spare;
+};
+
+static inline bool allocate_fit(FitMemory& m, size_t point_count, size_t triangle_count, Arena& arena) {
+    m.points = allocate_cell_scratch(arena, point_count);
+    const size_t swept = triangle_count <= kCrossingCheckLimit ? triangle_count : 0;
+    m.sweep = arena.alloc<GridItem>(swept);
+    m.spare = arena.alloc<GridItem>(swept);
     return !arena.failed;
 }
 
-// The workspace measure_webs() takes.
-static inline size_t webs_workspace_size(size_t point_count, size_t triangle_count) {
+static inline size_t fit_workspace_size(size_t point_count, size_t triangle_count) {
     Arena arena = Arena::measuring();
-    WebMemory m;
-    return allocate_webs(m, point_count, triangle_count, arena) ? arena.required_bytes() : 0;
+    FitMemory m;
+    return allocate_fit(m, point_count, triangle_count, arena) ? arena.required_bytes() : 0;
 }
 
-// Edges in the cloud's coordinates times a power of two that brings the cloud's extent
-// near 1 (exact): no square overflows or underflows. Where the cloud spans more than the
-// largest double, the points are halved first, so that no difference overflows.
-struct WebFrame {
-    double scale;
-    bool halved;
-    Vec3 point(const CloudReader& reader, uint32_t i) const {
-        return halved ? scaled(reader.point(i), 0.5) : reader.point(i);
+// The unit normal of the points p[0 .. n): the eigenvector of their scatter's least
+// eigenvalue, by power steps on the scatter's adjugate (whose largest eigenvalue that one
+// is), from its longest row: on a surface the least eigenvalue lies far below the others,
+// and two steps settle it. Zero where the points spread along a curve rather than a
+// surface, as on one contour of a CT stack: they have no normal to judge by.
+static inline Vec3 cloud_normal(const Vec3* p, uint32_t n) {
+    Vec3 mean = {0, 0, 0};
+    for (uint32_t i = 0; i < n; ++i) mean = {mean.x + p[i].x, mean.y + p[i].y, mean.z + p[i].z};
+    mean = scaled(mean, 1.0 / n);
+    Vec3 row[3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    for (uint32_t i = 0; i < n; ++i) {
+        const Vec3 d = p[i] - mean;
+        row[0] = {row[0].x + d.x * d.x, row[0].y + d.x * d.y, row[0].z + d.x * d.z};
+        row[1] = {row[1].x + d.y * d.x, row[1].y + d.y * d.y, row[1].z + d.y * d.z};
+        row[2] = {row[2].x + d.z * d.x, row[2].y + d.z * d.y, row[2].z + d.z * d.z};
     }
-    // ab, bc and ca of the triangle whose corners are numbered c.
-    void edges(const Vec3* points, const uint32_t* c, Vec3 e[3]) const {
-        const double s = halved ? 2 * scale : scale;
-        const Vec3 a = points[c[0]], b = points[c[1]], d = points[c[2]];
-        e[0] = scaled(b - a, s);
-        e[1] = scaled(d - b, s);
-        e[2] = scaled(a - d, s);
+    const Vec3 adjugate[3] = {cross(row[1], row[2]), cross(row[2], row[0]), cross(row[0], row[1])};
+    Vec3 v = adjugate[0];
+    for (const Vec3& a : adjugate)
+        if (dot(a, a) > dot(v, v)) v = a;
+    for (int step = 0; step < 2 && normalize(v); ++step)
+        v = {dot(adjugate[0], v), dot(adjugate[1], v), dot(adjugate[2], v)};
+    if (!normalize(v)) return {0, 0, 0};
+    // The other two eigenvalues are the roots of x^2 - sum x + product, from the trace and
+    // the adjugate's trace (the sum of the products of pairs).
+    const double least = dot(v, {dot(row[0], v), dot(row[1], v), dot(row[2], v)});
+    const double sum = row[0].x + row[1].y + row[2].z - least;
+    const double product = adjugate[0].x + adjugate[1].y + adjugate[2].z - least * sum;
+    const double square = sum * sum - 4 * product;
+    const double middle = (sum - std::sqrt(square > 0 ? square : 0)) / 2;
+    const double largest = sum - middle;
+    return middle >= kSurfaceSpread * least && middle >= kCurveSpread * largest ? v : Vec3{0, 0, 0};
+}
+
+static inline void corners(const FitFrame& f, const CloudReader& reader, const uint32_t* v, Vec3* out) {
+    for (int k = 0; k < 3; ++k) out[k] = f.point(reader, v[k]);
+}
+
+// The item of `items` (sorted by cell) in `cell`, or failing that the first after it
+// (n: past the end).
+static inline size_t item_at_cell(const GridItem* items, size_t n, uint64_t cell) {
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        const size_t mid = lo + (hi - lo) / 2;
+        if (items[mid].cell < cell) lo = mid + 1; else hi = mid;
     }
+    return lo;
+}
+
+// The kFitNeighbours points nearest `q` among those of the cells around `cell`, q's
+// (sorted nearest first into near[], their squared distances in d2[]); returns how many.
+static inline uint32_t nearest_points(const FitFrame& f, const CloudReader& reader, const GridItem* items,
+                                      size_t n, uint64_t cell, Vec3 q, Vec3* near, double* d2) {
+    const size_t hint = item_at_cell(items, n, cell);
+    const CellBlock block = block_of_cell(items, n, cell, hint < n ? hint : n - 1);
+    uint32_t found = 0;
+    for (uint32_t r = 0; r < block.count; ++r)
+        for (size_t i = block.begin[r]; i < block.end[r]; ++i) {
+            const Vec3 p = f.point(reader, items[i].index);
+            const Vec3 d = p - q;
+            const double dd = dot(d, d);
+            if (found == kFitNeighbours && !(dd < d2[found - 1])) continue;
+            uint32_t k = found < kFitNeighbours ? found++ : found - 1;
+            for (; k > 0 && d2[k - 1] > dd; --k) {
+                d2[k] = d2[k - 1];
+                near[k] = near[k - 1];
+            }
+            d2[k] = dd;
+            near[k] = p;
+        }
+    return found;
+}
+
+// The cell of side `side` from `low` that holds p, as sort_into_cells keys it.
+static inline uint64_t cell_of(Vec3 p, Vec3 low, double side) {
+    return cell_key(cell_coordinate(p.x - low.x, side), cell_coordinate(p.y - low.y, side),
+                    cell_coordinate(p.z - low.z, side));
+}
+
+// The sampled triangles' misfit: adds their areas, and the misfit ones' areas and box, to
+// the diagnostics (areas in the frame's units, squared).
+struct MisfitTally {
+    double area, misfit;
+    Box3f where;
+    size_t samples;
 };
 
-static inline WebFrame web_frame(const CloudSums& s) {
-    const Vec3 low = {s.lowest[0], s.lowest[1], s.lowest[2]};
-    const Vec3 high = {s.highest[0], s.highest[1], s.highest[2]};
-    const Vec3 size = high - low, half = scaled(high, 0.5) - scaled(low, 0.5);
-    double extent = half.x > half.y ? half.x : half.y;
-    if (half.z > extent) extent = half.z;
-    return {scale_for_extent(extent), !(is_finite(size.x) && is_finite(size.y) && is_finite(size.z))};
+// Whether the triangle abc (unit normal `normal`, centroid `centroid`) misfits the cloud
+// around it. `near` has room for kFitNeighbours + 3 points.
+static inline bool misfits(const FitFrame& f, const CloudReader& reader, const FitMemory& m,
+                           size_t n, Vec3 low, double side, double far, const Vec3* corner,
+                           Vec3 normal, Vec3 centroid, Vec3* near) {
+    double d2[kFitNeighbours];
+    const uint32_t found = nearest_points(f, reader, m.points.items, n, cell_of(centroid, low, side),
+                                          centroid, near, d2);
+    if (found == 0) return true;  // no point in the cells around: a web over a wide gap
+    const Vec3 around = cloud_normal(near, found);
+    if (dot(around, around) > 0)
+        // A surface around: the triangle misfits across it, or over a gap in it (its
+        // centroid far from every point, and the nearest hardly nearer than the rest).
+        return abs_value(dot(normal, around)) < kMisfitCosine ||
+               (d2[0] > far * far && d2[0] > kGapShare * kGapShare * d2[found - 1]);
+    // The points around lie along a curve (the contours of a CT stack): the triangle's
+    // corners, on the rows it joins, make the surface to judge by.
+    for (uint32_t k = 0; k < 3; ++k) near[found + k] = corner[k];
+    const Vec3 rows = cloud_normal(near, found + 3);
+    return dot(rows, rows) > 0 && abs_value(dot(normal, rows)) < kMisfitCosine;
 }
 
-// a, b in order (as min and max, which compile without a branch).
-static inline void order(float& a, float& b) {
-    const float low = b < a ? b : a, high = a < b ? b : a;
-    a = low;
-    b = high;
+// Tallies every step-th triangle of tri[0 .. count): its area, and whether it misfits.
+static inline void tally_misfit(const FitFrame& f, const CloudReader& reader, const FitMemory& m,
+                                size_t n, Vec3 low, double side, double spacing, const uint32_t* tri,
+                                size_t count, size_t step, MisfitTally& t) {
+    Vec3 near[kFitNeighbours + 3];
+    for (size_t k = 0; k < count; k += step) {
+        Vec3 c[3];
+        corners(f, reader, tri + 3 * k, c);
+        Vec3 normal = cross(c[1] - c[0], c[2] - c[0]);
+        const double area = std::sqrt(dot(normal, normal)) / 2;
+        const Vec3 centroid = scaled(c[0] + c[1] + c[2], 1.0 / 3);
+        ++t.samples;
+        t.area += area;
+        if (!normalize(normal) ||
+            !misfits(f, reader, m, n, low, side, kMisfitSpacings * spacing, c, normal, centroid, near))
+            continue;
+        t.misfit += area;
+        for (const Vec3& p : c) t.where.add(p);
+    }
 }
 
-// The lower median of v[0 .. count), count > 0: by a sorting network for a vertex's few
-// edges (no branch to mispredict), by heapsort for a large fan.
-static inline float lower_median(float* v, size_t count) {
-    if (count > 8) {
-        heap_sort(v, count);
-        return v[(count - 1) / 2];
-    }
-    float s[8];
-    for (size_t i = 0; i < 8; ++i) s[i] = i < count ? v[i] : FLT_MAX;
-    order(s[0], s[2]), order(s[1], s[3]), order(s[4], s[6]), order(s[5], s[7]);
-    order(s[0], s[4]), order(s[1], s[5]), order(s[2], s[6]), order(s[3], s[7]);
-    order(s[0], s[1]), order(s[2], s[3]), order(s[4], s[5]), order(s[6], s[7]);
-    order(s[2], s[4]), order(s[3], s[5]);
-    order(s[1], s[4]), order(s[3], s[6]);
-    order(s[1], s[2]), order(s[3], s[4]), order(s[5], s[6]);
-    return s[(count - 1) / 2];
+// The sign of the volume of (o, u, v, w), 0 within rounding (kFlatVolume).
+static inline int volume_sign(Vec3 o, Vec3 u, Vec3 v, Vec3 w) {
+    const Vec3 a = u - o, b = v - o, c = w - o;
+    const double volume = dot(cross(a, b), c);
+    const double size = std::sqrt(dot(a, a) * dot(b, b) * dot(c, c));
+    return volume > kFlatVolume * size ? 1 : volume < -kFlatVolume * size ? -1 : 0;
 }
 
-// Corners this far ahead are prefetched while the vertices are numbered, and points while
-// they are copied: the triangles name them in no order of the cloud's.
-const size_t kWebAhead = 16;
-
-// Numbers the vertices, renumbers the triangles' corners and counts the edges leaving each
-// vertex, then turns the counts into starts; returns how many vertices there are.
-static inline uint32_t number_vertices(uint32_t* tri, size_t count, size_t point_count,
-                                       const WebMemory& m) {
-    for (size_t v = 0; v < point_count; ++v) m.id[v] = kNoIndex;
-    uint32_t vertices = 0;
-    for (size_t k = 0; k < 3 * count; ++k) {
-        if (kFastLoops && k + kWebAhead < 3 * count) prefetch(m.id + tri[k + kWebAhead]);
-        uint32_t& id = m.id[tri[k]];
-        if (id == kNoIndex) {
-            id = vertices++;
-            m.index[id] = tri[k];
-            m.ends[id] = 0;
-        }
-        ++m.ends[id];
-        tri[k] = id;
-    }
-    size_t start = 0;
-    for (uint32_t v = 0; v < vertices; ++v) {
-        const size_t edges = m.ends[v];
-        m.ends[v] = start;
-        start += edges;
-    }
-    return vertices;
+// Whether segment pq pierces triangle abc's inside.
+static inline bool segment_crosses(Vec3 p, Vec3 q, Vec3 a, Vec3 b, Vec3 c) {
+    const int sp = volume_sign(a, b, c, p), sq = volume_sign(a, b, c, q);
+    if (sp == 0 || sq != -sp) return false;
+    const int s1 = volume_sign(p, q, a, b), s2 = volume_sign(p, q, b, c), s3 = volume_sign(p, q, c, a);
+    return s1 != 0 && s1 == s2 && s2 == s3;
 }
 
-// The passes over the vertices, by runs of them (see run_pass).
-struct WebVertexPass {
-    const CloudReader* reader;
-    const WebFrame* frame;
-    const WebMemory* m;
-    uint32_t vertices;
-    bool medians;  // else the points
-
-    void run(uint32_t k) const {
-        const size_t begin = run_start(vertices, k), end = run_start(vertices, k + 1);
-        if (!medians) {
-            for (size_t v = begin; v < end; ++v) {
-                if (kFastLoops && v + kWebAhead < end)
-                    prefetch(reader->base + m->index[v + kWebAhead] * reader->stride);
-                m->points[v] = frame->point(*reader, m->index[v]);
-            }
-            return;
-        }
-        for (size_t v = begin; v < end; ++v) {
-            const size_t first = v > 0 ? m->ends[v - 1] : 0;
-            m->spacings[v] = lower_median(m->lengths + first, m->ends[v] - first);
-        }
+static inline bool triangles_cross(const Vec3* u, const Vec3* v) {
+    for (int k = 0; k < 3; ++k) {
+        if (segment_crosses(u[k], u[(k + 1) % 3], v[0], v[1], v[2])) return true;
+        if (segment_crosses(v[k], v[(k + 1) % 3], u[0], u[1], u[2])) return true;
     }
+    return false;
+}
+
+
+static inline Box3f box_of_corners(const Vec3* c) {
+    Box3f b = {c[0], c[0]};
+    b.add(c[1]);
+    b.add(c[2]);
+    return b;
+}
+
+static inline bool share_a_corner(const uint32_t* u, const uint32_t* v) {
+    for (int a = 0; a < 3; ++a)
+        if (u[a] == v[0] || u[a] == v[1] || u[a] == v[2]) return true;
+    return false;
+}
+
+// The side (0, 1 or 2) along which the triangles' boxes overlap least: the least sum of
+// their extents along it over the cloud's extent `size` there.
+static inline int sweep_side(const FitFrame& f, const CloudReader& reader, const uint32_t* tri,
+                             size_t count, Vec3 size) {
+    Vec3 sum = {0, 0, 0};
+    for (size_t t = 0; t < count; ++t) {
+        Vec3 c[3];
+        corners(f, reader, tri + 3 * t, c);
+        const Box3f box = box_of_corners(c);
+        sum = sum + (box.high - box.low);
+    }
+    const double sums[3] = {sum.x, sum.y, sum.z}, sizes[3] = {size.x, size.y, size.z};
+    double share[3];
+    for (int k = 0; k < 3; ++k) share[k] = sizes[k] > 0 ? sums[k] / sizes[k] : DBL_MAX;
+    int side = 0;
+    for (int k = 1; k < 3; ++k)
+        if (share[k] < share[side]) side = k;
+    return side;
+}
+
+// The sweep: the triangles in the order of their boxes' low ends along `side` (0, 1 or 2),
+// from `low`. Keys are the bits of a non-negative double, which order as the values do.
+static inline void sort_sweep(const FitFrame& f, const CloudReader& reader, const uint32_t* tri,
+                                size_t count, int side, double low, FitMemory& m) {
+    uint64_t any = 0, every = ~uint64_t{0};
+    for (size_t t = 0; t < count; ++t) {
+        Vec3 c[3];
+        corners(f, reader, tri + 3 * t, c);
+        const double from = coordinate(box_of_corners(c).low, side) - low;
+        uint64_t key;
+        const double start = from > 0 ? from : 0;
+        std::memcpy(&key, &start, sizeof key);
+        m.sweep[t] = {key, static_cast<uint32_t>(t)};
+        any |= key;
+        every &= key;
+    }
+    sort_items(m.sweep, m.spare, count, any, every);
+}
+
+struct CrossingTally {
+    size_t pairs;
+    bool complete;
+    Box3f where;
 };
 
-// The lengths of the edges leaving each vertex, sorted by vertex (a counting sort: each
-// start becomes an end), and each triangle's longest edge. Returns the triangles' area.
-static inline double edge_lengths(const WebFrame& f, const uint32_t* tri, size_t count,
-                                  const WebMemory& m) {
-    double area = 0;
-    for (size_t t = 0; t < count; ++t) {
-        const uint32_t* c = tri + 3 * t;
-        Vec3 e[3];
-        f.edges(m.points, c, e);
-        const Vec3 n = cross(e[0], e[1]);
-        area += std::sqrt(dot(n, n)) / 2;
-        float longest = 0;
-        for (size_t j = 0; j < 3; ++j) {
-            const float length = static_cast<float>(std::sqrt(dot(e[j], e[j])));
-            m.lengths[m.ends[c[j]]++] = length;
-            longest = length > longest ? length : longest;
-        }
-        m.longest[t] = longest;
-    }
-    return area;
-}
-
-// The web triangles among the renumbered triangles (see Diagnostics), into d, while their
-// corners are numbered back; returns their area.
-static inline double find_webs(const WebFrame& f, uint32_t* tri, size_t count, const WebMemory& m,
-                               Diagnostics& d) {
-    double web = 0;
-    Vec3 low = {DBL_MAX, DBL_MAX, DBL_MAX}, high = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
-    for (size_t t = 0; t < count; ++t) {
-        uint32_t* c = tri + 3 * t;
-        float spacing = 0;
-        for (size_t j = 0; j < 3; ++j)
-            spacing = m.spacings[c[j]] > spacing ? m.spacings[c[j]] : spacing;
-        if (static_cast<double>(m.longest[t]) > kWebSpacings * static_cast<double>(spacing)) {
-            ++d.web_triangle_count;
-            Vec3 e[3];
-            f.edges(m.points, c, e);
-            const Vec3 n = cross(e[0], e[1]);
-            web += std::sqrt(dot(n, n)) / 2;
-            for (size_t j = 0; j < 3; ++j) {
-                const Vec3 p = m.points[c[j]];
-                low = {p.x < low.x ? p.x : low.x, p.y < low.y ? p.y : low.y,
-                       p.z < low.z ? p.z : low.z};
-                high = {p.x > high.x ? p.x : high.x, p.y > high.y ? p.y : high.y,
-                        p.z > high.z ? p.z : high.z};
+// The crossing pairs (each once), their boxes' union in t.where; stops, incomplete, past
+// kCrossingBudget box tests a triangle.
+static inline void count_crossings(const FitFrame& f, const CloudReader& reader, const uint32_t* tri,
+                                   const GridItem* items, size_t count, int side, double low,
+                                   CrossingTally& t) {
+    size_t budget = kCrossingBudget * count;
+    for (size_t k = 0; k < count; ++k) {
+        const uint32_t s = items[k].index;
+        Vec3 u[3], v[3];
+        corners(f, reader, tri + 3 * size_t{s}, u);
+        const Box3f box = box_of_corners(u);
+        const double to = coordinate(box.high, side) - low;
+        uint64_t last;
+        std::memcpy(&last, &to, sizeof last);
+        for (size_t i = k + 1; i < count && items[i].cell <= last; ++i) {
+            const uint32_t o = items[i].index;
+            if (budget-- == 0) {
+                t.complete = false;
+                return;
             }
+            if (share_a_corner(tri + 3 * size_t{s}, tri + 3 * size_t{o})) continue;
+            corners(f, reader, tri + 3 * size_t{o}, v);
+            if (!box.meets(box_of_corners(v)) || !triangles_cross(u, v)) continue;
+            ++t.pairs;
+            t.where.add(box.low);
+            t.where.add(box.high);
         }
-        for (size_t j = 0; j < 3; ++j) c[j] = m.index[c[j]];
     }
-    const double unhalve = f.halved ? 2 : 1;  // the copied points are halved then
-    const double lows[3] = {low.x, low.y, low.z}, highs[3] = {high.x, high.y, high.z};
-    for (int k = 0; d.web_triangle_count > 0 && k < 3; ++k) {
-        d.web_box_min[k] = lows[k] * unhalve;
-        d.web_box_max[k] = highs[k] * unhalve;
-    }
-    return web;
 }
 
-// Measures the webs of triangles[0 .. count) less the last `caps` into rep.diagnostics;
-// the triangles are renumbered meanwhile and come back as they were. False if the
-// workspace is too small (nothing is measured).
-static inline bool measure_webs(const Options& options, const CloudReader& reader,
-                                size_t point_count, const CloudSums& sums, uint32_t* triangles,
-                                size_t count, size_t caps, Arena& arena, Report& rep) {
+// The box `b` in the cloud's units into min and max (left zero when b is empty).
+static inline void put_box(const Box3f& b, double to_cloud, double* min, double* max) {
+    if (!(b.low.x <= b.high.x)) return;
+    const Vec3 lo = scaled(b.low, to_cloud), hi = scaled(b.high, to_cloud);
+    const double l[3] = {lo.x, lo.y, lo.z}, h[3] = {hi.x, hi.y, hi.z};
+    for (int k = 0; k < 3; ++k) {
+        min[k] = l[k];
+        max[k] = h[k];
+    }
+}
+
+// Measures the surface's fit (see above) into rep.diagnostics; false if the workspace is
+// too small. triangles[0 .. count - caps) are the walls, the rest caps: the caps are
+// checked for crossings, not for misfit.
+static inline bool measure_fit(const CloudReader& reader, size_t point_count, const CloudSums& sums,
+                               const uint32_t* triangles, size_t count, size_t caps, Arena& arena,
+                               Report& rep) {
     const size_t walls = caps < count ? count - caps : 0;
-    const size_t mark = arena.mark();
-    WebMemory m;
-    if (!allocate_webs(m, point_count, walls, arena)) return false;
-    const WebFrame f = web_frame(sums);
-    WebVertexPass pass = {&reader, &f, &m, number_vertices(triangles, walls, point_count, m),
-                          false};
-    run_pass(options, pass);
-    const double area = edge_lengths(f, triangles, walls, m);
-    pass.medians = true;
-    run_pass(options, pass);
     Diagnostics& d = rep.diagnostics;
-    const double web = find_webs(f, triangles, walls, m, d);
+    if (walls == 0) return true;
+    const size_t mark = arena.mark();
+    FitMemory m;
+    if (!allocate_fit(m, point_count, count, arena)) return false;
+    const Vec3 size = Vec3{sums.highest[0], sums.highest[1], sums.highest[2]} -
+                      Vec3{sums.lowest[0], sums.lowest[1], sums.lowest[2]};
+    const double extent = largest_of(size);
+    const CloudBox box = box_of(reader, point_count);
+    const double spacing =
+        is_finite(extent) ? nearest_spacing(reader, point_count, box, m.points, kMisfitSampleLimit) : 0;
+    if (!(spacing > 0)) {
+        arena.rewind(mark);
+        return true;
+    }
+    const FitFrame f = {scale_for_extent(extent)};
+    // The points' cells keyed from the reader's coordinates: the scaled ones key alike, the
+    // scale being a power of two.
+    const size_t n = sort_into_cells(reader, point_count, box.low, kFitCellSpacings * spacing, m.points);
+    const double side = kFitCellSpacings * spacing * f.scale;
+    const Vec3 low = scaled(box.low, f.scale);
+    const size_t step = walls > kMisfitSampleLimit ? (walls + kMisfitSampleLimit - 1) / kMisfitSampleLimit : 1;
+    const Box3f none = {{DBL_MAX, DBL_MAX, DBL_MAX}, {-DBL_MAX, -DBL_MAX, -DBL_MAX}};
+    MisfitTally t = {0, 0, none, 0};
+    tally_misfit(f, reader, m, n, low, side, spacing * f.scale, triangles, walls, step, t);
+    CrossingTally crossed = {0, count <= kCrossingCheckLimit, none};
+    if (crossed.complete) {
+        const int along = sweep_side(f, reader, triangles, count, scaled(size, f.scale));
+        const double from = coordinate(low, along);
+        sort_sweep(f, reader, triangles, count, along, from, m);
+        count_crossings(f, reader, triangles, m.sweep, count, along, from, crossed);
+    }
+    d.crossing_pair_count = crossed.pairs;
+    const double to_cloud = 1 / f.scale;
+    const double vertices = static_cast<double>(rep.points.used_count);
+    d.point_spacing = spacing;
+    // The sample's area stands for every step-th triangle's.
+    d.area_per_point = vertices > 0 ? t.area * static_cast<double>(step) * to_cloud * to_cloud /
+                                          (vertices * spacing * spacing)
+                                    : 0;
+    d.crossing_check_complete = crossed.complete;
+    d.fit_sample_count = t.samples;
+    d.misfit_area_fraction = t.area > 0 ? t.misfit / t.area : 0;
+    d.misfit_area = t.misfit * static_cast<double>(step) * to_cloud * to_cloud;
+    put_box(t.where, to_cloud, d.misfit_box_min, d.misfit_box_max);
+    put_box(crossed.where, to_cloud, d.crossing_box_min, d.crossing_box_max);
     arena.rewind(mark);
-    if (d.web_triangle_count == 0) return true;
-    d.web_area = web / f.scale / f.scale;
-    d.web_area_fraction = area > 0 ? web / area : 0;
     return true;
 }
 
@@ -10541,8 +10713,6 @@ static inline bool spans_surface(const PointGroup& g) {
     const double along = variance_along(m, principal_direction(m));
     return along > 0 && m[0][0] + m[1][1] + m[2][2] - along > kLineVariance * along;
 }
-
-static inline double coordinate(Vec3 p, int k) { return k == 0 ? p.x : k == 1 ? p.y : p.z; }
 
 // The points' positions along their bounding box's longest side, in up to kNoAreaBins bins.
 struct Binning {
@@ -13040,16 +13210,16 @@ static inline Status run_reconstruction(const Cloud& cloud, const Options& optio
     if (status == Status::ok)
         status = mesh_cloud(cloud, in, request, arena, triangles, triangle_capacity,
                             triangle_count, rep);
-    if (kMeasureWebs) arena.rewind(read);  // the surface is final: the scratch is free
+    if (kMeasureFit) arena.rewind(read);  // the surface is final: the scratch is free
     // A few far points or far clusters collapse the rest, so that no layer surrounds its
     // centre either: they are the reason then too.
     if (kDegenerateCheck && (status == Status::degenerate || status == Status::not_columnar)) {
         arena.rewind(read);
         status = explain_no_area(in, status, arena, rep);
     }
-    if (kMeasureWebs && status == Status::ok &&
-        !measure_webs(options, in.reader, in.count, in.sums, triangles, *triangle_count,
-                      rep.caps.triangle_count, arena, rep)) {
+    if (kMeasureFit && status == Status::ok &&
+        !measure_fit(in.reader, in.count, in.sums, triangles, *triangle_count,
+                     rep.caps.triangle_count, arena, rep)) {
         *triangle_count = 0;
         rep.triangle_count = 0;
         status = Status::out_of_memory;
@@ -13080,18 +13250,18 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
     if (detail::kDropOutliers && (options.flags & drop_outliers))
         arena.alloc<unsigned char>(point_count / 8 + 1);
     const size_t read = arena.required_bytes();
-    size_t steps[detail::kMeasureWebs ? 3 : 2] = {};
+    size_t steps[detail::kMeasureFit ? 3 : 2] = {};
     if (detail::kAxisTrials && options.axis == Axis::automatic)
         steps[0] = detail::axis_workspace_size(point_count, request);
 #if !defined(STRATMESH_SMALL_CODE)
     if (detail::searches_parts(request))
         steps[1] = detail::parts_workspace_size(point_count, request);
 #endif
-    // The webs are measured once the surface is final (far less than meshing it takes).
-    if (detail::kMeasureWebs) {
-        steps[detail::kMeasureWebs ? 2 : 0] = detail::webs_workspace_size(
+    // The fit is measured once the surface is final (far less than meshing it takes).
+    if (detail::kMeasureFit) {
+        steps[detail::kMeasureFit ? 2 : 0] = detail::fit_workspace_size(
             point_count, reconstruct_max_triangles(point_count, options));
-        if (steps[detail::kMeasureWebs ? 2 : 0] == 0) return 0;
+        if (steps[detail::kMeasureFit ? 2 : 0] == 0) return 0;
     }
     for (size_t bytes : steps) {
         if (bytes > SIZE_MAX - read) return 0;
@@ -13193,8 +13363,8 @@ STRATMESH_C_SAME(STRATMESH_PARTS_OUTCOME_JOINED, stratmesh::PartsOutcome::joined
 STRATMESH_C_SAME(STRATMESH_PARTS_OUTCOME_KEPT_APART, stratmesh::PartsOutcome::kept_apart)
 STRATMESH_C_SAME(STRATMESH_PARTS_OUTCOME_UNDONE, stratmesh::PartsOutcome::undone)
 #undef STRATMESH_C_SAME
-static_assert(STRATMESH_WEB_SPACINGS == stratmesh::kWebSpacings,
-              "STRATMESH_WEB_SPACINGS differs from stratmesh::kWebSpacings");
+static_assert(STRATMESH_POOR_MISFIT_FRACTION == stratmesh::kPoorMisfitFraction,
+              "STRATMESH_POOR_MISFIT_FRACTION differs from stratmesh::kPoorMisfitFraction");
 
 // A status added to the list needs its C constant too.
 #define STRATMESH_C_COUNT(name, message) +1
@@ -13331,12 +13501,19 @@ static inline void c_report(const Report& r, stratmesh_report& c) {
     c.diagnostics.fold_count = r.diagnostics.fold_count;
     c.diagnostics.illegal_removed_count = r.diagnostics.illegal_removed_count;
     c.diagnostics.diagonal_swap_count = r.diagnostics.diagonal_swap_count;
-    c.diagnostics.web_triangle_count = r.diagnostics.web_triangle_count;
-    c.diagnostics.web_area = r.diagnostics.web_area;
-    c.diagnostics.web_area_fraction = r.diagnostics.web_area_fraction;
+    const Diagnostics& d = r.diagnostics;
+    c.diagnostics.point_spacing = d.point_spacing;
+    c.diagnostics.area_per_point = d.area_per_point;
+    c.diagnostics.fit_sample_count = d.fit_sample_count;
+    c.diagnostics.misfit_area_fraction = d.misfit_area_fraction;
+    c.diagnostics.misfit_area = d.misfit_area;
+    c.diagnostics.crossing_pair_count = d.crossing_pair_count;
+    c.diagnostics.crossing_check_complete = d.crossing_check_complete ? 1 : 0;
     for (int i = 0; i < 3; ++i) {
-        c.diagnostics.web_box_min[i] = r.diagnostics.web_box_min[i];
-        c.diagnostics.web_box_max[i] = r.diagnostics.web_box_max[i];
+        c.diagnostics.misfit_box_min[i] = d.misfit_box_min[i];
+        c.diagnostics.misfit_box_max[i] = d.misfit_box_max[i];
+        c.diagnostics.crossing_box_min[i] = d.crossing_box_min[i];
+        c.diagnostics.crossing_box_max[i] = d.crossing_box_max[i];
     }
     c.detail = r.detail;
     c.workspace_used_bytes = r.workspace_used_bytes;

@@ -60,8 +60,8 @@ STRATMESH_C_SAME(STRATMESH_PARTS_OUTCOME_JOINED, stratmesh::PartsOutcome::joined
 STRATMESH_C_SAME(STRATMESH_PARTS_OUTCOME_KEPT_APART, stratmesh::PartsOutcome::kept_apart)
 STRATMESH_C_SAME(STRATMESH_PARTS_OUTCOME_UNDONE, stratmesh::PartsOutcome::undone)
 #undef STRATMESH_C_SAME
-static_assert(STRATMESH_WEB_SPACINGS == stratmesh::kWebSpacings,
-              "STRATMESH_WEB_SPACINGS differs from stratmesh::kWebSpacings");
+static_assert(STRATMESH_POOR_MISFIT_FRACTION == stratmesh::kPoorMisfitFraction,
+              "STRATMESH_POOR_MISFIT_FRACTION differs from stratmesh::kPoorMisfitFraction");
 
 // A status added to the list needs its C constant too.
 #define STRATMESH_C_COUNT(name, message) +1
@@ -198,12 +198,19 @@ static inline void c_report(const Report& r, stratmesh_report& c) {
     c.diagnostics.fold_count = r.diagnostics.fold_count;
     c.diagnostics.illegal_removed_count = r.diagnostics.illegal_removed_count;
     c.diagnostics.diagonal_swap_count = r.diagnostics.diagonal_swap_count;
-    c.diagnostics.web_triangle_count = r.diagnostics.web_triangle_count;
-    c.diagnostics.web_area = r.diagnostics.web_area;
-    c.diagnostics.web_area_fraction = r.diagnostics.web_area_fraction;
+    const Diagnostics& d = r.diagnostics;
+    c.diagnostics.point_spacing = d.point_spacing;
+    c.diagnostics.area_per_point = d.area_per_point;
+    c.diagnostics.fit_sample_count = d.fit_sample_count;
+    c.diagnostics.misfit_area_fraction = d.misfit_area_fraction;
+    c.diagnostics.misfit_area = d.misfit_area;
+    c.diagnostics.crossing_pair_count = d.crossing_pair_count;
+    c.diagnostics.crossing_check_complete = d.crossing_check_complete ? 1 : 0;
     for (int i = 0; i < 3; ++i) {
-        c.diagnostics.web_box_min[i] = r.diagnostics.web_box_min[i];
-        c.diagnostics.web_box_max[i] = r.diagnostics.web_box_max[i];
+        c.diagnostics.misfit_box_min[i] = d.misfit_box_min[i];
+        c.diagnostics.misfit_box_max[i] = d.misfit_box_max[i];
+        c.diagnostics.crossing_box_min[i] = d.crossing_box_min[i];
+        c.diagnostics.crossing_box_max[i] = d.crossing_box_max[i];
     }
     c.detail = r.detail;
     c.workspace_used_bytes = r.workspace_used_bytes;

@@ -74,7 +74,7 @@ const bool kPeelFoldedEnds = false;
 const bool kFoldMerge = false;
 const uint32_t kFoldMergeReach = 0;
 const bool kFastLoops = false;
-const bool kMeasureWebs = false;
+const bool kMeasureFit = false;
 #else
 const bool kNetShortcut = true;  // a chunk whose loop fans are whole skips the net
 const bool kStagePoints = true;  // reconstruct() keeps the grouped points in spare workspace
@@ -118,8 +118,8 @@ const uint32_t kFoldMergeReach = 2;
 // layer guess in layer_of, pseudo_angle without branches, floor by truncation in
 // exp_portable, the height range from choose_frame's extremes, count_folds' prefetching.
 const bool kFastLoops = true;
-// reconstruct() measures the webs of its output (Diagnostics; see >>webs).
-const bool kMeasureWebs = true;
+// reconstruct() measures the fit of its output to the cloud (Diagnostics; see >>fit).
+const bool kMeasureFit = true;
 #endif
 static const size_t kMaxPoints = 0xFFFFFFFEu;
 

@@ -52,8 +52,6 @@ static inline bool spans_surface(const PointGroup& g) {
     return along > 0 && m[0][0] + m[1][1] + m[2][2] - along > kLineVariance * along;
 }
 
-static inline double coordinate(Vec3 p, int k) { return k == 0 ? p.x : k == 1 ? p.y : p.z; }
-
 // The points' positions along their bounding box's longest side, in up to kNoAreaBins bins.
 struct Binning {
     int side;

@@ -164,12 +164,13 @@ struct CellBlock {
     }
 };
 
-// `member` is an item of `cell`. With `fingers` (18 valid positions, updated), each range
-// end is searched from where the same end was found last: a caller that goes through cells
-// in key order then finds each a few items on.
-static inline CellBlock block_around(const GridItem* items, size_t count, size_t member,
-                              size_t* fingers = nullptr) {
-    const uint64_t cell = items[member].cell;
+// The items of the cells around `cell` (empty or not), searched from items[hint]. With
+// `fingers` (18 valid positions, updated), each range end is searched from where the same
+// end was found last: a caller that goes through cells in key order then finds each a few
+// items on.
+static inline CellBlock block_of_cell(const GridItem* items, size_t count, uint64_t cell,
+                                      size_t hint, size_t* fingers = nullptr) {
+    const size_t member = hint;
     CellBlock b;
     b.count = 0;
     const uint64_t x = cell >> (2 * kCellBits), y = (cell >> kCellBits) & kCellTop, z = cell & kCellTop;
@@ -190,6 +191,12 @@ static inline CellBlock block_around(const GridItem* items, size_t count, size_t
         if (b.end[b.count] > b.begin[b.count]) ++b.count;
     }
     return b;
+}
+
+// The items of the cells around items[member]'s.
+static inline CellBlock block_around(const GridItem* items, size_t count, size_t member,
+                                     size_t* fingers = nullptr) {
+    return block_of_cell(items, count, items[member].cell, member, fingers);
 }
 
 // The samples of the scale measures are taken by a hash of the coordinates, about one

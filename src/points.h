@@ -12,6 +12,7 @@ struct Vec3 {
 };
 
 static inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+static inline Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 
 static inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
@@ -48,12 +49,15 @@ struct CloudReader {
     }
 };
 
-// False unless v's squared length is a normal double (v's length between about 1.5e-154
-// and 1.3e154): a subnormal square has lost the bits that make the result unit.
 static inline double largest_of(Vec3 v) {
     const double xy = v.x > v.y ? v.x : v.y;
     return xy > v.z ? xy : v.z;
 }
+
+static inline double coordinate(Vec3 p, int k) { return k == 0 ? p.x : k == 1 ? p.y : p.z; }
+
+// False unless v's squared length is a normal double (v's length between about 1.5e-154
+// and 1.3e154): a subnormal square has lost the bits that make the result unit.
 
 static inline bool normalize(Vec3& v) {
     const double square = dot(v, v);

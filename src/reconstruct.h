@@ -82,16 +82,16 @@ static inline Status run_reconstruction(const Cloud& cloud, const Options& optio
     if (status == Status::ok)
         status = mesh_cloud(cloud, in, request, arena, triangles, triangle_capacity,
                             triangle_count, rep);
-    if (kMeasureWebs) arena.rewind(read);  // the surface is final: the scratch is free
+    if (kMeasureFit) arena.rewind(read);  // the surface is final: the scratch is free
     // A few far points or far clusters collapse the rest, so that no layer surrounds its
     // centre either: they are the reason then too.
     if (kDegenerateCheck && (status == Status::degenerate || status == Status::not_columnar)) {
         arena.rewind(read);
         status = explain_no_area(in, status, arena, rep);
     }
-    if (kMeasureWebs && status == Status::ok &&
-        !measure_webs(options, in.reader, in.count, in.sums, triangles, *triangle_count,
-                      rep.caps.triangle_count, arena, rep)) {
+    if (kMeasureFit && status == Status::ok &&
+        !measure_fit(in.reader, in.count, in.sums, triangles, *triangle_count,
+                     rep.caps.triangle_count, arena, rep)) {
         *triangle_count = 0;
         rep.triangle_count = 0;
         status = Status::out_of_memory;
@@ -122,18 +122,18 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
     if (detail::kDropOutliers && (options.flags & drop_outliers))
         arena.alloc<unsigned char>(point_count / 8 + 1);
     const size_t read = arena.required_bytes();
-    size_t steps[detail::kMeasureWebs ? 3 : 2] = {};
+    size_t steps[detail::kMeasureFit ? 3 : 2] = {};
     if (detail::kAxisTrials && options.axis == Axis::automatic)
         steps[0] = detail::axis_workspace_size(point_count, request);
 #if !defined(STRATMESH_SMALL_CODE)
     if (detail::searches_parts(request))
         steps[1] = detail::parts_workspace_size(point_count, request);
 #endif
-    // The webs are measured once the surface is final (far less than meshing it takes).
-    if (detail::kMeasureWebs) {
-        steps[detail::kMeasureWebs ? 2 : 0] = detail::webs_workspace_size(
+    // The fit is measured once the surface is final (far less than meshing it takes).
+    if (detail::kMeasureFit) {
+        steps[detail::kMeasureFit ? 2 : 0] = detail::fit_workspace_size(
             point_count, reconstruct_max_triangles(point_count, options));
-        if (steps[detail::kMeasureWebs ? 2 : 0] == 0) return 0;
+        if (steps[detail::kMeasureFit ? 2 : 0] == 0) return 0;
     }
     for (size_t bytes : steps) {
         if (bytes > SIZE_MAX - read) return 0;

@@ -76,12 +76,18 @@ void check_same_report(const Report& r, const stratmesh_report& c, bool same_wor
     CHECK(c.diagnostics.fold_count == r.diagnostics.fold_count);
     CHECK(c.diagnostics.illegal_removed_count == r.diagnostics.illegal_removed_count);
     CHECK(c.diagnostics.diagonal_swap_count == r.diagnostics.diagonal_swap_count);
-    CHECK(c.diagnostics.web_triangle_count == r.diagnostics.web_triangle_count);
-    CHECK(c.diagnostics.web_area == r.diagnostics.web_area);
-    CHECK(c.diagnostics.web_area_fraction == r.diagnostics.web_area_fraction);
+    CHECK(c.diagnostics.point_spacing == r.diagnostics.point_spacing);
+    CHECK(c.diagnostics.area_per_point == r.diagnostics.area_per_point);
+    CHECK(c.diagnostics.fit_sample_count == r.diagnostics.fit_sample_count);
+    CHECK(c.diagnostics.misfit_area_fraction == r.diagnostics.misfit_area_fraction);
+    CHECK(c.diagnostics.misfit_area == r.diagnostics.misfit_area);
+    CHECK(c.diagnostics.crossing_pair_count == r.diagnostics.crossing_pair_count);
+    CHECK((c.diagnostics.crossing_check_complete != 0) == r.diagnostics.crossing_check_complete);
     for (int k = 0; k < 3; ++k) {
-        CHECK(c.diagnostics.web_box_min[k] == r.diagnostics.web_box_min[k]);
-        CHECK(c.diagnostics.web_box_max[k] == r.diagnostics.web_box_max[k]);
+        CHECK(c.diagnostics.misfit_box_min[k] == r.diagnostics.misfit_box_min[k]);
+        CHECK(c.diagnostics.misfit_box_max[k] == r.diagnostics.misfit_box_max[k]);
+        CHECK(c.diagnostics.crossing_box_min[k] == r.diagnostics.crossing_box_min[k]);
+        CHECK(c.diagnostics.crossing_box_max[k] == r.diagnostics.crossing_box_max[k]);
     }
     CHECK(c.detail == r.detail);
     if (same_workspace) CHECK(c.workspace_used_bytes == r.workspace_used_bytes);
@@ -182,11 +188,11 @@ TEST_CASE("C interface: reconstruct gives the C++ triangles and report") {
     cut.flags = stratmesh::add_caps;
     check_same_reconstruction(upright, cut);
 
-    // A fork meshed as one tube spans the gap between its prongs: the web fields too.
+    // A fork meshed as one tube spans the gap between its prongs: the misfit fields too.
     const Shape fork = shapes::forked_tube(3000, Pose::z);
     Options one = {};
     one.parts = stratmesh::Parts::one_tube;
-    CHECK(check_same_reconstruction(fork, one).diagnostics.web_triangle_count > 0);
+    CHECK(check_same_reconstruction(fork, one).diagnostics.misfit_area > 0);
 }
 
 TEST_CASE("C interface: a refusal gives the C++ status and report") {

@@ -116,7 +116,8 @@ const char kUsage[] =
     "                        still are)\n"
     "  --verbose             the summary also gives the branches and parts, the threads,\n"
     "                        the times, the memory and the stream\n"
-    "  --strict              warnings make the exit status 5 (the mesh is still written)\n"
+    "  --strict              a poor verdict makes the exit status 5 (the mesh is still\n"
+    "                        written)\n"
     "  --version             print the version and exit\n"
     "  -h, --help            print this help and exit\n"
     "\n"
@@ -138,11 +139,14 @@ const char kUsage[] =
     "\n"
     "Summary, on stderr: the input and output, the points, the layers (asked and used,\n"
     "and why layers were merged), the triangles and the ends (closed only where no\n"
-    "boundary loop is left; a small loop around a pole is named), then the warnings, each\n"
-    "on a line 'stratmesh: warning: ...': folds, webs (triangles spanning gaps between\n"
-    "limbs, from 0.5% of the surface's area; --stream does not measure them), branches\n"
-    "wrapped in one tube or left apart, points left out, caps left open, input faces\n"
-    "ignored, cuts outside the cloud.\n"
+    "boundary loop is left; a small loop around a pole is named), the warnings count, and\n"
+    "the verdict: good, or poor with how much of the surface does not follow the cloud\n"
+    "(folds across it or spans gaps), where, the crossing triangles, and the one action\n"
+    "that helps, with the axis and layers used. --stream does not measure the fit. The\n"
+    "warnings follow, each on a line 'stratmesh: warning: ...': branches left apart,\n"
+    "points left out, caps left open, input faces ignored, cuts outside the cloud (and a\n"
+    "poor verdict, under --quiet). --verbose adds the folds the library settled and the\n"
+    "branches one tube wraps.\n"
     "\n"
     "Files: no output may be the input or another output, by any name (a symlink, a hard\n"
     "link, standard input or output redirected from or to it), and at most one of -o,\n"
@@ -155,7 +159,7 @@ const char kUsage[] =
     "Exit status: 0 success; 1 the reconstruction refused the input; 2 usage error;\n"
     "3 file error (cannot open, read, parse or write; standard output closed early); 4 with\n"
     "--stream, a point lies below the one before it along the axis (sort the input along\n"
-    "the axis first); 5 with --strict, the mesh was written but with warnings.\n";
+    "the axis first); 5 with --strict, the mesh was written but judged poor.\n";
 
 bool parse_finite(std::string_view text, double& value) {
     return parse_number(text, value) && std::isfinite(value);

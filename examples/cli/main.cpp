@@ -48,7 +48,7 @@ const int kExitRefused = 1;
 const int kExitUsage = 2;
 const int kExitFile = 3;
 const int kExitUnsorted = 4;
-const int kExitWarned = 5; // --strict: the mesh is written, with warnings
+const int kExitPoor = 5; // --strict: the mesh is written, and judged poor
 
 // Progress is drawn for inputs this large, when stderr is a terminal.
 const size_t kProgressPoints = 200000;
@@ -396,14 +396,18 @@ bool write_output(const CommandLine& line, const std::vector<double>& xyz,
 }
 
 // Writes the report of a run whose mesh is written, publishes the outputs, then prints the
-// summary (not with --quiet) and the warnings (always).
+// summary (not with --quiet) and the warnings (always; a poor verdict among them with
+// --quiet). --strict fails exactly on a poor verdict.
 int finish_run(const CommandLine& line, RunRecord& record, Outputs& outputs) {
     record.peak_rss_bytes = peak_resident_bytes();
     if (!write_report(line, record, outputs.report) || !outputs.commit()) return kExitFile;
-    const std::vector<std::string> warnings = run_warnings(record);
-    if (!line.quiet) print_summary(stderr, record, warnings.size(), line.verbose);
+    const Verdict verdict = judge_mesh(record);
+    std::vector<std::string> warnings = run_warnings(record);
+    if (!line.quiet) print_summary(stderr, record, verdict, warnings.size(), line.verbose);
+    if (line.quiet && verdict.judged == Verdict::poor)
+        warnings.push_back("mesh " + verdict_text(verdict, record));
     print_warnings(stderr, warnings);
-    return line.strict && !warnings.empty() ? kExitWarned : kExitOk;
+    return line.strict && verdict.judged == Verdict::poor ? kExitPoor : kExitOk;
 }
 
 // Explains the refusal (with the tool's `advice`, if any) and writes the report alone.

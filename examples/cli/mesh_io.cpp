@@ -302,7 +302,10 @@ void put_ply_vertex_lines_with(BlockWriter& w, const double* xyz, size_t count,
 }
 
 void write_ply(BlockWriter& w, const MeshView& mesh, bool ascii) {
-    bool single = !ascii && all_coordinates_are_floats(mesh.xyz, mesh.vertex_count);
+    // Float coordinates are declared float, in binary and in text alike; text gives each
+    // coordinate the digits that read back as the same double, which a float reader
+    // rounds to that float.
+    const bool single = all_coordinates_are_floats(mesh.xyz, mesh.vertex_count);
     const PointAttributes* attributes =
         mesh.attributes && !mesh.attributes->empty() ? mesh.attributes : nullptr;
     w.append(ply_header(mesh.vertex_count, mesh.triangle_count, ascii, single, attributes));
@@ -647,7 +650,7 @@ bool MeshStreamWriter::close_bodies(std::string& failure) {
 }
 
 bool MeshStreamWriter::finish(std::string& error) {
-    const bool single = format_ == MeshFormat::ply && !ascii_ && all_floats_;
+    const bool single = format_ == MeshFormat::ply && all_floats_;
     if (format_ == MeshFormat::ply)
         out_->append(ply_header(vertex_count_, triangle_count_, ascii_, single));
     else if (format_ == MeshFormat::off)
@@ -655,7 +658,7 @@ bool MeshStreamWriter::finish(std::string& error) {
     else if (vertices_)
         out_->append(obj_header());
     std::string failure;
-    bool ok = !vertices_ || copy_body(*vertices_, single);
+    bool ok = !vertices_ || copy_body(*vertices_, single && !ascii_);
     ok = ok && (!faces_ || copy_body(*faces_, false));
     if (!ok) failure = "a temporary file cannot be read back";
     ok = close_bodies(failure) && ok;

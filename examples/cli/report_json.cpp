@@ -242,30 +242,53 @@ void write_status(JsonWriter& j, const RunRecord& r) {
         j.null();
 }
 
-// The triangles spanning gaps (Report::diagnostics): null with --stream, which does not
-// measure them; the box null without webs.
-void write_webs(JsonWriter& j, const stratmesh::Diagnostics& d, bool stream) {
-    j.key("webs");
-    if (stream) return j.null();
+// The fit of the surface to the cloud (Report::diagnostics) and the tool's verdict on it:
+// the fit null with --stream, which does not measure it; a box null when empty.
+void write_box(JsonWriter& j, const char* name, bool any, const double* low, const double* high) {
+    j.key(name);
+    if (!any) return j.null();
     j.begin_object();
-    j.count_field("triangles", d.web_triangle_count);
-    j.number_field("area", d.web_area);
-    j.number_field("area_fraction", d.web_area_fraction);
-    j.number_field("spacings", stratmesh::kWebSpacings);
-    j.key("box");
-    if (d.web_triangle_count == 0) {
-        j.null();
-    } else {
-        j.begin_object();
-        j.numbers_field("min", d.web_box_min, 3);
-        j.numbers_field("max", d.web_box_max, 3);
-        j.end_object();
-    }
+    j.numbers_field("min", low, 3);
+    j.numbers_field("max", high, 3);
     j.end_object();
 }
 
-void write_counts(JsonWriter& j, const stratmesh::Report& rep, stratmesh::Status status,
-                  bool stream) {
+void write_fit(JsonWriter& j, const RunRecord& r) {
+    const stratmesh::Diagnostics& d = r.report.diagnostics;
+    j.key("fit");
+    if (r.stream) {
+        j.null();
+    } else {
+        j.begin_object();
+        j.number_field("point_spacing", d.point_spacing);
+        j.number_field("area_per_point", d.area_per_point);
+        j.count_field("samples", d.fit_sample_count);
+        j.number_field("misfit_area_fraction", d.misfit_area_fraction);
+        j.number_field("misfit_area", d.misfit_area);
+        write_box(j, "misfit_box", d.misfit_area > 0, d.misfit_box_min, d.misfit_box_max);
+        j.count_field("crossing_pairs", d.crossing_pair_count);
+        j.flag_field("crossing_check_complete", d.crossing_check_complete);
+        write_box(j, "crossing_box", d.crossing_pair_count > 0, d.crossing_box_min,
+                  d.crossing_box_max);
+        j.end_object();
+    }
+    const Verdict v = judge_mesh(r);
+    j.key("verdict");
+    j.begin_object();
+    j.text_field("class", verdict_name(v.judged));
+    j.text_field("what", v.what);
+    j.key("action");
+    if (v.action.empty())
+        j.null();
+    else
+        j.string(v.action);
+    j.text_field("axis", v.axis);
+    j.end_object();
+}
+
+void write_counts(JsonWriter& j, const RunRecord& r) {
+    const stratmesh::Report& rep = r.report;
+    const stratmesh::Status status = r.status;
     j.key("points");
     j.begin_object();
     j.count_field("in", rep.points.in_count);
@@ -283,7 +306,7 @@ void write_counts(JsonWriter& j, const stratmesh::Report& rep, stratmesh::Status
     j.count_field("triangles", rep.triangle_count);
     j.count_field("illegal_removed", rep.diagnostics.illegal_removed_count);
     j.count_field("folds", rep.diagnostics.fold_count);
-    write_webs(j, rep.diagnostics, stream);
+    write_fit(j, r);
     j.key("caps");
     j.begin_object();
     j.count_field("closed", rep.caps.closed_count);
@@ -536,7 +559,7 @@ std::string run_record_json(const RunRecord& record) {
     write_options(j, record);
     j.flag_field("reconstructed", record.reconstructed);
     write_status(j, record);
-    write_counts(j, record.report, record.status, record.stream);
+    write_counts(j, record);
     write_layers(j, record);
     write_ends(j, record);
     // The warnings printed: a refused run's only warning is the input's faces.

@@ -195,27 +195,7 @@ std::string folds_warning(const RunRecord& r) {
             text += " in layer" + std::string(folding > 1 ? "s " : " ") + list + " of " +
                     std::to_string(r.layers.size()) + ", bottom up";
     }
-    return text + ": not star-shaped around any centre tried (a branch, an overhang), the "
-                  "surface may bridge gaps or cross itself there";
-}
-
-// Triangles spanning gaps (Report::diagnostics), from kWebAreaFloor of the surface's area:
-// how many, their share of the area and their bounding box, so that a user can look there.
-std::string webs_warning(const RunRecord& r) {
-    const stratmesh::Diagnostics& d = r.report.diagnostics;
-    if (d.web_triangle_count == 0 || !(d.web_area_fraction >= kWebAreaFloor)) return "";
-    const double percent = 100 * d.web_area_fraction;
-    char share[32];
-    std::snprintf(share, sizeof share, percent < 10 ? "%.1f%%" : "%.0f%%", percent);
-    std::string box;
-    const char* names[] = {"x", "y", "z"};
-    for (int k = 0; k < 3; ++k)
-        box += std::string(k ? " " : "") + names[k] + " [" + number_text(d.web_box_min[k]) + ", " +
-               number_text(d.web_box_max[k]) + "]";
-    return "web: " + plural(d.web_triangle_count, "triangle spans", "triangles span") +
-           " more than " + number_text(stratmesh::kWebSpacings) + " local spacings, " + share +
-           " of the surface's area, within " + box +
-           ": the cloud may have limbs or a handle that one tube cannot follow";
+    return text + ": not star-shaped around any centre tried (a branch, an overhang)";
 }
 
 // "above 12.5: 2 (750, 740 points); below: none (gap 0.8)".
@@ -244,18 +224,11 @@ bool branches_found(const RunRecord& r) {
            r.parting.above_branch_count + r.parting.below_branch_count > 0;
 }
 
-// Branches wrapped in one tube, which webs over the gaps between them; or left apart.
+// Branches left apart from the trunk: the surface is in pieces. (One tube around branches
+// is judged by the verdict, whose fit measure sees the gaps it spans.)
 std::string branches_warning(const RunRecord& r) {
-    if (!branches_found(r)) return "";
+    if (!branches_found(r) || r.split.empty() || r.split_undone) return "";
     const std::string where = parting_text(r.parting);
-    if (r.split.empty())
-        return "one tube wraps branches and the gaps between them, " + where +
-               ": mesh each side apart (README, \"Where the cloud parts\")";
-    if (r.split_undone)
-        return "the cloud parts into branches (" + where +
-               ") but the parts were not kept: meshed as one tube instead, which wraps the "
-               "branches and the gaps between them (--verbose says why; --parts apart "
-               "keeps the parts)";
     if (r.junction.apart_side_count > 0 || r.junction_status != stratmesh::Status::ok)
         return "branches left apart from the trunk, not joined (" + where +
                "): the surface is in pieces (--verbose says why)";
@@ -353,9 +326,15 @@ void print_split(std::FILE* out, const RunRecord& r) {
 }
 
 void print_costs(std::FILE* out, const RunRecord& r) {
-    if (!r.stream) // the stream triangulates in order, whatever --threads says
-        std::fprintf(out, "  threads    %u (%zu layers triangulated in parallel)\n",
-                     static_cast<unsigned>(r.threads), r.report.layers.parallel_count);
+    // The jobs triangulate planned layers ahead of the chain, which merges some: counted
+    // against the planned layers. The stream triangulates in order, whatever --threads says.
+    const stratmesh::LayerCounts& layers = r.report.layers;
+    if (!r.stream && layers.parallel_count == 0)
+        std::fprintf(out, "  threads    %u (the layers triangulated in order)\n",
+                     static_cast<unsigned>(r.threads));
+    else if (!r.stream)
+        std::fprintf(out, "  threads    %u (jobs triangulated %zu of the %zu planned layers)\n",
+                     static_cast<unsigned>(r.threads), layers.parallel_count, layers.planned_count);
     std::fprintf(out, "  time       read %s, reconstruct %s%s, %swrite %s\n",
                  seconds_text(r.read_seconds).c_str(), seconds_text(r.reconstruct_seconds).c_str(),
                  phase_times_text(r).c_str(),
@@ -389,9 +368,8 @@ std::string faces_warning(const RunRecord& record) {
 std::vector<std::string> run_warnings(const RunRecord& record) {
     std::vector<std::string> warnings;
     for (const std::string& warning :
-         {folds_warning(record), webs_warning(record), branches_warning(record),
-          left_out_warning(record),
-          caps_warning(record), faces_warning(record), cuts_warning(record)})
+         {branches_warning(record), left_out_warning(record), caps_warning(record),
+          faces_warning(record), cuts_warning(record)})
         if (!warning.empty()) warnings.push_back(warning);
     return warnings;
 }
@@ -410,7 +388,16 @@ std::string properties_text(const RunRecord& r) {
     return text + (r.point_properties == 1 ? " point property carried" : " point properties carried");
 }
 
-void print_summary(std::FILE* out, const RunRecord& record, size_t warning_count, bool verbose) {
+// With --verbose: what the library settled on its way, which the verdict weighs.
+void print_settled(std::FILE* out, const RunRecord& r) {
+    const std::string folds = folds_warning(r);
+    if (!folds.empty()) std::fprintf(out, "  folds      %s\n", folds.c_str());
+    if (branches_found(r) && r.split.empty())
+        std::fprintf(out, "  one tube   around the branches, %s\n", parting_text(r.parting).c_str());
+}
+
+void print_summary(std::FILE* out, const RunRecord& record, const Verdict& verdict,
+                   size_t warning_count, bool verbose) {
     std::fprintf(out, "stratmesh: %s (%s %s) -> %s (%s%s%s)\n",
                  file_name(record.input_path, "standard input").c_str(),
                  record.input_format.c_str(), record.input_encoding.c_str(),
@@ -419,6 +406,7 @@ void print_summary(std::FILE* out, const RunRecord& record, size_t warning_count
                  properties_text(record).c_str());
     print_counts(out, record);
     if (verbose) {
+        print_settled(out, record);
         print_branches(out, record);
         print_split(out, record);
         print_costs(out, record);
@@ -427,6 +415,7 @@ void print_summary(std::FILE* out, const RunRecord& record, size_t warning_count
         std::fprintf(out, "  warnings   none\n");
     else
         std::fprintf(out, "  warnings   %zu, below\n", warning_count);
+    std::fprintf(out, "  verdict    %s\n", verdict_text(verdict, record).c_str());
 }
 
 } // namespace stratmesh_cli

@@ -4,6 +4,7 @@
 #define STRATMESH_CLI_SUMMARY_H
 
 #include "report_json.h"
+#include "verdict.h"
 
 #include <cstdio>
 #include <string>
@@ -15,14 +16,9 @@ namespace stratmesh_cli {
 // with the next one).
 const size_t kFewestLayerPoints = 16;
 
-// Webs (Report::diagnostics) under this share of the surface's area are not warned about:
-// a single column shows none or a few stray ones (under 0.3%), an object with limbs meshed
-// as one tube several percent.
-const double kWebAreaFloor = 0.005;
-
-// What a user should check before trusting the mesh, each a sentence without the
-// "stratmesh: warning: " prefix: folds, webs, branches wrapped in one tube or left apart,
-// points left out, caps left open, input faces ignored, cuts outside the cloud.
+// What a user should know of the output besides the verdict, each a sentence without the
+// "stratmesh: warning: " prefix: branches left apart, points left out, caps left open,
+// input faces ignored, cuts outside the cloud.
 std::vector<std::string> run_warnings(const RunRecord& record);
 
 // The input faces left out of the cloud, or an empty string.
@@ -35,10 +31,11 @@ std::string in_tool_words(const char* library_sentence);
 // Each warning on a line of its own, "stratmesh: warning: ...".
 void print_warnings(std::FILE* out, const std::vector<std::string>& warnings);
 
-// At most five lines (input and output, points, layers, triangles and ends, warnings);
-// `verbose` adds the branches, the parts, the threads, the times, the memory and the
-// stream. The warnings themselves are print_warnings'.
-void print_summary(std::FILE* out, const RunRecord& record, size_t warning_count, bool verbose);
+// At most six lines (input and output, points, layers, triangles and ends, warnings, the
+// verdict last); `verbose` adds the folds, the branches, the parts, the threads, the times,
+// the memory and the stream. The warnings themselves are print_warnings'.
+void print_summary(std::FILE* out, const RunRecord& record, const Verdict& verdict,
+                   size_t warning_count, bool verbose);
 
 } // namespace stratmesh_cli
 

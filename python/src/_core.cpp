@@ -109,6 +109,8 @@ const char* parts_outcome_name(stratmesh::PartsOutcome outcome) {
     return "unknown";
 }
 
+py::tuple triple(const double* v) { return py::make_tuple(v[0], v[1], v[2]); }
+
 // The report as nested namespaces (report.points.used_count, ...): one place to extend
 // when the header's Report grows a group.
 py::object report_object(const stratmesh::Report& r, stratmesh::Status status) {
@@ -164,15 +166,17 @@ py::object report_object(const stratmesh::Report& r, stratmesh::Status status) {
             py::arg("fold_count") = r.diagnostics.fold_count,
             py::arg("illegal_removed_count") = r.diagnostics.illegal_removed_count,
             py::arg("diagonal_swap_count") = r.diagnostics.diagonal_swap_count,
-            py::arg("web_triangle_count") = r.diagnostics.web_triangle_count,
-            py::arg("web_area") = r.diagnostics.web_area,
-            py::arg("web_area_fraction") = r.diagnostics.web_area_fraction,
-            py::arg("web_box_min") = py::make_tuple(r.diagnostics.web_box_min[0],
-                                                    r.diagnostics.web_box_min[1],
-                                                    r.diagnostics.web_box_min[2]),
-            py::arg("web_box_max") = py::make_tuple(r.diagnostics.web_box_max[0],
-                                                    r.diagnostics.web_box_max[1],
-                                                    r.diagnostics.web_box_max[2])),
+            py::arg("point_spacing") = r.diagnostics.point_spacing,
+            py::arg("area_per_point") = r.diagnostics.area_per_point,
+            py::arg("fit_sample_count") = r.diagnostics.fit_sample_count,
+            py::arg("misfit_area_fraction") = r.diagnostics.misfit_area_fraction,
+            py::arg("misfit_area") = r.diagnostics.misfit_area,
+            py::arg("misfit_box_min") = triple(r.diagnostics.misfit_box_min),
+            py::arg("misfit_box_max") = triple(r.diagnostics.misfit_box_max),
+            py::arg("crossing_pair_count") = r.diagnostics.crossing_pair_count,
+            py::arg("crossing_check_complete") = r.diagnostics.crossing_check_complete,
+            py::arg("crossing_box_min") = triple(r.diagnostics.crossing_box_min),
+            py::arg("crossing_box_max") = triple(r.diagnostics.crossing_box_max)),
         py::arg("detail") = r.detail ? py::object(py::str(r.detail)) : py::object(py::none()),
         py::arg("workspace_used_bytes") = r.workspace_used_bytes);
 }
@@ -510,6 +514,7 @@ PYBIND11_MODULE(_core, m) {
     STRATMESH_STATUS_LIST(STRATMESH_PY_ENTRY)
 #undef STRATMESH_PY_ENTRY
     m.attr("STATUSES") = statuses;
+    m.attr("POOR_MISFIT_FRACTION") = stratmesh::kPoorMisfitFraction;
     m.def("reconstruct", &reconstruct, py::arg("points"), py::arg("options"),
           py::arg("progress"), py::arg("copy"), py::arg("workspace"));
     py::class_<Workspace>(m, "Workspace")

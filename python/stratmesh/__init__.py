@@ -13,8 +13,8 @@ from ._error import ArgumentTypeError, Error
 Error.__module__ = __name__  # shown as stratmesh.Error, where users catch it
 ArgumentTypeError.__module__ = __name__
 
-__all__ = ["ArgumentTypeError", "Error", "FLAGS", "PARTS", "STATUSES", "Stream", "Workspace",
-           "cap_ends", "reconstruct", "stream_workspace_size"]
+__all__ = ["ArgumentTypeError", "Error", "FLAGS", "PARTS", "POOR_MISFIT_FRACTION", "STATUSES",
+           "Stream", "Workspace", "cap_ends", "reconstruct", "stream_workspace_size"]
 __version__ = _core.__version__
 
 #: The library's Flags bits by name; flags=(...) accepts any of them.
@@ -23,6 +23,9 @@ FLAGS = dict(_core.FLAGS)
 PARTS = dict(_core.PARTS)
 #: Every status name with its one-line explanation.
 STATUSES = dict(_core.STATUSES)
+#: A surface with a crossing pair, or whose diagnostics.misfit_area_fraction exceeds this,
+#: is poor (the command line's verdict).
+POOR_MISFIT_FRACTION = _core.POOR_MISFIT_FRACTION
 
 
 class Workspace(_core.Workspace):

@@ -258,16 +258,22 @@ typedef struct stratmesh_diagnostics {
     size_t fold_count;             // output triangles whose normal faces the axis
     size_t illegal_removed_count;  // triangles removed by the manifold safety net
     size_t diagonal_swap_count;    // band diagonals swapped when stitching layers
-    size_t web_triangle_count;     // triangles spanning gaps: the longest edge over
-                                   // STRATMESH_WEB_SPACINGS local spacings (caps left out)
-    double web_area;               // their area, in the cloud's units squared
-    double web_area_fraction;      // of the surface's area, caps left out
-    double web_box_min[3];         // where they lie (zeros without webs)
-    double web_box_max[3];
+    double point_spacing;          // the fit (stratmesh::Diagnostics says each)
+    double area_per_point;
+    size_t fit_sample_count;
+    double misfit_area_fraction;
+    double misfit_area;
+    double misfit_box_min[3];
+    double misfit_box_max[3];
+    size_t crossing_pair_count;
+    int crossing_check_complete;   // 1: every pair checked
+    double crossing_box_min[3];
+    double crossing_box_max[3];
 } stratmesh_diagnostics;
 
-// stratmesh::kWebSpacings.
-#define STRATMESH_WEB_SPACINGS 6.0
+// stratmesh::kPoorMisfitFraction: a surface with a crossing pair, or a misfit share above
+// this, is poor.
+#define STRATMESH_POOR_MISFIT_FRACTION 0.05
 
 // stratmesh::Report, its groups as nested structs, so that C code reads the same counts
 // under the same names. stratmesh_reconstruct fills it on every status, counts adding up,

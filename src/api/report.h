@@ -98,8 +98,10 @@ struct LayerCounts {
     size_t planned_count;    // layers planned (cuts + 1, layer_count, or the automatic plan),
                              // before too small, thin, open or folding ones are merged
     size_t used_count;       // layers of the output
-    size_t parallel_count;   // of those, triangulated by Options::run_jobs' jobs (0 without
-                             // a runner, or when the workspace was too small for the jobs)
+    size_t parallel_count;   // planned layers that Options::run_jobs' jobs triangulated
+                             // ahead (0 without a runner, or when the workspace was too
+                             // small for the jobs); merges may redo some, so it can exceed
+                             // used_count
     // Optional per-layer details: the caller points `info` at an array of `info_capacity`
     // entries; the first min(used_count, info_capacity) are filled.
     LayerInfo* info;
@@ -118,34 +120,47 @@ struct CapCounts {
                              // add_caps); 0 in STRATMESH_SMALL_CODE
 };
 
-// A web triangle (Diagnostics) has its longest edge over this many times the largest local
-// spacing of its corners: far enough above a surface's own spread of edge lengths that a
-// single column shows next to none, while a tube wrapped around limbs shows its spans.
-constexpr double kWebSpacings = 6.0;
+// The fit of a surface to its cloud (Diagnostics). A sampled triangle misfits where its
+// normal parts from the cloud's own near its centroid (the direction in which the
+// kFitNeighbours nearest points spread least) by more than kMisfitDegrees, as where a layer
+// folds across the surface, or where its centroid lies farther than kMisfitSpacings point
+// spacings from every point, as where a web spans a gap between limbs.
+constexpr double kMisfitDegrees = 45.0;
+constexpr double kMisfitSpacings = 2.0;
+constexpr uint32_t kFitNeighbours = 12;
+// At most kMisfitSampleLimit triangles are sampled for misfit (every k-th); a surface of
+// at most kCrossingCheckLimit triangles is checked whole for crossing pairs, a larger one
+// not (crossing_check_complete false), as the check's cost grows faster than the cloud.
+constexpr size_t kMisfitSampleLimit = 4096;
+constexpr size_t kCrossingCheckLimit = 16384;
+// A surface with a crossing pair, or whose misfit share exceeds this, is poor: the
+// threshold that parts single columns from folded and webbed surfaces (the command line's
+// verdict; docs/design.md, "The fit measure").
+constexpr double kPoorMisfitFraction = 0.05;
 
 // Report::diagnostics: what a user checks before trusting the mesh.
 struct Diagnostics {
     size_t fold_count;             // output triangles whose normal faces the axis
     size_t illegal_removed_count;  // triangles removed by the manifold safety net
     size_t diagonal_swap_count;    // band diagonals swapped when stitching layers
-    // Webs: where one tube wraps limbs, fingers or branches, its triangles span the gaps
-    // between them, where the cloud has no surface; measured so that such a mesh does not
-    // pass silently. On ok, reconstruct() measures its output, caps left out (the last
-    // caps.triangle_count triangles span their loops by design). A vertex's local spacing
-    // is the median (the lower of two middles) of the lengths of the edges leaving it, one
-    // a triangle (so each of its edges once, but one of a boundary vertex's two boundary
-    // edges): the median, so that the long edges across a CT stack's slices and a few
-    // long edges at a web's border count as the vertex's own. A web triangle's longest
-    // edge exceeds kWebSpacings times the largest local spacing of its corners: the
-    // largest, so that a sparse region beside a dense one is no web. Lengths are measured
-    // in double and compared rounded to float; areas are summed in the triangles' order:
-    // the same bytes for every runner and platform. All 0 from the stream (it never holds
-    // the whole surface), cap_ends() and the reduced build (STRATMESH_SMALL_CODE).
-    size_t web_triangle_count;
-    double web_area;               // their area, in the cloud's units squared
-    double web_area_fraction;      // web_area over the surface's area, caps left out
-    double web_box_min[3];         // the bounding box of the web triangles' corners, to
-    double web_box_max[3];         // show where the gaps are (zeros without webs)
+    // The fit, measured by reconstruct() on ok from the cloud alone, in the same bytes on
+    // every platform and runner; all zero from the stream (it never holds the whole
+    // surface), cap_ends() and the reduced build (STRATMESH_SMALL_CODE).
+    double point_spacing;          // nine points in ten have their nearest neighbour within
+                                   // it (cloud units)
+    double area_per_point;         // the walls' area (caps left out; from the sample) over
+                                   // the vertices, in squared point spacings: near 1 where
+                                   // the surface follows the cloud, larger over gaps
+    size_t fit_sample_count;       // wall triangles measured (caps span their loops by design)
+    double misfit_area_fraction;   // the misfit samples' share of the samples' area
+    double misfit_area;            // the misfit area it implies, in cloud units squared
+    double misfit_box_min[3];      // the box of the misfit samples' corners (zeros without)
+    double misfit_box_max[3];
+    size_t crossing_pair_count;    // triangle pairs that share no corner and cross, caps
+                                   // included
+    bool crossing_check_complete;  // every pair was checked
+    double crossing_box_min[3];    // the box of the crossing triangles (zeros without)
+    double crossing_box_max[3];
 };
 
 struct Report {

@@ -175,11 +175,11 @@ static void test_reconstruct(const double* xyz, int add_caps) {
         if (k > 0) CHECK(layers[k - 1].top <= layers[k].bottom);
     }
     CHECK(report.diagnostics.fold_count == 0);
-    /* A tube spans no gap: no web triangle, and then no web box. */
-    CHECK(report.diagnostics.web_triangle_count == 0);
-    CHECK(report.diagnostics.web_area == 0 && report.diagnostics.web_area_fraction == 0);
-    CHECK(report.diagnostics.web_box_min[0] == 0 && report.diagnostics.web_box_max[2] == 0);
-    CHECK(STRATMESH_WEB_SPACINGS > 1);
+    /* A tube follows its cloud: measured, no crossing pair, a misfit share far under the
+       poor one. */
+    CHECK(report.diagnostics.fit_sample_count > 0 && report.diagnostics.point_spacing > 0);
+    CHECK(report.diagnostics.crossing_pair_count == 0 && report.diagnostics.crossing_check_complete == 1);
+    CHECK(report.diagnostics.misfit_area_fraction < STRATMESH_POOR_MISFIT_FRACTION / 5);
     CHECK(report.parts.outcome == STRATMESH_PARTS_OUTCOME_ONE_TUBE);
     if (add_caps) {
         CHECK(report.caps.closed_count == 2);

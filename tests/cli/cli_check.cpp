@@ -376,6 +376,11 @@ int make_inputs(const std::string& dir) {
               write_file(dir + "/four_legged.xyz",
                          as_xyz(shapes::four_legged(10000, shapes::Pose::z).xyz, 0,
                                 "a four-legged body")) &&
+              write_file(dir + "/u_tube.xyz",
+                         as_xyz(shapes::u_tube(6000, shapes::Pose::z).xyz, 0, "a U of pipe")) &&
+              write_file(dir + "/cad_spool.xyz",
+                         as_xyz(shapes::cad_spool(48, shapes::Pose::z).xyz, 0,
+                                "a spool's CAD vertices")) &&
               write_file(dir + "/forked_speck.xyz",
                          as_xyz(forked_speck_points(), 0, "a forked tube and a speck")) &&
               write_file(dir + "/cylinder_nan.xyz", as_xyz(cylinder, 500)) &&

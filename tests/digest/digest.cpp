@@ -6,7 +6,7 @@
 //
 // A second digest, "full", covers what STRATMESH_SMALL_CODE leaves out or meshes
 // differently (closed ends, the crescent rule, caps, drop_outliers, cap_ends, the
-// surface_flips flag, bands that fold between peeled loops, the measure of webs): it is
+// surface_flips flag, bands that fold between peeled loops, the fit measure): it is
 // printed by builds without the macro (x86-64 and aarch64 in .ci/arm.sh), which must agree.
 //
 // The clouds come from tests/support/shapes.h, whose coordinates go through sin, cos and
@@ -88,11 +88,14 @@ void reconstruct_case(const char* name, const std::vector<double>& raw, stratmes
                                                  tris.size() / 3, &count, &report);
     record(output, "reconstruct", name, n, s, tris.data(), count,
            {report.layers.used_count, report.points.rejected_count, report.caps.closed_count}, report.layers.used_count, "layers");
-    // The webs, which the small build does not measure: in the full digest only.
+    // The fit, which the small build does not measure: in the full digest only.
     if (&output == &g_full) {
         const stratmesh::Diagnostics& d = report.diagnostics;
-        output.u64(d.web_triangle_count);
-        for (double v : {d.web_area, d.web_area_fraction, d.web_box_min[0], d.web_box_max[2]})
+        output.u64(d.fit_sample_count);
+        output.u64(d.crossing_pair_count);
+        for (double v : {d.point_spacing, d.area_per_point, d.misfit_area_fraction,
+                         d.misfit_area, d.misfit_box_min[0], d.misfit_box_max[2],
+                         d.crossing_box_min[1]})
             output.f64(v);
     }
 }

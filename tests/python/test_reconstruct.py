@@ -40,6 +40,21 @@ def test_report_counts_add_up(tube):
     assert report.caps.closed_count == 0
 
 
+def test_the_fit_of_a_tube_and_of_two_tubes_as_one():
+    tube = bumpy_tube(4000)  # small enough for the whole crossing check
+    _, report = stratmesh.reconstruct(tube, axis="z")
+    d = report.diagnostics
+    assert d.fit_sample_count > 0 and d.point_spacing > 0
+    assert d.crossing_pair_count == 0 and d.crossing_check_complete
+    assert d.misfit_area_fraction < stratmesh.POOR_MISFIT_FRACTION
+    # Two tubes side by side meshed as one: the surface spans the gap between them.
+    twins = np.concatenate([tube + [3, 0, 0], tube - [3, 0, 0]])
+    _, report = stratmesh.reconstruct(twins, axis="z", parts="one_tube")
+    d = report.diagnostics
+    assert d.misfit_area_fraction > stratmesh.POOR_MISFIT_FRACTION
+    assert d.misfit_box_min[0] < -2 and d.misfit_box_max[0] > 2
+
+
 def test_caps_close_the_tube(tube):
     triangles, report = stratmesh.reconstruct(tube, axis="z", layers=8, cap=True)
     assert report.caps.closed_count == 2

@@ -564,6 +564,38 @@ inline Shape twice_forked(size_t n, Pose pose, uint64_t seed = 36) {
                                         -3, 1e9, n, seed);
 }
 
+// A U of pipe: two upright legs of radius 0.5 at x = -2 and 2, open at z = 4, joined at the
+// bottom by a pipe along x. Along z its sections are two discs, then one long one.
+inline Shape u_tube(size_t n, Pose pose, uint64_t seed = 37) {
+    return detail::union_of_round_cones("U of pipe", pose,
+                                        {{{-2, 0, 0}, {-2, 0, 5}, 0.5, 0.5},
+                                         {{2, 0, 0}, {2, 0, 5}, 0.5, 0.5},
+                                         {{-2, 0, 0}, {2, 0, 0}, 0.5, 0.5}},
+                                        -1e9, 4, n, seed);
+}
+
+// A spool as a CAD model gives it: the vertices of its tessellation, rings of `per_ring`
+// points on the circles where its faces meet (a shaft of radius 0.5 from z = -1.6 to 1.6
+// between two flanges of radius 2 and thickness 0.4), and none inside its flat faces.
+inline Shape cad_spool(size_t per_ring, Pose pose) {
+    Shape s = detail::start("CAD spool", pose, cylinder_radius, -2, 2);
+    const double rings[][2] = {{-2, 0.5}, {-2, 2}, {-1.6, 2}, {-1.6, 0.5},
+                               {1.6, 0.5}, {1.6, 2}, {2, 2}, {2, 0.5}};
+    for (const auto& ring : rings)
+        for (size_t k = 0; k < per_ring; ++k)
+            s.add_local(2 * kPi * static_cast<double>(k) / static_cast<double>(per_ring), ring[0], ring[1]);
+    s.closed_distance = [](const double* p) {
+        const double r = std::hypot(p[0], p[1]), z = std::fabs(p[2]);
+        auto box = [&](double radius, double low, double high) {  // a solid cylinder's distance
+            const double dr = r - radius, dz = std::max(low - z, z - high);
+            return dr > 0 && dz > 0 ? std::hypot(dr, dz) : std::max(dr, dz);
+        };
+        return std::min(box(0.5, 0, 2), box(2, 1.6, 2));
+    };
+    s.spacing = 2 * kPi * 2 / static_cast<double>(per_ring);
+    return s;
+}
+
 // A cylindrical range scan: a regular (theta, z) grid on the unit cylinder over
 // z in [-3, 3], with about n points in rows of equal angular and vertical spacing. Every
 // grid cell is a rectangle: four cocircular points, everywhere.

@@ -285,7 +285,7 @@ void explain_refusal(const CommandLine& line, const RunRecord& record, const std
 
 // The valid points' range along the axis used, the cuts given outside it, and with layers
 // from the options, how many of the layers planned as the library plans them (Options:
-// the cuts inside the range, or equal heights) hold fewer than kFewestLayerPoints points.
+// the cuts inside the range, or equal heights) hold fewer than stratmesh::kMinLayerPoints points.
 // Counted over the valid points as given: duplicates and outliers, which the library
 // leaves out first, count too.
 void measure_along_axis(const std::vector<double>& xyz, RunRecord& record) {
@@ -327,7 +327,7 @@ void measure_along_axis(const std::vector<double>& xyz, RunRecord& record) {
         const auto stop = k + 2 == bounds.size()
                               ? heights.end()
                               : std::lower_bound(heights.begin(), heights.end(), bounds[k + 1]);
-        if (stop - first < static_cast<std::ptrdiff_t>(kFewestLayerPoints))
+        if (stop - first < static_cast<std::ptrdiff_t>(stratmesh::kMinLayerPoints))
             ++record.sparse_planned_layers;
     }
 }

@@ -107,7 +107,7 @@ std::string ends_text(const RunRecord& r) {
 // points, when the tool could count them, and its other rules, in the words of
 // LayerCounts::planned_count (Options in stratmesh.h says each).
 std::string merge_reason(const RunRecord& r) {
-    const std::string fewest = "under " + std::to_string(kFewestLayerPoints) + " points";
+    const std::string fewest = "under " + std::to_string(stratmesh::kMinLayerPoints) + " points";
     if (!r.range_known) return "merged where a layer held " + fewest + ", or was thin, open or folding";
     if (r.sparse_planned_layers == 0)
         return "merged where a layer was thin, open or folding (none held " + fewest + ")";

@@ -12,10 +12,6 @@
 
 namespace stratmesh_cli {
 
-// The fewest points the library keeps a layer with (Options: a layer with fewer is merged
-// with the next one).
-const size_t kFewestLayerPoints = 16;
-
 // What a user should know of the output besides the verdict, each a sentence without the
 // "stratmesh: warning: " prefix: branches left apart, points left out, caps left open,
 // input faces ignored, cuts outside the cloud.

@@ -551,7 +551,7 @@ private:
 static inline bool fill_gap(size_t count, const TracedLoop& loop, const SideView& view, JoinMemory& m) {
     const uint32_t n = loop.length;
     if (m.filled_count + (n - 2) > kMostGapTriangles) return false;
-    double xy[2 * kMostGapCorners];
+    double xy[2 * kMostGapCorners] = {};
     for (uint32_t i = 0; i < n; ++i) {
         const Local p = view.at(loop.ids[i]);
         xy[2 * i] = p.x;

@@ -10781,6 +10781,15 @@ static inline uint32_t gather_groups(const TubeInput& in, const Binning& binning
     return count;
 }
 
+// The bytes why_no_area() takes for point_count points.
+static inline size_t no_area_workspace_size(size_t point_count) {
+    Arena arena = Arena::measuring();
+    const size_t bins = point_count < kNoAreaBins ? point_count : kNoAreaBins;
+    arena.alloc<uint32_t>(bins);
+    arena.alloc<PointGroup>(bins);
+    return arena.required_bytes();
+}
+
 // Why the kept points of `in` span no area: binned along their bounding box's longest side,
 // they fall into groups (runs of occupied bins, so the points of a collapsed cluster share
 // one). None spans a surface (3 points off a line): a line. The largest that does is a
@@ -13250,9 +13259,11 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
     if (detail::kDropOutliers && (options.flags & drop_outliers))
         arena.alloc<unsigned char>(point_count / 8 + 1);
     const size_t read = arena.required_bytes();
-    size_t steps[detail::kMeasureFit ? 3 : 2] = {};
+    size_t steps[detail::kMeasureFit ? 4 : 3] = {};
     if (detail::kAxisTrials && options.axis == Axis::automatic)
         steps[0] = detail::axis_workspace_size(point_count, request);
+    // A refusal for no area is explained with the groups of why_no_area().
+    if (detail::kDegenerateCheck) steps[detail::kMeasureFit ? 3 : 2] = detail::no_area_workspace_size(point_count);
 #if !defined(STRATMESH_SMALL_CODE)
     if (detail::searches_parts(request))
         steps[1] = detail::parts_workspace_size(point_count, request);

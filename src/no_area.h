@@ -119,6 +119,15 @@ static inline uint32_t gather_groups(const TubeInput& in, const Binning& binning
     return count;
 }
 
+// The bytes why_no_area() takes for point_count points.
+static inline size_t no_area_workspace_size(size_t point_count) {
+    Arena arena = Arena::measuring();
+    const size_t bins = point_count < kNoAreaBins ? point_count : kNoAreaBins;
+    arena.alloc<uint32_t>(bins);
+    arena.alloc<PointGroup>(bins);
+    return arena.required_bytes();
+}
+
 // Why the kept points of `in` span no area: binned along their bounding box's longest side,
 // they fall into groups (runs of occupied bins, so the points of a collapsed cluster share
 // one). None spans a surface (3 points off a line): a line. The largest that does is a

@@ -122,9 +122,11 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
     if (detail::kDropOutliers && (options.flags & drop_outliers))
         arena.alloc<unsigned char>(point_count / 8 + 1);
     const size_t read = arena.required_bytes();
-    size_t steps[detail::kMeasureFit ? 3 : 2] = {};
+    size_t steps[detail::kMeasureFit ? 4 : 3] = {};
     if (detail::kAxisTrials && options.axis == Axis::automatic)
         steps[0] = detail::axis_workspace_size(point_count, request);
+    // A refusal for no area is explained with the groups of why_no_area().
+    if (detail::kDegenerateCheck) steps[detail::kMeasureFit ? 3 : 2] = detail::no_area_workspace_size(point_count);
 #if !defined(STRATMESH_SMALL_CODE)
     if (detail::searches_parts(request))
         steps[1] = detail::parts_workspace_size(point_count, request);

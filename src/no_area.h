@@ -21,8 +21,16 @@ static inline bool on_a_line(const TubeInput& in, Arena& arena) {
 // Why a cloud's surface has no area (explain_no_area()).
 enum class NoArea : uint32_t { unexplained, line, few_far_points, far_clusters };
 
-// The bins along the bounding box's longest side in which why_no_area() looks for groups.
+// The bins along the bounding box's longest side in which why_no_area() looks for groups:
+// one for kPointsABin points, at least 3 (the two ends and between), at most kNoAreaBins,
+// so that its groups take a few bytes a point.
 const uint32_t kNoAreaBins = 4096;
+const size_t kPointsABin = 16;
+
+static inline uint32_t no_area_bins(size_t point_count) {
+    const size_t bins = point_count / kPointsABin;
+    return bins < 3 ? 3u : bins > kNoAreaBins ? kNoAreaBins : static_cast<uint32_t>(bins);
+}
 
 // A group whose largest side is under this share of the cloud's is a point beside the
 // cloud: its surface has no area there (kLeastArea is this share squared).
@@ -122,7 +130,7 @@ static inline uint32_t gather_groups(const TubeInput& in, const Binning& binning
 // The bytes why_no_area() takes for point_count points.
 static inline size_t no_area_workspace_size(size_t point_count) {
     Arena arena = Arena::measuring();
-    const size_t bins = point_count < kNoAreaBins ? point_count : kNoAreaBins;
+    const size_t bins = no_area_bins(point_count);
     arena.alloc<uint32_t>(bins);
     arena.alloc<PointGroup>(bins);
     return arena.required_bytes();
@@ -142,7 +150,7 @@ static inline NoArea why_no_area(const TubeInput& in, Arena& arena) {
     binning.span = largest_of(half_side);
     binning.side = binning.span == half_side.x ? 0 : binning.span == half_side.y ? 1 : 2;
     binning.start = coordinate(low, binning.side) * 0.5;
-    binning.bins = in.sums.valid < kNoAreaBins ? static_cast<uint32_t>(in.sums.valid) : kNoAreaBins;
+    binning.bins = no_area_bins(in.sums.valid);
     if (!(binning.span > 0) || binning.bins == 0) return NoArea::line;
     const size_t mark = arena.mark();
     uint32_t* group_of = arena.alloc<uint32_t>(binning.bins);

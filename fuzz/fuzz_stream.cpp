@@ -47,6 +47,7 @@ bool is_refusal(Status s) {
     switch (s) {
     case Status::invalid_point:
     case Status::invalid_layers:
+    case Status::invalid_origin:
     case Status::out_of_order:
     case Status::out_of_memory:
     case Status::too_many_points:

@@ -12,6 +12,7 @@ build=build-fuzz
 jobs=$(nproc 2>/dev/null || echo 2)
 
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER="$cxx" \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
   -DSTRATMESH_BUILD_FUZZ=ON -DSTRATMESH_BUILD_TESTS=OFF -DSTRATMESH_BUILD_EXAMPLES=ON \
   -DSTRATMESH_INSTALL=OFF -DSTRATMESH_WERROR=ON \
   -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"

@@ -371,9 +371,11 @@ enum Flags : uint32_t {
     // each seam between layers once they are stitched: the unrolling squeezes whatever lies
     // almost across the axis (the underside of an ear, a chin), and there the flips join
     // the points that are near on the surface. No vertex or loop changes; a flip never
-    // makes a fold nor an angle wider than a fixed obtuse limit (unless it narrows one) and
-    // is checked against crossing the nearby triangles; the stream gives the same triangles
-    // as reconstruct() with it. Off by default: it costs time. The reduced build returns
+    // turns a triangle over against its neighbours nor makes an angle wider than a fixed
+    // obtuse limit (unless it narrows one), and never makes two triangles of the layer
+    // cross or touch; it may turn a triangle to face the axis where the surface does (the
+    // fold counts stay the unrolling's). The stream gives the same triangles as
+    // reconstruct() with it. Off by default: it costs time. The reduced build returns
     // not_compiled.
     surface_flips = 1u << 4,
     // No end of the surface is taken for a closed one (see ClosedEnd): the end layers are
@@ -636,7 +638,8 @@ constexpr double kPoorMisfitFraction = 0.05;
 
 // Report::diagnostics: what a user checks before trusting the mesh.
 struct Diagnostics {
-    size_t fold_count;             // output triangles whose normal faces the axis
+    size_t fold_count;             // output triangles whose normal faces the axis (with
+                                   // surface_flips, as unrolled: before the flips)
     size_t illegal_removed_count;  // triangles removed by the manifold safety net
     size_t diagonal_swap_count;    // band diagonals swapped when stitching layers
     // The fit, measured by reconstruct() on ok from the cloud alone, in the same bytes on
@@ -1264,7 +1267,8 @@ typedef struct stratmesh_part_counts {
 
 // stratmesh::Diagnostics: what a user checks before trusting the mesh.
 typedef struct stratmesh_diagnostics {
-    size_t fold_count;             // output triangles whose normal faces the axis
+    size_t fold_count;             // output triangles whose normal faces the axis (with
+                                   // the surface flips, before them)
     size_t illegal_removed_count;  // triangles removed by the manifold safety net
     size_t diagonal_swap_count;    // band diagonals swapped when stitching layers
     double point_spacing;          // the fit (stratmesh::Diagnostics says each)
@@ -4943,7 +4947,8 @@ struct LayerDuplicates {
 // Per vertex of a layer's triangulation, in triangulate_layer (the flip stack's room).
 const uint32_t kOnBottomLoop = 1, kEmitted = 2, kOnTopLoop = 4;
 
-const uint32_t kFlippedBefore = 8, kFlippedNow = 16;  // see flip_layer_on_surface
+// See flip_layer_on_surface.
+const uint32_t kFlippedBefore = 8, kFlippedNow = 16, kVisited = 32, kNearFold = 64;
 
 const uint32_t kPassShift = 8;  // above it: the peeling pass that put a vertex on its loop
 
@@ -6646,21 +6651,26 @@ namespace detail {
 // normals; the normals are estimated anew at the start of each of the first
 // kNormalSweeps sweeps and then kept, so that the flips settle (the clouds measured: at
 // most 2 flips in the last sweep).
-// A flip is kept only if neither new triangle faces the axis (no new fold) nor is
-// degenerate, the new triangles' widest angle is at most 150 degrees (kWidestAngle) or
-// less wide than the old ones' (the bend alone makes needles: without that limit 17% of
-// the bust's triangles had an angle under 5 degrees, with it 2%, as without flips), pq is
-// not already an edge nor a chord of a loop (where add_caps puts its cap), and, unless
-// both new normals are within 26 degrees of the old pair's (kGentleFlip: the new
-// triangles cover about the same place as the old), neither new triangle meets a surface
-// triangle around the quad's corners (the test is in floating point, on triangles shrunk
-// by a millionth about their centroids, so that shared corners and edges do not count;
-// testing the triangles around the corners' neighbours too changed nothing on the
-// synthetic bust). Loop edges are never flipped, so the loops, the bands and the peeled
-// triangles that add_group may put back are the same as without the flips (the band and
-// the triangles at its loops are flipped later, see "flips across the seam"). The first
-// sweep visits every edge; later sweeps only the triangles the sweep before changed. The
-// sweeps are bounded (kSurfaceFlipSweeps).
+// A flip is kept only if neither new triangle is degenerate, the new triangles' widest
+// angle is at most 150 degrees (kWidestAngle) or less wide than the old ones' (the bend
+// alone makes needles: without that limit 17% of the bust's triangles had an angle under
+// 5 degrees, with it 2%, as without flips), pq is not already an edge nor a chord of a
+// loop (where add_caps puts its cap), and neither new triangle meets another surface
+// triangle of the layer. A new triangle may face the axis: where the surface does (a
+// crown, the underside of a chin) the annulus squeezes it, and forbidding that kept a
+// third of the flips that mend its slivers (5th percentile of the smallest angle, with
+// and without: femur 6.2 and 8.0 degrees, mannequin head 4.7 and 5.8, lion head 3.5 and
+// 5.4). The layer's fold count stays the unrolling's. Near a fold (a corner of a triangle
+// facing the axis, from the unrolling or a flip), where the lifted annulus may lie over
+// itself, the new triangles are tested against every surface triangle of the layer that
+// could reach them (see "the crossing test"); elsewhere the layer is its annulus lifted
+// and a flip covers about the place the old pair covered: a gentle one (both new normals
+// within 26 degrees of the old pair's, kGentleFlip) is not tested, another against the
+// triangles around the quad's corners. Loop edges are never flipped, so the loops, the
+// bands and the peeled triangles that add_group may put back are the same as without the
+// flips (the band and the triangles at its loops are flipped later, see "flips across the
+// seam"). The first sweep visits every edge; later sweeps only the triangles the sweep
+// before changed. The sweeps are bounded (kSurfaceFlipSweeps).
 const uint32_t kSurfaceFlipSweeps = 8;
 
 const uint32_t kNormalSweeps = 4;  // the sweeps that start with the normals estimated anew
@@ -6672,6 +6682,8 @@ const double kFlipMargin = 1e-9;
 const double kGentleFlip = 0.9;  // cosine of the largest angle between a new and the mean normal
 
 const double kShrink = 1e-6;
+
+const double kGrow = 1e-9;
 
 const double kBendVeto = 3;  // a flip by the empty-circle rule may bend at most 3 times more
 
@@ -6714,10 +6726,12 @@ static inline bool flip_helps(Vec3 a, Vec3 b, Vec3 p, Vec3 q) {
     return sin_p * cos_q + cos_p * sin_q < -kFlipMargin * lengths;
 }
 
-// Whether triangles u and v, each shrunk by kShrink about its centroid, overlap along every
+// Whether triangles u and v, each scaled by `scale` about its centroid, overlap along every
 // axis that could separate them: their normals, the cross products of their edges, and
-// each normal crossed with the triangle's own edges (for coplanar triangles).
-static inline bool triangles_meet(const Vec3* u, const Vec3* v) {
+// each normal crossed with the triangle's own edges (for coplanar triangles). Triangles
+// with a shared corner are shrunk (kShrink) so that it does not count; others are grown
+// (kGrow), so that a touch counts too.
+static inline bool triangles_meet(const Vec3* u, const Vec3* v, double scale) {
     Vec3 s[3], t[3];
     const Vec3 cu = scaled(Vec3{u[0].x + u[1].x + u[2].x, u[0].y + u[1].y + u[2].y,
                                 u[0].z + u[1].z + u[2].z}, 1.0 / 3);
@@ -6725,10 +6739,8 @@ static inline bool triangles_meet(const Vec3* u, const Vec3* v) {
                                 v[0].z + v[1].z + v[2].z}, 1.0 / 3);
     for (int k = 0; k < 3; ++k) {
         const Vec3 du = u[k] - cu, dv = v[k] - cv;
-        s[k] = Vec3{cu.x + du.x * (1 - kShrink), cu.y + du.y * (1 - kShrink),
-                    cu.z + du.z * (1 - kShrink)};
-        t[k] = Vec3{cv.x + dv.x * (1 - kShrink), cv.y + dv.y * (1 - kShrink),
-                    cv.z + dv.z * (1 - kShrink)};
+        s[k] = Vec3{cu.x + du.x * scale, cu.y + du.y * scale, cu.z + du.z * scale};
+        t[k] = Vec3{cv.x + dv.x * scale, cv.y + dv.y * scale, cv.z + dv.z * scale};
     }
     Vec3 es[3], et[3];
     for (int k = 0; k < 3; ++k) {
@@ -6770,45 +6782,323 @@ static inline bool around_vertex(const Triangulation& tr, uint32_t from, Visit v
     return false;
 }
 
-// The vertex normals, kept in the room of the annulus coordinates (two doubles a vertex,
-// free once the loops are settled) as three floats, copied in and out so that no type is
-// read through another: the sum of the unit normals of the surface triangles around the
-// vertex, made unit.
+// The crossing test. A flip is made only if neither new triangle meets a surface triangle
+// of the layer but the two it replaces (shared corners aside), in floating point: those
+// with a shared corner shrunk by kShrink about their centroids, the others grown by kGrow,
+// so that a touch counts. A triangle lies within the ball about any of its corners c
+// through c's farther neighbour in it, so a triangle that meets a region has every corner
+// within that corner's longest surface edge of it. The layer's vertices (the centre,
+// vertex 0, aside) are kept in levels by that edge: level l holds those whose edges are at
+// most bound(l) = base * 2^l long, base half the mean surface edge (the last level holds
+// the rest, its bound the longest edge), sorted within a level by the cell of a grid whose
+// cells are at least as wide as its bound and two mean edges: the vertices of a level
+// within its bound of a flip's quad are in a few cells. Each vertex has a half-edge leaving
+// it, so that its triangles are at hand. A flip that would give p or q an edge longer than
+// its level's bound is not made, so the levels stay as sorted.
+const uint32_t kLevels = 16;
+
+const uint32_t kGridCells = 1024;  // cells along a side of a level's grid, at most
+
+const uint32_t kGridColumns = 1024;  // a flip whose region spans more columns is not made
+
+// A flip with more vertices near it is not made (their list is on the stack, 4 KB; the
+// scans measured never reach it).
+const uint32_t kMostVisited = 1024;
+
+// Per vertex, one word: its level above kSpanBits, and below its longest edge as a share of
+// the level's bound, rounded up.
+const uint32_t kSpanBits = 27;
+
+const double kSpanScale = 134217728;  // 2^kSpanBits
+
+struct GridLevel {
+    uint32_t first, count;  // its vertices: ids[first, first + count)
+    double bound, inverse_side;
+    uint32_t cells[3];
+
+    uint32_t cell_along(double x, double low_x, uint32_t n) const {
+        const double c = (x - low_x) * inverse_side;
+        if (!(c > 0)) return 0;
+        return c >= n - 1 ? n - 1 : static_cast<uint32_t>(c);
+    }
+    uint32_t key(uint32_t ix, uint32_t iy, uint32_t iz) const {
+        return (ix * cells[1] + iy) * cells[2] + iz;
+    }
+};
+
+struct LayerGrid {
+    const Local* points;
+    uint32_t* ids;    // the vertices by level, then cell
+    uint32_t* edge;   // per vertex, a half-edge leaving it
+    uint32_t* spans;  // per vertex: its level and longest edge (see kSpanBits)
+    uint32_t count;
+    bool sorted;  // ids and spans are filled only once a flip near a fold needs them
+    Vec3 low;
+    GridLevel levels[kLevels];
+
+    uint32_t level_of(uint32_t v) const { return spans[v] >> kSpanBits; }
+    // At least the longest surface edge at v.
+    double span(uint32_t v) const {
+        const double share = static_cast<double>((spans[v] & ((1u << kSpanBits) - 1)) + 1);
+        return levels[level_of(v)].bound * share / kSpanScale;
+    }
+    // The word of a vertex at level l whose longest edge is `length`.
+    uint32_t span_word(uint32_t l, double length) const {
+        const double share = levels[l].bound > 0 ? length / levels[l].bound * kSpanScale : 0;
+        const uint32_t most = (1u << kSpanBits) - 1;
+        return (l << kSpanBits) | (share >= most ? most : static_cast<uint32_t>(share));
+    }
+    uint32_t key_of(uint32_t v) const {
+        const GridLevel& l = levels[level_of(v)];
+        const Local& p = points[v - 1];
+        return l.key(l.cell_along(p.x, low.x, l.cells[0]), l.cell_along(p.y, low.y, l.cells[1]),
+                     l.cell_along(p.h, low.z, l.cells[2]));
+    }
+    bool before(uint32_t v, uint32_t w) const {
+        if (level_of(v) != level_of(w)) return level_of(v) < level_of(w);
+        const uint32_t kv = key_of(v), kw = key_of(w);
+        return kv < kw || (kv == kw && v < w);
+    }
+    // The first position of level l whose vertex's key is at least k.
+    uint32_t first_at(const GridLevel& l, uint32_t k) const {
+        uint32_t lo = l.first, hi = l.first + l.count;
+        while (lo < hi) {
+            const uint32_t mid = lo + (hi - lo) / 2;
+            if (key_of(ids[mid]) < k)
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        return lo;
+    }
+    // Whether vertex v may have an edge of `length`.
+    bool admits(uint32_t v, double length) const {
+        return !sorted || length <= levels[level_of(v)].bound;
+    }
+    // Vertex v has an edge of `length` (admitted).
+    void stretch(uint32_t v, double length) {
+        if (!sorted) return;
+        const uint32_t word = span_word(level_of(v), length);
+        spans[v] = word > spans[v] ? word : spans[v];
+    }
+};
+
+// Sorts grid.ids by level, then cell (a heap sort: no recursion, no room).
+static inline void sort_by_cell(LayerGrid& grid) {
+    uint32_t* v = grid.ids;
+    const size_t n = grid.count;
+    auto sift_down = [&grid, v](size_t root, size_t end) {
+        for (;;) {
+            size_t child = 2 * root + 1;
+            if (child >= end) return;
+            if (child + 1 < end && grid.before(v[child], v[child + 1])) ++child;
+            if (!grid.before(v[root], v[child])) return;
+            const uint32_t swap = v[root];
+            v[root] = v[child];
+            v[child] = swap;
+            root = child;
+        }
+    };
+    for (size_t i = n / 2; i-- > 0;) sift_down(i, n);
+    for (size_t end = n; end-- > 1;) {
+        const uint32_t swap = v[0];
+        v[0] = v[end];
+        v[end] = swap;
+        sift_down(0, end);
+    }
+}
+
+// The length of edge k of surface triangle t.
+static inline double edge_length(const Triangulation& tr, const Local* points, uint32_t t,
+                                 uint32_t k) {
+    const uint32_t* v = tr.vertex + 3 * t;
+    const Vec3 d = vec_of(points[v[(k + 1) % 3] - 1]) - vec_of(points[v[k] - 1]);
+    return std::sqrt(dot(d, d));
+}
+
+// Sets up the grid of a layer's `vertices` in `ids`, `edge` and `spans`, each with room for
+// every vertex: the half-edges now, the rest once a flip needs it (sort_layer_grid).
+static inline void link_layer_grid(const Triangulation& tr, const Local* points, size_t vertices,
+                                   uint32_t* ids, uint32_t* edge, uint32_t* spans,
+                                   LayerGrid& grid) {
+    grid.points = points;
+    grid.ids = ids;
+    grid.edge = edge;
+    grid.spans = spans;
+    grid.count = static_cast<uint32_t>(vertices - 1);
+    grid.sorted = false;
+    for (size_t v = 0; v < vertices; ++v) edge[v] = kNoIndex;  // duplicates have none
+    for (uint32_t h = 0; h < 3 * tr.triangle_count; ++h)
+        if (tr.vertex[h] != kGhost) edge[tr.vertex[h]] = h;
+}
+
+// Sorts the grid's vertices by level and cell (see above), once a flip needs it.
+static inline void sort_layer_grid(const Triangulation& tr, LayerGrid& grid) {
+    const Local* points = grid.points;
+    uint32_t* ids = grid.ids;
+    uint32_t* spans = grid.spans;
+    const size_t vertices = size_t{grid.count} + 1;
+    grid.sorted = true;
+    for (size_t v = 0; v < vertices; ++v) spans[v] = 0;
+    double length_sum = 0, longest = 0;
+    size_t edges = 0;
+    for (uint32_t t = 0; t < tr.triangle_count; ++t)
+        for (uint32_t k = 0; on_surface(tr, t) && k < 3; ++k) {
+            const double length = edge_length(tr, points, t, k);
+            length_sum += length;
+            longest = length > longest ? length : longest;
+            ++edges;
+        }
+    const double mean = edges > 0 ? length_sum / static_cast<double>(edges) : 0;
+    Vec3 low = vec_of(points[0]), high = low;
+    for (size_t v = 1; v < vertices; ++v) {
+        const Vec3 p = vec_of(points[v - 1]);
+        low = Vec3{std::fmin(low.x, p.x), std::fmin(low.y, p.y), std::fmin(low.z, p.z)};
+        high = Vec3{std::fmax(high.x, p.x), std::fmax(high.y, p.y), std::fmax(high.z, p.z)};
+        ids[v - 1] = static_cast<uint32_t>(v);
+    }
+    grid.low = low;
+    const double extent[3] = {high.x - low.x, high.y - low.y, high.z - low.z};
+    for (uint32_t l = 0; l < kLevels; ++l) {
+        GridLevel& g = grid.levels[l];
+        g.bound = std::ldexp(mean / 2, static_cast<int>(l));
+        if (l + 1 == kLevels) g.bound = std::fmax(g.bound, longest);
+        double side = std::fmax(g.bound, 2 * mean);
+        for (double e : extent) side = std::fmax(side, e / kGridCells);
+        g.inverse_side = side > 0 ? 1 / side : 0;
+        for (int d = 0; d < 3; ++d) {
+            const double n = extent[d] * g.inverse_side + 1;
+            g.cells[d] = n >= kGridCells ? kGridCells : static_cast<uint32_t>(n);
+        }
+        g.first = g.count = 0;
+    }
+    for (uint32_t t = 0; t < tr.triangle_count; ++t)
+        for (uint32_t k = 0; on_surface(tr, t) && k < 3; ++k) {
+            const double length = edge_length(tr, points, t, k);
+            uint32_t l = 0;
+            while (l + 1 < kLevels && length > grid.levels[l].bound) ++l;
+            const uint32_t word = grid.span_word(l, length);
+            const uint32_t a = tr.vertex[3 * t + k], b = tr.vertex[3 * t + (k + 1) % 3];
+            spans[a] = word > spans[a] ? word : spans[a];
+            spans[b] = word > spans[b] ? word : spans[b];
+        }
+    sort_by_cell(grid);
+    for (uint32_t i = 0; i < grid.count; ++i) {
+        GridLevel& g = grid.levels[grid.level_of(ids[i])];
+        if (g.count++ == 0) g.first = i;
+    }
+}
+
+// Whether clear(g) holds for every half-edge g leaving a vertex within its level's bound of
+// `box` (each triangle tested from the first of its corners visited: kVisited marks them);
+// false too if a level's region spans more than kGridColumns columns, more than
+// kMostVisited vertices are near, or one has more than kFanLimit neighbours.
+template <class Clear>
+static inline bool region_clear(const Triangulation& tr, const LayerGrid& grid, const Box3& box,
+                                uint32_t* flags, Clear clear) {
+    uint32_t visited[kMostVisited];
+    uint32_t visits = 0;
+    auto unmark = [&]() {
+        for (uint32_t k = 0; k < visits; ++k) flags[visited[k]] &= ~kVisited;
+    };
+    auto clear_once = [&](uint32_t g) {
+        const uint32_t* c = tr.vertex + 3 * (g / 3);
+        return c[0] == kGhost || c[1] == kGhost || c[2] == kGhost ||
+               ((flags[c[0]] | flags[c[1]] | flags[c[2]]) & kVisited) || clear(g);
+    };
+    for (const GridLevel& l : grid.levels) {
+        if (l.count == 0) continue;
+        const double r = l.bound;
+        const uint32_t x0 = l.cell_along(box.low.x - r, grid.low.x, l.cells[0]);
+        const uint32_t x1 = l.cell_along(box.high.x + r, grid.low.x, l.cells[0]);
+        const uint32_t y0 = l.cell_along(box.low.y - r, grid.low.y, l.cells[1]);
+        const uint32_t y1 = l.cell_along(box.high.y + r, grid.low.y, l.cells[1]);
+        const uint32_t z0 = l.cell_along(box.low.z - r, grid.low.z, l.cells[2]);
+        const uint32_t z1 = l.cell_along(box.high.z + r, grid.low.z, l.cells[2]);
+        if (size_t{x1 - x0 + 1} * (y1 - y0 + 1) > kGridColumns) {
+            unmark();
+            return false;
+        }
+        for (uint32_t ix = x0; ix <= x1; ++ix)
+            for (uint32_t iy = y0; iy <= y1; ++iy) {
+                const uint32_t last = l.key(ix, iy, z1), end = l.first + l.count;
+                for (uint32_t i = grid.first_at(l, l.key(ix, iy, z0));
+                     i < end && grid.key_of(grid.ids[i]) <= last; ++i) {
+                    const uint32_t v = grid.ids[i];
+                    const Vec3 p = vec_of(grid.points[v - 1]);
+                    const Vec3 off = {
+                        p.x < box.low.x ? box.low.x - p.x : p.x > box.high.x ? p.x - box.high.x : 0,
+                        p.y < box.low.y ? box.low.y - p.y : p.y > box.high.y ? p.y - box.high.y : 0,
+                        p.z < box.low.z ? box.low.z - p.z : p.z > box.high.z ? p.z - box.high.z : 0};
+                    const double near = grid.span(v) * (1 + kGrow);
+                    if (dot(off, off) > near * near || grid.edge[v] == kNoIndex) continue;
+                    if (visits == kMostVisited || !around_vertex(tr, grid.edge[v], clear_once)) {
+                        unmark();
+                        return false;
+                    }
+                    flags[v] |= kVisited;
+                    visited[visits++] = v;
+                }
+            }
+    }
+    unmark();
+    return true;
+}
+
+// The vertex normals, kept in the room of the annulus coordinates (free once the loops are
+// settled) as two 16-bit integers a vertex, a unit vector's octahedral encoding (its
+// coordinates over their absolute sum, the lower half folded out, to 1/32767): the sum of
+// the unit normals of the surface triangles around the vertex, made unit.
 struct VertexNormals {
-    double* room;
+    int16_t* room;
+    static constexpr int16_t kNone = INT16_MIN;  // no normal
+    static constexpr double kScale = 32767, kUnit = 1 / kScale;
+
     // The unit normal at vertex v; zero if it has no surface triangle of nonzero area.
     Vec3 at(uint32_t v) const {
-        float n[3];
-        std::memcpy(n, room + 2 * static_cast<size_t>(v), sizeof n);
-        return Vec3{static_cast<double>(n[0]), static_cast<double>(n[1]),
-                    static_cast<double>(n[2])};
+        if (room[2 * size_t{v}] == kNone) return Vec3{0, 0, 0};
+        const double u = room[2 * size_t{v}] * kUnit, w = room[2 * size_t{v} + 1] * kUnit;
+        const double z = 1 - std::fabs(u) - std::fabs(w);
+        Vec3 n = z >= 0 ? Vec3{u, w, z}
+                        : Vec3{std::copysign(1 - std::fabs(w), u),
+                               std::copysign(1 - std::fabs(u), w), z};
+        return scaled(n, 1 / std::sqrt(dot(n, n)));
     }
-    void estimate(const Triangulation& tr, const Local* points, size_t vertices) {
-        std::memset(room, 0, 2 * vertices * sizeof(double));
-        for (uint32_t t = 0; t < tr.triangle_count; ++t) {
-            if (!on_surface(tr, t)) continue;
-            const uint32_t* v = tr.vertex + 3 * t;
-            Vec3 n = normal_of(points[v[0] - 1], points[v[1] - 1], points[v[2] - 1]);
-            const double length = std::sqrt(dot(n, n));
-            if (length == 0) continue;
-            n = scaled(n, 1 / length);
-            for (uint32_t k = 0; k < 3; ++k) {
-                float sum[3];
-                std::memcpy(sum, room + 2 * static_cast<size_t>(v[k]), sizeof sum);
-                sum[0] += static_cast<float>(n.x);
-                sum[1] += static_cast<float>(n.y);
-                sum[2] += static_cast<float>(n.z);
-                std::memcpy(room + 2 * static_cast<size_t>(v[k]), sum, sizeof sum);
-            }
+    void put(uint32_t v, Vec3 sum) {
+        int16_t* slot = room + 2 * size_t{v};
+        const double l1 = std::fabs(sum.x) + std::fabs(sum.y) + std::fabs(sum.z);
+        if (!(l1 > 0)) {
+            slot[0] = slot[1] = kNone;
+            return;
         }
-        for (size_t v = 0; v < vertices; ++v) {
-            const Vec3 sum = at(static_cast<uint32_t>(v));
-            const double length = std::sqrt(dot(sum, sum));
-            if (length == 0) continue;
-            const float unit[3] = {static_cast<float>(sum.x / length),
-                                   static_cast<float>(sum.y / length),
-                                   static_cast<float>(sum.z / length)};
-            std::memcpy(room + 2 * v, unit, sizeof unit);
+        double u = sum.x / l1, w = sum.y / l1;
+        if (sum.z < 0) {
+            const double fu = std::copysign(1 - std::fabs(w), u);
+            w = std::copysign(1 - std::fabs(u), w);
+            u = fu;
+        }
+        slot[0] = static_cast<int16_t>(std::lround(u * kScale));
+        slot[1] = static_cast<int16_t>(std::lround(w * kScale));
+    }
+    // The normal from the triangles around it (a vertex with more than kFanLimit
+    // neighbours has none) of every vertex, or with `changed` of those flagged with it (the
+    // corners of the quads flipped since: no other vertex's triangles changed).
+    void estimate(const Triangulation& tr, const Local* points, const LayerGrid& grid,
+                  const uint32_t* flags, uint32_t changed) {
+        put(0, Vec3{0, 0, 0});
+        for (uint32_t v = 1; v <= grid.count; ++v) {
+            if (changed && !(flags[v] & changed)) continue;
+            Vec3 sum = {0, 0, 0};
+            const bool fan = grid.edge[v] != kNoIndex && around_vertex(tr, grid.edge[v], [&](uint32_t g) {
+                const uint32_t s = g / 3;
+                if (!on_surface(tr, s)) return true;
+                const uint32_t* c = tr.vertex + 3 * s;
+                const Vec3 n = normal_of(points[c[0] - 1], points[c[1] - 1], points[c[2] - 1]);
+                const double length = std::sqrt(dot(n, n));
+                if (length > 0) sum = sum + scaled(n, 1 / length);
+                return true;
+            });
+            put(v, fan ? sum : Vec3{0, 0, 0});
         }
     }
 };
@@ -6864,9 +7154,17 @@ static inline bool gentle_flip(const Local& la, const Local& lb, const Local& lp
            dot(n2, mean) > kGentleFlip * std::sqrt(dot(n2, n2) * dot(mean, mean));
 }
 
+// Whether a new triangle of that flip faces away from the old pair's mean normal: turned
+// over, a pleat in the surface.
+static inline bool turns_over(const Local& la, const Local& lb, const Local& lp, const Local& lq) {
+    const Vec3 mean = normal_of(la, lb, lp) + normal_of(lb, la, lq);
+    return !(dot(normal_of(lp, la, lq), mean) > 0) || !(dot(normal_of(lq, lb, lp), mean) > 0);
+}
+
 // Flips half-edge e of a layer's triangulation on the surface if that helps (see above).
-static inline bool flip_on_surface(Triangulation& tr, const Local* points, const uint32_t* flags,
-                                   VertexNormals& normals, const Cylinder& cyl, uint32_t e) {
+static inline bool flip_on_surface(Triangulation& tr, const Local* points, uint32_t* flags,
+                                   VertexNormals& normals, LayerGrid& grid, const Cylinder& cyl,
+                                   uint32_t e) {
     const uint32_t f = tr.twin[e];
     const uint32_t t = e / 3, u = f / 3;
     if (!on_surface(tr, u)) return false;
@@ -6878,50 +7176,92 @@ static inline bool flip_on_surface(Triangulation& tr, const Local* points, const
     if (!flip_wanted(la, lb, lp, lq, normals.at(a), normals.at(b), normals.at(p), normals.at(q)))
         return false;
     // The new triangles (p, a, q) and (q, b, p), counter-clockwise on the annulus.
-    if (faces_axis(lq, la, lp, cyl) || faces_axis(lp, lb, lq, cyl) ||
-        doubled_area(lp, la, lq) == 0 || doubled_area(lq, lb, lp) == 0)
+    if (doubled_area(lp, la, lq) == 0 || doubled_area(lq, lb, lp) == 0 ||
+        turns_over(la, lb, lp, lq))
         return false;
     if (!around_vertex(tr, prev_edge(e), [&tr, q](uint32_t g) {
             return tr.vertex[next_edge(g)] != q;
         }))
         return false;
-    // A flip in a gently curved quad, convex seen along its normal, covers about the
-    // same place as before: nothing else to check.
-    if (!gentle_flip(la, lb, lp, lq)) {
-        const Vec3 first[3] = {vec_of(lp), vec_of(la), vec_of(lq)};
-        const Vec3 second[3] = {vec_of(lq), vec_of(lb), vec_of(lp)};
-        const Box3 quad = box_of(first[0], first[1], first[2], second[1]);
-        auto clear_of = [&](uint32_t g) {
-            const uint32_t s = g / 3;
-            if (s == t || s == u || !on_surface(tr, s)) return true;
-            const uint32_t* v = tr.vertex + 3 * s;
-            const Vec3 other[3] = {vec_of(points[v[0] - 1]), vec_of(points[v[1] - 1]),
-                                   vec_of(points[v[2] - 1])};
-            return !quad.meets(box_of(other[0], other[1], other[2], other[2])) ||
-                   (!triangles_meet(first, other) && !triangles_meet(second, other));
-        };
-        // The triangles around the quad's corners.
+    const Vec3 first[3] = {vec_of(lp), vec_of(la), vec_of(lq)};
+    const Vec3 second[3] = {vec_of(lq), vec_of(lb), vec_of(lp)};
+    const Box3 quad = box_of(first[0], first[1], first[2], second[1]);
+    auto clear_of = [&](uint32_t g) {
+        const uint32_t s = g / 3;
+        if (s == t || s == u || !on_surface(tr, s)) return true;
+        const uint32_t* v = tr.vertex + 3 * s;
+        const Vec3 other[3] = {vec_of(points[v[0] - 1]), vec_of(points[v[1] - 1]),
+                               vec_of(points[v[2] - 1])};
+        if (!quad.meets(box_of(other[0], other[1], other[2], other[2]))) return true;
+        const auto has = [v](uint32_t x) { return v[0] == x || v[1] == x || v[2] == x; };
+        const bool shares_pq = has(p) || has(q);
+        return !triangles_meet(first, other, shares_pq || has(a) ? 1 - kShrink : 1 + kGrow) &&
+               !triangles_meet(second, other, shares_pq || has(b) ? 1 - kShrink : 1 + kGrow);
+    };
+    const Vec3 pq = first[2] - first[0];
+    const double pq_length = std::sqrt(dot(pq, pq));
+    const bool new_fold = faces_axis(lq, la, lp, cyl) || faces_axis(lp, lb, lq, cyl);
+    if (new_fold || ((flags[a] | flags[b] | flags[p] | flags[q]) & kNearFold)) {
+        if (!grid.sorted) sort_layer_grid(tr, grid);
+        if (!grid.admits(p, pq_length) || !grid.admits(q, pq_length) ||
+            !region_clear(tr, grid, quad, flags, clear_of))
+            return false;
+    } else {
+        if (!grid.admits(p, pq_length) || !grid.admits(q, pq_length)) return false;
+        // Away from folds the layer is its annulus lifted: a gentle flip covers about the
+        // same place as before, another is checked against the triangles around the quad.
         const uint32_t corners[4] = {e, f, prev_edge(e), prev_edge(f)};
-        for (uint32_t corner : corners)
-            if (!around_vertex(tr, corner, clear_of)) return false;
+        if (!gentle_flip(la, lb, lp, lq))
+            for (uint32_t corner : corners)
+                if (!around_vertex(tr, corner, clear_of)) return false;
     }
     flip_edge<false>(tr, e, nullptr);
+    // t is (p, a, q) now and u (q, b, p); their corners leave by these half-edges.
+    grid.edge[p] = 3 * t;
+    grid.edge[a] = 3 * t + 1;
+    grid.edge[q] = 3 * u;
+    grid.edge[b] = 3 * u + 1;
+    grid.stretch(p, pq_length);
+    grid.stretch(q, pq_length);
+    if (new_fold) {
+        flags[a] |= kNearFold;
+        flags[b] |= kNearFold;
+        flags[p] |= kNearFold;
+        flags[q] |= kNearFold;
+    }
     return true;
 }
 
 // Flips the surface edges of a layer's triangulation, sweep after sweep, until a sweep
 // flips none or kSurfaceFlipSweeps have run; after the first sweep, only edges between
 // two corners of quads flipped in the sweep before (the edges whose triangles changed).
-// `flags` holds a word per vertex (see triangulate_layer); the bits kFlippedBefore and
-// kFlippedNow are used here and cleared. `room` is the annulus coordinates, two doubles a
-// vertex, overwritten. Returns the number of flips.
+// `flags` holds a word per vertex (see triangulate_layer); the bits kFlippedBefore,
+// kFlippedNow, kVisited and kNearFold are used here and cleared. `room` is the annulus
+// coordinates, two doubles a vertex, overwritten by four words a vertex: the normals, the
+// grid's order, each vertex's half-edge and its span. Returns the number of flips.
 static inline size_t flip_layer_on_surface(Triangulation& tr, const Local* points,
                                            const Cylinder& cyl, uint32_t* flags, double* room,
                                            size_t vertices) {
-    VertexNormals normals = {room};
+    // Four words a vertex: the normal, the grid's order, the half-edges and the spans.
+    int16_t* normal_room = reinterpret_cast<int16_t*>(room);
+    uint32_t* grid_room = reinterpret_cast<uint32_t*>(room) + vertices;
+    LayerGrid grid;
+    link_layer_grid(tr, points, vertices, grid_room, grid_room + vertices,
+                    grid_room + 2 * vertices, grid);
+    for (uint32_t t = 0; t < tr.triangle_count; ++t) {
+        const uint32_t* v = tr.vertex + 3 * t;
+        // Counter-clockwise on the annulus: faces_axis takes the corners the other way.
+        if (on_surface(tr, t) && faces_axis(points[v[2] - 1], points[v[1] - 1], points[v[0] - 1], cyl)) {
+            flags[v[0]] |= kNearFold;
+            flags[v[1]] |= kNearFold;
+            flags[v[2]] |= kNearFold;
+        }
+    }
+    VertexNormals normals = {normal_room};
     size_t flips = 0;
     for (uint32_t sweep = 0; sweep < kSurfaceFlipSweeps; ++sweep) {
-        if (sweep < kNormalSweeps) normals.estimate(tr, points, vertices);
+        if (sweep < kNormalSweeps)
+            normals.estimate(tr, points, grid, flags, sweep == 0 ? 0 : kFlippedBefore);
         size_t flipped = 0;
         for (uint32_t t = 0; t < tr.triangle_count; ++t) {
             if (!on_surface(tr, t)) continue;
@@ -6934,7 +7274,7 @@ static inline size_t flip_layer_on_surface(Triangulation& tr, const Local* point
                 // Each edge once a sweep, from the side of its larger half-edge.
                 const uint32_t a = tr.vertex[e], b = tr.vertex[next_edge(e)];
                 if (tr.twin[e] > e || (sweep > 0 && !(flags[a] & flags[b] & kFlippedBefore)) ||
-                    !flip_on_surface(tr, points, flags, normals, cyl, e))
+                    !flip_on_surface(tr, points, flags, normals, grid, cyl, e))
                     continue;
                 ++flipped;
                 // t is (p, a, q) after the flip, and the twin's triangle (q, b, p).
@@ -6951,7 +7291,7 @@ static inline size_t flip_layer_on_surface(Triangulation& tr, const Local* point
         flips += flipped;
         if (flipped == 0) break;
     }
-    for (size_t v = 0; v < vertices; ++v) flags[v] &= ~kFlippedBefore;
+    for (size_t v = 0; v < vertices; ++v) flags[v] &= ~(kFlippedBefore | kNearFold);
     return flips;
 }
 
@@ -6972,14 +7312,19 @@ static inline size_t flip_layer_on_surface(Triangulation& tr, const Local* point
 //    points of one loop (the loop below, the layer's bottom or top loop) is refused, as it
 //    would stand where the next band or a cap goes; both new triangles keep that corner,
 //    so they stay in the seam;
-//  - only gentle flips (kGentleFlip), which need no crossing test, and none that makes or
-//    unmakes a fold (the layer's cylinder), so Report::diagnostics.fold_count keeps its count.
+//  - only gentle flips (kGentleFlip), which need no crossing test, none that makes or
+//    unmakes a fold (the layer's cylinder), so Report::diagnostics.fold_count keeps its
+//    count, and none with a corner on a triangle facing the axis (kSeamNearFold), where the
+//    layer's flips may have laid the lifted annulus over itself (without that, seam flips
+//    made 3 crossing pairs on a lion head scan).
 // Vertex normals come from every triangle of the chunk. The seam's memory, at most about
 // 72 bytes per vertex of the chunk and 4 per point read, fits in the safety net's room
 // (reconstruct_scratch_size: 91 per point) because a seam of more triangles than three
 // quarters of the chunk's vertices is left as it is: a thin layer, mostly loop.
 
 const uint32_t kLoopBelow = 1, kBottomLoopPoint = 2, kTopLoopPoint = 4, kLoopBits = 3;
+
+const unsigned char kSeamNearFold = 8;  // in Seam::loop: a corner of a triangle facing the axis
 
 struct Seam {
     uint32_t* chunk;        // the chunk's triangles, reader indices
@@ -7166,6 +7511,23 @@ static inline void estimate_seam_normals(const SurfaceChain& c, const Seam& seam
     }
 }
 
+// Marks kSeamNearFold the seam points at a corner of a chunk triangle facing the axis: the
+// layer's flips on the surface may leave such triangles where the surface turns to face the
+// axis, and a flip beside them, gentle as it is, could cross them.
+static inline void mark_near_folds(const SurfaceChain& c, Seam& seam, const Cylinder& cyl,
+                                   size_t count) {
+    for (size_t t = 0; t < count; ++t) {
+        const uint32_t* v = seam.chunk + 3 * t;
+        const uint32_t at[3] = {seam.point_of(v[0]), seam.point_of(v[1]), seam.point_of(v[2])};
+        if (at[0] == kNoIndex && at[1] == kNoIndex && at[2] == kNoIndex) continue;
+        if (!faces_axis(c.frame.local(c.reader.point(v[0])), c.frame.local(c.reader.point(v[1])),
+                        c.frame.local(c.reader.point(v[2])), cyl))
+            continue;
+        for (uint32_t k : at)
+            if (k != kNoIndex) seam.loop[k] |= kSeamNearFold;
+    }
+}
+
 // Whether seam point x's triangles, walked around it from half-edge `from` (leaving x) both
 // ways, are all of its seam triangles and none has an edge to y.
 static inline bool fan_misses(const Seam& seam, uint32_t from, uint32_t x, uint32_t y) {
@@ -7200,8 +7562,9 @@ static inline bool flip_seam_edge(const SurfaceChain& c, Seam& seam, const Cylin
     if (f == kNoIndex) return false;
     const uint32_t a = seam.vertex[e], b = seam.vertex[next_edge(e)];
     const uint32_t p = seam.vertex[prev_edge(e)], q = seam.vertex[prev_edge(f)];
-    if (p == q || (seam.loop[p] & seam.loop[q]) ||
-        !((seam.loop[p] | seam.loop[q]) & (kLoopBelow | kBottomLoopPoint)))
+    if (p == q || (seam.loop[p] & seam.loop[q] & 7u) ||
+        !((seam.loop[p] | seam.loop[q]) & (kLoopBelow | kBottomLoopPoint)) ||
+        ((seam.loop[a] | seam.loop[b] | seam.loop[p] | seam.loop[q]) & kSeamNearFold))
         return false;
     const bool p_anchors = (seam.loop[p] & (kLoopBelow | kBottomLoopPoint)) != 0;
     if (p_anchors ? !fan_misses(seam, prev_edge(e), p, q) : !fan_misses(seam, prev_edge(f), q, p))
@@ -7257,6 +7620,7 @@ static inline bool flip_seam(const SurfaceChain& c, const LoadedLayer& layer,
         return !arena.failed;
     }
     sum_fixed_normals(c, seam, count);
+    mark_near_folds(c, seam, layer.cyl, count);
     for (uint32_t sweep = 0; sweep < kSurfaceFlipSweeps; ++sweep) {
         if (sweep < kNormalSweeps) estimate_seam_normals(c, seam);
         size_t flipped = 0;
@@ -7402,9 +7766,10 @@ static inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& la
     if (folds == 0 || kPeelFoldedEnds) peel_layer_loops(tr, layer, folds, flags, loops);
     name_loop(tr, order, flags, loops.bottom, loops.bottom_count, loops.bottom_flags, false);
     name_loop(tr, order, flags, loops.top, loops.top_count, loops.top_flags, true);
-    if (kSurfaceFlips && layer.surface_flips &&
-        flip_layer_on_surface(tr, layer.points, layer.cyl, flags, xy, total) && folds)
-        folds = count_folds(tr, layer.points, 1, layer.cyl, nullptr);
+    // The folds stay those of the unrolling: the flips may turn triangles to face the axis
+    // where the surface does (see "flips on the surface").
+    if (kSurfaceFlips && layer.surface_flips)
+        flip_layer_on_surface(tr, layer.points, layer.cyl, flags, xy, total);
     emit_layer(tr, order, flags, total, sink, loops);
     sink.folds += folds;
     arena.rewind(mark);

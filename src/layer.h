@@ -48,7 +48,8 @@ struct LayerDuplicates {
 // Per vertex of a layer's triangulation, in triangulate_layer (the flip stack's room).
 const uint32_t kOnBottomLoop = 1, kEmitted = 2, kOnTopLoop = 4;
 
-const uint32_t kFlippedBefore = 8, kFlippedNow = 16;  // see flip_layer_on_surface
+// See flip_layer_on_surface.
+const uint32_t kFlippedBefore = 8, kFlippedNow = 16, kVisited = 32, kNearFold = 64;
 
 const uint32_t kPassShift = 8;  // above it: the peeling pass that put a vertex on its loop
 

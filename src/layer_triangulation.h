@@ -124,9 +124,10 @@ static inline Status triangulate_layer(const CloudReader& cloud, LoadedLayer& la
     if (folds == 0 || kPeelFoldedEnds) peel_layer_loops(tr, layer, folds, flags, loops);
     name_loop(tr, order, flags, loops.bottom, loops.bottom_count, loops.bottom_flags, false);
     name_loop(tr, order, flags, loops.top, loops.top_count, loops.top_flags, true);
-    if (kSurfaceFlips && layer.surface_flips &&
-        flip_layer_on_surface(tr, layer.points, layer.cyl, flags, xy, total) && folds)
-        folds = count_folds(tr, layer.points, 1, layer.cyl, nullptr);
+    // The folds stay those of the unrolling: the flips may turn triangles to face the axis
+    // where the surface does (see "flips on the surface").
+    if (kSurfaceFlips && layer.surface_flips)
+        flip_layer_on_surface(tr, layer.points, layer.cyl, flags, xy, total);
     emit_layer(tr, order, flags, total, sink, loops);
     sink.folds += folds;
     arena.rewind(mark);

@@ -3178,11 +3178,11 @@ TEST_CASE("add_caps: a triangle array too small for the caps gives triangle_capa
 
 // surface_flips re-triangulates each layer by the empty-circle rule in 3D. It must keep
 // everything the plain run guarantees (one manifold annulus through every point, outward,
-// no self-intersection, no more folds). On the bumpy tube, whose bumps turn the surface
+// no more folds) and add no crossing pair of triangles, also where the flips turn
+// triangles to face the axis. On the bumpy tube, whose bumps turn the surface
 // steeply around the axis so that the unrolling squeezes them, it must bring the surface
-// nearer the truth (measured: 11% at 1 layer, 10% at 6). The smooth surfaces of revolution
-// come out farther (vase 9%, cone 7% at 1 layer; README, "Flips on the surface"), within
-// the bound below; the grid and the CT slices have nothing to flip.
+// nearer the truth (measured: 43% at 1 layer, 42% at 6; the cone 49% and 46%, the head 19%
+// and 15%, the vase 4% and 3%); the grid and the CT slices have nothing to flip.
 TEST_CASE("surface_flips: the same guarantees, the bumpy tube nearer the true surface, no shape farther") {
     const std::vector<Shape> list = {
         shapes::bumpy_tube(kLarge, Pose::tilted), shapes::head(kLarge, Pose::x),
@@ -3213,10 +3213,11 @@ TEST_CASE("surface_flips: the same guarantees, the bumpy tube nearer the true su
             CHECK(m.boundary_loops == 2);
             CHECK(m.vertices_used ==
                   check_mesh(s, plain.triangles.data(), plain.count, false).vertices_used);
-            if (plain.report.diagnostics.fold_count == 0) {
-                CHECK(m.intersecting_pairs == 0);
-                CHECK(m.vertex_overlaps == 0);
-            }
+            const mesh_check::Result unflipped =
+                check_mesh(s, plain.triangles.data(), plain.count, true);
+            CHECK(m.intersecting_pairs <= unflipped.intersecting_pairs);
+            CHECK(m.vertex_overlaps <= unflipped.vertex_overlaps);
+            if (plain.report.diagnostics.fold_count == 0) CHECK(m.intersecting_pairs == 0);
             const double before = mean_centroid_deviation(s, plain.triangles);
             const double after = mean_centroid_deviation(s, flipped.triangles);
             const size_t wide_before = triangles_wider_than(s, plain.triangles, 150);

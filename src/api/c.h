@@ -255,7 +255,8 @@ typedef struct stratmesh_part_counts {
 
 // stratmesh::Diagnostics: what a user checks before trusting the mesh.
 typedef struct stratmesh_diagnostics {
-    size_t fold_count;             // output triangles whose normal faces the axis
+    size_t fold_count;             // output triangles whose normal faces the axis (with
+                                   // the surface flips, before them)
     size_t illegal_removed_count;  // triangles removed by the manifold safety net
     size_t diagonal_swap_count;    // band diagonals swapped when stitching layers
     double point_spacing;          // the fit (stratmesh::Diagnostics says each)

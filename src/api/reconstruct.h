@@ -61,9 +61,11 @@ enum Flags : uint32_t {
     // each seam between layers once they are stitched: the unrolling squeezes whatever lies
     // almost across the axis (the underside of an ear, a chin), and there the flips join
     // the points that are near on the surface. No vertex or loop changes; a flip never
-    // makes a fold nor an angle wider than a fixed obtuse limit (unless it narrows one) and
-    // is checked against crossing the nearby triangles; the stream gives the same triangles
-    // as reconstruct() with it. Off by default: it costs time. The reduced build returns
+    // turns a triangle over against its neighbours nor makes an angle wider than a fixed
+    // obtuse limit (unless it narrows one), and never makes two triangles of the layer
+    // cross or touch; it may turn a triangle to face the axis where the surface does (the
+    // fold counts stay the unrolling's). The stream gives the same triangles as
+    // reconstruct() with it. Off by default: it costs time. The reduced build returns
     // not_compiled.
     surface_flips = 1u << 4,
     // No end of the surface is taken for a closed one (see ClosedEnd): the end layers are

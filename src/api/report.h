@@ -140,7 +140,8 @@ constexpr double kPoorMisfitFraction = 0.05;
 
 // Report::diagnostics: what a user checks before trusting the mesh.
 struct Diagnostics {
-    size_t fold_count;             // output triangles whose normal faces the axis
+    size_t fold_count;             // output triangles whose normal faces the axis (with
+                                   // surface_flips, as unrolled: before the flips)
     size_t illegal_removed_count;  // triangles removed by the manifold safety net
     size_t diagonal_swap_count;    // band diagonals swapped when stitching layers
     // The fit, measured by reconstruct() on ok from the cloud alone, in the same bytes on

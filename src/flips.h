@@ -581,19 +581,17 @@ static inline bool flip_on_surface(Triangulation& tr, const Local* points, uint3
     const Vec3 pq = first[2] - first[0];
     const double pq_length = std::sqrt(dot(pq, pq));
     const bool new_fold = faces_axis(lq, la, lp, cyl) || faces_axis(lp, lb, lq, cyl);
-    if (new_fold || ((flags[a] | flags[b] | flags[p] | flags[q]) & kNearFold)) {
-        if (!grid.sorted) sort_layer_grid(tr, grid);
-        if (!grid.admits(p, pq_length) || !grid.admits(q, pq_length) ||
-            !region_clear(tr, grid, quad, flags, clear_of))
-            return false;
-    } else {
-        if (!grid.admits(p, pq_length) || !grid.admits(q, pq_length)) return false;
+    const bool near_fold = new_fold || ((flags[a] | flags[b] | flags[p] | flags[q]) & kNearFold);
+    if (near_fold && !grid.sorted) sort_layer_grid(tr, grid);
+    if (!grid.admits(p, pq_length) || !grid.admits(q, pq_length)) return false;
+    if (near_fold) {
+        if (!region_clear(tr, grid, quad, flags, clear_of)) return false;
+    } else if (!gentle_flip(la, lb, lp, lq)) {
         // Away from folds the layer is its annulus lifted: a gentle flip covers about the
         // same place as before, another is checked against the triangles around the quad.
         const uint32_t corners[4] = {e, f, prev_edge(e), prev_edge(f)};
-        if (!gentle_flip(la, lb, lp, lq))
-            for (uint32_t corner : corners)
-                if (!around_vertex(tr, corner, clear_of)) return false;
+        for (uint32_t corner : corners)
+            if (!around_vertex(tr, corner, clear_of)) return false;
     }
     flip_edge<false>(tr, e, nullptr);
     // t is (p, a, q) now and u (q, b, p); their corners leave by these half-edges.

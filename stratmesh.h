@@ -1592,14 +1592,14 @@ static inline double abs_value(double x) { return x < 0 ? -x : x; }
 #endif
 static inline bool is_finite(double x) { return x - x == 0; }
 
-// Sorts ascending in place: heapsort, O(n log n) on any input (a million cuts, a huge fan)
-// with no recursion and no memory.
-template <class T> void sift_down(T* v, size_t root, size_t count) {
+// Sorts in place so that no element comes before one it is `before`: heapsort, O(n log n)
+// on any input (a million cuts, a huge fan) with no recursion and no memory.
+template <class T, class Before> void sift_down(T* v, size_t root, size_t count, Before before) {
     for (;;) {
         size_t child = 2 * root + 1;
         if (child >= count) return;
-        if (child + 1 < count && v[child + 1] > v[child]) ++child;
-        if (!(v[child] > v[root])) return;
+        if (child + 1 < count && before(v[child], v[child + 1])) ++child;
+        if (!before(v[root], v[child])) return;
         T t = v[root];
         v[root] = v[child];
         v[child] = t;
@@ -1607,14 +1607,19 @@ template <class T> void sift_down(T* v, size_t root, size_t count) {
     }
 }
 
-template <class T> void heap_sort(T* v, size_t count) {
-    for (size_t i = count / 2; i-- > 0;) sift_down(v, i, count);
+template <class T, class Before> void heap_sort(T* v, size_t count, Before before) {
+    for (size_t i = count / 2; i-- > 0;) sift_down(v, i, count, before);
     for (size_t end = count; end-- > 1;) {
         T t = v[0];
         v[0] = v[end];
         v[end] = t;
-        sift_down(v, 0, end);
+        sift_down(v, 0, end, before);
     }
+}
+
+// Sorts ascending.
+template <class T> void heap_sort(T* v, size_t count) {
+    heap_sort(v, count, [](const T& a, const T& b) { return a < b; });
 }
 
 static inline double read_double(const unsigned char* p) {
@@ -6883,31 +6888,6 @@ struct LayerGrid {
     }
 };
 
-// Sorts grid.ids by level, then cell (a heap sort: no recursion, no room).
-static inline void sort_by_cell(LayerGrid& grid) {
-    uint32_t* v = grid.ids;
-    const size_t n = grid.count;
-    auto sift_down = [&grid, v](size_t root, size_t end) {
-        for (;;) {
-            size_t child = 2 * root + 1;
-            if (child >= end) return;
-            if (child + 1 < end && grid.before(v[child], v[child + 1])) ++child;
-            if (!grid.before(v[root], v[child])) return;
-            const uint32_t swap = v[root];
-            v[root] = v[child];
-            v[child] = swap;
-            root = child;
-        }
-    };
-    for (size_t i = n / 2; i-- > 0;) sift_down(i, n);
-    for (size_t end = n; end-- > 1;) {
-        const uint32_t swap = v[0];
-        v[0] = v[end];
-        v[end] = swap;
-        sift_down(0, end);
-    }
-}
-
 // The length of edge k of surface triangle t.
 static inline double edge_length(const Triangulation& tr, const Local* points, uint32_t t,
                                  uint32_t k) {
@@ -6982,7 +6962,7 @@ static inline void sort_layer_grid(const Triangulation& tr, LayerGrid& grid) {
             spans[a] = word > spans[a] ? word : spans[a];
             spans[b] = word > spans[b] ? word : spans[b];
         }
-    sort_by_cell(grid);
+    heap_sort(ids, grid.count, [&grid](uint32_t v, uint32_t w) { return grid.before(v, w); });
     for (uint32_t i = 0; i < grid.count; ++i) {
         GridLevel& g = grid.levels[grid.level_of(ids[i])];
         if (g.count++ == 0) g.first = i;

@@ -156,14 +156,14 @@ static inline double abs_value(double x) { return x < 0 ? -x : x; }
 #endif
 static inline bool is_finite(double x) { return x - x == 0; }
 
-// Sorts ascending in place: heapsort, O(n log n) on any input (a million cuts, a huge fan)
-// with no recursion and no memory.
-template <class T> void sift_down(T* v, size_t root, size_t count) {
+// Sorts in place so that no element comes before one it is `before`: heapsort, O(n log n)
+// on any input (a million cuts, a huge fan) with no recursion and no memory.
+template <class T, class Before> void sift_down(T* v, size_t root, size_t count, Before before) {
     for (;;) {
         size_t child = 2 * root + 1;
         if (child >= count) return;
-        if (child + 1 < count && v[child + 1] > v[child]) ++child;
-        if (!(v[child] > v[root])) return;
+        if (child + 1 < count && before(v[child], v[child + 1])) ++child;
+        if (!before(v[root], v[child])) return;
         T t = v[root];
         v[root] = v[child];
         v[child] = t;
@@ -171,14 +171,19 @@ template <class T> void sift_down(T* v, size_t root, size_t count) {
     }
 }
 
-template <class T> void heap_sort(T* v, size_t count) {
-    for (size_t i = count / 2; i-- > 0;) sift_down(v, i, count);
+template <class T, class Before> void heap_sort(T* v, size_t count, Before before) {
+    for (size_t i = count / 2; i-- > 0;) sift_down(v, i, count, before);
     for (size_t end = count; end-- > 1;) {
         T t = v[0];
         v[0] = v[end];
         v[end] = t;
-        sift_down(v, 0, end);
+        sift_down(v, 0, end, before);
     }
+}
+
+// Sorts ascending.
+template <class T> void heap_sort(T* v, size_t count) {
+    heap_sort(v, count, [](const T& a, const T& b) { return a < b; });
 }
 
 static inline double read_double(const unsigned char* p) {

@@ -263,31 +263,6 @@ struct LayerGrid {
     }
 };
 
-// Sorts grid.ids by level, then cell (a heap sort: no recursion, no room).
-static inline void sort_by_cell(LayerGrid& grid) {
-    uint32_t* v = grid.ids;
-    const size_t n = grid.count;
-    auto sift_down = [&grid, v](size_t root, size_t end) {
-        for (;;) {
-            size_t child = 2 * root + 1;
-            if (child >= end) return;
-            if (child + 1 < end && grid.before(v[child], v[child + 1])) ++child;
-            if (!grid.before(v[root], v[child])) return;
-            const uint32_t swap = v[root];
-            v[root] = v[child];
-            v[child] = swap;
-            root = child;
-        }
-    };
-    for (size_t i = n / 2; i-- > 0;) sift_down(i, n);
-    for (size_t end = n; end-- > 1;) {
-        const uint32_t swap = v[0];
-        v[0] = v[end];
-        v[end] = swap;
-        sift_down(0, end);
-    }
-}
-
 // The length of edge k of surface triangle t.
 static inline double edge_length(const Triangulation& tr, const Local* points, uint32_t t,
                                  uint32_t k) {
@@ -362,7 +337,7 @@ static inline void sort_layer_grid(const Triangulation& tr, LayerGrid& grid) {
             spans[a] = word > spans[a] ? word : spans[a];
             spans[b] = word > spans[b] ? word : spans[b];
         }
-    sort_by_cell(grid);
+    heap_sort(ids, grid.count, [&grid](uint32_t v, uint32_t w) { return grid.before(v, w); });
     for (uint32_t i = 0; i < grid.count; ++i) {
         GridLevel& g = grid.levels[grid.level_of(ids[i])];
         if (g.count++ == 0) g.first = i;

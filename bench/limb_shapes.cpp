@@ -5,9 +5,10 @@
 //   stratmesh_limb_shapes check NAME MESH.off    one JSON line on MESH (ascii OFF whose
 //                                                vertices are the cloud's, in order)
 //
-// NAME is one of y, branched, hand, animal, tee, twice (tests/support/shapes.h: a Y of
-// tubes, a trunk with three side branches, a hand, a four-legged body with a neck and
-// head, a tee of pipes, a Y whose arm parts again). The check measures against the
+// NAME is one of y, branched, hand, animal, tee, twice, elbow, u_bend, coil, torus
+// (tests/support/shapes.h: a Y of tubes, a trunk with three side branches, a hand, a
+// four-legged body with a neck and head, a tee of pipes, a Y whose arm parts again, an
+// elbow of pipe, a U bend, a coil of two turns, a torus). The check measures against the
 // shape's analytic surface: "mean" is the area-weighted mean distance from the mesh to the
 // surface (four points a triangle) over the bounding box's diagonal, "area" the mesh's
 // area over the surface's (estimated from the sampling), then the tests' mesh checker's
@@ -30,7 +31,8 @@
 
 namespace {
 
-const char* const kNames[] = {"y", "branched", "hand", "animal", "tee", "twice"};
+const char* const kNames[] = {"y", "branched", "hand", "animal", "tee", "twice",
+                              "elbow", "u_bend", "coil", "torus"};
 
 bool make(const std::string& name, size_t n, shapes::Shape& s) {
     const shapes::Pose z = shapes::Pose::z;
@@ -40,6 +42,10 @@ bool make(const std::string& name, size_t n, shapes::Shape& s) {
     else if (name == "animal") s = shapes::four_legged(n, z);
     else if (name == "tee") s = shapes::tee(n, z);
     else if (name == "twice") s = shapes::twice_forked(n, z);
+    else if (name == "elbow") s = shapes::elbow(n, z);
+    else if (name == "u_bend") s = shapes::u_bend(n, z);
+    else if (name == "coil") s = shapes::coil(n, z);
+    else if (name == "torus") s = shapes::torus(n, z);
     else return false;
     return true;
 }

@@ -3,7 +3,8 @@
 # and along z, the trunk's axis) and by CGAL's advancing front (stratmesh_afr_peer), each
 # checked against the shape's analytic surface by stratmesh_limb_shapes.
 #
-#   bench/limbs.sh [--points N] [SHAPE...]      (shapes: y branched hand animal tee twice)
+#   bench/limbs.sh [--points N] [SHAPE...]      (shapes: y branched hand animal tee twice
+#                                                elbow u_bend coil torus)
 #
 # Prints one markdown table row per shape and mesher: the mean distance to the surface
 # over the bounding box's diagonal, the area ratio, components, crossing pairs, points
@@ -20,7 +21,7 @@ afr=${AFR_PEER:-$root/build-bench/bench/stratmesh_afr_peer}
 shapes=${LIMB_SHAPES:-$root/build-bench/bench/stratmesh_limb_shapes}
 points=20000
 if [ "${1:-}" = "--points" ]; then points=$2; shift 2; fi
-names=${*:-y branched hand animal tee twice}
+names=${*:-y branched hand animal tee twice elbow u_bend coil torus}
 export LIMB_POINTS=$points
 
 dir=$(mktemp -d)

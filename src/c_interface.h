@@ -179,6 +179,7 @@ static inline void c_report(const Report& r, stratmesh_report& c) {
     c.layers.planned_count = r.layers.planned_count;
     c.layers.used_count = r.layers.used_count;
     c.layers.parallel_count = r.layers.parallel_count;
+    c.layers.skeleton_node_count = r.layers.skeleton_node_count;
     c.caps.closed_count = r.caps.closed_count;
     c.caps.open_count = r.caps.open_count;
     c.caps.triangle_count = r.caps.triangle_count;

@@ -1,5 +1,5 @@
 // >>reconstruct ==========================================================================
-// reconstruct() in its steps: validate, axis, parts or one tube.
+// reconstruct() in its steps: validate, a bent skeleton, axis, parts or one tube.
 
 namespace stratmesh {
 namespace detail {
@@ -78,8 +78,14 @@ static inline Status run_reconstruction(const Cloud& cloud, const Options& optio
     // and along it a layer would only seem not to surround its axis.
     if (status == Status::ok && kDegenerateCheck && in.sums.distinct >= 3 && on_a_line(in, arena))
         status = Status::degenerate;
-    if (status == Status::ok) status = resolve_axis(in, arena, request, &rep.detail);
-    if (status == Status::ok)
+    bool bent = false;
+#if !defined(STRATMESH_SMALL_CODE)
+    if (status == Status::ok && follows_bends(request))
+        status = mesh_if_bent(in, request, arena, triangles, triangle_capacity, triangle_count,
+                              rep, &bent);
+#endif
+    if (status == Status::ok && !bent) status = resolve_axis(in, arena, request, &rep.detail);
+    if (status == Status::ok && !bent)
         status = mesh_cloud(cloud, in, request, arena, triangles, triangle_capacity,
                             triangle_count, rep);
     if (kMeasureFit) arena.rewind(read);  // the surface is final: the scratch is free
@@ -122,7 +128,7 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
     if (detail::kDropOutliers && (options.flags & drop_outliers))
         arena.alloc<unsigned char>(point_count / 8 + 1);
     const size_t read = arena.required_bytes();
-    size_t steps[detail::kMeasureFit ? 4 : 3] = {};
+    size_t steps[detail::kMeasureFit ? 5 : 4] = {};
     if (detail::kAxisTrials && options.axis == Axis::automatic)
         steps[0] = detail::axis_workspace_size(point_count, request);
     // A refusal for no area is explained with the groups of why_no_area().
@@ -130,6 +136,10 @@ size_t reconstruct_workspace_size(size_t point_count, const Options& options) {
 #if !defined(STRATMESH_SMALL_CODE)
     if (detail::searches_parts(request))
         steps[1] = detail::parts_workspace_size(point_count, request);
+    if (detail::follows_bends(request)) {
+        steps[detail::kMeasureFit ? 4 : 3] = detail::bent_workspace_size(point_count, request);
+        if (steps[detail::kMeasureFit ? 4 : 3] == 0) return 0;
+    }
 #endif
     // The fit is measured once the surface is final (far less than meshing it takes).
     if (detail::kMeasureFit) {

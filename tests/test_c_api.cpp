@@ -64,6 +64,7 @@ void check_same_report(const Report& r, const stratmesh_report& c, bool same_wor
     CHECK(c.layers.planned_count == r.layers.planned_count);
     CHECK(c.layers.used_count == r.layers.used_count);
     CHECK(c.layers.parallel_count == r.layers.parallel_count);
+    CHECK(c.layers.skeleton_node_count == r.layers.skeleton_node_count);
     CHECK(c.caps.closed_count == r.caps.closed_count);
     CHECK(c.caps.open_count == r.caps.open_count);
     CHECK(c.caps.triangle_count == r.caps.triangle_count);

@@ -465,7 +465,9 @@ int run(const CommandLine& line) {
     if (record.status != stratmesh::Status::ok) return refuse(line, record, "", outputs);
     measure_along_axis(xyz, record);
     record.ends = find_surface_ends(xyz.data(), result.triangles.get(), result.triangle_count,
-                                    record.report.axis, record.layers);
+                                    record.report.axis, record.layers,
+                                    record.report.layers.skeleton_node_count > 0,
+                                    record.report.axis_origin);
     if (!write_output(line, xyz, attributes, result, record, outputs.mesh) ||
         !write_preview(line, xyz, result, record, outputs.preview))
         return kExitFile;

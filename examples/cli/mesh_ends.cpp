@@ -118,14 +118,69 @@ void name_pole_loop(SurfaceEnd& end, const std::vector<uint32_t>* only_loop, con
                         kPoleShare * layer->radius;
 }
 
+// The unit direction from a to b; false where they coincide.
+bool direction(const double* a, const double* b, double out[3]) {
+    double length = 0;
+    for (size_t k = 0; k < 3; ++k) {
+        out[k] = b[k] - a[k];
+        length += out[k] * out[k];
+    }
+    length = std::sqrt(length);
+    if (!(length > 0)) return false;
+    for (size_t k = 0; k < 3; ++k) out[k] /= length;
+    return true;
+}
+
+// Along a bent skeleton (Report::layers.skeleton_node_count) the bottom end is where the
+// skeleton starts (Report::axis_origin, Report::axis its direction there), wherever the top
+// end lies: a loop within kStartRadii of the first layer's radius of the start is at the
+// bottom, any other at the top. The top's centre line runs from the last layer but one to
+// the last (a single layer names no pole loop at the top).
+const double kStartRadii = 3.0;
+
+bool skeleton_ends(const double* xyz, const std::vector<std::vector<uint32_t>>& loops,
+                   const double axis[3], const double origin[3],
+                   const std::vector<stratmesh::LayerInfo>& layers, SurfaceEnds& ends) {
+    if (layers.empty()) return false;
+    const std::vector<uint32_t>* bottom_loop = nullptr;
+    const std::vector<uint32_t>* top_loop = nullptr;
+    for (const std::vector<uint32_t>& loop : loops) {
+        double from_start = 0;
+        for (uint32_t v : loop) {
+            double square = 0;
+            for (size_t k = 0; k < 3; ++k)
+                square += (xyz[3 * size_t{v} + k] - origin[k]) * (xyz[3 * size_t{v} + k] - origin[k]);
+            from_start += std::sqrt(square);
+        }
+        const bool bottom =
+            from_start / static_cast<double>(loop.size()) < kStartRadii * layers.front().radius;
+        (bottom ? ends.bottom : ends.top).loop_edges.push_back(loop.size());
+        (bottom ? bottom_loop : top_loop) = &loop;
+    }
+    stratmesh::LayerInfo start = layers.front();
+    for (size_t k = 0; k < 3; ++k) start.centre[k] = origin[k];
+    name_pole_loop(ends.bottom, ends.bottom.loop_edges.size() == 1 ? bottom_loop : nullptr, xyz,
+                   axis, &start, stratmesh::closed_bottom);
+    const size_t n = layers.size();
+    double top_axis[3];
+    if (n >= 2 && direction(layers[n - 2].centre, layers[n - 1].centre, top_axis))
+        name_pole_loop(ends.top, ends.top.loop_edges.size() == 1 ? top_loop : nullptr, xyz,
+                       top_axis, &layers.back(), stratmesh::closed_top);
+    return true;
+}
+
 } // namespace
 
 SurfaceEnds find_surface_ends(const double* xyz, const uint32_t* triangles,
                               size_t triangle_count, const double axis[3],
-                              const std::vector<stratmesh::LayerInfo>& layers) {
+                              const std::vector<stratmesh::LayerInfo>& layers,
+                              bool along_skeleton, const double* origin) {
     SurfaceEnds ends;
     ends.known = true;
     if (triangle_count == 0) return ends;
+    if (along_skeleton && skeleton_ends(xyz, chain_loops(boundary_edges(triangles, triangle_count)),
+                                        axis, origin, layers, ends))
+        return ends;
     // The median corner (of an even sample of at most kSampledCorners): a stray vertex far
     // along the axis does not move it.
     const size_t corners = 3 * triangle_count;

@@ -31,9 +31,12 @@ std::vector<uint64_t> boundary_edges(const uint32_t* triangles, size_t count);
 // The boundary loops of a mesh whose vertices are `xyz` (3 doubles each): a loop is put at
 // the bottom end when its vertices' mean height, dot(point, axis), lies below the median
 // height of the triangles' corners. `layers` (bottom up, possibly empty) names pole loops.
+// Where the layers follow a bent skeleton starting at `origin` (Report::axis_origin), a
+// loop near the start is at the bottom, any other at the top.
 SurfaceEnds find_surface_ends(const double* xyz, const uint32_t* triangles,
                               size_t triangle_count, const double axis[3],
-                              const std::vector<stratmesh::LayerInfo>& layers);
+                              const std::vector<stratmesh::LayerInfo>& layers,
+                              bool along_skeleton = false, const double* origin = nullptr);
 
 } // namespace stratmesh_cli
 

@@ -321,6 +321,7 @@ void write_counts(JsonWriter& j, const RunRecord& r) {
     j.end_object();
     j.count_field("layer_count", rep.layers.used_count);
     j.count_field("parallel_layers", rep.layers.parallel_count);
+    j.count_field("skeleton_nodes", rep.layers.skeleton_node_count);
     j.count_field("points_held", rep.points.held_count);
 }
 

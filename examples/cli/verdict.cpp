@@ -98,7 +98,10 @@ Verdict judge_mesh(const RunRecord& r) {
 }
 
 std::string verdict_text(const Verdict& v, const RunRecord& r) {
-    const std::string used = "axis " + v.axis + ", " + std::to_string(r.report.layers.used_count) +
+    const size_t nodes = r.report.layers.skeleton_node_count;
+    const std::string along = nodes > 0 ? "along its bent skeleton (" + std::to_string(nodes) + " nodes)"
+                                        : "axis " + v.axis;
+    const std::string used = along + ", " + std::to_string(r.report.layers.used_count) +
                              (r.report.layers.used_count == 1 ? " layer" : " layers");
     std::string text = std::string(verdict_name(v.judged)) + ": " + v.what + "; " + used;
     if (v.judged == Verdict::poor) text += ": " + v.action;

@@ -143,7 +143,8 @@ py::object report_object(const stratmesh::Report& r, stratmesh::Status status) {
         py::arg("layers") = ns(
             py::arg("planned_count") = r.layers.planned_count,
             py::arg("used_count") = r.layers.used_count,
-            py::arg("parallel_count") = r.layers.parallel_count, py::arg("info") = layers),
+            py::arg("parallel_count") = r.layers.parallel_count,
+            py::arg("skeleton_node_count") = r.layers.skeleton_node_count, py::arg("info") = layers),
         py::arg("caps") = ns(
             py::arg("closed_count") = r.caps.closed_count,
             py::arg("open_count") = r.caps.open_count,

@@ -225,6 +225,7 @@ typedef struct stratmesh_layer_counts {
     size_t parallel_count;  // of those, triangulated by run_jobs' jobs
     stratmesh_layer_info* info;
     size_t info_capacity;
+    size_t skeleton_node_count;  // 0: stacked along the axis; else the bent skeleton's nodes
 } stratmesh_layer_counts;
 
 // stratmesh::CapCounts, with STRATMESH_FLAG_ADD_CAPS; all 0 without it.

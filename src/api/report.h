@@ -106,6 +106,12 @@ struct LayerCounts {
     // entries; the first min(used_count, info_capacity) are filled.
     LayerInfo* info;
     size_t info_capacity;
+    // 0 where the layers are stacked along Report::axis. Otherwise the object bends and
+    // the layers are cross-sections of its skeleton, a polyline of this many nodes through
+    // the centres of its rings (see reconstruct()): Report::axis is the skeleton's direction
+    // at its start, Report::axis_origin the start, LayerInfo::bottom and top are arc lengths
+    // along it from there, and LayerInfo::centre lies on it.
+    size_t skeleton_node_count;
 };
 
 // Report::caps, with add_caps (and from cap_ends()); all 0 without it.
@@ -211,6 +217,15 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // branches bridges the gaps between them with webs, and a join that folds adds area too.
 // Report::parts.parting.axis is the axis of the cut kept, which is squared to the trunk's
 // own axis where the two differ. The caps (add_caps) come last.
+//
+// Before any of that, where the options leave the axis, the origin and the layers to it and
+// look for parts (the defaults), an object that bends without branching (an elbow, a U
+// bend, a coil, a bowed bone) is meshed as one tube across its skeleton: one ring around
+// the object at every distance along its surface from one end, the rings' centres a curve
+// at least 8 ring radii long that strays 2 radii or more from a straight line and turns
+// nowhere tighter than 1.5 radii. Each point is then placed across and along that curve and
+// the layers are its cross-sections; LayerCounts::skeleton_node_count says so. A branching
+// or looped object (two rings at one distance), or a straight one, goes on as above.
 //
 // cloud           the points (see Cloud), at most 2^32 - 3. They are only read.
 // options         see Options; `Options options = {};` gives the defaults.

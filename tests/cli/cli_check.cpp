@@ -378,6 +378,8 @@ int make_inputs(const std::string& dir) {
                                 "a four-legged body")) &&
               write_file(dir + "/u_tube.xyz",
                          as_xyz(shapes::u_tube(6000, shapes::Pose::z).xyz, 0, "a U of pipe")) &&
+              write_file(dir + "/u_bend.xyz",
+                         as_xyz(shapes::u_bend(6000, shapes::Pose::z).xyz, 0, "a U bend of pipe")) &&
               write_file(dir + "/cad_spool.xyz",
                          as_xyz(shapes::cad_spool(48, shapes::Pose::z).xyz, 0,
                                 "a spool's CAD vertices")) &&

@@ -22,10 +22,12 @@
 #define STRATMESH_TESTS_SUPPORT_SHAPES_H
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -572,6 +574,289 @@ inline Shape u_tube(size_t n, Pose pose, uint64_t seed = 37) {
                                          {{2, 0, 0}, {2, 0, 5}, 0.5, 0.5},
                                          {{-2, 0, 0}, {2, 0, 0}, 0.5, 0.5}},
                                         -1e9, 4, n, seed);
+}
+
+namespace detail {
+
+// A pipe's centre line: a polyline, with a bounding sphere for each run of kRun segments so
+// that queries skip the runs too far away to matter (a coil's other turn, a U's other leg).
+class CentreLine {
+public:
+    static constexpr size_t kNone = static_cast<size_t>(-1);
+
+    explicit CentreLine(std::vector<std::array<double, 3>> vertices) : v_(std::move(vertices)) {
+        for (size_t first = 0; first + 1 < v_.size(); first += kRun) {
+            Run run;
+            run.first = first;
+            run.last = std::min(first + kRun, v_.size() - 1);
+            double lo[3], hi[3];
+            for (size_t k = 0; k < 3; ++k) lo[k] = hi[k] = v_[first][k];
+            for (size_t j = first; j <= run.last; ++j)
+                for (size_t k = 0; k < 3; ++k) {
+                    lo[k] = std::min(lo[k], v_[j][k]);
+                    hi[k] = std::max(hi[k], v_[j][k]);
+                }
+            for (size_t k = 0; k < 3; ++k) run.centre[k] = (lo[k] + hi[k]) / 2;
+            run.radius = 0;
+            for (size_t j = first; j <= run.last; ++j)
+                run.radius = std::max(run.radius, std::sqrt(distance2(v_[j].data(), run.centre)));
+            runs_.push_back(run);
+        }
+    }
+
+    size_t segments() const { return v_.size() - 1; }
+    const double* vertex(size_t j) const { return v_[j].data(); }
+
+    // The distance from p to the polyline, exact: a run is skipped only when its bounding
+    // sphere is farther than the nearest segment found so far (first in the nearest run).
+    double distance(const double* p) const {
+        size_t nearest = 0;
+        double gap = std::numeric_limits<double>::infinity();
+        for (size_t r = 0; r < runs_.size(); ++r) {
+            const double g = std::sqrt(distance2(p, runs_[r].centre)) - runs_[r].radius;
+            if (g < gap) gap = g, nearest = r;
+        }
+        double best2 = std::numeric_limits<double>::infinity();
+        for (size_t s = runs_[nearest].first; s < runs_[nearest].last; ++s)
+            best2 = std::min(best2, segment_distance2(s, p));
+        double best = std::sqrt(best2);
+        for (size_t r = 0; r < runs_.size(); ++r) {
+            const Run& run = runs_[r];
+            const double reach = best + run.radius;
+            if (r == nearest || distance2(p, run.centre) >= reach * reach) continue;
+            for (size_t s = run.first; s < run.last; ++s) best2 = std::min(best2, segment_distance2(s, p));
+            best = std::sqrt(best2);
+        }
+        return best;
+    }
+
+    // Whether p is strictly inside the solid cylinder (flat ends) of radius r of a segment
+    // other than own_segment, or the ball of radius r of a vertex other than own_vertex.
+    bool inside(const double* p, double r, size_t own_segment, size_t own_vertex) const {
+        for (const Run& run : runs_) {
+            const double reach = run.radius + r;
+            if (distance2(p, run.centre) >= reach * reach) continue;
+            for (size_t j = run.first; j <= run.last; ++j) {
+                if (j != own_vertex && distance2(p, v_[j].data()) < r * r) return true;
+                if (j == run.last || j == own_segment) continue;
+                double ab[3], ap[3];
+                for (size_t k = 0; k < 3; ++k) ab[k] = v_[j + 1][k] - v_[j][k], ap[k] = p[k] - v_[j][k];
+                const double t = (ab[0] * ap[0] + ab[1] * ap[1] + ab[2] * ap[2]) /
+                                 (ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2]);
+                if (t <= 0 || t >= 1) continue;
+                double d2 = 0;
+                for (size_t k = 0; k < 3; ++k) d2 += (ap[k] - t * ab[k]) * (ap[k] - t * ab[k]);
+                if (d2 < r * r) return true;
+            }
+        }
+        return false;
+    }
+
+private:
+    static constexpr size_t kRun = 16;
+    struct Run {
+        size_t first, last;  // vertices first..last, segments first..last - 1
+        double centre[3], radius;
+    };
+
+    static double distance2(const double* a, const double* b) {
+        return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+    }
+    double segment_distance2(size_t s, const double* p) const {
+        const double* a = v_[s].data();
+        const double* b = v_[s + 1].data();
+        double ab[3], ap[3];
+        for (size_t k = 0; k < 3; ++k) ab[k] = b[k] - a[k], ap[k] = p[k] - a[k];
+        const double t = std::max(0.0, std::min(1.0, (ab[0] * ap[0] + ab[1] * ap[1] + ab[2] * ap[2]) /
+                                                         (ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2])));
+        double d2 = 0;
+        for (size_t k = 0; k < 3; ++k) d2 += (ap[k] - t * ab[k]) * (ap[k] - t * ab[k]);
+        return d2;
+    }
+
+    std::vector<std::array<double, 3>> v_;
+    std::vector<Run> runs_;
+};
+
+// A unit vector across the unit vector a: (z, 0, -x) normalised, or x for a along y.
+inline std::array<double, 3> unit_across(const double* a) {
+    std::array<double, 3> e = {a[2], 0, -a[0]};
+    const double l = std::hypot(e[0], e[1], e[2]);
+    if (l < 1e-9) return {1, 0, 0};
+    for (double& x : e) x /= l;
+    return e;
+}
+inline std::array<double, 3> cross(const double* a, const double* b) {
+    return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+// n points spread evenly over a pipe of radius r around a centre line given as a dense
+// polyline, closed at both ends by half spheres: the boundary of the union of its
+// segments' capsules, whose signed distance deviation() is (the distance to the centre
+// line less r). That boundary is made of the segments' cylinder sides, less what a
+// neighbour's cylinder covers inside a bend, and at each vertex the lune of its ball
+// between the two segments' end planes, outside the bend (the rest of the ball is inside a
+// neighbouring cylinder or ball); the ends' half spheres are lunes of half a turn. Each
+// piece is drawn by its area and a point kept unless another piece holds it strictly
+// inside. The pipe must not touch itself.
+inline Shape swept_pipe(const char* name, Pose pose, std::vector<std::array<double, 3>> centre_line,
+                        double r, size_t n, uint64_t seed) {
+    const CentreLine line(std::move(centre_line));
+    const size_t segments = line.segments();
+    double z0 = line.vertex(0)[2], z1 = z0;
+    for (size_t j = 0; j <= segments; ++j) {
+        z0 = std::min(z0, line.vertex(j)[2]);
+        z1 = std::max(z1, line.vertex(j)[2]);
+    }
+    Shape s = start(name, pose, cylinder_radius, z0 - r, z1 + r);
+    s.closed_distance = [line, r](const double* p) { return line.distance(p) - r; };
+
+    // The pieces, cylinder sides then lunes, by their cumulative area.
+    std::vector<double> cumulative;
+    double total = 0;
+    std::vector<std::array<double, 3>> along(segments), across(segments);
+    std::vector<double> length(segments);
+    for (size_t c = 0; c < segments; ++c) {
+        const double* a = line.vertex(c);
+        const double* b = line.vertex(c + 1);
+        length[c] = std::hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
+        for (size_t k = 0; k < 3; ++k) along[c][k] = (b[k] - a[k]) / length[c];
+        across[c] = unit_across(along[c].data());
+        total += 2 * kPi * r * length[c];
+        cumulative.push_back(total);
+    }
+    // A lune at a vertex: unit vectors e (the way in), f (across it, towards the way out)
+    // and n (normal to the bend); its points are e cos(alpha) + f sin(alpha) turned about
+    // n, alpha in [-pi/2, angle - pi/2] (angle: the bend's, or pi at an end).
+    struct Lune {
+        std::array<double, 3> e, f, n;
+        double angle;
+    };
+    std::vector<Lune> lunes(segments + 1);
+    // Area: Pappus's 2 pi r a unit length of centre line (the cylinders cut by the mitre
+    // planes, which is what the union is inside a bend), plus the ends' sphere, plus at
+    // each bend its lune, 2 r^2 angle, less the mitre's two wedges outside the bend,
+    // 2 r^2 tan(angle / 2) each: about -r^2 angle^3 / 6 a bend.
+    double area = total + 4 * kPi * r * r;
+    for (size_t j = 0; j <= segments; ++j) {
+        Lune& l = lunes[j];
+        if (j == 0) {
+            for (size_t k = 0; k < 3; ++k) l.e[k] = -along[0][k];
+        } else {
+            l.e = along[j - 1];
+        }
+        l.angle = kPi;
+        l.n = unit_across(l.e.data());
+        if (j > 0 && j < segments) {
+            const std::array<double, 3> normal = cross(l.e.data(), along[j].data());
+            const double sine = std::hypot(normal[0], normal[1], normal[2]);
+            const double cosine = l.e[0] * along[j][0] + l.e[1] * along[j][1] + l.e[2] * along[j][2];
+            l.angle = std::atan2(sine, cosine);
+            if (sine > 1e-300)
+                for (size_t k = 0; k < 3; ++k) l.n[k] = normal[k] / sine;
+            area += 2 * r * r * (l.angle - 2 * std::tan(l.angle / 2));
+        }
+        l.f = cross(l.n.data(), l.e.data());
+        total += 2 * r * r * l.angle;
+        cumulative.push_back(total);
+    }
+    s.spacing = std::sqrt(area / static_cast<double>(n));
+
+    Rng rng(seed);
+    s.xyz.reserve(3 * n);
+    while (s.size() < n) {
+        const size_t piece = static_cast<size_t>(
+            std::upper_bound(cumulative.begin(), cumulative.end(), rng.uniform(0, total)) - cumulative.begin());
+        double p[3];
+        if (piece < segments) {
+            const size_t c = piece;
+            const double t = rng.uniform() * length[c], phi = rng.uniform(0, 2 * kPi);
+            const std::array<double, 3> e2 = cross(along[c].data(), across[c].data());
+            for (size_t k = 0; k < 3; ++k)
+                p[k] = line.vertex(c)[k] + t * along[c][k] +
+                       r * (std::cos(phi) * across[c][k] + std::sin(phi) * e2[k]);
+            if (line.inside(p, r, c, CentreLine::kNone)) continue;
+        } else {
+            const size_t j = piece - segments;
+            const Lune& l = lunes[j];
+            // Uniform by area: alpha uniform, and the height along n too (Archimedes).
+            const double alpha = l.angle * rng.uniform() - kPi / 2, h = rng.uniform(-1, 1);
+            const double w = std::sqrt(1 - h * h);
+            for (size_t k = 0; k < 3; ++k)
+                p[k] = line.vertex(j)[k] +
+                       r * (w * (std::cos(alpha) * l.e[k] + std::sin(alpha) * l.f[k]) + h * l.n[k]);
+            if (line.inside(p, r, CentreLine::kNone, j)) continue;
+        }
+        s.add_local(std::atan2(p[1], p[0]), p[2], std::hypot(p[0], p[1]));
+    }
+    return s;
+}
+
+}  // namespace detail
+
+// Bent pipes of radius 0.5, their ends rounded: the centre lines are polylines of segments
+// about 0.01 long on the bends, within 1e-5 of the circle or helix, and the surface and
+// deviation() are exactly the polyline's pipe's.
+
+// An elbow: a leg up z from (0, 0, -3) to the origin, a quarter circle of radius 1.5 about
+// (1.5, 0, 0) to (1.5, 0, 1.5), then a leg along x to (4.5, 0, 1.5). Along z its sections
+// are a disc, then longer and longer ones across the bend, then one long one.
+inline Shape elbow(size_t n, Pose pose, uint64_t seed = 38) {
+    std::vector<std::array<double, 3>> line = {{0, 0, -3}};
+    const size_t arc = 256;
+    for (size_t i = 0; i <= arc; ++i) {
+        const double a = kPi / 2 * static_cast<double>(i) / static_cast<double>(arc);
+        line.push_back({1.5 - 1.5 * std::cos(a), 0, 1.5 * std::sin(a)});
+    }
+    line.push_back({4.5, 0, 1.5});
+    return detail::swept_pipe("elbow", pose, std::move(line), 0.5, n, seed);
+}
+
+// A U bend: legs up z at x = -1.5 and 1.5 from z = 0 to 4, joined below by a half circle
+// of radius 1.5 about the origin in the xz plane, lowest at (0, 0, -1.5). Unlike u_tube's
+// joint, the bend is smooth: along z the sections are one long disc, then two discs.
+inline Shape u_bend(size_t n, Pose pose, uint64_t seed = 39) {
+    std::vector<std::array<double, 3>> line = {{-1.5, 0, 4}, {-1.5, 0, 0}};
+    const size_t arc = 512;  // even: the lowest point is a vertex
+    for (size_t i = 1; i < arc; ++i) {
+        const double a = kPi * static_cast<double>(i) / static_cast<double>(arc);
+        line.push_back({-1.5 * std::cos(a), 0, -1.5 * std::sin(a)});
+    }
+    line.push_back({1.5, 0, 0});
+    line.push_back({1.5, 0, 4});
+    return detail::swept_pipe("U bend", pose, std::move(line), 0.5, n, seed);
+}
+
+// A coil: two turns of the helix (2 cos t, 2 sin t, 3 t / (2 pi)), t in [0, 4 pi], about
+// the axis: turns 3 apart, a gap of 2 between them. Along z each section is one crescent,
+// turning about the axis with the height.
+inline Shape coil(size_t n, Pose pose, uint64_t seed = 40) {
+    std::vector<std::array<double, 3>> line;
+    const size_t segments = 2048;
+    for (size_t i = 0; i <= segments; ++i) {
+        const double f = static_cast<double>(i) / static_cast<double>(segments);
+        line.push_back({2 * std::cos(4 * kPi * f), 2 * std::sin(4 * kPi * f), 6 * f});
+    }
+    return detail::swept_pipe("coil", pose, std::move(line), 0.5, n, seed);
+}
+
+// A torus about the axis: major radius 2, minor 0.6. Its sections along z are rings.
+inline Shape torus(size_t n, Pose pose, uint64_t seed = 41) {
+    const double major = 2, minor = 0.6;
+    Shape s = detail::start("torus", pose, cylinder_radius, -minor, minor);
+    s.closed_distance = [major, minor](const double* p) {
+        return std::hypot(std::hypot(p[0], p[1]) - major, p[2]) - minor;
+    };
+    s.spacing = std::sqrt(4 * kPi * kPi * major * minor / static_cast<double>(n));
+    Rng rng(seed);
+    s.xyz.reserve(3 * n);
+    while (s.size() < n) {
+        const double u = rng.uniform(0, 2 * kPi), v = rng.uniform(0, 2 * kPi);
+        // The area element grows with the distance from the axis.
+        if (rng.uniform() * (major + minor) > major + minor * std::cos(v)) continue;
+        s.add_local(u, minor * std::sin(v), major + minor * std::cos(v));
+    }
+    return s;
 }
 
 // A spool as a CAD model gives it: the vertices of its tessellation, rings of `per_ring`

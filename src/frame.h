@@ -170,10 +170,7 @@ static inline Status choose_frame(const CloudSums& sums, const TubeRequest& requ
     default: return Status::invalid_axis;
     }
     // e1: the coordinate axis least aligned with the stacking axis, made orthogonal.
-    Vec3 helper = {1, 0, 0};
-    if (abs_value(axis.x) > abs_value(axis.y) || abs_value(axis.x) > abs_value(axis.z))
-        helper = abs_value(axis.y) < abs_value(axis.z) ? Vec3{0, 1, 0} : Vec3{0, 0, 1};
-    Vec3 e1 = cross(helper, axis);
+    Vec3 e1 = cross(axis_least_along(axis), axis);
     if (!normalize(e1)) return Status::invalid_axis;
     frame.axis = axis;
     frame.surface_flips = request.surface_flips;

@@ -49,6 +49,14 @@ struct CloudReader {
     }
 };
 
+// The coordinate axis along which d is shortest (x where it ties for that, else z over y):
+// crossed with d, it gives a direction well across d.
+static inline Vec3 axis_least_along(Vec3 d) {
+    if (abs_value(d.x) > abs_value(d.y) || abs_value(d.x) > abs_value(d.z))
+        return abs_value(d.y) < abs_value(d.z) ? Vec3{0, 1, 0} : Vec3{0, 0, 1};
+    return {1, 0, 0};
+}
+
 static inline double largest_of(Vec3 v) {
     const double xy = v.x > v.y ? v.x : v.y;
     return xy > v.z ? xy : v.z;

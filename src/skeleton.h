@@ -1,40 +1,42 @@
 // >>skeleton =============================================================================
 // Objects that bend: layers across a skeleton of geodesic rings, not one straight axis.
 //
-// find_skeleton(): on every k-th kept point (at most kSkeletonSample), a neighbourhood
-// graph (points within kReachDeciles nearest-neighbour deciles of each other, found in a
-// grid of that side), its largest connected piece, and the geodesic distance over it from
-// one end of the object (Dijkstra from the point farthest along the graph from an extreme
-// point; its heap an array). Bands of that distance, each at least two reaches wide, fall
-// into connected pieces: the object's rings around its centre line (Verroust and Lazarus,
-// "Extracting skeletal curves from 3D scattered data", 2000). Where every band holds one
-// ring, the centres of circles fitted to the rings are the skeleton: a polyline, with a
-// frame carried along it without twist (parallel transport), smoothed so as not to pull a
-// bend's nodes inward (Taubin's filter).
-// The object counts as bent where that polyline is long for its rings' radius, strays from
-// its chord by more than a radius, and turns nowhere more tightly than kTightestTurn radii
-// (tighter, the straightened coordinates below would fold). Then mesh_if_bent() meshes it as
-// one tube in straightened coordinates: each point across its nearest skeleton segment (two
-// coordinates in the frame there) and along it (arc length), so the layers are the
-// skeleton's cross-sections wherever the object goes, and the triangles index the cloud as
-// ever. A band with two rings is a branch (or a handle): such an object goes on to the
-// parts (>>parts), as does a straight one.
+// find_skeleton(): on a sample of about kSkeletonSample kept points (by a hash of their
+// coordinates), a graph joining each point to its kMostNeighbours nearest within
+// kReachDeciles nearest-neighbour deciles (found in a grid of that side), its largest
+// connected piece, and the distance along the graph from one end of the object (Dijkstra
+// from the point farthest along the graph from an extreme point; its heap an array). Bands
+// of that distance, each at least two reaches wide, fall into connected pieces: the
+// object's rings around its centre line (Verroust and Lazarus, "Extracting skeletal curves
+// from 3D scattered data", 2000). Where every band holds one ring, the centres of circles
+// fitted to the rings, smoothed by Taubin's filter (which does not pull a bend inward), are
+// the skeleton: a polyline with a frame carried along it without twist.
+// The object counts as bent where that polyline is kLongRadii ring radii long or more,
+// strays kStrayRadii from its chord, and turns nowhere more tightly than kTightestTurn
+// radii (tighter, the straightened coordinates below would fold). Then mesh_if_bent()
+// meshes it as one tube in straightened coordinates: each point across its nearest
+// skeleton segment (two coordinates in the frame there) and along it (arc length), so the
+// layers are the skeleton's cross-sections wherever the object goes, and the triangles
+// index the cloud as ever. A band with two rings is a branch (or a handle): such an object
+// goes on to the parts (>>parts), as does a straight one.
 
 namespace stratmesh {
 namespace detail {
 
-// Points the skeleton is found on: enough for rings a few points wide on a long coil.
+// Points the skeleton is found on: enough for rings of tens of points on a coil of two
+// turns, few enough to cost a few milliseconds.
 const size_t kSkeletonSample = 4096;
 // Points the nearest-neighbour decile is measured on: a decile needs no more.
 const size_t kSpacingSample = 2048;
 // Neighbours are joined within this many nearest-neighbour deciles: on a uniformly random
-// sample of a surface, about 20 neighbours, and a graph in one piece.
+// sample of a surface, about 20 points, and a graph in one piece.
 const double kReachDeciles = 3.0;
 // The most bands (so skeleton nodes): the smallest band is two reaches wide, or this share
 // of the object's geodesic length.
 const uint32_t kMostBands = 256;
 // A piece of a band counts as a ring from this share of the band's points (and at least
-// kMinRingPoints): smaller pieces are specks the graph did not join.
+// kMinRingPoints): smaller pieces are specks the graph did not join. Small enough that an
+// animal's leg beside its body counts.
 const uint32_t kRingShare = 32;
 const uint32_t kMinRingPoints = 8;
 // Bent: at least this long and straying this far from the chord, in ring radii.
@@ -334,10 +336,7 @@ static inline void fit_ring_circles(SkeletonMemory& m, uint32_t bands, double wi
         while (hi + 1 < bands && (hi == b || m.band_points[hi] == 0)) ++hi;
         Vec3 along = m.band_centre[hi] - m.band_centre[lo];
         if (m.band_points[lo] == 0 || m.band_points[hi] == 0 || !normalize(along)) continue;
-        Vec3 helper = {1, 0, 0};
-        if (abs_value(along.x) > abs_value(along.y) || abs_value(along.x) > abs_value(along.z))
-            helper = abs_value(along.y) < abs_value(along.z) ? Vec3{0, 1, 0} : Vec3{0, 0, 1};
-        f.u = cross(helper, along);
+        f.u = cross(axis_least_along(along), along);
         f.plane = normalize(f.u);
         f.v = cross(along, f.u);
     }
@@ -388,11 +387,7 @@ static inline bool chain_nodes(const SkeletonMemory& m, uint32_t first, uint32_t
         if (!normalize(sk.tangent[i])) return false;
     }
     // The first normal: across the tangent, from the coordinate axis least along it.
-    const Vec3 t = sk.tangent[0];
-    Vec3 helper = {1, 0, 0};
-    if (abs_value(t.x) > abs_value(t.y) || abs_value(t.x) > abs_value(t.z))
-        helper = abs_value(t.y) < abs_value(t.z) ? Vec3{0, 1, 0} : Vec3{0, 0, 1};
-    sk.normal[0] = cross(helper, t);
+    sk.normal[0] = cross(axis_least_along(sk.tangent[0]), sk.tangent[0]);
     if (!normalize(sk.normal[0])) return false;
     for (uint32_t i = 1; i < sk.count; ++i) {
         const Vec3 n = sk.normal[i - 1], ti = sk.tangent[i];

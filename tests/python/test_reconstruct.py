@@ -217,3 +217,25 @@ def test_a_forked_cloud_is_meshed_in_parts_joined_into_one_surface():
     _, one = stratmesh.reconstruct(points, axis="z", layers=4, parts="one_tube")
     assert one.parts.outcome == "one_tube"
     assert one.parts.part_count == 0
+
+
+def test_a_bent_pipe_is_meshed_across_its_skeleton():
+    # Half a torus, open at both ends: a pipe of radius 0.5 bent around a circle of radius 3.
+    rng = np.random.default_rng(5)
+    t = rng.uniform(0, np.pi, 8000)
+    phi = rng.uniform(0, 2 * np.pi, 8000)
+    radial = np.stack([np.cos(t), np.zeros_like(t), -np.sin(t)], axis=1)
+    across = np.array([0.0, 1.0, 0.0])
+    points = (3 * radial + 0.5 * (np.cos(phi)[:, None] * radial + np.sin(phi)[:, None] * across))
+    triangles, report = stratmesh.reconstruct(points)
+    assert report.layers.skeleton_node_count >= 4
+    # Every triangle lies on the pipe: its centroid within a tenth of the radius of it.
+    centroid = points[triangles].mean(axis=1)
+    off_centre_line = np.hypot(np.hypot(centroid[:, 0], centroid[:, 2]) - 3, centroid[:, 1])
+    assert np.abs(off_centre_line - 0.5).max() < 0.05
+    # One tube along one axis webs across the bend instead.
+    tube, straight = stratmesh.reconstruct(points, parts="one_tube")
+    assert straight.layers.skeleton_node_count == 0
+    centroid = points[tube].mean(axis=1)
+    off_centre_line = np.hypot(np.hypot(centroid[:, 0], centroid[:, 2]) - 3, centroid[:, 1])
+    assert np.abs(off_centre_line - 0.5).max() > 0.2

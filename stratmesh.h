@@ -723,7 +723,9 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // at least 8 ring radii long that strays 2 radii or more from a straight line and turns
 // nowhere tighter than 1.5 radii. Each point is then placed across and along that curve and
 // the layers are its cross-sections; LayerCounts::skeleton_node_count says so. A branching
-// or looped object (two rings at one distance), or a straight one, goes on as above.
+// or looped object (two rings at one distance) goes on as above; a straight one with one
+// ring at every distance is one tube along the automatic axis, without the search for
+// parts (Report::parts then finds none).
 //
 // cloud           the points (see Cloud), at most 2^32 - 3. They are only read.
 // options         see Options; `Options options = {};` gives the defaults.
@@ -13928,8 +13930,10 @@ static inline bool bent_enough(const Skeleton& sk, double radius) {
 }
 
 // The skeleton of the kept points of `in` (see above), in `sk`; false where the object is
-// not one bent chain of rings.
-static inline bool find_skeleton(const TubeInput& in, Arena& arena, Skeleton& sk) {
+// not one bent chain of rings. *unbranched: every band held one ring (bent or not).
+static inline bool find_skeleton(const TubeInput& in, Arena& arena, Skeleton& sk,
+                                 bool* unbranched) {
+    *unbranched = false;
     SkeletonMemory m;
     const size_t samples = skeleton_sample_count(in.sums.valid);
     allocate_skeleton_scratch(m, samples, arena);
@@ -14022,7 +14026,9 @@ static inline bool find_skeleton(const TubeInput& in, Arena& arena, Skeleton& sk
     const double end_bands = std::ceil(radius / width);
     if (!(end_bands < bands / 2.0 - 2)) return false;
     const uint32_t skip = static_cast<uint32_t>(end_bands);
-    return chain_nodes(m, skip, bands - 1 - skip, sk) && bent_enough(sk, radius);
+    if (!chain_nodes(m, skip, bands - 1 - skip, sk)) return false;
+    *unbranched = true;
+    return bent_enough(sk, radius);
 }
 
 // The frame across the skeleton at segment j, parameter t clamped to [0, 1] (the frame
@@ -14106,18 +14112,21 @@ static inline size_t bent_workspace_size(size_t point_count, const TubeRequest& 
 }
 
 // Where the object bends (find_skeleton), meshes it as one tube in straightened
-// coordinates and sets *bent; otherwise leaves everything as it was. The report's axis is
-// then the skeleton's tangent at its start (axis_origin the start), its layers' bottom and
-// top arc lengths along the skeleton, their centres in the cloud's space.
+// coordinates and sets *bent; otherwise leaves everything as it was, and sets *unbranched
+// where every band held one ring: a straight object that does not branch, which needs no
+// search for parts. The report's axis is then the skeleton's tangent at its start
+// (axis_origin the start), its layers' bottom and top arc lengths along the skeleton, their
+// centres in the cloud's space.
 static inline Status mesh_if_bent(const TubeInput& in, const TubeRequest& request, Arena& arena,
                                   uint32_t* triangles, size_t triangle_capacity,
-                                  size_t* triangle_count, Report& rep, bool* bent) {
+                                  size_t* triangle_count, Report& rep, bool* bent,
+                                  bool* unbranched) {
     *bent = false;
     const size_t start = arena.mark();
     Skeleton sk;
     allocate_skeleton(sk, arena);
     const size_t scratch = arena.mark();
-    const bool found = !arena.failed && find_skeleton(in, arena, sk);
+    const bool found = !arena.failed && find_skeleton(in, arena, sk, unbranched);
     arena.rewind(scratch);
     double* xyz = found ? allocate_straightened(in.count, arena) : nullptr;
     if (arena.failed) {
@@ -14239,12 +14248,13 @@ static inline Status run_reconstruction(const Cloud& cloud, const Options& optio
     // and along it a layer would only seem not to surround its axis.
     if (status == Status::ok && kDegenerateCheck && in.sums.distinct >= 3 && on_a_line(in, arena))
         status = Status::degenerate;
-    bool bent = false;
+    bool bent = false, unbranched = false;
 #if !defined(STRATMESH_SMALL_CODE)
     if (status == Status::ok && follows_bends(request))
         status = mesh_if_bent(in, request, arena, triangles, triangle_capacity, triangle_count,
-                              rep, &bent);
+                              rep, &bent, &unbranched);
 #endif
+    if (unbranched) request.parts = Parts::one_tube;  // one ring at every distance: no branch
     if (status == Status::ok && !bent) status = resolve_axis(in, arena, request, &rep.detail);
     if (status == Status::ok && !bent)
         status = mesh_cloud(cloud, in, request, arena, triangles, triangle_capacity,

@@ -78,12 +78,13 @@ static inline Status run_reconstruction(const Cloud& cloud, const Options& optio
     // and along it a layer would only seem not to surround its axis.
     if (status == Status::ok && kDegenerateCheck && in.sums.distinct >= 3 && on_a_line(in, arena))
         status = Status::degenerate;
-    bool bent = false;
+    bool bent = false, unbranched = false;
 #if !defined(STRATMESH_SMALL_CODE)
     if (status == Status::ok && follows_bends(request))
         status = mesh_if_bent(in, request, arena, triangles, triangle_capacity, triangle_count,
-                              rep, &bent);
+                              rep, &bent, &unbranched);
 #endif
+    if (unbranched) request.parts = Parts::one_tube;  // one ring at every distance: no branch
     if (status == Status::ok && !bent) status = resolve_axis(in, arena, request, &rep.detail);
     if (status == Status::ok && !bent)
         status = mesh_cloud(cloud, in, request, arena, triangles, triangle_capacity,

@@ -416,8 +416,10 @@ static inline bool bent_enough(const Skeleton& sk, double radius) {
 }
 
 // The skeleton of the kept points of `in` (see above), in `sk`; false where the object is
-// not one bent chain of rings.
-static inline bool find_skeleton(const TubeInput& in, Arena& arena, Skeleton& sk) {
+// not one bent chain of rings. *unbranched: every band held one ring (bent or not).
+static inline bool find_skeleton(const TubeInput& in, Arena& arena, Skeleton& sk,
+                                 bool* unbranched) {
+    *unbranched = false;
     SkeletonMemory m;
     const size_t samples = skeleton_sample_count(in.sums.valid);
     allocate_skeleton_scratch(m, samples, arena);
@@ -510,7 +512,9 @@ static inline bool find_skeleton(const TubeInput& in, Arena& arena, Skeleton& sk
     const double end_bands = std::ceil(radius / width);
     if (!(end_bands < bands / 2.0 - 2)) return false;
     const uint32_t skip = static_cast<uint32_t>(end_bands);
-    return chain_nodes(m, skip, bands - 1 - skip, sk) && bent_enough(sk, radius);
+    if (!chain_nodes(m, skip, bands - 1 - skip, sk)) return false;
+    *unbranched = true;
+    return bent_enough(sk, radius);
 }
 
 // The frame across the skeleton at segment j, parameter t clamped to [0, 1] (the frame
@@ -594,18 +598,21 @@ static inline size_t bent_workspace_size(size_t point_count, const TubeRequest& 
 }
 
 // Where the object bends (find_skeleton), meshes it as one tube in straightened
-// coordinates and sets *bent; otherwise leaves everything as it was. The report's axis is
-// then the skeleton's tangent at its start (axis_origin the start), its layers' bottom and
-// top arc lengths along the skeleton, their centres in the cloud's space.
+// coordinates and sets *bent; otherwise leaves everything as it was, and sets *unbranched
+// where every band held one ring: a straight object that does not branch, which needs no
+// search for parts. The report's axis is then the skeleton's tangent at its start
+// (axis_origin the start), its layers' bottom and top arc lengths along the skeleton, their
+// centres in the cloud's space.
 static inline Status mesh_if_bent(const TubeInput& in, const TubeRequest& request, Arena& arena,
                                   uint32_t* triangles, size_t triangle_capacity,
-                                  size_t* triangle_count, Report& rep, bool* bent) {
+                                  size_t* triangle_count, Report& rep, bool* bent,
+                                  bool* unbranched) {
     *bent = false;
     const size_t start = arena.mark();
     Skeleton sk;
     allocate_skeleton(sk, arena);
     const size_t scratch = arena.mark();
-    const bool found = !arena.failed && find_skeleton(in, arena, sk);
+    const bool found = !arena.failed && find_skeleton(in, arena, sk, unbranched);
     arena.rewind(scratch);
     double* xyz = found ? allocate_straightened(in.count, arena) : nullptr;
     if (arena.failed) {

@@ -225,7 +225,9 @@ size_t reconstruct_max_triangles(size_t point_count, const Options& options);
 // at least 8 ring radii long that strays 2 radii or more from a straight line and turns
 // nowhere tighter than 1.5 radii. Each point is then placed across and along that curve and
 // the layers are its cross-sections; LayerCounts::skeleton_node_count says so. A branching
-// or looped object (two rings at one distance), or a straight one, goes on as above.
+// or looped object (two rings at one distance) goes on as above; a straight one with one
+// ring at every distance is one tube along the automatic axis, without the search for
+// parts (Report::parts then finds none).
 //
 // cloud           the points (see Cloud), at most 2^32 - 3. They are only read.
 // options         see Options; `Options options = {};` gives the defaults.

@@ -4,8 +4,8 @@
 // triangles, on the surface and no larger than it; the layers' centres on the centre line.
 // Straight, branching and handled objects keep the meshing they had.
 #include "stratmesh.h"
-#include "support/mesh_check.h"
 #include "support/reconstructed.h"
+#include "support/shape_check.h"
 #include "support/shapes.h"
 
 #include <doctest/doctest.h>
@@ -21,16 +21,7 @@ namespace {
 using reconstructed::mesh;
 using Meshed = reconstructed::Mesh;
 
-mesh_check::Result check(const shapes::Shape& s, const Meshed& m) {
-    mesh_check::Input in;
-    in.points = s.xyz.data();
-    in.point_count = s.size();
-    in.triangles = m.triangles.data();
-    in.triangle_count = m.triangles.size() / 3;
-    for (int k = 0; k < 3; ++k) in.axis_direction[k] = m.report.axis[k];
-    in.surface = [&s](const double* p) { return s.deviation(p); };
-    return mesh_check::check(in);
-}
+using shape_check::check;
 
 // The triangles' area and their area-weighted mean distance to the analytic surface.
 void area_and_distance(const shapes::Shape& s, const std::vector<uint32_t>& t, double& area,
@@ -83,17 +74,9 @@ TEST_CASE("bends: an elbow, a U bend and a coil of pipe are meshed across their 
             REQUIRE(m.status == Status::ok);
             CHECK(report.layers.skeleton_node_count >= 4);
             CHECK(report.workspace_used_bytes <= bound);
-            const mesh_check::Result r = check(s, m);
-            INFO(r.summary());
-            CHECK(r.manifold());
-            CHECK(r.oriented());
-            CHECK(r.components == 1);
-            CHECK(r.unused_expected == 0);
-            CHECK(r.intersecting_pairs == 0);
-            CHECK(r.vertex_overlaps == 0);
             // Through the points, so inside the surface by at most a chord's sag; a web
             // across a bend would pass a radius away.
-            CHECK(r.max_deviation() < 0.1 * kPipeRadius);
+            shape_check::check_whole(check(s, m), 0.1 * kPipeRadius);
             double area = 0, distance = 0;
             area_and_distance(s, m.triangles, area, distance);
             const double surface_area = s.spacing * s.spacing * static_cast<double>(s.size());

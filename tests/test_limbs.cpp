@@ -4,8 +4,8 @@
 // cones): one oriented manifold through every point, close to the surface; and the parts
 // kept only where they make a smaller surface than one tube.
 #include "stratmesh.h"
-#include "support/mesh_check.h"
 #include "support/reconstructed.h"
+#include "support/shape_check.h"
 #include "support/shapes.h"
 
 #include <doctest/doctest.h>
@@ -24,16 +24,7 @@ namespace {
 using reconstructed::mesh;
 using Meshed = reconstructed::Mesh;
 
-mesh_check::Result check(const shapes::Shape& s, const Meshed& m) {
-    mesh_check::Input in;
-    in.points = s.xyz.data();
-    in.point_count = s.size();
-    in.triangles = m.triangles.data();
-    in.triangle_count = m.triangles.size() / 3;
-    for (int k = 0; k < 3; ++k) in.axis_direction[k] = m.report.axis[k];
-    in.surface = [&s](const double* p) { return s.deviation(p); };
-    return mesh_check::check(in);
-}
+using shape_check::check;
 
 double area(const std::vector<double>& xyz, const std::vector<uint32_t>& t) {
     double sum = 0;
@@ -47,19 +38,6 @@ double area(const std::vector<double>& xyz, const std::vector<uint32_t>& t) {
                           u[0] * v[1] - u[1] * v[0]) / 2;
     }
     return sum;
-}
-
-// One oriented manifold through every point, with no crossing triangles, within
-// `deviation` of the surface.
-void check_joined_y(const mesh_check::Result& r, double deviation) {
-    INFO(r.summary());
-    CHECK(r.manifold());
-    CHECK(r.oriented());
-    CHECK(r.components == 1);
-    CHECK(r.unused_expected == 0);
-    CHECK(r.intersecting_pairs == 0);
-    CHECK(r.vertex_overlaps == 0);
-    CHECK(r.max_deviation() < deviation);
 }
 
 Options along_z() {
@@ -77,7 +55,7 @@ TEST_CASE("limbs: a Y of tubes meshed along its trunk is one oriented manifold t
     CHECK(m.report.parts.outcome == PartsOutcome::joined);
     CHECK(m.report.parts.parting.above_branch_count == 2);
     // A web between the arms would pass half an arm's radius (0.6) away from the surface.
-    check_joined_y(check(y, m), 0.05);
+    shape_check::check_whole(check(y, m), 0.05);
     // One tube along z wraps both arms.
     Options wrapped = along_z();
     wrapped.parts = stratmesh::Parts::one_tube;
@@ -106,7 +84,7 @@ TEST_CASE("limbs: the Y along an axis tilted from its trunk's is cut square to t
         CHECK(std::fabs(m.report.parts.parting.axis[2]) > std::cos(degree));
         CHECK(m.report.workspace_used_bytes <= m.bound);
         // A web between the arms passes half an arm's radius (0.6) away or more.
-        check_joined_y(check(y, m), 0.15);
+        shape_check::check_whole(check(y, m), 0.15);
     }
 }
 
@@ -132,7 +110,7 @@ TEST_CASE("limbs: the Y tilted toward its other arm is grafted where the trunk's
         CHECK(m.report.parts.outcome == PartsOutcome::joined);
         CHECK(m.report.parts.grafted_branch_count == 2);
         CHECK(m.report.workspace_used_bytes <= m.bound);
-        check_joined_y(check(y, m), 0.15);
+        shape_check::check_whole(check(y, m), 0.15);
     }
 }
 

@@ -90,6 +90,9 @@ Verdict judge_mesh(const RunRecord& r) {
     if (r.axis != "automatic")
         v.action = "try --axis auto, which picks the direction along which the cloud is most "
                    "like a column";
+    else if (r.report.layers.skeleton_node_count > 0)
+        v.action = "its skeleton straightens it badly there (a wide end, a tight turn): try "
+                   "--parts one-tube, or a method for general surfaces";
     else
         v.action = "the object is not one column along any axis (it bends, branches or folds "
                    "back), which this method cannot follow: mesh its parts apart or use a "

@@ -1628,6 +1628,16 @@ template <class T, class Before> void sift_down(T* v, size_t root, size_t count,
     }
 }
 
+// A union-find's root of i, halving the path on the way (no recursion); parent[i] == i at
+// a root.
+static inline uint32_t find_root(uint32_t* parent, uint32_t i) {
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
 template <class T, class Before> void heap_sort(T* v, size_t count, Before before) {
     for (size_t i = count / 2; i-- > 0;) sift_down(v, i, count, before);
     for (size_t end = count; end-- > 1;) {
@@ -11415,13 +11425,7 @@ struct PartingSweep {
     bool crowded;             // the checks ran out: the sweep stopped
 
     double level(uint32_t t) const { return sign * position[added[t]].h; }
-    uint32_t root(uint32_t t) {
-        while (parent[t] != t) {
-            parent[t] = parent[parent[t]];
-            t = parent[t];
-        }
-        return t;
-    }
+    uint32_t root(uint32_t t) { return find_root(parent, t); }
     void join(uint32_t a, uint32_t b) {
         a = root(a);
         b = root(b);
@@ -13658,15 +13662,7 @@ template <class Visit> void for_each_neighbour(const SkeletonGraph& g, size_t j,
     for (uint32_t e = g.first[j]; e < g.first[j + 1]; ++e) visit(size_t{g.neighbour[e]});
 }
 
-// Union-find with path halving (no recursion); parent[i] == i at a root.
-static inline uint32_t find_root(uint32_t* parent, uint32_t i) {
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    return i;
-}
-
+// Union-find (find_root): the lower root index wins.
 static inline void join_roots(uint32_t* parent, uint32_t a, uint32_t b) {
     a = find_root(parent, a);
     b = find_root(parent, b);

@@ -171,6 +171,16 @@ template <class T, class Before> void sift_down(T* v, size_t root, size_t count,
     }
 }
 
+// A union-find's root of i, halving the path on the way (no recursion); parent[i] == i at
+// a root.
+static inline uint32_t find_root(uint32_t* parent, uint32_t i) {
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
 template <class T, class Before> void heap_sort(T* v, size_t count, Before before) {
     for (size_t i = count / 2; i-- > 0;) sift_down(v, i, count, before);
     for (size_t end = count; end-- > 1;) {

@@ -81,13 +81,7 @@ struct PartingSweep {
     bool crowded;             // the checks ran out: the sweep stopped
 
     double level(uint32_t t) const { return sign * position[added[t]].h; }
-    uint32_t root(uint32_t t) {
-        while (parent[t] != t) {
-            parent[t] = parent[parent[t]];
-            t = parent[t];
-        }
-        return t;
-    }
+    uint32_t root(uint32_t t) { return find_root(parent, t); }
     void join(uint32_t a, uint32_t b) {
         a = root(a);
         b = root(b);

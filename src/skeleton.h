@@ -144,15 +144,7 @@ template <class Visit> void for_each_neighbour(const SkeletonGraph& g, size_t j,
     for (uint32_t e = g.first[j]; e < g.first[j + 1]; ++e) visit(size_t{g.neighbour[e]});
 }
 
-// Union-find with path halving (no recursion); parent[i] == i at a root.
-static inline uint32_t find_root(uint32_t* parent, uint32_t i) {
-    while (parent[i] != i) {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    return i;
-}
-
+// Union-find (find_root): the lower root index wins.
 static inline void join_roots(uint32_t* parent, uint32_t a, uint32_t b) {
     a = find_root(parent, a);
     b = find_root(parent, b);
